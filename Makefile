@@ -1,0 +1,53 @@
+# Two commands: `make demo` and `make test`. Both create .venv when missing.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+# What a virtual display and Qt's xcb platform plugin need on Debian; checked
+# one by one so a machine that has them all needs neither root nor network.
+APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxcb-keysyms1 \
+	libxcb-image0 libxcb-render-util0 libxcb-xinerama0 libxcb-shape0 libxcb-randr0 \
+	libxcb-xfixes0 libxcb-xkb1 libxkbcommon0 libegl1 libgl1 libglx-mesa0 libgl1-mesa-dri \
+	libfontconfig1 libdbus-1-3
+DEMO_OUT ?= demo-out
+
+.PHONY: demo test install install-test system-deps lint bench clean
+
+$(VENV)/.installed: pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e .
+	touch $@
+
+$(VENV)/.installed-test: $(VENV)/.installed
+	$(PY) -m pip install -q -e '.[test]'
+	touch $@
+
+install: $(VENV)/.installed
+install-test: $(VENV)/.installed-test
+
+system-deps:
+	@missing=$$(for p in $(APT_PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -z "$$missing" ]; then exit 0; fi; \
+	if [ "$$(id -u)" = 0 ]; then \
+		echo "installing Debian packages: $$missing"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+	else \
+		echo "missing Debian packages for the virtual display; run:"; \
+		echo "  sudo apt-get install -y $$missing"; exit 1; \
+	fi
+
+demo: install
+	$(VENV)/bin/volanim demo -o $(DEMO_OUT)
+
+test: install-test system-deps
+	$(PY) -m pytest
+
+lint: install-test
+	$(VENV)/bin/ruff check src tests benchmarks
+
+bench: install
+	$(PY) benchmarks/bench_skeleton.py
+	$(PY) benchmarks/bench_reconstruct.py
+
+clean:
+	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache

@@ -1,0 +1,91 @@
+"""The bone skeleton: named joints and bones in root order (``.bones``).
+
+Bone i is "root node i" of the old skelselect. Bone Q is a child of bone P
+when Q's proximal joint is P's distal joint; the bones form a forest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Bone:
+    """A segment from joint ``proximal`` to joint ``distal`` (joint names)."""
+
+    proximal: str
+    distal: str
+    name: str = ""
+
+    @property
+    def label(self) -> str:
+        """The bone's name, or ``PROXIMAL-DISTAL`` when it has none."""
+        return self.name or f"{self.proximal}-{self.distal}"
+
+
+@dataclass(eq=False)
+class BoneSkeleton:
+    """Joints (name -> position) and bones in root order."""
+
+    joints: dict[str, np.ndarray] = field(default_factory=dict)
+    bones: list[Bone] = field(default_factory=list)
+
+    def __post_init__(self):
+        self.joints = {k: np.asarray(v, dtype=np.float64).reshape(3) for k, v in self.joints.items()}
+        self.bones = list(self.bones)
+        self.validate()
+
+    def validate(self) -> None:
+        """Raise ValueError when a bone names a missing joint or repeats."""
+        seen = set()
+        for i, b in enumerate(self.bones):
+            for j in (b.proximal, b.distal):
+                if j not in self.joints:
+                    raise ValueError(f"bone {i} ({b.label}) names unknown joint {j!r}")
+            if b.proximal == b.distal:
+                raise ValueError(f"bone {i} ({b.label}) joins joint {b.proximal!r} to itself")
+            key = (b.proximal, b.distal)
+            if key in seen:
+                raise ValueError(f"bone {b.label} appears twice")
+            seen.add(key)
+
+    def __eq__(self, other) -> bool:
+        return (
+            isinstance(other, BoneSkeleton)
+            and self.bones == other.bones
+            and list(self.joints) == list(other.joints)
+            and all(np.array_equal(self.joints[k], other.joints[k]) for k in self.joints)
+        )
+
+    def __len__(self) -> int:
+        return len(self.bones)
+
+    def segment(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        b = self.bones[i]
+        return self.joints[b.proximal], self.joints[b.distal]
+
+    def segments(self) -> np.ndarray:
+        """``(B, 2, 3)`` array of proximal and distal joint positions."""
+        if not self.bones:
+            return np.zeros((0, 2, 3))
+        return np.array([self.segment(i) for i in range(len(self.bones))])
+
+    def parent(self, i: int) -> int | None:
+        """Index of bone ``i``'s parent bone, or None for a top-level bone."""
+        prox = self.bones[i].proximal
+        for j, b in enumerate(self.bones):
+            if b.distal == prox:
+                return j
+        return None
+
+    def parents(self) -> list[int | None]:
+        distal_of = {b.distal: j for j, b in enumerate(self.bones)}
+        return [distal_of.get(b.proximal) for b in self.bones]
+
+    def index(self, label: str) -> int:
+        for i, b in enumerate(self.bones):
+            if label in (b.name, b.label):
+                return i
+        raise KeyError(f"no bone named {label!r}")

@@ -1,0 +1,72 @@
+"""The ``volanim`` command line: one subcommand per tool of the old pipeline.
+
+Each subcommand lives in a small module with a ``register(subparsers)``
+function; ``main`` turns library errors into one-line messages (exit 2) and a
+cancel (Ctrl+C) into exit 130, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import Cancelled, FormatError
+from . import demo_command, volume_commands
+
+EPILOG = """examples:
+  volanim samples mannequin -o data/          write the demo mannequin
+  volanim info data/mannequin.VOL             size, value range, bounds
+  volanim threshold data/mannequin.VOL mask.VOL --range 1:255
+  volanim demo -o demo-out/                   run the whole pipeline headless
+
+Run 'volanim COMMAND --help' for each command's options and an example."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="volanim",
+        description="Volume animation: segment, skeletonize, connect, pose and reconstruct volumes.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"volanim {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for module in _modules():
+        module.register(sub)
+    return parser
+
+
+def _modules():
+    mods = [volume_commands, demo_command]
+    try:
+        from . import skeleton_commands
+
+        mods.insert(1, skeleton_commands)
+    except ImportError:  # pragma: no cover - only while a module is being added
+        pass
+    try:
+        from . import reconstruct_commands
+
+        mods.insert(2, reconstruct_commands)
+    except ImportError:  # pragma: no cover
+        pass
+    return mods
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 0
+    try:
+        result = args.func(args)
+    except (FormatError, ValueError, OSError) as exc:
+        print(f"volanim {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except (Cancelled, KeyboardInterrupt):
+        print(f"\nvolanim {args.command}: cancelled", file=sys.stderr)
+        return 130
+    return int(result or 0)

@@ -1,0 +1,243 @@
+"""Volume subcommands: info, convert, threshold, fill, crop, tightbounds, flip,
+count, diff, reverse, remap, addheader, rmheader, fitpow2, float2uchar, samples."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .. import samples, volume
+from ..io import add_header, float_to_uint8, histogram_file, remove_header
+from ..io._text import parse_int, read_records
+from ..io.raw_volumes import raw_layout
+from ._common import add_command, add_dims, add_volume_in, bounds_arg, load, parse_range, save
+
+
+def _info(args):
+    vol = load(args.volume, args)
+    b = volume.tight_bounds(vol)
+    print(f"{args.volume}: {vol.shape[0]} x {vol.shape[1]} x {vol.shape[2]} voxels, {vol.dtype}")
+    print(f"values {vol.min()} .. {vol.max()}, non-zero {int(np.count_nonzero(vol))}")
+    print(f"tight bounds (inclusive x0 y0 z0 x1 y1 z1): {b if b else 'none (all zero)'}")
+
+
+def _convert(args):
+    vol = load(args.input, args)
+    if args.rescale:
+        vol = float_to_uint8(vol)
+    save(args.output, vol)
+
+
+def _threshold(args):
+    lo, hi = args.range
+    save(args.output, volume.threshold(load(args.input, args), lo, hi, value=args.value))
+
+
+def _fill(args):
+    vol = load(args.input, args)
+    if not args.cavities and args.box is None:
+        raise ValueError("nothing to do: give --cavities and/or --box x0 y0 z0 x1 y1 z1")
+    if args.cavities:
+        before = np.count_nonzero(vol)
+        vol = volume.fill_cavities(vol)
+        print(f"filled {np.count_nonzero(vol) - before} cavity voxels")
+    if args.box is not None:
+        vol = volume.box_fill(vol, bounds_arg(args.box), args.value)
+    save(args.output, vol)
+
+
+def _crop(args):
+    vol = load(args.input, args)
+    if args.bounds:
+        b = bounds_arg(args.bounds)
+    else:
+        b = volume.tight_bounds(vol)
+        if b is None:
+            raise ValueError(f"{args.input}: the volume is all zero, there is nothing to crop to")
+    if args.pad:
+        b = volume.Bounds(tuple(v - args.pad for v in b.lo), tuple(v + args.pad for v in b.hi))
+    print(f"crop bounds: {b}  (origin of the output in the input: {b.lo})")
+    save(args.output, volume.crop(vol, b))
+
+
+def _tightbounds(args):
+    b = volume.tight_bounds(load(args.input, args), args.level)
+    print(b if b is not None else "none (no voxel above the level)")
+
+
+def _flip(args):
+    save(args.output, volume.flip(load(args.input, args), args.axis))
+
+
+def _count(args):
+    path = Path(args.input)
+    if path.is_file() and path.suffix.lower() == ".vol":
+        raw_layout(path, args.dims)  # validate before streaming
+        counts = histogram_file(path, args.dims)
+    else:
+        counts = volume.histogram(load(args.input, args))
+    total = int(counts.sum())
+    print(f"{total} voxels, {total - int(counts[0])} non-zero")
+    for v in range(256) if args.all else np.flatnonzero(counts):
+        print(f"{v:3d} {int(counts[v])}")
+
+
+def _diff(args):
+    out = volume.super_diff(load(args.first, args), load(args.second, args))
+    counts = np.bincount(out.ravel(), minlength=201)
+    for label, code in volume.SUPER_DIFF_CODES.items():
+        print(f"{code:3d} {label:12s} {int(counts[code])}")
+    if args.output:
+        save(args.output, out)
+
+
+def _reverse(args):
+    save(args.output, volume.reverse(load(args.input, args)))
+
+
+def read_remap_table(path: str) -> np.ndarray:
+    """A remap table file: ``FROM TO`` pairs (others unchanged) or 256 single values."""
+    rec = read_records(path)
+    table = np.arange(256)
+    if all(len(t) == 1 for _, t in rec.records):
+        if len(rec.records) != 256:
+            raise rec.error(None, f"a table of single values needs 256 lines, got {len(rec.records)}")
+        for i, (line, toks) in enumerate(rec.records):
+            table[i] = parse_int(rec, line, toks[0], "value")
+    else:
+        for line, toks in rec.records:
+            if len(toks) != 2:
+                raise rec.error(line, f"expected 'FROM TO', got {len(toks)} tokens")
+            a, b = (parse_int(rec, line, t, "value") for t in toks)
+            if not (0 <= a <= 255 and 0 <= b <= 255):
+                raise rec.error(line, "values must be 0..255")
+            table[a] = b
+    if table.min() < 0 or table.max() > 255:
+        raise rec.error(None, "values must be 0..255")
+    return table
+
+
+def _remap(args):
+    save(args.output, volume.remap(load(args.input, args), read_remap_table(args.table)))
+
+
+def _addheader(args):
+    dims = add_header(args.input, args.output, args.dims)
+    print(f"wrote {args.output} ({dims[0]}x{dims[1]}x{dims[2]} with header)")
+
+
+def _rmheader(args):
+    dims = remove_header(args.input, args.output)
+    print(f"wrote {args.output} ({dims[0]}x{dims[1]}x{dims[2]}, no header)")
+
+
+def _fitpow2(args):
+    out, offset = volume.fit_pow2(load(args.input, args), center=args.center)
+    print(f"old voxel (0,0,0) is at {offset} in the output")
+    save(args.output, out)
+
+
+def _float2uchar(args):
+    lo, hi = args.range if args.range else (None, None)
+    save(args.output, float_to_uint8(load(args.input, args), lo, hi))
+
+
+def _samples(args):
+    for name in samples.NAMES if args.name == "all" else [args.name]:
+        for path in samples.write_sample(name, args.output):
+            print(f"wrote {path}")
+
+
+def _io(p, output=True):
+    add_volume_in(p, "input")
+    if output:
+        p.add_argument("output", help="output volume (.vol, .VOL, .vti or .nrrd)")
+    add_dims(p)
+
+
+def register(sub) -> None:
+    p = add_command(sub, "info", "Print a volume's size, value range and tight bounds.",
+                    "volanim info frog.VOL", _info)
+    add_volume_in(p)
+    add_dims(p)
+
+    p = add_command(sub, "convert", "Convert between volume formats (Vol2Vtk / Vtk2Vol).",
+                    "volanim convert frog.VOL frog.vti", _convert)
+    _io(p)
+    p.add_argument("--rescale", action="store_true", help="map non-uint8 data min..max onto 0..255")
+
+    p = add_command(sub, "threshold", "Band-pass threshold to a binary volume (Convert2Binary).",
+                    "volanim threshold ct.VOL bone.VOL --range 180:255", _threshold)
+    _io(p)
+    p.add_argument("--range", type=parse_range, required=True, metavar="LO[:HI]", help="keep LO <= v <= HI")
+    p.add_argument("--value", type=int, default=255, help="value of kept voxels (default 255)")
+
+    p = add_command(sub, "fill", "Fill enclosed cavities and/or a box (Fill).",
+                    "volanim fill mask.VOL filled.VOL --cavities", _fill)
+    _io(p)
+    p.add_argument("--cavities", action="store_true", help="fill background regions enclosed by the object")
+    p.add_argument("--box", nargs=6, type=int, metavar="N", help="inclusive box x0 y0 z0 x1 y1 z1 to set")
+    p.add_argument("--value", type=int, default=255, help="value for --box (default 255)")
+
+    p = add_command(sub, "crop", "Crop (or pad) to bounds, or to the tight bounds (CropVolume).",
+                    "volanim crop frog.VOL small.VOL --pad 2", _crop)
+    _io(p)
+    p.add_argument("--bounds", nargs=6, type=int, metavar="N", help="inclusive x0 y0 z0 x1 y1 z1 (default: tight)")
+    p.add_argument("--pad", type=int, default=0, help="grow the bounds by N voxels on every side")
+
+    p = add_command(sub, "tightbounds", "Print the inclusive bounds of the non-zero voxels (TightBounds).",
+                    "volanim tightbounds frog.VOL", _tightbounds)
+    _io(p, output=False)
+    p.add_argument("--level", type=float, default=0, help="count voxels above this value (default 0)")
+
+    p = add_command(sub, "flip", "Mirror a volume along an axis.", "volanim flip in.VOL out.VOL --axis x", _flip)
+    _io(p)
+    p.add_argument("--axis", choices=("x", "y", "z"), required=True)
+
+    p = add_command(sub, "count", "Histogram of voxel values; streams raw files (Count).",
+                    "volanim count frog.VOL", _count)
+    _io(p, output=False)
+    p.add_argument("--all", action="store_true", help="list all 256 values, also those with count 0")
+
+    p = add_command(sub, "diff", "Compare two volumes: 0 both empty, 100 both, 150 only first, 200 only second "
+                    "(VolumeSuperDiff).", "volanim diff before.VOL after.VOL diff.VOL", _diff)
+    add_volume_in(p, "first")
+    add_volume_in(p, "second")
+    p.add_argument("output", nargs="?", help="optional coded difference volume")
+    add_dims(p)
+
+    p = add_command(sub, "reverse", "Invert intensities, 255 - v (ReverseData).",
+                    "volanim reverse in.VOL out.VOL", _reverse)
+    _io(p)
+
+    p = add_command(sub, "remap", "Remap values through a table file (remapVolume): 'FROM TO' lines, "
+                    "or 256 lines of one value.", "volanim remap labels.VOL merged.VOL --table merge.txt", _remap)
+    _io(p)
+    p.add_argument("--table", required=True, help="table file")
+
+    p = add_command(sub, "addheader", "Add the 100-byte .VOL header, streaming (AddHeader).",
+                    "volanim addheader frog.500x470x136.vol frog.VOL", _addheader)
+    p.add_argument("input", help="headerless .vol")
+    p.add_argument("output", help="output .VOL")
+    add_dims(p)
+
+    p = add_command(sub, "rmheader", "Remove the 100-byte .VOL header, streaming (rmhdr).",
+                    "volanim rmheader frog.VOL frog.500x470x136.vol", _rmheader)
+    p.add_argument("input", help=".VOL with header")
+    p.add_argument("output", help="output .vol")
+
+    p = add_command(sub, "fitpow2", "Pad every dimension up to a power of two (FitVolume).",
+                    "volanim fitpow2 frog.VOL frog512.VOL --center", _fitpow2)
+    _io(p)
+    p.add_argument("--center", action="store_true", help="centre the data instead of padding at the end")
+
+    p = add_command(sub, "float2uchar", "Map a range of float (or 16-bit) data onto 0..255 (float2uchar).",
+                    "volanim float2uchar ct.nii.gz ct.VOL --range -1000 2000", _float2uchar)
+    _io(p)
+    p.add_argument("--range", nargs=2, type=float, metavar=("LO", "HI"), help="input range (default: data min max)")
+
+    p = add_command(sub, "samples", "Write a demo dataset: mannequin, aliascube, frog or all.",
+                    "volanim samples mannequin -o data/", _samples)
+    p.add_argument("name", choices=(*samples.NAMES, "all"))
+    p.add_argument("-o", "--output", default=".", help="folder (default: current)")

@@ -1,0 +1,35 @@
+"""Exceptions shared by the whole library.
+
+Every reader raises :class:`FormatError` for a bad file, so callers (the CLI,
+the studio) catch one type and show its message, which always names the file,
+the line where there is one, and what was expected.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class FormatError(ValueError):
+    """A file that does not follow ``FORMATS.md``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The offending file.
+    message : str
+        What was wrong and what was expected.
+    line : int, optional
+        1-based line number for text formats.
+    """
+
+    def __init__(self, path: str | Path, message: str, line: int | None = None):
+        self.path = str(path)
+        self.line = line
+        self.reason = message
+        where = f"{self.path}:{line}" if line is not None else self.path
+        super().__init__(f"{where}: {message}")
+
+
+class Cancelled(Exception):
+    """Raised inside long computations when the caller's cancel flag is set."""

@@ -1,0 +1,57 @@
+"""Readers and writers for every file of FORMATS.md.
+
+All readers raise :class:`volanim_core.errors.FormatError` (and nothing else)
+for a bad file; all writers are atomic.
+"""
+
+from ..errors import FormatError
+from .bones_files import read_bones, read_connections, write_bones, write_connections
+from .connect_files import (
+    connect_filename,
+    read_connect,
+    read_trans,
+    read_tskel,
+    write_connect,
+    write_trans,
+    write_tskel,
+)
+from .raw_volumes import (
+    add_header,
+    dims_from_name,
+    histogram_file,
+    read_raw,
+    remove_header,
+    write_raw,
+)
+from .skeleton_files import read_mskel, read_skel, write_mskel, write_skel
+from .volume_files import float_to_uint8, read_image_folder, read_volume, read_volume_grid, write_volume
+
+__all__ = [
+    "FormatError",
+    "add_header",
+    "connect_filename",
+    "dims_from_name",
+    "float_to_uint8",
+    "histogram_file",
+    "read_bones",
+    "read_connect",
+    "read_connections",
+    "read_image_folder",
+    "read_mskel",
+    "read_raw",
+    "read_skel",
+    "read_trans",
+    "read_tskel",
+    "read_volume",
+    "read_volume_grid",
+    "remove_header",
+    "write_bones",
+    "write_connect",
+    "write_connections",
+    "write_mskel",
+    "write_raw",
+    "write_skel",
+    "write_trans",
+    "write_tskel",
+    "write_volume",
+]

@@ -1,0 +1,179 @@
+"""``.connect``, ``.trans`` and ``.tskel``: files organised by ``Root:`` lines.
+
+    Root: px py pz :: dx dy dz [NAME]     starts bone b (root order)
+    m00 m01 m02 m03   x4                  .trans / .tskel: bone b's matrix
+    x y z dt [thinness]                   .connect / .tskel: bone b's points
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..connectivity import Connectivity, RootBone, Trans, Tskel
+from ._atomic import atomic_write_text
+from ._columns import format_point_rows, parse_point_rows
+from ._text import TextRecords, fmt_float, parse_float, parse_metric, read_records
+
+ROOT_SYNTAX = "'Root: x y z :: x y z [NAME]'"
+
+
+def _is_root(toks: list[str]) -> bool:
+    return toks[0].lower().startswith("root:")
+
+
+def _parse_root(rec: TextRecords, line: int, toks: list[str]) -> RootBone:
+    first = toks[0]
+    rest = ([first[5:]] if len(first) > 5 else []) + toks[1:]  # allow 'Root:212'
+    if "::" not in rest:
+        raise rec.error(line, f"'Root:' line has no '::' between the joints, expected {ROOT_SYNTAX}")
+    k = rest.index("::")
+    prox, tail = rest[:k], rest[k + 1 :]
+    if len(prox) != 3 or len(tail) not in (3, 4):
+        raise rec.error(line, f"expected {ROOT_SYNTAX}, got {' '.join(toks)!r}")
+    p = [parse_float(rec, line, t, "proximal joint coordinate") for t in prox]
+    d = [parse_float(rec, line, t, "distal joint coordinate") for t in tail[:3]]
+    return RootBone(p, d, tail[3] if len(tail) == 4 else "")
+
+
+def _format_root(b: RootBone) -> str:
+    p = " ".join(fmt_float(v) for v in b.proximal)
+    d = " ".join(fmt_float(v) for v in b.distal)
+    return f"Root: {p} :: {d}" + (f" {b.name}" if b.name else "")
+
+
+def _parse_matrix(rec: TextRecords, records, start: int, root_line: int) -> np.ndarray:
+    rows = []
+    for k in range(4):
+        if start + k >= len(records):
+            raise rec.error(root_line, f"the matrix after this 'Root:' line has {k} rows, expected 4 rows of 4 numbers")
+        line, toks = records[start + k]
+        if _is_root(toks):
+            raise rec.error(line, f"the matrix of the previous bone has {k} rows, expected 4 rows of 4 numbers")
+        if len(toks) != 4:
+            raise rec.error(line, f"expected matrix row {k + 1} of 4 (4 numbers), got {len(toks)} tokens")
+        rows.append([parse_float(rec, line, t, f"matrix row {k + 1}") for t in toks])
+    m = np.array(rows)
+    # Row-vector convention: the last column of an affine matrix is (0 0 0 1).
+    # Checking it also catches a 3-row matrix swallowing the first point line.
+    if not np.allclose(m[:, 3], [0, 0, 0, 1], atol=1e-6):
+        line = records[start][0]
+        raise rec.error(line, "matrix is not affine: its last column must be 0 0 0 1 "
+                        "(row-vector convention, translation in row 4)")
+    return m
+
+
+def _read_rooted(path, *, matrices: bool, points: bool):
+    rec = read_records(path)
+    records = rec.records
+    bones: list[RootBone] = []
+    mats: list[np.ndarray] = []
+    rows: list[tuple[int, list[str]]] = []
+    owner: list[int] = []
+    i = 0
+    while i < len(records):
+        line, toks = records[i]
+        if _is_root(toks):
+            bones.append(_parse_root(rec, line, toks))
+            i += 1
+            if matrices:
+                mats.append(_parse_matrix(rec, records, i, line))
+                i += 4
+            continue
+        if not bones:
+            raise rec.error(line, f"expected a {ROOT_SYNTAX} line before any data, got {toks[0]!r}")
+        if not points:
+            raise rec.error(line, f"expected a {ROOT_SYNTAX} line, got {' '.join(toks)!r}")
+        rows.append((line, toks))
+        owner.append(len(bones) - 1)
+        i += 1
+    if not bones:
+        raise rec.error(None, f"no {ROOT_SYNTAX} line, expected at least one bone")
+    arr = parse_point_rows(rec, rows, (4, 5), "x y z dt [thinness]")
+    if len(arr):
+        coords = arr[:, :3].astype(np.int64)
+        _, first, counts = np.unique(coords, axis=0, return_index=True, return_counts=True)
+        if (counts > 1).any():
+            dup = np.setdiff1d(np.arange(len(coords)), first)[0]
+            twin = np.flatnonzero((coords == coords[dup]).all(axis=1))[0]
+            raise rec.error(rows[dup][0], f"point {tuple(coords[dup])} is listed twice (also on line "
+                            f"{rows[twin][0]}); a point belongs to at most one bone")
+    return rec, bones, np.array(mats).reshape(-1, 4, 4), arr, np.array(owner, dtype=np.int32)
+
+
+def read_connect(path: str | Path) -> Connectivity:
+    """Read a ``.connect`` file (FORMATS.md)."""
+    rec, bones, _, arr, owner = _read_rooted(path, matrices=False, points=True)
+    threshold = rec.header.get("thinness")
+    if threshold is not None:
+        threshold = parse_float(rec, None, threshold, "'# thinness:' header")
+    return Connectivity(bones, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), threshold)
+
+
+def read_trans(path: str | Path) -> Trans:
+    """Read a ``.trans`` file: per bone a ``Root:`` line and 4 matrix rows."""
+    _, bones, mats, _, _ = _read_rooted(path, matrices=True, points=False)
+    return Trans(bones, mats)
+
+
+def read_tskel(path: str | Path) -> Tskel:
+    """Read a ``.tskel`` file: per bone ``Root:``, 4 matrix rows, then points."""
+    rec, bones, mats, arr, owner = _read_rooted(path, matrices=True, points=True)
+    return Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec))
+
+
+def _format_matrix(m: np.ndarray) -> list[str]:
+    return [" ".join(fmt_float(v) for v in row) for row in np.asarray(m).reshape(4, 4)]
+
+
+def _bone_blocks(bones, bone_index, points, dt, thinness, matrices=None) -> list[str]:
+    order = np.argsort(bone_index, kind="stable")
+    starts = np.searchsorted(bone_index[order], np.arange(len(bones) + 1))
+    rows = format_point_rows(points[order], dt[order], thinness[order] if thinness is not None else None)
+    lines = []
+    for b, root in enumerate(bones):
+        lines.append(_format_root(root))
+        if matrices is not None:
+            lines.extend(_format_matrix(matrices[b]))
+        lines.extend(rows[starts[b] : starts[b + 1]])
+    return lines
+
+
+def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | None = None) -> None:
+    """Write a ``.connect`` file atomically.
+
+    When ``thinness`` is given only points with thinness >= it are written and
+    it is recorded in the ``# thinness:`` header (FORMATS.md's convention).
+    """
+    keep = np.ones(len(conn), bool)
+    if thinness is not None:
+        keep = ~(conn.thinness < thinness)  # NaN thinness (unknown) is kept
+    th = thinness if thinness is not None else conn.thinness_threshold
+    lines = ["# volanim connect 1"]
+    if th is not None:
+        lines.append(f"# thinness: {th:.2f}" if round(th, 2) == th else f"# thinness: {fmt_float(th)}")
+    lines.append(f"# metric: {conn.metric}")
+    lines += _bone_blocks(conn.bones, conn.bone[keep], conn.points[keep], conn.dt[keep], conn.thinness[keep])
+    atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def write_trans(path: str | Path, trans: Trans) -> None:
+    """Write a ``.trans`` file atomically."""
+    lines = ["# volanim trans 1"]
+    for root, m in zip(trans.bones, trans.matrices):
+        lines.append(_format_root(root))
+        lines.extend(_format_matrix(m))
+    atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def write_tskel(path: str | Path, tskel: Tskel) -> None:
+    """Write a ``.tskel`` file atomically, points grouped under their bone."""
+    lines = ["# volanim tskel 1", f"# metric: {tskel.metric}"]
+    lines += _bone_blocks(tskel.bones, tskel.bone, tskel.points, tskel.dt, tskel.thinness, tskel.matrices)
+    atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def connect_filename(stem: str, thinness: float) -> str:
+    """``NAME.THINNESS.connect``, the convention for a file saved at a slider value."""
+    return f"{stem}.{thinness:.2f}.connect"

@@ -1,0 +1,190 @@
+"""Raw volumes: ``.vol`` (bare uint8 voxels) and ``.VOL`` (100-byte header).
+
+Bytes are x fastest, then y, then z; in memory ``vol[x, y, z]`` is the bytes
+viewed with ``order="F"``. Header add/remove and counting stream in chunks so
+they never hold a whole volume (the old AddHeader / rmhdr / Count).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+from ._atomic import atomic_open
+
+HEADER_BYTES = 100
+_NAME_DIMS = re.compile(r"\.(\d+)x(\d+)x(\d+)\.vol$", re.IGNORECASE)
+CHUNK = 1 << 24
+
+
+def dims_from_name(path: str | Path) -> tuple[int, int, int] | None:
+    """Dimensions from the ``NAME.XxYxZ.vol`` convention, or None."""
+    m = _NAME_DIMS.search(Path(path).name)
+    return tuple(int(g) for g in m.groups()) if m else None
+
+
+def _check_dims(path, dims) -> tuple[int, int, int]:
+    try:
+        dims = tuple(int(d) for d in dims)
+    except (TypeError, ValueError):
+        raise FormatError(path, f"dimensions must be three integers X Y Z, got {dims!r}") from None
+    if len(dims) != 3 or min(dims) < 1:
+        raise FormatError(path, f"dimensions must be three positive integers X Y Z, got {dims!r}")
+    return dims
+
+
+def has_header(path: str | Path) -> bool:
+    """Whether ``path`` is to be read as a ``.VOL`` (header) file.
+
+    By extension case: ``.VOL`` has a header, ``.vol`` has none. Mixed case
+    (``.Vol``) is sniffed: a header starts with three integers.
+    """
+    suffix = Path(path).suffix
+    if suffix == ".VOL":
+        return True
+    if suffix == ".vol":
+        return False
+    try:
+        with Path(path).open("rb") as fh:
+            return _parse_header(path, fh.read(HEADER_BYTES)) is not None
+    except (FormatError, OSError):
+        return False
+
+
+def _parse_header(path, head: bytes) -> tuple[int, int, int] | None:
+    if len(head) < HEADER_BYTES:
+        raise FormatError(path, f"file has {len(head)} bytes, expected a {HEADER_BYTES}-byte .VOL header")
+    nums = re.findall(rb"\d+", head.split(b"\n", 1)[0])
+    if len(nums) < 3:
+        raise FormatError(path, "the .VOL header's first line does not hold three dimensions 'X Y Z'", 1)
+    return tuple(int(n) for n in nums[:3])
+
+
+def read_header_dims(path: str | Path) -> tuple[int, int, int]:
+    """The dimensions recorded in a ``.VOL`` header."""
+    with Path(path).open("rb") as fh:
+        return _check_dims(path, _parse_header(path, fh.read(HEADER_BYTES)))
+
+
+def raw_layout(path: str | Path, dims=None) -> tuple[tuple[int, int, int], int]:
+    """``(dims, byte offset of the voxels)`` of a raw volume, checked against the file size."""
+    path = Path(path)
+    if not path.is_file():
+        raise FormatError(path, "no such file")
+    size = path.stat().st_size
+    if has_header(path):
+        dims = _check_dims(path, dims) if dims is not None else read_header_dims(path)
+        want = int(np.prod(dims)) + HEADER_BYTES
+        if size != want:
+            raise FormatError(path, f"file has {size} bytes, expected {want} "
+                              f"({HEADER_BYTES}-byte header + {dims[0]}x{dims[1]}x{dims[2]} voxels)")
+        return dims, HEADER_BYTES
+    dims = dims if dims is not None else dims_from_name(path)
+    if dims is None:
+        raise FormatError(path, "unknown dimensions: give them (e.g. --dims X Y Z) or name the file NAME.XxYxZ.vol")
+    dims = _check_dims(path, dims)
+    want = int(np.prod(dims))
+    if size == want + HEADER_BYTES:
+        raise FormatError(path, f"file has {size} bytes = {dims[0]}x{dims[1]}x{dims[2]} + {HEADER_BYTES}: "
+                          "it looks like a .VOL with a 100-byte header; rename it to .VOL or strip "
+                          "the header with 'volanim rmheader'")
+    if size != want:
+        raise FormatError(path, f"file has {size} bytes, expected {want} for {dims[0]}x{dims[1]}x{dims[2]} voxels")
+    return dims, 0
+
+
+def read_raw(path: str | Path, dims=None, *, mmap: bool = False) -> np.ndarray:
+    """Read a ``.vol`` or ``.VOL`` file as a ``(X, Y, Z)`` uint8 array indexed ``[x, y, z]``.
+
+    ``mmap=True`` maps the file read-only instead of loading it.
+    """
+    dims, offset = raw_layout(path, dims)
+    if mmap:
+        return np.memmap(path, np.uint8, "r", offset=offset, shape=dims, order="F")
+    with Path(path).open("rb") as fh:
+        fh.seek(offset)
+        data = np.fromfile(fh, np.uint8, count=int(np.prod(dims)))
+    return data.reshape(dims, order="F")
+
+
+def header_bytes(dims) -> bytes:
+    """A ``.VOL`` header: ``X Y Z`` padded with spaces to 99 bytes, then ``\\n``."""
+    line = f"{dims[0]} {dims[1]} {dims[2]}".encode()
+    return line.ljust(HEADER_BYTES - 1, b" ") + b"\n"
+
+
+def _as_uint8(vol: np.ndarray) -> np.ndarray:
+    vol = np.asarray(vol)
+    if vol.ndim != 3:
+        raise ValueError(f"a volume must be 3-D, got shape {vol.shape}")
+    if vol.dtype != np.uint8:
+        if vol.dtype == bool or (vol.size and vol.min() >= 0 and vol.max() <= 255
+                                 and np.issubdtype(vol.dtype, np.integer)):
+            return vol.astype(np.uint8)
+        raise ValueError(f".vol files hold uint8 voxels, got {vol.dtype}; convert with float_to_uint8 first")
+    return vol
+
+
+def write_raw(path: str | Path, vol: np.ndarray, *, header: bool | None = None) -> None:
+    """Write ``vol`` as ``.vol`` (no header) or ``.VOL`` (header), atomically.
+
+    ``header=None`` decides by the extension's case (``.VOL`` -> header).
+    """
+    vol = _as_uint8(vol)
+    if header is None:
+        header = Path(path).suffix == ".VOL"
+    with atomic_open(path, "wb") as fh:
+        if header:
+            fh.write(header_bytes(vol.shape))
+        # Transposing the F-order view gives C order: bytes x fastest.
+        fh.write(np.ascontiguousarray(vol.T).tobytes())
+
+
+def _copy_stream(src, dst, remaining: int) -> None:
+    while remaining > 0:
+        chunk = src.read(min(CHUNK, remaining))
+        if not chunk:
+            raise OSError("file ended early")
+        dst.write(chunk)
+        remaining -= len(chunk)
+
+
+def add_header(src: str | Path, dst: str | Path, dims=None) -> tuple[int, int, int]:
+    """Stream a ``.vol`` into a ``.VOL`` with a header (AddHeader)."""
+    dims, offset = raw_layout(src, dims)
+    if offset:
+        raise FormatError(src, "already has a .VOL header")
+    with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
+        fout.write(header_bytes(dims))
+        _copy_stream(fin, fout, int(np.prod(dims)))
+    return dims
+
+
+def remove_header(src: str | Path, dst: str | Path) -> tuple[int, int, int]:
+    """Stream a ``.VOL`` into a bare ``.vol`` (rmhdr)."""
+    dims = read_header_dims(src)
+    want = int(np.prod(dims)) + HEADER_BYTES
+    size = Path(src).stat().st_size
+    if size != want:
+        raise FormatError(src, f"file has {size} bytes, expected {want} for header + {dims} voxels")
+    with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
+        fin.seek(HEADER_BYTES)
+        _copy_stream(fin, fout, int(np.prod(dims)))
+    return dims
+
+
+def histogram_file(path: str | Path, dims=None) -> np.ndarray:
+    """Counts of each value 0..255 in a raw volume, streamed in chunks (Count)."""
+    dims, offset = raw_layout(path, dims)
+    counts = np.zeros(256, np.int64)
+    remaining = int(np.prod(dims))
+    with Path(path).open("rb") as fh:
+        fh.seek(offset)
+        while remaining:
+            chunk = np.frombuffer(fh.read(min(CHUNK, remaining)), np.uint8)
+            counts += np.bincount(chunk, minlength=256)
+            remaining -= len(chunk)
+    return counts

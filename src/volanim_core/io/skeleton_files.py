@@ -1,0 +1,50 @@
+"""``.skel`` (x y z dt) and ``.mskel`` (x y z dt thinness, sorted) files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..skeleton import Skeleton
+from ._atomic import atomic_write_text
+from ._columns import format_point_rows, parse_point_rows
+from ._text import parse_metric, read_records
+
+
+def _header(kind: str, metric: str) -> list[str]:
+    return [f"# volanim {kind} 1", f"# metric: {metric}"]
+
+
+def read_skel(path: str | Path) -> Skeleton:
+    """Read a ``.skel`` file (``x y z dt`` a line) into a Skeleton (thinness NaN)."""
+    rec = read_records(path)
+    arr = parse_point_rows(rec, rec.records, (4,), "x y z dt")
+    return Skeleton(arr[:, :3].astype(np.int32), arr[:, 3], None, parse_metric(rec))
+
+
+def write_skel(path: str | Path, skel: Skeleton) -> None:
+    """Write ``x y z dt`` lines atomically."""
+    lines = _header("skel", skel.metric) + format_point_rows(skel.points, skel.dt)
+    atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def read_mskel(path: str | Path) -> Skeleton:
+    """Read a ``.mskel`` file; the result is sorted by decreasing thinness.
+
+    Readers do not rely on the file's order (FORMATS.md), so the points are
+    stably re-sorted if needed.
+    """
+    rec = read_records(path)
+    arr = parse_point_rows(rec, rec.records, (5,), "x y z dt thinness")
+    skel = Skeleton(arr[:, :3].astype(np.int32), arr[:, 3], arr[:, 4], parse_metric(rec))
+    return skel if skel.is_sorted() else skel.sorted()
+
+
+def write_mskel(path: str | Path, skel: Skeleton) -> None:
+    """Write ``x y z dt thinness`` lines, stably sorted by decreasing thinness."""
+    if np.isnan(skel.thinness).any():
+        raise ValueError("a .mskel needs a thinness for every point")
+    skel = skel if skel.is_sorted() else skel.sorted()
+    lines = _header("mskel", skel.metric) + format_point_rows(skel.points, skel.dt, skel.thinness)
+    atomic_write_text(path, "\n".join(lines) + "\n")

@@ -1,0 +1,166 @@
+"""Every volume format behind two calls: :func:`read_volume` and :func:`write_volume`.
+
+    .vol/.VOL           raw_volumes (ours)
+    .vti .mha .mhd .nii .nii.gz               VTK readers through pyvista (lazy import)
+    .nrrd                                     nrrd_files (ours: VTK's reader mangles 3-D scalars)
+    folder of 2-D images                      scikit-image, stacked along z
+
+VTK stores x fastest, exactly like ``.vol``, so its flat scalars reshape with
+``order="F"`` to ``vol[x, y, z]``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+from . import raw_volumes
+from .nrrd_files import read_nrrd, write_nrrd
+
+VTK_SUFFIXES = (".vti", ".mha", ".mhd", ".nii", ".nii.gz", ".vtk")
+NRRD_SUFFIXES = (".nrrd",)
+IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm")
+WRITE_SUFFIXES = (".vol", ".VOL", ".vti", ".nrrd")
+
+
+def _suffix(path: Path) -> str:
+    name = path.name.lower()
+    return ".nii.gz" if name.endswith(".nii.gz") else path.suffix.lower()
+
+
+def float_to_uint8(vol: np.ndarray, lo: float | None = None, hi: float | None = None) -> np.ndarray:
+    """Map ``[lo, hi]`` linearly onto 0..255 and clip (float2uchar).
+
+    ``lo``/``hi`` default to the data's minimum and maximum.
+    """
+    vol = np.asarray(vol)
+    lo = float(np.min(vol)) if lo is None else float(lo)
+    hi = float(np.max(vol)) if hi is None else float(hi)
+    if hi <= lo:
+        return np.zeros(vol.shape, np.uint8) if vol.size == 0 or hi < lo else (vol > lo).astype(np.uint8) * 255
+    out = (np.asarray(vol, np.float64) - lo) * (255.0 / (hi - lo))
+    return np.clip(np.rint(out), 0, 255).astype(np.uint8)
+
+
+def _read_vtk(path: Path):
+    import pyvista as pv  # lazy: VTK only when a VTK format is used
+
+    try:
+        img = pv.read(str(path))
+    except Exception as exc:  # VTK raises many types; report them as one
+        raise FormatError(path, f"VTK could not read it as {_suffix(path)}: {exc}") from exc
+    if not isinstance(img, pv.ImageData) or img.n_points == 0 or img.point_data.active_scalars is None:
+        raise FormatError(path, "expected a 3-D image with point scalars")
+    scalars = np.asarray(img.point_data.active_scalars)
+    if scalars.ndim > 1:  # vector data: take the first component
+        scalars = scalars[:, 0]
+    data = scalars.reshape(img.dimensions, order="F")
+    return data, tuple(img.origin), tuple(img.spacing)
+
+
+def _natural_key(name: str):
+    return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
+
+
+def read_image_folder(folder: str | Path) -> np.ndarray:
+    """Stack a folder of 2-D slice images along z (combineToGrayVolume).
+
+    Files are taken in natural order (``s2`` before ``s10``). Colour images are
+    converted to grey (luminance). Image rows are y, columns x.
+    """
+    from skimage import io as skio
+
+    folder = Path(folder)
+    files = sorted((f for f in folder.iterdir() if f.suffix.lower() in IMAGE_SUFFIXES),
+                   key=lambda f: _natural_key(f.name))
+    if not files:
+        raise FormatError(folder, f"no slice images ({', '.join(IMAGE_SUFFIXES)}) in this folder")
+    slices = []
+    for f in files:
+        try:
+            img = np.asarray(skio.imread(f))
+        except Exception as exc:  # imageio/PIL raise many types
+            raise FormatError(f, f"cannot read image: {exc}") from exc
+        if img.ndim == 3:
+            rgb = img[..., :3].astype(np.float64)
+            img = np.rint(rgb @ [0.2125, 0.7154, 0.0721]).astype(img.dtype)
+        if img.ndim != 2:
+            raise FormatError(f, f"expected a 2-D image, got shape {img.shape}")
+        if slices and img.shape != slices[0].shape[::-1]:
+            raise FormatError(f, f"slice is {img.shape}, expected {slices[0].shape[::-1]} like {files[0].name}")
+        slices.append(img.T)
+    return np.stack(slices, axis=2)
+
+
+def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False):
+    """Read any supported volume: ``(data[x, y, z], origin, spacing)``.
+
+    Parameters
+    ----------
+    path : str or Path
+        A file, or a folder of slice images.
+    dims : (3,) ints, optional
+        Dimensions of a headerless ``.vol``.
+    rescale : bool
+        Map non-uint8 data onto 0..255 (min..max). Off by default: data keep
+        their type unless the user asks.
+    """
+    path = Path(path)
+    if path.is_dir():
+        data, origin, spacing = read_image_folder(path), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
+    elif not path.exists():
+        raise FormatError(path, "no such file or folder")
+    elif path.suffix.lower() == ".vol":
+        data, origin, spacing = raw_volumes.read_raw(path, dims), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
+    elif _suffix(path) in NRRD_SUFFIXES:
+        data, origin, spacing = read_nrrd(path)
+    elif _suffix(path) in VTK_SUFFIXES:
+        data, origin, spacing = _read_vtk(path)
+    else:
+        raise FormatError(path, f"unknown volume format {path.suffix!r}; expected .vol, .VOL, "
+                          + ", ".join(VTK_SUFFIXES + NRRD_SUFFIXES) + " or a folder of slice images")
+    if rescale and data.dtype != np.uint8:
+        data = float_to_uint8(data)
+    return data, origin, spacing
+
+
+def read_volume(path: str | Path, *, dims=None, rescale: bool = False) -> np.ndarray:
+    """Read any supported volume as an array indexed ``[x, y, z]``."""
+    return read_volume_grid(path, dims=dims, rescale=rescale)[0]
+
+
+def _write_vti(path: Path, vol: np.ndarray, origin, spacing) -> None:
+    import pyvista as pv
+
+    img = pv.ImageData(dimensions=vol.shape, origin=origin, spacing=spacing)
+    img.point_data["values"] = vol.ravel(order="F")
+    # VTK writes by file name: write a temporary name beside it, then rename.
+    tmp_path = path.with_name(f".{path.name}.tmp.vti")
+    try:
+        img.save(str(tmp_path))
+        tmp_path.replace(path)
+    finally:
+        tmp_path.unlink(missing_ok=True)
+
+
+def write_volume(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)) -> None:
+    """Write a volume as ``.vol``, ``.VOL``, ``.vti`` or ``.nrrd``, atomically.
+
+    ``.vol``/``.VOL`` hold uint8 only and no origin: callers print the origin.
+    """
+    path = Path(path)
+    vol = np.asarray(vol)
+    if vol.ndim != 3:
+        raise ValueError(f"a volume must be 3-D, got shape {vol.shape}")
+    suffix = _suffix(path)
+    if suffix == ".vol":
+        raw_volumes.write_raw(path, vol)
+    elif suffix == ".vti":
+        _write_vti(path, vol, origin, spacing)
+    elif suffix == ".nrrd":
+        write_nrrd(path, vol, origin, spacing)
+    else:
+        raise ValueError(f"cannot write {path.name}: choose one of {', '.join(WRITE_SUFFIXES)}")

@@ -1,0 +1,183 @@
+"""Demo data: a procedural mannequin, the thesis's aliascube, and the real frog.
+
+    mannequin()  (160, 100, 300) uint8  layered humanoid + BoneSkeleton + part labels
+    aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
+    frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline)
+
+The mannequin faces -y with z up, so its left side (``L_`` bones) is at +x.
+Each body part is a tapered capsule around one bone; a voxel belongs to the
+part in which it lies deepest, which also gives the ground-truth bone of every
+voxel (``part``), used to score automatic connectivity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .bones import Bone, BoneSkeleton
+
+NAMES = ("mannequin", "aliascube", "frog")
+
+# Tissue values: distinct so sampled reconstruction shows the interior moving.
+SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
+MANNEQUIN_SHAPE = (160, 100, 300)
+
+
+@dataclass
+class Sample:
+    """A demo dataset: volume ``[x, y, z]``, its bone skeleton, and metadata."""
+
+    name: str
+    volume: np.ndarray
+    bones: BoneSkeleton | None = None
+    part: np.ndarray | None = None  # bone index + 1 per voxel, 0 background
+    spacing: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    mask_level: int = 1  # the object is volume >= mask_level
+
+    @property
+    def mask(self) -> np.ndarray:
+        return self.volume >= self.mask_level
+
+
+def _mirror(x: float) -> float:
+    return 2 * 80 - x
+
+
+def mannequin_bones() -> BoneSkeleton:
+    """The mannequin's bone skeleton: 18 bones, root order spine, head, arms, legs."""
+    j = {
+        "PELVIS": (80, 50, 140), "NECK": (80, 50, 234), "HEAD": (80, 50, 288),
+        "L_SHOULDER": (108, 50, 226), "L_ELBOW": (124, 50, 178), "L_WRIST": (139, 50, 133),
+        "L_FINGERS": (144, 50, 115),
+        "L_HIP": (94, 50, 138), "L_KNEE": (96, 50, 78), "L_ANKLE": (97, 50, 16), "L_TOE": (97, 26, 6),
+    }
+    for name in [k for k in j if k.startswith("L_")]:
+        x, y, z = j[name]
+        j["R_" + name[2:]] = (_mirror(x), y, z)
+    bones = [Bone("PELVIS", "NECK", "SPINE"), Bone("NECK", "HEAD", "HEAD")]
+    for s in ("L_", "R_"):
+        bones += [
+            Bone("NECK", s + "SHOULDER", s + "CLAVICLE"), Bone(s + "SHOULDER", s + "ELBOW", s + "UPPERARM"),
+            Bone(s + "ELBOW", s + "WRIST", s + "FOREARM"), Bone(s + "WRIST", s + "FINGERS", s + "HAND"),
+        ]
+    for s in ("L_", "R_"):
+        bones += [
+            Bone("PELVIS", s + "HIP", s + "PELVIS"), Bone(s + "HIP", s + "KNEE", s + "THIGH"),
+            Bone(s + "KNEE", s + "ANKLE", s + "SHIN"), Bone(s + "ANKLE", s + "TOE", s + "FOOT"),
+        ]
+    return BoneSkeleton(j, bones)
+
+
+# (bone name, start, end, radius at start, radius at end, y squash, bone-rod radius)
+def _mannequin_parts(bones: BoneSkeleton):
+    J = bones.joints
+    parts = [
+        ("SPINE", (80, 50, 136), (80, 50, 226), 21, 25, 0.62, 0),
+        ("HEAD", (80, 50, 230), (80, 50, 250), 8, 8, 1.0, 0),
+        ("HEAD", (80, 50, 266), (80, 50, 272), 17, 17, 0.95, 0),
+    ]
+    for s in ("L_", "R_"):
+        parts += [
+            (s + "CLAVICLE", J["NECK"] + (0, 0, -6), J[s + "SHOULDER"], 9, 10, 0.9, 0),
+            (s + "UPPERARM", J[s + "SHOULDER"], J[s + "ELBOW"], 9, 7, 1.0, 2.5),
+            (s + "FOREARM", J[s + "ELBOW"], J[s + "WRIST"], 7, 5, 1.0, 2.0),
+            (s + "HAND", J[s + "WRIST"], J[s + "FINGERS"], 5, 4, 0.6, 0),
+            (s + "PELVIS", J["PELVIS"], J[s + "HIP"], 13, 12, 0.8, 0),
+            (s + "THIGH", J[s + "HIP"], J[s + "KNEE"], 12, 9, 1.0, 3.5),
+            (s + "SHIN", J[s + "KNEE"], J[s + "ANKLE"], 8, 6, 1.0, 2.5),
+            (s + "FOOT", J[s + "ANKLE"], J[s + "TOE"], 6, 5, 1.0, 0),
+        ]
+    return parts
+
+
+def mannequin() -> Sample:
+    """A procedural humanoid, about 160 x 100 x 300 voxels, with layered interior.
+
+    Skin, fat, striped muscle (stripes across each limb, so they move with it)
+    and bone rods inside the limbs; a skull and brain in the head.
+    """
+    shape = MANNEQUIN_SHAPE
+    bones = mannequin_bones()
+    vol = np.zeros(shape, np.uint8, order="F")
+    part = np.zeros(shape, np.uint8, order="F")
+    best = np.full(shape, -np.inf, np.float32, order="F")
+    for k, (name, a, b, ra, rb, squash, rod) in enumerate(_mannequin_parts(bones)):
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        r = max(ra, rb)
+        lo = np.maximum(np.floor(np.minimum(a, b) - r - 1), 0).astype(int)
+        hi = np.minimum(np.ceil(np.maximum(a, b) + r + 1), np.array(shape) - 1).astype(int)
+        x, y, z = np.meshgrid(*(np.arange(lo[i], hi[i] + 1, dtype=np.float64) for i in range(3)), indexing="ij")
+        ab = b - a
+        length = float(np.linalg.norm(ab))
+        t = np.clip(((x - a[0]) * ab[0] + (y - a[1]) * ab[1] + (z - a[2]) * ab[2]) / length**2, 0, 1)
+        dx, dy, dz = x - (a[0] + t * ab[0]), (y - (a[1] + t * ab[1])) / squash, z - (a[2] + t * ab[2])
+        d = np.sqrt(dx * dx + dy * dy + dz * dz)
+        radius = ra + (rb - ra) * t
+        depth = (radius - d).astype(np.float32)
+        sl = tuple(slice(lo[i], hi[i] + 1) for i in range(3))
+        win = (depth > 0) & (depth > best[sl])
+        stripe = ((t * length) // 5).astype(int) % 2 == 0
+        tissue = np.where(depth < 1.5, SKIN, np.where(depth < 4, FAT, np.where(stripe, MUSCLE_A, MUSCLE_B)))
+        if rod:
+            tissue = np.where(d < rod, BONE, tissue)
+        if name == "HEAD" and k == 2:
+            tissue = np.where(depth < 1.5, SKIN, np.where(depth < 4, SKULL, np.where(stripe, BRAIN, BRAIN + 12)))
+        best[sl] = np.where(win, depth, best[sl])
+        vol[sl] = np.where(win, tissue, vol[sl])
+        part[sl] = np.where(win, bones.index(name) + 1, part[sl])
+    return Sample("mannequin", vol, bones, part)
+
+
+ALIAS_SIZE, ALIAS_CUBE, ALIAS_BLOCK = 128, 107, 9
+
+
+def aliascube() -> Sample:
+    """The thesis's aliasing test cube: 128^3, a 107^3 checkerboard of 50 and 250.
+
+    Blocks of 9 voxels: the largest block size whose checkerboard gives exactly
+    the thesis's Table 5.2 counts (872109 zeros, 612521 of 50, 612522 of 250);
+    sizes 1, 2, 3, 6, 9, 18 and 27 all do, and 9 shows clear squares.
+    """
+    start = (ALIAS_SIZE - ALIAS_CUBE) // 2
+    i = np.arange(ALIAS_CUBE) // ALIAS_BLOCK
+    parity = (i[:, None, None] + i[None, :, None] + i[None, None, :]) % 2
+    vol = np.zeros((ALIAS_SIZE,) * 3, np.uint8, order="F")
+    sl = slice(start, start + ALIAS_CUBE)
+    vol[sl, sl, sl] = np.where(parity == 0, 250, 50)
+    return Sample("aliascube", vol)
+
+
+def frog() -> Sample:
+    """The segmented frog shipped with pyvista (500 x 470 x 136 tissue labels, 1 x 1 x 1.5 mm)."""
+    from pyvista import examples  # lazy: VTK only here
+
+    img = examples.load_frog_tissues()
+    data = np.asarray(img.point_data.active_scalars).reshape(img.dimensions, order="F")
+    return Sample("frog", np.asfortranarray(data.astype(np.uint8)), spacing=tuple(img.spacing))
+
+
+def load(name: str) -> Sample:
+    """A demo dataset by name: 'mannequin', 'aliascube' or 'frog'."""
+    makers = {"mannequin": mannequin, "aliascube": aliascube, "frog": frog}
+    if name not in makers:
+        raise ValueError(f"unknown sample {name!r}; choose one of {', '.join(NAMES)}")
+    return makers[name]()
+
+
+def write_sample(name: str, folder: str | Path) -> list[Path]:
+    """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``)."""
+    from .io import write_bones, write_connections, write_raw
+
+    sample = load(name)
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = [folder / f"{name}.VOL"]
+    write_raw(written[0], sample.volume)
+    if sample.bones is not None:
+        written += [folder / f"{name}.bones", folder / f"{name}.connections"]
+        write_bones(written[1], sample.bones)
+        write_connections(written[2], sample.bones)
+    return written

@@ -1,0 +1,220 @@
+"""Volume tools of the old pipeline as pure functions on ``vol[x, y, z]`` arrays.
+
+=================  ==============================  ==========================
+function           old tool                         note
+=================  ==============================  ==========================
+threshold          Convert2Binary                   band-pass lo <= v <= hi
+fill_cavities      (segmentation)                   enclosed background -> object
+box_fill           Fill                             set a box to a value
+crop               CropVolume                       bounds may reach outside: pads
+tight_bounds       TightBounds                      inclusive min/max of v > level
+flip               (flip)                           along x, y or z
+histogram          Count                            256 counts
+super_diff         VolumeSuperDiff                  0/100/150/200 coding
+reverse            ReverseData                      255 - v
+remap              remapVolume                      256-entry lookup table
+fit_pow2           FitVolume                        pad up to powers of two
+float_to_uint8     float2uchar                      (in volanim_core.io)
+=================  ==============================  ==========================
+
+Bounds are inclusive voxel index ranges ``(lo, hi)`` with ``lo, hi`` 3-tuples,
+as the old tools printed them.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from scipy import ndimage
+
+from .io.volume_files import float_to_uint8
+
+__all__ = [
+    "Bounds", "box_fill", "crop", "fill_cavities", "fit_pow2", "flip", "float_to_uint8",
+    "histogram", "remap", "reverse", "super_diff", "threshold", "tight_bounds",
+]
+
+
+class Bounds(NamedTuple):
+    """Inclusive voxel bounds: ``lo <= (x, y, z) <= hi``."""
+
+    lo: tuple[int, int, int]
+    hi: tuple[int, int, int]
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return tuple(int(h - lo + 1) for lo, h in zip(self.lo, self.hi))
+
+    def slices(self) -> tuple[slice, slice, slice]:
+        return tuple(slice(lo, h + 1) for lo, h in zip(self.lo, self.hi))
+
+    def __str__(self) -> str:
+        return " ".join(str(int(v)) for v in (*self.lo, *self.hi))
+
+
+def _check3d(vol, name="volume") -> np.ndarray:
+    vol = np.asarray(vol)
+    if vol.ndim != 3:
+        raise ValueError(f"{name} must be a 3-D array indexed [x, y, z], got shape {vol.shape}")
+    return vol
+
+
+def threshold(vol: np.ndarray, lo: float, hi: float | None = None, *, value: int = 1) -> np.ndarray:
+    """Band-pass threshold to a binary uint8 volume (Convert2Binary).
+
+    Parameters
+    ----------
+    vol : (X, Y, Z) ndarray
+    lo, hi : float
+        Voxels with ``lo <= v <= hi`` become ``value``, others 0. ``hi``
+        defaults to no upper limit.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> threshold(np.array([[[0, 5, 10]]]), 5).ravel().tolist()
+    [0, 1, 1]
+    """
+    vol = _check3d(vol)
+    if not 0 <= value <= 255:
+        raise ValueError(f"value must be 0..255, got {value}")
+    inside = vol >= lo
+    if hi is not None:
+        if hi < lo:
+            raise ValueError(f"threshold range is empty: hi {hi} < lo {lo}")
+        inside &= vol <= hi
+    return inside.astype(np.uint8) * np.uint8(value)
+
+
+def fill_cavities(mask: np.ndarray) -> np.ndarray:
+    """Fill background regions fully enclosed by the object.
+
+    The object is taken as 26-connected, so background is 6-connected: a
+    cavity is any background region with no 6-connected path to the border.
+    Returns a mask of the input's dtype with enclosed voxels set to the
+    object's value (the maximum of ``mask``).
+    """
+    mask = _check3d(mask, "mask")
+    filled = ndimage.binary_fill_holes(mask != 0)
+    out = mask.copy()
+    out[filled & (mask == 0)] = mask.max() if mask.size else 1
+    return out
+
+
+def box_fill(vol: np.ndarray, bounds: Bounds, value: int) -> np.ndarray:
+    """A copy of ``vol`` with the inclusive box ``bounds`` set to ``value`` (Fill)."""
+    vol = _check3d(vol).copy()
+    lo = np.maximum(bounds.lo, 0)
+    hi = np.minimum(bounds.hi, np.array(vol.shape) - 1)
+    if np.all(hi >= lo):
+        vol[lo[0] : hi[0] + 1, lo[1] : hi[1] + 1, lo[2] : hi[2] + 1] = value
+    return vol
+
+
+def crop(vol: np.ndarray, bounds: Bounds, *, fill: int = 0) -> np.ndarray:
+    """The part of ``vol`` inside ``bounds``; parts outside the volume read ``fill`` (CropVolume).
+
+    So crop also pads: ``crop(v, Bounds((-2,)*3, np.array(v.shape) + 1))`` adds
+    two voxels on every side.
+    """
+    vol = _check3d(vol)
+    shape = Bounds(tuple(bounds.lo), tuple(bounds.hi)).shape
+    if min(shape) < 1:
+        raise ValueError(f"empty crop bounds {bounds}")
+    out = np.full(shape, fill, dtype=vol.dtype, order="F")
+    src_lo = np.maximum(bounds.lo, 0)
+    src_hi = np.minimum(bounds.hi, np.array(vol.shape) - 1)
+    if np.all(src_hi >= src_lo):
+        dst_lo = src_lo - np.asarray(bounds.lo)
+        dst_hi = dst_lo + (src_hi - src_lo)
+        out[dst_lo[0] : dst_hi[0] + 1, dst_lo[1] : dst_hi[1] + 1, dst_lo[2] : dst_hi[2] + 1] = vol[
+            src_lo[0] : src_hi[0] + 1, src_lo[1] : src_hi[1] + 1, src_lo[2] : src_hi[2] + 1
+        ]
+    return out
+
+
+def tight_bounds(vol: np.ndarray, level: float = 0) -> Bounds | None:
+    """Inclusive bounds of the voxels with value > ``level`` (TightBounds); None if there are none."""
+    vol = _check3d(vol)
+    lo, hi = [], []
+    for axis in range(3):
+        other = tuple(a for a in range(3) if a != axis)
+        hit = np.flatnonzero((vol > level).any(axis=other))
+        if not len(hit):
+            return None
+        lo.append(int(hit[0]))
+        hi.append(int(hit[-1]))
+    return Bounds(tuple(lo), tuple(hi))
+
+
+def flip(vol: np.ndarray, axis: str | int) -> np.ndarray:
+    """Mirror the volume along ``axis`` ('x', 'y', 'z' or 0..2)."""
+    vol = _check3d(vol)
+    ax = {"x": 0, "y": 1, "z": 2}.get(axis, axis)
+    if ax not in (0, 1, 2):
+        raise ValueError(f"axis must be x, y or z, got {axis!r}")
+    return np.flip(vol, ax).copy(order="F")
+
+
+def histogram(vol: np.ndarray) -> np.ndarray:
+    """Counts of each value 0..255 of a uint8 volume (Count)."""
+    vol = _check3d(vol)
+    if vol.dtype != np.uint8:
+        raise ValueError(f"histogram expects uint8 data, got {vol.dtype}")
+    return np.bincount(vol.ravel(order="K"), minlength=256)
+
+
+SUPER_DIFF_CODES = {"both empty": 0, "both filled": 100, "only first": 150, "only second": 200}
+
+
+def super_diff(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Voxel-by-voxel comparison of two volumes (VolumeSuperDiff).
+
+    Output: 0 where both are 0, 100 where both are non-zero, 150 where only
+    ``a`` is non-zero, 200 where only ``b`` is.
+    """
+    a, b = _check3d(a, "first volume"), _check3d(b, "second volume")
+    if a.shape != b.shape:
+        raise ValueError(f"volumes differ in size: {a.shape} vs {b.shape}")
+    fa, fb = a != 0, b != 0
+    out = np.zeros(a.shape, np.uint8, order="F")
+    out[fa & fb] = 100
+    out[fa & ~fb] = 150
+    out[~fa & fb] = 200
+    return out
+
+
+def reverse(vol: np.ndarray) -> np.ndarray:
+    """Invert intensities, ``255 - v`` (ReverseData)."""
+    vol = _check3d(vol)
+    if vol.dtype != np.uint8:
+        raise ValueError(f"reverse expects uint8 data, got {vol.dtype}")
+    return (255 - vol).astype(np.uint8)
+
+
+def remap(vol: np.ndarray, table) -> np.ndarray:
+    """Replace each value v by ``table[v]`` (remapVolume); ``table`` has 256 entries 0..255."""
+    vol = _check3d(vol)
+    table = np.asarray(table)
+    if table.shape != (256,):
+        raise ValueError(f"a remap table has 256 entries, got {table.shape}")
+    if table.min() < 0 or table.max() > 255:
+        raise ValueError("remap table values must be 0..255")
+    if vol.dtype != np.uint8:
+        raise ValueError(f"remap expects uint8 data, got {vol.dtype}")
+    return table.astype(np.uint8)[vol]
+
+
+def fit_pow2(vol: np.ndarray, *, center: bool = False) -> tuple[np.ndarray, tuple[int, int, int]]:
+    """Pad every dimension up to a power of two (FitVolume).
+
+    Returns the padded volume and the offset of the old voxel (0, 0, 0) in it
+    (zero unless ``center``).
+    """
+    vol = _check3d(vol)
+    target = [1 << int(np.ceil(np.log2(max(n, 1)))) for n in vol.shape]
+    offset = tuple((t - n) // 2 if center else 0 for t, n in zip(target, vol.shape))
+    lo = tuple(-o for o in offset)
+    hi = tuple(lo_ + t - 1 for lo_, t in zip(lo, target))
+    return crop(vol, Bounds(lo, hi)), offset

@@ -1,0 +1,1 @@
+"""volanim studio: the desktop application (PySide6 + pyvista/pyvistaqt)."""

@@ -1,0 +1,55 @@
+"""Demo datasets."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+from volanim_core import io, samples
+
+
+def test_aliascube_matches_thesis_table_5_2():
+    v = samples.aliascube().volume
+    counts = np.bincount(v.ravel(), minlength=256)
+    assert v.shape == (128, 128, 128)
+    assert (counts[0], counts[50], counts[250]) == (872109, 612521, 612522)
+    assert counts.sum() == counts[0] + counts[50] + counts[250]
+
+
+def test_mannequin_is_one_layered_body_with_bones():
+    s = samples.mannequin()
+    assert s.volume.shape == (160, 100, 300)
+    _, n = ndimage.label(s.mask)
+    assert n == 1
+    values = set(np.unique(s.volume)) - {0}
+    assert len(values) >= 6  # skin, fat, two muscle stripes, bone, skull, brain
+    assert len(s.bones) == 18
+    names = {j for j in s.bones.joints}
+    for j in ("NECK", "HEAD", "SHOULDER", "ELBOW", "WRIST", "HIP", "KNEE", "ANKLE"):
+        assert j in names or f"L_{j}" in names and f"R_{j}" in names
+    # every object voxel has a ground-truth bone, and every bone owns voxels
+    assert np.array_equal(s.part > 0, s.mask)
+    assert set(np.unique(s.part)) == set(range(len(s.bones) + 1))
+    # left is at +x: the left hand's voxels are right of centre
+    assert np.argwhere(s.part == s.bones.index("L_HAND") + 1)[:, 0].min() > 80
+
+
+def test_mannequin_is_mirror_symmetric_in_shape():
+    s = samples.mannequin()
+    mirrored = np.zeros_like(s.mask)
+    mirrored[0:160] = s.mask[::-1]
+    # x -> 160 - x maps voxel i to 160 - i: shift by one to compare exactly
+    assert np.array_equal(s.mask[1:], mirrored[:-1])
+
+
+def test_frog_loads_offline():
+    s = samples.frog()
+    assert s.volume.shape == (500, 470, 136) and s.volume.dtype == np.uint8
+    assert s.spacing == (1.0, 1.0, 1.5)
+
+
+def test_write_sample_files(tmp_path):
+    paths = samples.write_sample("mannequin", tmp_path)
+    assert [p.name for p in paths] == ["mannequin.VOL", "mannequin.bones", "mannequin.connections"]
+    assert np.array_equal(io.read_volume(paths[0]), samples.mannequin().volume)
+    assert io.read_bones(paths[1]) == samples.mannequin_bones()
