@@ -227,3 +227,15 @@ def test_writer_is_atomic_keeps_old_file_on_failure(tmp_path, small_bones, monke
         io.write_bones(path, small_bones)
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["b.bones"]  # no temporary left behind
+
+
+def test_written_files_get_normal_permissions(tmp_path, small_bones):
+    import os
+
+    io.write_bones(tmp_path / "a.bones", small_bones)
+    mask = os.umask(0)
+    os.umask(mask)
+    assert (tmp_path / "a.bones").stat().st_mode & 0o777 == 0o666 & ~mask
+    os.chmod(tmp_path / "a.bones", 0o640)
+    io.write_bones(tmp_path / "a.bones", small_bones)  # replacing keeps the old mode
+    assert (tmp_path / "a.bones").stat().st_mode & 0o777 == 0o640

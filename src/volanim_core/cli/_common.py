@@ -19,7 +19,8 @@ def add_command(sub, name: str, help: str, example: str, func) -> argparse.Argum
 
 
 def add_volume_in(p: argparse.ArgumentParser, name: str = "volume", help: str = "input volume") -> None:
-    p.add_argument(name, help=f"{help} (.vol with --dims or NAME.XxYxZ.vol, .VOL, .vti, .nrrd, .nii, .mha, or a folder of slices)")
+    p.add_argument(name, help=f"{help} (.vol with --dims or NAME.XxYxZ.vol, .VOL, .vti, .nrrd, .nii, .mha, "
+                   "or a folder of slices)")
 
 
 def add_dims(p: argparse.ArgumentParser) -> None:

@@ -1,0 +1,70 @@
+"""Benchmark harness: each case runs in a fresh subprocess, so peak memory
+(peak RSS of a warm call minus the RSS before it) and first-call (numba cache
+load) times are real; the median of warm repeats gives the time.
+
+A case is ``name -> callable(data) -> None``; ``data`` comes from a loader
+that the child calls before measuring.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+
+def rss_bytes() -> int:
+    with open("/proc/self/statm") as fh:
+        return int(fh.read().split()[1]) * resource.getpagesize()
+
+
+def _peak_rss() -> int:
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) * 1024
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def _reset_peak() -> None:
+    # Linux: writing 5 to clear_refs resets the peak RSS (VmHWM) of this process,
+    # so imports and JIT compilation in the first call do not count as the case's memory.
+    with open("/proc/self/clear_refs", "w") as fh:
+        fh.write("5")
+
+
+def child(cases: dict, loader, case: str, dataset: str, repeats: int) -> None:
+    data = loader(dataset)
+    fn = cases[case]
+    t0 = time.perf_counter()
+    fn(data)
+    first = time.perf_counter() - t0
+    _reset_peak()
+    before = rss_bytes()
+    fn(data)
+    peak = _peak_rss() - before
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn(data)
+        times.append(time.perf_counter() - t0)
+    print(json.dumps({"first": first, "time": statistics.median(times) if times else first, "peak": max(peak, 0)}))
+
+
+def measure(script: str, case: str, dataset: str, repeats: int = 3, env=None) -> dict:
+    out = subprocess.run([sys.executable, script, "--child", case, dataset, str(repeats)],
+                         capture_output=True, text=True, env=env, check=False)
+    if out.returncode:
+        return {"error": out.stderr.strip().splitlines()[-1] if out.stderr else "failed"}
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def table(rows: list[list], header: list[str]) -> str:
+    cols = [header] + [[str(c) for c in r] for r in rows]
+    widths = [max(len(r[i]) for r in cols) for i in range(len(header))]
+    lines = [" | ".join(c.ljust(w) for c, w in zip(r, widths)) for r in cols]
+    lines.insert(1, "-|-".join("-" * w for w in widths))
+    return "\n".join(lines)

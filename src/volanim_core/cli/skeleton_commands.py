@@ -1,0 +1,68 @@
+"""Skeleton subcommands: skeletonize, isosurface."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .. import volume
+from ..io import write_mskel
+from ..isosurface import isosurface, write_mesh
+from ..progress import TextProgress
+from ..skeletonize import DEFAULT_MIN_THINNESS, skeletonize
+from ._common import add_command, add_dims, add_volume_in, load, parse_range
+
+
+def segment(vol: np.ndarray, threshold, fill: bool) -> np.ndarray:
+    """The object mask: ``threshold`` band (default: non-zero), cavities filled if asked."""
+    lo, hi = threshold if threshold else (1, None)
+    mask = volume.threshold(vol, lo, hi).view(bool)
+    return volume.fill_cavities(mask) if fill else mask
+
+
+def _skeletonize(args):
+    vol = load(args.volume, args)
+    mask = segment(vol, args.threshold, args.fill_cavities)
+    bar = TextProgress("skeletonize")
+    t0 = time.perf_counter()
+    skel = skeletonize(mask, metric=args.metric, min_thinness=args.min_thinness, progress=bar)
+    elapsed = time.perf_counter() - t0
+    write_mskel(args.output, skel)
+    lo, hi = (skel.thinness.min(), skel.thinness.max()) if len(skel) else (float("nan"),) * 2
+    print(f"{len(skel)} points from {int(mask.sum())} object voxels, thinness {lo:.3f} .. {hi:.3f}, "
+          f"dt up to {skel.dt.max() if len(skel) else 0:.2f} ({args.metric}), {elapsed:.2f} s -> {args.output}")
+
+
+def _isosurface(args):
+    vol = load(args.volume, args)
+    mask = segment(vol, args.threshold, args.fill_cavities)
+    t0 = time.perf_counter()
+    verts, faces = isosurface(mask, step=args.step, engine=args.engine)
+    write_mesh(args.output, verts, faces)
+    print(f"{len(verts)} vertices, {len(faces)} triangles in {time.perf_counter() - t0:.2f} s -> {args.output}")
+
+
+def _segment_args(p):
+    add_volume_in(p)
+    add_dims(p)
+    p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
+                   help="object = LO <= v <= HI (default: every non-zero voxel)")
+    p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background first")
+
+
+def register(sub) -> None:
+    p = add_command(sub, "skeletonize", "Distance transform + thinness -> multi-resolution skeleton (.mskel).",
+                    "volanim skeletonize frog.VOL --threshold 1:255 --fill-cavities -o frog.mskel", _skeletonize)
+    _segment_args(p)
+    p.add_argument("--metric", choices=("euclid", "345"), default="euclid", help="distance metric (default euclid)")
+    p.add_argument("--min-thinness", type=float, default=DEFAULT_MIN_THINNESS,
+                   help=f"keep points with thinness >= this (default {DEFAULT_MIN_THINNESS}; -inf keeps all)")
+    p.add_argument("-o", "--output", required=True, help="output .mskel")
+
+    p = add_command(sub, "isosurface", "Isosurface hull of the object as a mesh (.ply, .vtp, .obj, .stl).",
+                    "volanim isosurface frog.VOL --threshold 1:255 -o frog-hull.ply", _isosurface)
+    _segment_args(p)
+    p.add_argument("--step", type=int, default=1, help="sampling step; > 1 gives a coarser mesh (skimage)")
+    p.add_argument("--engine", choices=("vtk", "skimage"), default="vtk", help="marching cubes engine (default vtk)")
+    p.add_argument("-o", "--output", required=True, help="output mesh")
