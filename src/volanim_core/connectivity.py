@@ -153,6 +153,8 @@ class Tskel:
             self.points, self.dt, self.thinness, self.bone
         )
         check_metric(self.metric)
+        if len(self.bone) and (self.bone.min() < 0 or self.bone.max() >= len(self.bones)):
+            raise ValueError("point bone index out of range of the bone list")
 
     def __len__(self) -> int:
         return len(self.points)

@@ -2,7 +2,9 @@
 
     sample volume --> NAME.VOL + NAME.bones
       --skeletonize--> NAME.mskel, --isosurface--> NAME-hull.ply
-      (the reconstruction stages are appended by later modules)
+      connectivity (assets/, else nearest bone) --> NAME.0.50.connect
+      --identity--> rest.tskel --reconstruct--> rest-sampled.vti
+      --pose (left upper arm 45 deg)--> arm.trans --> arm.tskel --> arm-sampled.vti, arm-bone.vti
 """
 
 from __future__ import annotations
@@ -13,14 +15,38 @@ from pathlib import Path
 import numpy as np
 
 from . import samples, volume
-from .io import write_bones, write_connections, write_mskel, write_raw
+from .attach import connect_nearest
+from .connectivity import Trans
+from .io import (
+    connect_filename,
+    read_connect,
+    write_bones,
+    write_connect,
+    write_connections,
+    write_mskel,
+    write_raw,
+    write_trans,
+    write_tskel,
+    write_volume,
+)
 from .isosurface import isosurface, write_mesh
+from .pose import pose_matrices, root_bones
 from .progress import TextProgress
-from .skeletonize import skeletonize
+from .reconstruct import reconstruct, sphere_neighbours
+from .skeletonize import DEFAULT_MIN_THINNESS, skeletonize
+from .tskel import check_root_order, connect_to_tskel, identity_tskel
+
+POSES = {"mannequin": ("L_UPPERARM", (0.0, -45.0, 0.0)), "frog": ("LEGS", (0.0, 0.0, 45.0))}
 
 
 def _say(msg: str) -> None:
     print(msg, flush=True)
+
+
+def bundled_connect(sample: str) -> Path | None:
+    """The connectivity shipped in ``assets/`` for ``sample``, when running from the repository."""
+    path = Path(__file__).resolve().parents[2] / "assets" / connect_filename(sample, DEFAULT_MIN_THINNESS)
+    return path if path.is_file() else None
 
 
 def run_demo(folder: Path, sample: str = "mannequin") -> dict:
@@ -35,11 +61,10 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     counts = volume.histogram(s.volume)
     _say(f"[1] sample {sample}: {s.volume.shape} voxels, {int(np.count_nonzero(s.volume))} in the object, "
          f"tight bounds {b}, {int((counts[1:] > 0).sum())} distinct values -> {out['volume'].name}")
-    if s.bones is not None:
-        out["bones"] = folder / f"{sample}.bones"
-        write_bones(out["bones"], s.bones)
-        write_connections(folder / f"{sample}.connections", s.bones)
-        _say(f"    bone skeleton: {len(s.bones.joints)} joints, {len(s.bones)} bones -> {out['bones'].name}")
+    out["bones"] = folder / f"{sample}.bones"
+    write_bones(out["bones"], s.bones)
+    write_connections(folder / f"{sample}.connections", s.bones)
+    _say(f"    bone skeleton: {len(s.bones.joints)} joints, {len(s.bones)} bones -> {out['bones'].name}")
 
     t = time.perf_counter()
     skel = skeletonize(s.mask, progress=TextProgress("    skeletonize"))
@@ -52,7 +77,45 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     out["hull"] = folder / f"{sample}-hull.ply"
     write_mesh(out["hull"], verts, faces)
     _say(f"    hull: {len(faces)} triangles, {time.perf_counter() - t:.2f} s -> {out['hull'].name}")
-    out["skeleton"] = skel
-    out["sample"] = s
+
+    shipped = bundled_connect(sample)
+    if shipped is not None:
+        conn = read_connect(shipped)
+        check_root_order(conn.bones, root_bones(s.bones), ".bones")
+        how = f"bundled {shipped.name}"
+    else:
+        conn = connect_nearest(skel.at(DEFAULT_MIN_THINNESS), s.bones)
+        how = "each point on its nearest bone"
+    out["connect"] = folder / connect_filename(sample, DEFAULT_MIN_THINNESS)
+    write_connect(out["connect"], conn, thinness=DEFAULT_MIN_THINNESS)
+    per_bone = np.bincount(conn.bone, minlength=len(conn.bones))
+    _say(f"[3] connectivity ({how}): {len(conn)} points on {len(conn.bones)} bones "
+         f"({per_bone.min()}..{per_bone.max()} per bone) -> {out['connect'].name}")
+
+    rest = identity_tskel(conn)
+    write_tskel(folder / "rest.tskel", rest)
+    r = reconstruct(rest, mode="sampled", source=s.volume, progress=TextProgress("    reconstruct"))
+    out["rest"] = folder / "rest-sampled.vti"
+    write_volume(out["rest"], r.volume, origin=r.origin)
+    loss = 100.0 * (int(s.mask.sum()) - r.stats["filled"]) / s.mask.sum()
+    _say(f"[4] identity reconstruction: {r.stats['filled']} voxels ({loss:.2f} % loss from the object), "
+         f"{r.stats['seconds']:.3f} s -> {out['rest'].name}")
+
+    bone, angles = POSES[sample]
+    trans = Trans(root_bones(s.bones), pose_matrices(s.bones, {bone: angles}))
+    write_trans(folder / "arm.trans", trans)
+    posed = connect_to_tskel(conn, trans)
+    write_tskel(folder / "arm.tskel", posed)
+    nbrs = sphere_neighbours(posed)
+    r = reconstruct(posed, mode="sampled", source=s.volume, neighbours=nbrs, progress=TextProgress("    reconstruct"))
+    out["posed"] = folder / "arm-sampled.vti"
+    write_volume(out["posed"], r.volume, origin=r.origin)
+    hot = reconstruct(posed, mode="hotspot")
+    boned = reconstruct(posed, mode="bone", neighbours=nbrs)
+    write_volume(folder / "arm-bone.vti", boned.volume, origin=boned.origin)
+    _say(f"[5] {bone} turned {angles} deg: sampled reconstruction {r.stats['filled']} voxels in "
+         f"{r.stats['seconds']:.3f} s (overdraw {r.stats['overdraw']:.1f}), hotspot max {hot.stats['hotspot_max']}, "
+         f"origin {r.origin} -> {out['posed'].name}, arm-bone.vti")
+    out["skeleton"], out["sample"], out["connectivity"] = skel, s, conn
     _say(f"done in {time.perf_counter() - t0:.1f} s; files in {folder}/")
     return out

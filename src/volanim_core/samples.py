@@ -2,7 +2,8 @@
 
     mannequin()  (160, 100, 300) uint8  layered humanoid + BoneSkeleton + part labels
     aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
-    frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline)
+    frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
+                                         with a two-bone principal-axis chain
 
 The mannequin faces -y with z up, so its left side (``L_`` bones) is at +x.
 Each body part is a tapered capsule around one bone; a voxel belongs to the
@@ -155,8 +156,27 @@ def frog() -> Sample:
     from pyvista import examples  # lazy: VTK only here
 
     img = examples.load_frog_tissues()
-    data = np.asarray(img.point_data.active_scalars).reshape(img.dimensions, order="F")
-    return Sample("frog", np.asfortranarray(data.astype(np.uint8)), spacing=tuple(img.spacing))
+    data = np.asfortranarray(np.asarray(img.point_data.active_scalars).reshape(img.dimensions, order="F"))
+    data = data.astype(np.uint8, copy=False)
+    return Sample("frog", data, bones=principal_axis_bones(data > 0), spacing=tuple(img.spacing))
+
+
+def principal_axis_bones(mask: np.ndarray, names=("BODY", "LEGS")) -> BoneSkeleton:
+    """A two-bone chain along the object's principal axis (PCA of its voxels).
+
+    Joints: both ends of the object along the axis (5th and 95th percentiles)
+    and the middle. Crude, but it gives any dataset -- like the frog, which
+    ships no skeleton -- a bone to pose for benchmarks and the demo.
+    """
+    pts = np.argwhere(mask)[:: max(1, int(mask.sum()) // 200000)].astype(np.float64)
+    centre = pts.mean(0)
+    _, _, vt = np.linalg.svd(pts - centre, full_matrices=False)
+    axis = vt[0]
+    t = (pts - centre) @ axis
+    lo, hi = np.percentile(t, [5, 95])
+    joints = {"A": centre + lo * axis, "MID": centre + 0.5 * (lo + hi) * axis, "B": centre + hi * axis}
+    joints = {k: np.round(v, 1) for k, v in joints.items()}
+    return BoneSkeleton(joints, [Bone("MID", "A", names[0]), Bone("MID", "B", names[1])])
 
 
 def load(name: str) -> Sample:

@@ -1,0 +1,149 @@
+"""Reconstruction benchmark on the frog (real data, default skeleton, thinness >= 0.5).
+
+Two frames: identity, and the frog's LEGS bone turned 45 degrees at its
+proximal joint. Each case runs in a fresh process (first call = numba cache
+load; peak memory of a warm call beyond the loaded source). Ratios are
+against baselines measured in the same run:
+
+    ours (2 threads)  vs  thesis cube scan in numba (2 threads),
+                          plain NumPy per sphere, ours on 1 thread,
+                          the memory floor (one np.copyto over output + stencil bytes)
+
+Run: .venv/bin/python benchmarks/bench_reconstruct.py [--dataset frog|mannequin] [--repeats N]
+"""
+
+from __future__ import annotations
+
+import sys
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _harness import child, measure, table  # noqa: E402
+
+
+@cache
+def load(dataset: str):
+    from volanim_core import samples
+    from volanim_core.attach import connect_nearest
+    from volanim_core.connectivity import Trans
+    from volanim_core.pose import pose_matrices, root_bones
+    from volanim_core.reconstruct import grid_bounds, sphere_neighbours
+    from volanim_core.skeletonize import skeletonize
+    from volanim_core.tskel import connect_to_tskel, identity_tskel
+
+    s = samples.load(dataset)
+    conn = connect_nearest(skeletonize(s.mask), s.bones)
+    bone = "LEGS" if dataset == "frog" else "L_UPPERARM"
+    posed = connect_to_tskel(conn, Trans(root_bones(s.bones), pose_matrices(s.bones, {bone: (0, -45, 45)})))
+    ident = identity_tskel(conn)
+    return {"source": s.volume, "posed": posed, "identity": ident, "neighbours": sphere_neighbours(posed),
+            "bounds": {"posed": grid_bounds(posed), "identity": grid_bounds(ident)}}
+
+
+def _ours(frame, mode, threads, cached=True, reuse_out=False):
+    from volanim_core.reconstruct import reconstruct
+
+    def run(d):
+        r = reconstruct(d[frame], mode=mode, source=d["source"], threads=threads,
+                        neighbours=d["neighbours"] if cached else None, out=run.last if reuse_out else None)
+        run.last = r.volume
+    run.last = None
+    return run
+
+
+def _old(frame, sampled, threads):
+    from _old_reconstruct import run_cube_scan
+
+    return lambda d: run_cube_scan(d[frame], d["bounds"][frame], d["source"], sampled, threads)
+
+
+def _numpy(frame, sampled):
+    from _old_reconstruct import numpy_per_sphere
+
+    return lambda d: numpy_per_sphere(d[frame], d["bounds"][frame], d["source"], sampled)
+
+
+CASES = {
+    "ours posed sampled 2T": _ours("posed", "sampled", 2),
+    "ours posed sampled 2T (+neighbours)": _ours("posed", "sampled", 2, cached=False),
+    "ours posed sampled 1T": _ours("posed", "sampled", 1),
+    "ours posed sampled 2T, out= reused (studio)": _ours("posed", "sampled", 2, reuse_out=True),
+    "ours posed sampled 1T, out= reused (studio)": _ours("posed", "sampled", 1, reuse_out=True),
+    "old cube scan posed sampled 2T": _old("posed", True, 2),
+    "old cube scan posed sampled 1T": _old("posed", True, 1),
+    "numpy posed sampled": _numpy("posed", True),
+    "ours identity binary 2T": _ours("identity", "binary", 2),
+    "numpy identity binary": _numpy("identity", False),
+    "ours posed hotspot 2T": _ours("posed", "hotspot", 2),
+    "ours posed bone 2T": _ours("posed", "bone", 2),
+}
+
+
+def floor_seconds(dataset: str, frame: str) -> float:
+    import time
+
+    d = load(dataset)
+    n = int(np.prod(d["bounds"][frame].shape)) * 5
+    a, b = np.ones(n, np.uint8), np.zeros(n, np.uint8)
+    np.copyto(b, a)
+    times = []
+    for _ in range(7):
+        t = time.perf_counter()
+        np.copyto(b, a)
+        times.append(time.perf_counter() - t)
+    return float(np.median(times))
+
+
+def main() -> None:
+    dataset = sys.argv[sys.argv.index("--dataset") + 1] if "--dataset" in sys.argv else "frog"
+    repeats = int(sys.argv[sys.argv.index("--repeats") + 1]) if "--repeats" in sys.argv else 5
+    from volanim_core.reconstruct import reconstruct
+
+    d = load(dataset)
+    stats = {f: reconstruct(d[f], mode="sampled", source=d["source"], neighbours=d["neighbours"]).stats
+             for f in ("posed", "identity")}
+    results = {}
+    for case in CASES:
+        reps = 0 if case.startswith("numpy") else repeats
+        results[case] = measure(__file__, case, dataset, reps)
+    base = results["ours posed sampled 2T"]["time"]
+    rows = []
+    for case, r in results.items():
+        if "error" in r:
+            rows.append([case, "-", "-", "-", r["error"][:50]])
+            continue
+        frame = "identity" if "identity" in case else "posed"
+        voxels = int(np.prod(d["bounds"][frame].shape))
+        rows.append([case, f"{r['time']:.4f}", f"{r['first']:.3f}", f"{r['peak'] / voxels:.2f}",
+                     f"{r['time'] / base:.2f}"])
+    floor = floor_seconds(dataset, "posed")
+    rows.append(["memory floor: np.copyto of output+stencil", f"{floor:.4f}", "-", "-", f"{floor / base:.2f}"])
+    posed_vox = int(np.prod(d["bounds"]["posed"].shape))
+    print(f"\n{dataset}: {len(d['posed'])} spheres (mean radius {d['posed'].dt.mean():.2f}), "
+          f"posed grid {d['bounds']['posed'].shape} = {posed_vox} voxels; "
+          f"filled {stats['posed']['filled']} (identity {stats['identity']['filled']}); "
+          f"overdraw posed {stats['posed']['overdraw']:.2f}, identity {stats['identity']['overdraw']:.2f}")
+    print(table(rows, ["case", "time s", "first call s", "peak B/out voxel", "time / ours 2T"]))
+    t = {k: v.get("time", float("nan")) for k, v in results.items()}
+    print("\nratios (target):")
+    print(f"  old cube scan 2T / ours 2T     = {t['old cube scan posed sampled 2T'] / base:6.2f}  (>= 2)")
+    print(f"  numpy posed sampled / ours 2T  = {t['numpy posed sampled'] / base:6.1f}  (>= 50)")
+    ident = t["numpy identity binary"] / t["ours identity binary 2T"]
+    print(f"  numpy identity binary / ours   = {ident:6.1f}  (>= 50)")
+    print(f"  ours 1T / ours 2T              = {t['ours posed sampled 1T'] / base:6.2f}  (>= 1.7)")
+    reuse2, reuse1 = t["ours posed sampled 2T, out= reused (studio)"], t["ours posed sampled 1T, out= reused (studio)"]
+    print(f"  ... with out= reused: 1T / 2T  = {reuse1 / reuse2:6.2f}")
+    print(f"  ours 2T / memory floor         = {base / floor:6.2f}  (<= 6); with out= reused {reuse2 / floor:.2f}")
+    print(f"  old cube scan 2T / ours 2T reused = {t['old cube scan posed sampled 2T'] / reuse2:.2f}")
+    print(f"  first call (fresh process) - warm = {results['ours posed sampled 2T']['first'] - base:.3f} s  (<= 1)")
+
+
+if __name__ == "__main__":
+    if "--child" in sys.argv:
+        i = sys.argv.index("--child")
+        child(CASES, load, sys.argv[i + 1], sys.argv[i + 2], int(sys.argv[i + 3]))
+    else:
+        main()

@@ -1,0 +1,182 @@
+"""Posing and reconstruction subcommands: connect, pose, connect2tskel,
+connect2identitytskel, sorttskel, bounds, reconstruct."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from ..attach import connect_nearest
+from ..connectivity import Trans
+from ..io import (
+    read_bones,
+    read_connect,
+    read_mskel,
+    read_trans,
+    read_tskel,
+    read_volume_grid,
+    write_connect,
+    write_trans,
+    write_tskel,
+    write_volume,
+)
+from ..pose import pose_matrices, root_bones
+from ..progress import TextProgress
+from ..reconstruct import MODES, grid_bounds, reconstruct
+from ..tskel import connect_to_tskel, identity_tskel, sort_tskel
+from ._common import add_command, bounds_arg
+
+
+def _connect(args):
+    skel = read_mskel(args.mskel)
+    if args.thinness is not None:
+        skel = skel.at(args.thinness)
+    conn = connect_nearest(skel, read_bones(args.bones))
+    write_connect(args.output, conn, thinness=args.thinness)
+    counts = np.bincount(conn.bone, minlength=len(conn.bones))
+    print(f"attached {len(conn)} points to {len(conn.bones)} bones (nearest segment); "
+          f"fewest on one bone: {counts.min()} -> {args.output}")
+
+
+def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
+    """``BONE=RX,RY,RZ`` (degrees)."""
+    name, sep, angles = text.partition("=")
+    try:
+        values = tuple(float(v) for v in angles.split(","))
+    except ValueError:
+        values = ()
+    if not sep or len(values) != 3:
+        raise argparse.ArgumentTypeError(f"expected BONE=RX,RY,RZ in degrees, got {text!r}")
+    return name, values
+
+
+def _pose(args):
+    bones = read_bones(args.bones)
+    rotations = {}
+    for name, angles in args.rotate or []:
+        try:
+            bones.index(name)
+        except KeyError:
+            raise ValueError(f"{args.bones}: no bone named {name!r}; bones are "
+                             + ", ".join(b.label for b in bones.bones)) from None
+        rotations[name] = angles
+    trans = Trans(root_bones(bones), pose_matrices(bones, rotations))
+    write_trans(args.output, trans)
+    print(f"posed {len(rotations)} of {len(bones)} bones (children follow) -> {args.output}")
+
+
+def _connect2tskel(args):
+    t = connect_to_tskel(read_connect(args.connect), read_trans(args.trans))
+    write_tskel(args.output, t)
+    print(f"{len(t)} points, {len(t.bones)} bones -> {args.output}")
+
+
+def _connect2identity(args):
+    t = identity_tskel(read_connect(args.connect))
+    write_tskel(args.output, t)
+    print(f"{len(t)} points, {len(t.bones)} bones, identity matrices -> {args.output}")
+
+
+def _sorttskel(args):
+    write_tskel(args.output, sort_tskel(read_tskel(args.tskel)))
+    print(f"sorted -> {args.output}")
+
+
+def _bounds(args):
+    b = grid_bounds([read_tskel(p) for p in args.tskel], args.padding)
+    print(b)
+
+
+def _check_output(path: str) -> None:
+    from ..io.volume_files import WRITE_SUFFIXES
+
+    if not any(path.endswith(sfx) for sfx in WRITE_SUFFIXES):
+        raise ValueError(f"cannot write {path}: the output must end in {', '.join(WRITE_SUFFIXES)}")
+
+
+def _reconstruct(args):
+    _check_output(args.output)
+    t = read_tskel(args.tskel)
+    source, source_origin = None, (0, 0, 0)
+    if args.source:
+        source, origin, _ = read_volume_grid(args.source, dims=args.dims)
+        source_origin = tuple(int(round(v)) for v in origin)
+    elif args.mode == "sampled":
+        raise ValueError("sampled mode needs --source VOLUME")
+    bounds = bounds_arg(args.bounds) if args.bounds else None
+    bar = TextProgress("reconstruct")
+    r = reconstruct(t, mode=args.mode, source=source, source_origin=source_origin, kernel=args.kernel,
+                    bounds=bounds, padding=args.padding, threads=args.threads, progress=bar)
+    volume = r.volume
+    if args.output.lower().endswith(".vol") and volume.dtype != np.uint8:
+        if volume.max() > 255:
+            print(f"note: values above 255 (max {int(volume.max())}) are clipped to 255 in {args.output}; "
+                  "write .vti or .nrrd to keep them")
+        volume = np.minimum(volume, 255).astype(np.uint8)
+    write_volume(args.output, volume, origin=r.origin)
+    s = r.stats
+    print(f"{s['spheres']} spheres -> {s['filled']} voxels filled in {s['seconds']:.3f} s "
+          f"(overdraw {s['overdraw']:.1f}); grid {r.volume.shape[0]}x{r.volume.shape[1]}x{r.volume.shape[2]}, "
+          f"origin {r.origin[0]} {r.origin[1]} {r.origin[2]} -> {args.output}")
+    if s["clipped"]:
+        print(f"clipped: {s['clipped']} sphere voxels fell outside the given bounds")
+    if args.mode == "hotspot":
+        print(f"hotspot: max {s['hotspot_max']} spheres on one voxel, mean {s['hotspot_mean']:.2f}")
+    if args.loss:
+        rest = reconstruct(identity_tskel(t.connectivity), mode="binary", threads=args.threads)
+        lost = rest.stats["filled"] - s["filled"]
+        print(f"voxel loss against the identity frame: {lost} of {rest.stats['filled']} "
+              f"({100 * lost / max(rest.stats['filled'], 1):.2f} %)")
+
+
+def register(sub) -> None:
+    p = add_command(sub, "connect", "Attach every skeleton point to its nearest bone -> .connect.",
+                    "volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
+                    _connect)
+    p.add_argument("mskel")
+    p.add_argument("bones")
+    p.add_argument("--thinness", type=float, help="only points with thinness >= this")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "pose", "Write a .trans frame: rotate bones about their proximal joints (FK).",
+                    "volanim pose mannequin.bones --rotate L_UPPERARM=0,-45,0 -o arm.trans", _pose)
+    p.add_argument("bones", help=".bones file")
+    p.add_argument("--rotate", action="append", type=parse_rotation, metavar="BONE=RX,RY,RZ",
+                   help="Euler angles in degrees about x, y, z (repeatable)")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "connect2tskel", "A .connect plus one .trans frame -> .tskel (root orders must match).",
+                    "volanim connect2tskel man.0.50.connect arm.trans -o arm.tskel", _connect2tskel)
+    p.add_argument("connect")
+    p.add_argument("trans")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "connect2identitytskel", "The identity (rest) .tskel of a .connect.",
+                    "volanim connect2identitytskel man.0.50.connect -o rest.tskel", _connect2identity)
+    p.add_argument("connect")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "sorttskel", "Sort each bone's points by decreasing DT.",
+                    "volanim sorttskel arm.tskel -o arm.sorted.tskel", _sorttskel)
+    p.add_argument("tskel")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "bounds", "Inclusive bounds of the posed spheres of one or more frames (tskelbounds).",
+                    "volanim bounds walk-*.tskel --padding 2", _bounds)
+    p.add_argument("tskel", nargs="+")
+    p.add_argument("--padding", type=int, default=2)
+
+    p = add_command(sub, "reconstruct", "Re-grow a volume from a .tskel frame (numba, parallel).",
+                    "volanim reconstruct arm.tskel --source mannequin.VOL --mode sampled -o arm.vti", _reconstruct)
+    p.add_argument("tskel")
+    p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
+    p.add_argument("--dims", nargs=3, type=int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
+    p.add_argument("--kernel", type=int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--bounds", nargs=6, type=int, metavar="N", help="inclusive output bounds x0 y0 z0 x1 y1 z1")
+    group.add_argument("--padding", type=int, default=2, help="voxels around the posed spheres (default 2)")
+    p.add_argument("--threads", type=int, help="numba threads (default: all cores)")
+    p.add_argument("--loss", action="store_true", help="also report voxel loss against the identity frame")
+    p.add_argument("-o", "--output", required=True, help=".vti/.nrrd keep the origin; .vol/.VOL: it is printed")

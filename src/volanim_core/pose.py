@@ -1,0 +1,97 @@
+"""Posing a bone skeleton: forward kinematics to one 4x4 matrix per bone.
+
+Each bone may rotate about its proximal joint; a child moves with its parent:
+
+    L_b = translate(-j_b) . R_b . translate(j_b)      local, rest frame
+    M_b = L_b . M_parent(b)                            row-vector order
+
+so ``[x y z 1] @ M_b`` first turns the point about the bone's own joint and
+then applies every ancestor's motion. Rigid motions keep bone lengths.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .bones import BoneSkeleton
+from .connectivity import RootBone
+
+
+def rotation_about(joint, rotation: np.ndarray) -> np.ndarray:
+    """Row-vector 4x4 matrix turning points by ``rotation`` (3x3, column convention) about ``joint``."""
+    j = np.asarray(joint, np.float64)
+    m = np.eye(4)
+    m[:3, :3] = np.asarray(rotation, np.float64).T
+    m[3, :3] = j - j @ m[:3, :3]
+    return m
+
+
+def euler(degrees) -> np.ndarray:
+    """3x3 rotation from x, y, z angles in degrees (extrinsic, applied x then y then z)."""
+    return Rotation.from_euler("xyz", np.asarray(degrees, np.float64), degrees=True).as_matrix()
+
+
+def _order(parents: list[int | None]) -> list[int]:
+    """Bone indices with every parent before its children (the forest may list them in any order)."""
+    done: list[int] = []
+    seen: set[int] = set()
+
+    def visit(i, stack=()):
+        if i in seen:
+            return
+        if i in stack:
+            raise ValueError(f"the bone hierarchy has a cycle through bone {i}")
+        p = parents[i]
+        if p is not None:
+            visit(p, (*stack, i))
+        seen.add(i)
+        done.append(i)
+
+    for i in range(len(parents)):
+        visit(i)
+    return done
+
+
+def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None) -> np.ndarray:
+    """Forward kinematics: ``(B, 4, 4)`` matrices, rest voxel coordinates -> posed.
+
+    Parameters
+    ----------
+    bones : BoneSkeleton
+    rotations : dict, optional
+        Bone index or name -> 3x3 rotation matrix (column convention) or three
+        Euler angles in degrees, applied about the bone's proximal joint.
+    """
+    n = len(bones)
+    local = [np.eye(3) for _ in range(n)]
+    for key, rot in (rotations or {}).items():
+        i = key if isinstance(key, int | np.integer) else bones.index(key)
+        if not 0 <= i < n:
+            raise ValueError(f"no bone {key!r}")
+        rot = np.asarray(rot, np.float64)
+        local[i] = euler(rot) if rot.shape == (3,) else rot
+        if local[i].shape != (3, 3):
+            raise ValueError(f"rotation of bone {key!r} must be 3x3 or three angles")
+    parents = bones.parents()
+    out = np.zeros((n, 4, 4))
+    for i in _order(parents):
+        m = rotation_about(bones.joints[bones.bones[i].proximal], local[i])
+        out[i] = m if parents[i] is None else m @ out[parents[i]]
+    return out
+
+
+def root_bones(bones: BoneSkeleton) -> list[RootBone]:
+    """The ``Root:`` records of a bone skeleton, in root order."""
+    return [RootBone(*bones.segment(i), b.label) for i, b in enumerate(bones.bones)]
+
+
+def posed_joints(bones: BoneSkeleton, matrices: np.ndarray) -> dict[str, np.ndarray]:
+    """Where each joint goes: a bone's distal joint moves with the bone, a top-level proximal joint too."""
+    out = {}
+    for i, b in enumerate(bones.bones):
+        m = matrices[i]
+        for name in (b.proximal, b.distal):
+            if name == b.distal or name not in out:
+                out[name] = np.append(bones.joints[name], 1.0) @ m
+    return {k: v[:3] for k, v in out.items()}

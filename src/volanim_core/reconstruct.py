@@ -1,0 +1,389 @@
+"""Reconstruction: re-grow a volume from a posed skeleton (``.tskel``).
+
+    Tskel --posed_centres, radius_squared--> spheres in output-grid coordinates
+          --grid_bounds (or given bounds)--> output grid + origin
+          --slice_lists--> spheres per z-slice (file order)
+          --fill_slices, z-chunks (progress, cancel)--> volume [x, y, z]
+
+Semantics (FORMATS.md, "Reconstruction semantics"), with the two numerical
+details FORMATS.md leaves open pinned down here and in the oracle alike:
+
+* a posed centre is snapped to a 2^-20 voxel grid (kills ~1e-15 noise from
+  rotation matrices, so a 90-degree turn lands exactly on voxels);
+* ``dt`` values are square roots of integers written to float precision, so
+  ``dt**2`` within 1e-9 (relative) of an integer is taken as that integer:
+  otherwise the float nearest ``sqrt(2)`` would let a voxel exactly
+  ``sqrt(2)`` away -- a background voxel -- into the strict ``|q - c| < dt``.
+
+Ties in distance go to the sphere first in file order; distances are compared
+as float32 (squared Euclidean, or integer 3-4-5 chamfer).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from . import _reconstruct_kernels as K
+from .connectivity import Tskel
+from .progress import CancelFn, ProgressFn, Reporter
+from .volume import Bounds
+
+MODES = ("binary", "mottled", "bone", "sampled", "hotspot")
+_MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT}
+SNAP = 2.0**20
+
+
+@dataclass
+class Reconstruction:
+    """A reconstructed volume and what it took.
+
+    Attributes
+    ----------
+    volume : (X, Y, Z) ndarray indexed ``[x, y, z]``
+        uint8 (binary, mottled, bone with < 256 bones), uint16 (hotspot, bone
+        with more bones) or the source's dtype (sampled).
+    origin : (3,) ints
+        Voxel ``[0, 0, 0]`` of ``volume`` is voxel ``origin`` of the rest frame.
+    stats : dict
+        ``spheres``, ``filled`` (voxels), ``visits`` (sphere-voxel visits),
+        ``overdraw`` (visits / filled), ``clipped`` (sphere voxels outside
+        given bounds), ``seconds``; hotspot adds ``hotspot_max`` and
+        ``hotspot_mean`` (over covered voxels).
+    """
+
+    volume: np.ndarray
+    origin: tuple[int, int, int]
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def bounds(self) -> Bounds:
+        lo = tuple(int(v) for v in self.origin)
+        return Bounds(lo, tuple(lo[i] + self.volume.shape[i] - 1 for i in range(3)))
+
+
+def radius_squared(dt: np.ndarray) -> np.ndarray:
+    """``dt**2``, snapped to the nearest integer when within 1e-9 (relative) of it."""
+    r2 = np.asarray(dt, np.float64) ** 2
+    near = np.rint(r2)
+    return np.where(np.abs(r2 - near) <= 1e-9 * np.maximum(1.0, r2), near, r2)
+
+
+def check_matrices(tskel: Tskel) -> np.ndarray:
+    """Inverse of every bone matrix; a singular one is a ValueError naming the bone."""
+    inv = np.empty_like(tskel.matrices)
+    for b, m in enumerate(tskel.matrices):
+        det = np.linalg.det(m[:3, :3])
+        if not np.isfinite(m).all() or abs(det) < 1e-9:
+            raise ValueError(f"bone {b} ({tskel.bones[b].label}) has a singular matrix (det {det:.3g}); "
+                             "it cannot be inverted to sample the source")
+        inv[b] = np.linalg.inv(m)
+    return inv
+
+
+def posed_centres(tskel: Tskel) -> np.ndarray:
+    """Each point's centre moved by its bone's matrix, ``[x y z 1] @ M`` (snapped; 345: rounded).
+
+    In the 3-4-5 metric the posed centre is rounded to the nearest voxel
+    (half-way rounds up), as FORMATS.md says.
+    """
+    if len(tskel) == 0:
+        return np.zeros((0, 3))
+    p = np.asarray(tskel.points, np.float64)
+    c = np.empty_like(p)
+    for b, m in enumerate(tskel.matrices):  # one product per bone, not a matrix per point
+        sel = tskel.bone == b
+        c[sel] = p[sel] @ m[:3, :3] + m[3, :3]
+    c = np.floor(c * SNAP + 0.5) / SNAP
+    if tskel.metric == "345":
+        c = np.floor(c + 0.5)
+    return c
+
+
+def file_ordered(tskel: Tskel) -> Tskel:
+    """Points grouped by bone in root order (stable), the order a ``.tskel`` file lists them.
+
+    Ties go to the sphere first in file order, so a frame built in memory must
+    reconstruct exactly like the same frame written out and read back.
+    """
+    if len(tskel) < 2 or bool(np.all(tskel.bone[:-1] <= tskel.bone[1:])):
+        return tskel
+    o = np.argsort(tskel.bone, kind="stable")
+    return Tskel(tskel.bones, tskel.matrices, tskel.points[o], tskel.dt[o], tskel.thinness[o], tskel.bone[o],
+                 tskel.metric)
+
+
+def _extent(tskel: Tskel) -> np.ndarray:
+    """Half-size of each sphere's bounding box: dt (Euclid) or dt / 3 (345: 3a <= distance)."""
+    return tskel.dt / 3.0 if tskel.metric == "345" else tskel.dt
+
+
+def grid_bounds(tskels: Tskel | list[Tskel], padding: int = 2) -> Bounds:
+    """Inclusive bounds of the posed spheres of one or several frames, plus ``padding`` (tskelbounds)."""
+    frames = [tskels] if isinstance(tskels, Tskel) else list(tskels)
+    los, his = [], []
+    for t in frames:
+        if len(t):
+            c, e = posed_centres(t), _extent(t)
+            los.append((c - e[:, None]).min(0))
+            his.append((c + e[:, None]).max(0))
+    if not los:
+        raise ValueError("no points to bound: every frame is empty")
+    lo = np.floor(np.min(los, axis=0)).astype(int) - padding
+    hi = np.ceil(np.max(his, axis=0)).astype(int) + padding
+    return Bounds(tuple(int(v) for v in lo), tuple(int(v) for v in hi))
+
+
+HALFSPACES = 8  # larger neighbours per sphere whose bisector planes clip it
+CUT_MIN_RADIUS = 6.0  # below it, clipping rows costs more than the visits it saves (bench_reconstruct.py)
+
+
+def sphere_neighbours(tskel: Tskel, k: int = HALFSPACES) -> np.ndarray:
+    """For each sphere, up to ``k`` nearby spheres of the same bone with radius >= its own.
+
+    ``(N, k)`` int32, -1 where there are fewer. Same-bone neighbours keep their
+    distances under any pose (a bone moves rigidly), so this depends only on
+    the connectivity: compute it once and pass it to :func:`reconstruct` for
+    every frame (the studio does).
+    """
+    from scipy.spatial import cKDTree
+
+    n = len(tskel)
+    out = np.full((n, k), -1, np.int32)
+    r2 = radius_squared(tskel.dt)
+    for b in np.unique(tskel.bone):
+        idx = np.flatnonzero(tskel.bone == b)
+        if len(idx) < 2:
+            continue
+        q = min(len(idx), 4 * k + 1)
+        _, nn = cKDTree(tskel.points[idx]).query(tskel.points[idx], k=q)
+        nn = idx[nn]  # global indices, nearest first (self included)
+        ok = (r2[nn] >= r2[idx][:, None]) & (nn != idx[:, None])
+        rank = np.cumsum(ok, axis=1) - 1
+        keep = ok & (rank < k)
+        rows, cols = np.nonzero(keep)
+        out[idx[rows], rank[rows, cols]] = nn[rows, cols]
+    return out
+
+
+class _Workspace:
+    """The stencil of the last call, kept for the next one.
+
+    Page faults on fresh memory are the largest cost after the kernel itself
+    on a sparse grid (the posed frog: 36 M voxels, 1.1 M filled) and they do
+    not parallelise here, so the stencil -- a temporary -- is reused between
+    calls of the same grid size (rows are re-initialised lazily by the
+    kernel, so only the small row-flag array is cleared).
+    """
+
+    def __init__(self):
+        self.stencil = np.empty((0, 0, 0), np.float32)
+
+    def stencil_for(self, shape) -> np.ndarray:
+        if self.stencil.size < int(np.prod(shape)):
+            self.stencil = np.empty(int(np.prod(shape)), np.float32)
+        return self.stencil.reshape(-1)[: int(np.prod(shape))].reshape(shape)
+
+    def release(self) -> None:
+        self.stencil = np.empty((0, 0, 0), np.float32)
+
+
+_WORKSPACE = _Workspace()
+
+
+def release_workspace() -> None:
+    """Free the stencil kept between calls (up to 4 bytes per output voxel)."""
+    _WORKSPACE.release()
+
+
+def mottled_values(n: int) -> np.ndarray:
+    """One value 1..255 per sphere, neighbours in file order far apart (uint8)."""
+    return (1 + (np.arange(n, dtype=np.int64) * 97) % 255).astype(np.uint8)
+
+
+def gaussian_weights(kernel: int) -> np.ndarray:
+    """Normalised ``kernel**3`` Gaussian weights (sigma = kernel / 4), ``[z, y, x]``."""
+    half = kernel // 2
+    g = np.exp(-0.5 * (np.arange(-half, half + 1) / (kernel / 4.0)) ** 2)
+    w = g[:, None, None] * g[None, :, None] * g[None, None, :]
+    return w / w.sum()
+
+
+def reconstruct(
+    tskel: Tskel,
+    *,
+    mode: str = "binary",
+    source: np.ndarray | None = None,
+    source_origin=(0, 0, 0),
+    kernel: int = 1,
+    bounds: Bounds | None = None,
+    padding: int = 2,
+    value: int = 255,
+    threads: int | None = None,
+    neighbours: np.ndarray | None = None,
+    out: np.ndarray | None = None,
+    progress: ProgressFn | None = None,
+    cancel: CancelFn | None = None,
+) -> Reconstruction:
+    """Re-grow a volume from the spheres of a ``.tskel`` frame.
+
+    Parameters
+    ----------
+    tskel : Tskel
+        Points with their bone's matrix (rest voxel coordinates -> posed).
+    mode : {'binary', 'mottled', 'bone', 'sampled', 'hotspot'}
+    source : (X, Y, Z) ndarray indexed ``[x, y, z]``, required for 'sampled'
+        The rest-pose volume; positions outside it read 0.
+    source_origin : 3 ints
+        Rest-frame voxel of ``source[0, 0, 0]`` (non-zero for a cropped source).
+    kernel : {1, 3, 5}
+        Sampled mode: nearest voxel (1) or a Gaussian-weighted average over
+        a 3^3 / 5^3 neighbourhood (anti-aliasing; leave 1 for label volumes).
+    bounds : Bounds, optional
+        Inclusive output bounds in the posed frame; spheres outside are
+        clipped and counted. Default: the posed spheres plus ``padding``.
+    value : int
+        Binary mode's value.
+    threads : int, optional
+        numba threads (default: all cores). The result does not depend on it.
+    neighbours : (N, k) int ndarray, optional
+        :func:`sphere_neighbours` of this connectivity (computed when not
+        given); lets each sphere skip voxels a larger neighbour provably wins.
+        The result does not depend on it; ``neighbours=False`` turns the cut off.
+    out : ndarray, optional
+        A previous result's ``volume`` of the same grid and dtype to overwrite
+        (saves the first-touch cost of a fresh array; the studio's live preview).
+    progress, cancel : callables, optional
+        ``progress(done, total)`` in output slices; ``cancel() -> True``
+        raises :class:`~volanim_core.errors.Cancelled`.
+
+    Returns
+    -------
+    Reconstruction
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from volanim_core.connectivity import RootBone, Tskel
+    >>> t = Tskel([RootBone((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[5, 5, 5]], [2.0], None, [0])
+    >>> r = reconstruct(t, padding=0)
+    >>> int((r.volume > 0).sum()), r.origin   # voxels strictly within 2 of the centre: 3x3x3
+    (27, (3, 3, 3))
+    """
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    if kernel not in (1, 3, 5):
+        raise ValueError(f"kernel must be 1, 3 or 5, got {kernel!r}")
+    if mode == "sampled":
+        if source is None:
+            raise ValueError("sampled mode needs the source volume (source=...)")
+        source = np.asarray(source)
+        if source.ndim != 3:
+            raise ValueError(f"source must be a 3-D volume, got shape {source.shape}")
+    t0 = time.perf_counter()
+    report = Reporter(progress, cancel)
+    minv_rest = check_matrices(tskel)
+    tskel = file_ordered(tskel)
+    if bounds is None:
+        bounds = grid_bounds(tskel, padding) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
+    origin = np.asarray(bounds.lo, np.float64)
+    shape_xyz = bounds.shape
+    if min(shape_xyz) < 1:
+        raise ValueError(f"empty output bounds {bounds}")
+    nz, ny, nx = shape_xyz[2], shape_xyz[1], shape_xyz[0]
+
+    metric = K.CHAMFER if tskel.metric == "345" else K.EUCLID
+    centres = np.ascontiguousarray(posed_centres(tskel) - origin)
+    r2s = radius_squared(tskel.dt)
+    radii = np.ascontiguousarray(tskel.dt, np.float64)
+    # output-grid coordinates -> source-array coordinates: shift in, invert, shift out
+    shift_in = np.eye(4)
+    shift_in[3, :3] = origin
+    shift_out = np.eye(4)
+    shift_out[3, :3] = -np.asarray(source_origin, np.float64)
+    minv = np.ascontiguousarray(shift_in @ minv_rest @ shift_out)
+
+    bone_dtype = np.uint8 if len(tskel.bones) < 256 else np.uint16
+    if mode == "hotspot":
+        out_dtype = np.uint16
+    elif mode in ("bone", "sampled"):  # sampled relaxes like bone mode, then samples (K.sample_rows)
+        out_dtype = bone_dtype
+    else:
+        out_dtype = np.uint8
+    if mode == "binary":
+        if not 0 < value <= 255:
+            raise ValueError(f"binary value must be 1..255, got {value}")
+        values = np.full(len(tskel), value, np.uint8)
+    elif mode in ("bone", "sampled"):
+        values = (tskel.bone + 1).astype(out_dtype)
+    elif mode == "mottled":
+        values = mottled_values(len(tskel))
+    else:
+        values = np.zeros(len(tskel), out_dtype)
+    values = values.astype(out_dtype)
+
+    final_dtype = source.dtype if mode == "sampled" else out_dtype
+    if out is not None and out.shape == shape_xyz and out.dtype == final_dtype and final_dtype == out_dtype \
+            and out.T.flags.c_contiguous:
+        out = out.T  # the [z, y, x] view of a previous [x, y, z] result
+        out.fill(0)
+    else:
+        out = np.zeros((nz, ny, nx), out_dtype)
+    relax = mode not in ("hotspot", "binary")  # binary is a union and hotspot a count: no stencil
+    stencil = _WORKSPACE.stencil_for((nz, ny, nx) if relax else (1, 1, 1))  # rows set on first use
+    row_ready = np.zeros((nz, ny) if relax else (1, 1), np.bool_)
+    weights = gaussian_weights(kernel) if mode == "sampled" and kernel > 1 else np.ones((1, 1, 1))
+    half = kernel // 2 if mode == "sampled" else 0
+
+    if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
+        nbrs = sphere_neighbours(tskel) if neighbours is None else np.asarray(neighbours, np.int32)
+        plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
+    else:
+        plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 4))
+
+    ext = _extent(tskel)
+    zlo = np.floor(centres[:, 2] - ext).astype(np.int64) - 1
+    zhi = np.ceil(centres[:, 2] + ext).astype(np.int64) + 1
+    offsets, ids = K.slice_lists(zlo, zhi, nz)
+    filled = np.zeros(nz, np.int64)
+    visits = np.zeros(nz, np.int64)
+
+    nthreads = int(threads or numba.config.NUMBA_NUM_THREADS)
+    nthreads = max(1, min(nthreads, numba.config.NUMBA_NUM_THREADS))
+    previous = numba.get_num_threads()
+    numba.set_num_threads(nthreads)
+    try:
+        chunk = max(nthreads * 8, nz // 8)  # few calls: each parallel launch costs
+        report(0, nz)
+        for z0 in range(0, nz, chunk):
+            z1 = min(nz, z0 + chunk)
+            K.fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric,
+                          _MODE_CODE[mode], plane_start, planes,
+                          row_ready, filled, visits)
+            report(z1, nz)
+        if mode == "sampled":
+            src = np.ascontiguousarray(source.T)  # [z, y, x]; free for an F-ordered source
+            owner = out
+            out = owner if src.dtype == owner.dtype else np.zeros((nz, ny, nx), src.dtype)
+            K.sample_rows(owner, out, 0, nz, nthreads, row_ready, minv, src, weights, half)
+    finally:
+        numba.set_num_threads(previous)
+
+    clipped = int(K.count_outside(centres, r2s, radii, metric, (nz, ny, nx))) if len(tskel) else 0
+    n_filled = int(filled.sum())
+    stats = {"spheres": len(tskel), "filled": n_filled, "visits": int(visits.sum()),
+             "overdraw": float(visits.sum() / n_filled) if n_filled else 0.0, "clipped": clipped}
+    volume = out.T  # [x, y, z] view of the [z, y, x] array: no copy
+    if mode == "hotspot":
+        stats["hotspot_max"] = int(out.max()) if out.size else 0
+        stats["hotspot_mean"] = float(visits.sum() / n_filled) if n_filled else 0.0
+    stats["seconds"] = time.perf_counter() - t0
+    return Reconstruction(volume, tuple(int(v) for v in bounds.lo), stats)
+
+
+def default_threads() -> int:
+    return os.cpu_count() or 1
