@@ -122,13 +122,16 @@ def _extent(tskel: Tskel) -> np.ndarray:
     return tskel.dt / 3.0 if tskel.metric == "345" else tskel.dt
 
 
-def grid_bounds(tskels: Tskel | list[Tskel], padding: int = 2) -> Bounds:
-    """Inclusive bounds of the posed spheres of one or several frames, plus ``padding`` (tskelbounds)."""
+def grid_bounds(tskels: Tskel | list[Tskel], padding: int = 2, *, centres: list | None = None) -> Bounds:
+    """Inclusive bounds of the posed spheres of one or several frames, plus ``padding`` (tskelbounds).
+
+    ``centres``: the frames' :func:`posed_centres`, when the caller has them already.
+    """
     frames = [tskels] if isinstance(tskels, Tskel) else list(tskels)
     los, his = [], []
-    for t in frames:
+    for k, t in enumerate(frames):
         if len(t):
-            c, e = posed_centres(t), _extent(t)
+            c, e = (posed_centres(t) if centres is None else centres[k]), _extent(t)
             los.append((c - e[:, None]).min(0))
             his.append((c + e[:, None]).max(0))
     if not los:
@@ -288,8 +291,9 @@ def reconstruct(
     report = Reporter(progress, cancel)
     minv_rest = check_matrices(tskel)
     tskel = file_ordered(tskel)
+    posed = posed_centres(tskel)
     if bounds is None:
-        bounds = grid_bounds(tskel, padding) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
+        bounds = grid_bounds(tskel, padding, centres=[posed]) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
     origin = np.asarray(bounds.lo, np.float64)
     shape_xyz = bounds.shape
     if min(shape_xyz) < 1:
@@ -297,7 +301,7 @@ def reconstruct(
     nz, ny, nx = shape_xyz[2], shape_xyz[1], shape_xyz[0]
 
     metric = K.CHAMFER if tskel.metric == "345" else K.EUCLID
-    centres = np.ascontiguousarray(posed_centres(tskel) - origin)
+    centres = np.ascontiguousarray(posed - origin)
     r2s = radius_squared(tskel.dt)
     radii = np.ascontiguousarray(tskel.dt, np.float64)
     # output-grid coordinates -> source-array coordinates: shift in, invert, shift out
