@@ -34,12 +34,15 @@ def test_mannequin_is_one_layered_body_with_bones():
     assert np.argwhere(s.part == s.bones.index("L_HAND") + 1)[:, 0].min() > 80
 
 
-def test_mannequin_is_mirror_symmetric_in_shape():
+def test_mannequin_is_mirror_symmetric_about_mid_plane():
     s = samples.mannequin()
-    mirrored = np.zeros_like(s.mask)
-    mirrored[0:160] = s.mask[::-1]
-    # x -> 160 - x maps voxel i to 160 - i: shift by one to compare exactly
-    assert np.array_equal(s.mask[1:], mirrored[:-1])
+    assert np.array_equal(s.mask, s.mask[::-1])
+    for name, xyz in s.bones.joints.items():
+        if name[:2] in ("L_", "R_"):
+            twin = s.bones.joints[("R_" if name[0] == "L" else "L_") + name[2:]]
+            assert np.allclose([159 - xyz[0], xyz[1], xyz[2]], twin)
+        else:
+            assert xyz[0] == 79.5
 
 
 def test_frog_loads_offline():

@@ -5,7 +5,8 @@
     frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
                                          with a two-bone principal-axis chain
 
-The mannequin faces -y with z up, so its left side (``L_`` bones) is at +x.
+The mannequin faces -y with z up, so its left side (``L_`` bones) is at +x;
+it is mirror-symmetric about the volume's mid-plane x = 79.5.
 Each body part is a tapered capsule around one bone; a voxel belongs to the
 part in which it lies deepest, which also gives the ground-truth bone of every
 voxel (``part``), used to score automatic connectivity.
@@ -43,14 +44,17 @@ class Sample:
         return self.volume >= self.mask_level
 
 
+MID_X = (MANNEQUIN_SHAPE[0] - 1) / 2  # 79.5: the volume's mid-plane, the studio's default symmetry plane
+
+
 def _mirror(x: float) -> float:
-    return 2 * 80 - x
+    return 2 * MID_X - x
 
 
 def mannequin_bones() -> BoneSkeleton:
     """The mannequin's bone skeleton: 18 bones, root order spine, head, arms, legs."""
     j = {
-        "PELVIS": (80, 50, 140), "NECK": (80, 50, 234), "HEAD": (80, 50, 288),
+        "PELVIS": (MID_X, 50, 140), "NECK": (MID_X, 50, 234), "HEAD": (MID_X, 50, 288),
         "L_SHOULDER": (108, 50, 226), "L_ELBOW": (124, 50, 178), "L_WRIST": (139, 50, 133),
         "L_FINGERS": (144, 50, 115),
         "L_HIP": (94, 50, 138), "L_KNEE": (96, 50, 78), "L_ANKLE": (97, 50, 16), "L_TOE": (97, 26, 6),
@@ -76,9 +80,9 @@ def mannequin_bones() -> BoneSkeleton:
 def _mannequin_parts(bones: BoneSkeleton):
     J = bones.joints
     parts = [
-        ("SPINE", (80, 50, 136), (80, 50, 226), 21, 25, 0.62, 0),
-        ("HEAD", (80, 50, 230), (80, 50, 250), 8, 8, 1.0, 0),
-        ("HEAD", (80, 50, 266), (80, 50, 272), 17, 17, 0.95, 0),
+        ("SPINE", (MID_X, 50, 136), (MID_X, 50, 226), 21, 25, 0.62, 0),
+        ("HEAD", (MID_X, 50, 230), (MID_X, 50, 250), 8, 8, 1.0, 0),
+        ("HEAD", (MID_X, 50, 266), (MID_X, 50, 272), 17, 17, 0.95, 0),
     ]
     for s in ("L_", "R_"):
         parts += [

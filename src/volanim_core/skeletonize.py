@@ -28,7 +28,7 @@ from .skeleton import Skeleton, check_metric
 from .volume import tight_bounds
 
 #: Default thinness floor. Keeps the medial points and their first shells:
-#: ~11.8 k points on the demo mannequin and ~137 k on the frog (see README's
+#: ~4.4 k points on the demo mannequin and ~137 k on the frog (see README's
 #: Table 2.1); pass ``min_thinness=-np.inf`` to keep every object voxel.
 DEFAULT_MIN_THINNESS = 0.5
 

@@ -1,0 +1,81 @@
+"""Undo lives in the model: a bounded stack of command atoms.
+
+A command is a pair of callables, ``redo`` and ``undo``, plus a label shown
+in the Edit menu. ``push`` runs ``redo`` once; the GUI only calls
+:meth:`UndoStack.undo` and :meth:`UndoStack.redo`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from .events import EventEmitter
+
+
+@dataclass
+class Command:
+    label: str
+    redo: Callable[[], None]
+    undo: Callable[[], None]
+
+
+class UndoStack:
+    """Bounded history; pushing after undos drops the redo branch."""
+
+    def __init__(self, limit: int = 500):
+        self.limit = limit
+        self._done: list[Command] = []
+        self._undone: list[Command] = []
+        self.events = EventEmitter("changed")
+        self.edits = 0  # monotonically counts pushes, undos and redos (autosave watches it)
+
+    def push(self, command: Command) -> None:
+        command.redo()
+        self._done.append(command)
+        del self._done[: -self.limit]
+        self._undone.clear()
+        self._changed()
+
+    def undo(self) -> str | None:
+        if not self._done:
+            return None
+        cmd = self._done.pop()
+        cmd.undo()
+        self._undone.append(cmd)
+        self._changed()
+        return cmd.label
+
+    def redo(self) -> str | None:
+        if not self._undone:
+            return None
+        cmd = self._undone.pop()
+        cmd.redo()
+        self._done.append(cmd)
+        self._changed()
+        return cmd.label
+
+    def clear(self) -> None:
+        self._done.clear()
+        self._undone.clear()
+        self._changed()
+
+    @property
+    def can_undo(self) -> bool:
+        return bool(self._done)
+
+    @property
+    def can_redo(self) -> bool:
+        return bool(self._undone)
+
+    @property
+    def undo_label(self) -> str:
+        return self._done[-1].label if self._done else ""
+
+    @property
+    def redo_label(self) -> str:
+        return self._undone[-1].label if self._undone else ""
+
+    def _changed(self) -> None:
+        self.edits += 1
+        self.events.changed.emit()
