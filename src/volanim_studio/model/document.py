@@ -1,0 +1,391 @@
+"""The studio document: everything a session edits, with undo and change events.
+
+    volume, mask, spacing ......... what was loaded (or None)
+    skeleton (Skeleton) ........... the cloud, sorted by decreasing thinness
+    hull (vertices, faces) ........ isosurface, drawn translucent and not pickable
+    thinness ...................... the slider: points with thinness >= it are shown
+    bones (BoneSkeleton) .......... named joints, bones in root order  [undoable]
+    selected_bones, picked_point .. view state (not undoable)
+    symmetry_x .................... mirror plane for Symmetrize
+
+Every setter validates, stores, then emits ``events.<name>``; views never
+write the model except through these methods. Bone edits are snapshot
+commands on the UndoStack: a bone skeleton is small, so a copy per edit is
+simpler and safer than hand-written inverse operations.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+
+from volanim_core import io
+from volanim_core.bones import Bone, BoneSkeleton
+from volanim_core.io._atomic import atomic_write_text
+from volanim_core.skeleton import Skeleton
+
+from . import symmetry
+from .events import EventEmitter
+from .undo import Command, UndoStack
+
+PROJECT_FORMAT = "volanim project"
+SNAP_DISTANCE = 0.5  # voxels: a click this close to a joint reuses it
+
+
+class Document:
+    """The Qt-free model of one studio session."""
+
+    def __init__(self):
+        self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
+                                   "symmetry", "message", "project")
+        self.undo = UndoStack()
+        self.volume: np.ndarray | None = None
+        self.mask: np.ndarray | None = None
+        self.spacing = (1.0, 1.0, 1.0)
+        self.volume_path: str | None = None
+        self.volume_dims: tuple | None = None
+        self.threshold: tuple | None = None
+        self.skeleton: Skeleton | None = None
+        self.mskel_path: str | None = None
+        self.hull: tuple[np.ndarray, np.ndarray] | None = None
+        self._thinness = 0.0
+        self.bones = BoneSkeleton()
+        self.bones_path: str | None = None
+        self.selected_bones: tuple[int, ...] = ()
+        self.picked_point: int | None = None
+        self._symmetry_x: float | None = None
+        self.project_path: str | None = None
+        self._joint_counter = 0
+
+    # ------------------------------------------------------------------ data
+    def set_volume(self, volume, mask=None, *, spacing=(1.0, 1.0, 1.0), path=None, threshold=None, dims=None):
+        self.volume = volume
+        self.mask = mask if mask is not None or volume is None else volume > 0
+        self.spacing = tuple(float(s) for s in spacing)
+        self.volume_path = str(path) if path else None
+        self.volume_dims = tuple(dims) if dims is not None else None
+        self.threshold = tuple(threshold) if threshold is not None else None
+        self.events.volume.emit()
+        self.events.symmetry.emit()
+
+    def set_skeleton(self, skeleton: Skeleton | None, path=None) -> None:
+        if skeleton is not None and not skeleton.is_sorted():
+            skeleton = skeleton.sorted()
+        self.skeleton = skeleton
+        self.mskel_path = str(path) if path else None
+        self.picked_point = None
+        if skeleton is not None and len(skeleton):
+            lo, hi = float(skeleton.thinness.min()), float(skeleton.thinness.max())
+            self._thinness = float(np.clip(self._thinness, lo, hi))
+        self.events.skeleton.emit()
+        self.events.thinness.emit(value=self._thinness)
+
+    def set_hull(self, vertices, faces) -> None:
+        self.hull = None if vertices is None else (np.asarray(vertices), np.asarray(faces))
+        self.events.hull.emit()
+
+    @property
+    def shape(self) -> tuple[int, int, int] | None:
+        if self.volume is not None:
+            return tuple(self.volume.shape)
+        if self.skeleton is not None and len(self.skeleton):
+            return tuple(int(v) + 1 for v in self.skeleton.points.max(0))
+        return None
+
+    # ------------------------------------------------------------- thinness
+    @property
+    def thinness(self) -> float:
+        return self._thinness
+
+    @thinness.setter
+    def thinness(self, value: float) -> None:
+        value = float(value)
+        if not np.isfinite(value):
+            raise ValueError(f"thinness must be a finite number, got {value!r}")
+        if value == self._thinness:
+            return
+        self._thinness = value
+        self.events.thinness.emit(value=value)
+
+    @property
+    def thinness_range(self) -> tuple[float, float]:
+        if self.skeleton is None or not len(self.skeleton):
+            return (0.0, 1.0)
+        return float(self.skeleton.thinness.min()), float(self.skeleton.thinness.max())
+
+    @property
+    def visible_count(self) -> int:
+        """Points shown: the sorted prefix with thinness >= the slider."""
+        return 0 if self.skeleton is None else self.skeleton.count_at(self._thinness)
+
+    # ------------------------------------------------------------- symmetry
+    @property
+    def symmetry_x(self) -> float:
+        if self._symmetry_x is not None:
+            return self._symmetry_x
+        shape = self.shape
+        return (shape[0] - 1) / 2.0 if shape else 0.0
+
+    @symmetry_x.setter
+    def symmetry_x(self, value: float) -> None:
+        self._symmetry_x = float(value)
+        self.events.symmetry.emit()
+
+    # ------------------------------------------------------ picks and status
+    def pick_point(self, index: int | None) -> None:
+        if index is not None and (self.skeleton is None or not 0 <= index < len(self.skeleton)):
+            raise ValueError(f"no skeleton point {index}")
+        self.picked_point = index
+        self.events.picked.emit(index=index)
+
+    def point_info(self, index: int) -> dict:
+        """What the status bar shows for a point: position, DT, thinness, its bone."""
+        s = self.skeleton
+        p = s.points[index]
+        return {"x": int(p[0]), "y": int(p[1]), "z": int(p[2]), "dt": float(s.dt[index]),
+                "thinness": float(s.thinness[index]), "bone": self.bone_of_point(index)}
+
+    def bone_of_point(self, index: int) -> str | None:
+        """The bone a point is attached to (connectivity arrives with the Connect modes)."""
+        return None
+
+    def select_bones(self, indices) -> None:
+        indices = tuple(sorted({int(i) for i in indices}))
+        for i in indices:
+            if not 0 <= i < len(self.bones):
+                raise ValueError(f"no bone {i}")
+        if indices != self.selected_bones:
+            self.selected_bones = indices
+            self.events.selection.emit(indices=indices)
+
+    def message(self, text: str) -> None:
+        self.events.message.emit(text=text)
+
+    # ------------------------------------------------------------ bone edits
+    def _apply_bones(self, label: str, new: BoneSkeleton) -> None:
+        old = copy.deepcopy(self.bones)
+        new = copy.deepcopy(new)
+        new.validate()
+
+        def redo():
+            self._set_bones(copy.deepcopy(new))
+
+        def undo():
+            self._set_bones(copy.deepcopy(old))
+
+        self.undo.push(Command(label, redo, undo))
+
+    def _set_bones(self, bones: BoneSkeleton) -> None:
+        self.bones = bones
+        self.selected_bones = tuple(i for i in self.selected_bones if i < len(bones))
+        self.events.bones.emit()
+        self.events.selection.emit(indices=self.selected_bones)
+
+    def _edited(self) -> BoneSkeleton:
+        return copy.deepcopy(self.bones)
+
+    def joint_at(self, position, tolerance: float = SNAP_DISTANCE) -> str | None:
+        """The joint within ``tolerance`` voxels of ``position``, if any."""
+        best, name = tolerance, None
+        for n, xyz in self.bones.joints.items():
+            d = float(np.linalg.norm(xyz - np.asarray(position, float)))
+            if d <= best:
+                best, name = d, n
+        return name
+
+    def default_joint_name(self, position) -> str:
+        """``L_J7`` / ``R_J7`` / ``J7`` by the side of the symmetry plane: the UI nudges towards L_/R_."""
+        while True:
+            self._joint_counter += 1
+            x = float(position[0])
+            prefix = "" if abs(x - self.symmetry_x) < 1.0 else ("L_" if x > self.symmetry_x else "R_")
+            name = f"{prefix}J{self._joint_counter}"
+            if name not in self.bones.joints:
+                return name
+
+    def add_bone(self, a, b, name: str = "") -> int:
+        """A bone from joint/position ``a`` to joint/position ``b``; returns its index.
+
+        ``a``/``b`` are joint names or positions; a position reuses a joint
+        within :data:`SNAP_DISTANCE` or creates a new one. One undo step.
+        """
+        new = self._edited()
+        names = []
+        for end in (a, b):
+            if isinstance(end, str):
+                if end not in new.joints:
+                    raise ValueError(f"no joint named {end!r}")
+                names.append(end)
+                continue
+            found = self.joint_at(end)
+            if found is None:
+                found = next((n for n, xyz in new.joints.items() if np.allclose(xyz, end)), None)
+            if found is None:
+                found = self.default_joint_name(end)
+                new.joints[found] = np.asarray(end, np.float64)
+            names.append(found)
+        if names[0] == names[1]:
+            raise ValueError("a bone needs two different joints")
+        if any({x.proximal, x.distal} == set(names) for x in new.bones):
+            raise ValueError(f"there is already a bone between {names[0]} and {names[1]}")
+        new.bones.append(Bone(names[0], names[1], name))
+        self._apply_bones(f"Add bone {names[0]}-{names[1]}", new)
+        return len(self.bones) - 1
+
+    def remove_bones(self, indices) -> None:
+        """Remove bones; joints no bone uses any more go too. One undo step."""
+        indices = set(int(i) for i in indices)
+        if not indices:
+            return
+        new = self._edited()
+        new.bones = [b for i, b in enumerate(new.bones) if i not in indices]
+        used = {j for b in new.bones for j in (b.proximal, b.distal)}
+        new.joints = {k: v for k, v in new.joints.items() if k in used}
+        self.selected_bones = ()
+        self._apply_bones(f"Remove {len(indices)} bone(s)", new)
+
+    def rename_joint(self, old: str, new_name: str) -> None:
+        new_name = new_name.strip()
+        if not new_name or any(c.isspace() for c in new_name):
+            raise ValueError(f"joint names cannot be empty or contain spaces: {new_name!r}")
+        if old == new_name:
+            return
+        if new_name in self.bones.joints:
+            raise ValueError(f"there is already a joint named {new_name!r}")
+        new = self._edited()
+        new.joints = {(new_name if k == old else k): v for k, v in new.joints.items()}
+        new.bones = [Bone(new_name if b.proximal == old else b.proximal, new_name if b.distal == old else b.distal,
+                          b.name) for b in new.bones]
+        self._apply_bones(f"Rename joint {old} to {new_name}", new)
+
+    def rename_bone(self, index: int, name: str) -> None:
+        name = name.strip()
+        if any(c.isspace() for c in name):
+            raise ValueError(f"bone names cannot contain spaces: {name!r}")
+        new = self._edited()
+        b = new.bones[index]
+        new.bones[index] = Bone(b.proximal, b.distal, name)
+        self._apply_bones(f"Rename bone {b.label} to {name or '(none)'}", new)
+
+    def move_joint(self, name: str, position) -> None:
+        new = self._edited()
+        new.joints[name] = np.asarray(position, np.float64)
+        self._apply_bones(f"Move joint {name}", new)
+
+    def set_root_order(self, order) -> None:
+        """Reorder bones: ``order[k]`` is the old index of the new bone k."""
+        order = [int(i) for i in order]
+        if sorted(order) != list(range(len(self.bones))):
+            raise ValueError(f"root order must be a permutation of 0..{len(self.bones) - 1}, got {order}")
+        if order == list(range(len(self.bones))):
+            return
+        new = self._edited()
+        new.bones = [new.bones[i] for i in order]
+        self._apply_bones("Reorder bones", new)
+
+    def set_bones(self, bones: BoneSkeleton, label: str = "Load bones") -> None:
+        self._apply_bones(label, bones)
+
+    def symmetrize(self, indices=None) -> list[str]:
+        """Mirror bones (default: the selection) to the other side by their L_/R_ names.
+
+        Each sided joint's twin (``L_X`` <-> ``R_X``) is created or moved to
+        the mirror image across ``x = symmetry_x``, snapped to the nearest
+        skeleton point; centre joints stay. Missing twin bones are added.
+        Returns the names of the joints written. One undo step.
+        """
+        indices = self.selected_bones if indices is None else tuple(indices)
+        if not indices:
+            raise ValueError("select the bones to mirror first")
+        new = self._edited()
+        pts = self.skeleton.points if self.skeleton is not None else None
+        written = []
+        for i in indices:
+            b = new.bones[i]
+            if symmetry.side(b.proximal) is None and symmetry.side(b.distal) is None:
+                raise ValueError(f"bone {b.label} has no L_/R_ joint to mirror; rename its joints first")
+            twin_ends = []
+            for j in (b.proximal, b.distal):
+                t = symmetry.mirror_name(j)
+                if t != j:
+                    new.joints[t] = symmetry.snap(pts, symmetry.mirror_point(new.joints[j], self.symmetry_x))
+                    written.append(t)
+                twin_ends.append(t)
+            twin = Bone(twin_ends[0], twin_ends[1], symmetry.mirror_name(b.name) if b.name else "")
+            existing = [k for k, x in enumerate(new.bones) if (x.proximal, x.distal) == tuple(twin_ends)]
+            if existing:
+                new.bones[existing[0]] = twin
+            else:
+                new.bones.append(twin)
+        self._apply_bones(f"Symmetrize {len(indices)} bone(s)", new)
+        return written
+
+    # ----------------------------------------------------------------- files
+    def load_bones(self, path) -> None:
+        bones = io.read_bones(path)
+        self.set_bones(bones, f"Load {Path(path).name}")
+        self.bones_path = str(path)
+
+    def save_bones(self, path) -> None:
+        io.write_bones(path, self.bones)
+        self.bones_path = str(path)
+
+    def save_connections(self, path) -> None:
+        io.write_connections(path, self.bones)
+
+    def save_project(self, path, camera: dict | None = None) -> Path:
+        """Write ``NAME.volanim`` (JSON) plus the data it names that exists only in memory.
+
+        The bone skeleton is written to ``NAME.bones``; a skeleton computed in
+        this session (no ``.mskel`` on disk yet) to ``NAME.mskel``.
+        """
+        path = Path(path)
+        if path.suffix != ".volanim":
+            path = path.with_suffix(".volanim")
+        stem = path.with_suffix("")
+        self.save_bones(f"{stem}.bones")
+        if self.skeleton is not None and not self.mskel_path:
+            io.write_mskel(f"{stem}.mskel", self.skeleton)
+            self.mskel_path = f"{stem}.mskel"
+
+        def rel(p):
+            if not p:
+                return None
+            try:
+                return str(Path(p).resolve().relative_to(path.parent.resolve()))
+            except ValueError:
+                return str(Path(p).resolve())
+
+        data = {
+            "format": PROJECT_FORMAT, "version": 1,
+            "volume": rel(self.volume_path), "volume_dims": list(self.volume_dims) if self.volume_dims else None,
+            "threshold": list(self.threshold) if self.threshold else None,
+            "mskel": rel(self.mskel_path), "bones": rel(self.bones_path),
+            "thinness": self._thinness, "symmetry_x": self._symmetry_x, "camera": camera,
+        }
+        atomic_write_text(path, json.dumps(data, indent=2) + "\n")
+        self.project_path = str(path)
+        self.events.project.emit(path=str(path))
+        return path
+
+
+def read_project(path) -> dict:
+    """A ``.volanim`` file's content with paths made absolute; FormatError when it is not one."""
+    from volanim_core.errors import FormatError
+
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FormatError(path, f"cannot read project: {exc}") from exc
+    except json.JSONDecodeError as exc:
+        raise FormatError(path, f"not a volanim project (JSON error: {exc.msg})", exc.lineno) from exc
+    if not isinstance(data, dict) or data.get("format") != PROJECT_FORMAT:
+        raise FormatError(path, f"not a volanim project: expected \"format\": \"{PROJECT_FORMAT}\"")
+    for key in ("volume", "mskel", "bones", "connect"):
+        if data.get(key):
+            data[key] = str((path.parent / data[key]).resolve())
+    return data

@@ -1,0 +1,175 @@
+"""Interaction modes as small Qt-free classes: plain pick events in, model calls out.
+
+    scene click --PickEvent(point, joint, bone, button)--> mode.press(event) --> Document
+    key press   --"Escape" / "Delete"-->                    mode.key(name)   --> Document
+
+The Qt layer only turns mouse and keys into these events, so tests drive a
+mode with plain objects and assert on the document.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+
+from .document import Document
+
+
+class Mode(str, Enum):
+    VIEW = "view"
+    BONES = "bones"
+    ROOT_ORDER = "root_order"
+
+
+@dataclass(frozen=True)
+class PickEvent:
+    """What is under the cursor: a skeleton point, a joint, a bone (each optional)."""
+
+    point: int | None = None
+    joint: str | None = None
+    bone: int | None = None
+    button: str = "left"
+
+
+class ModeHandler:
+    """Base: a left click on a point shows its details; on a bone selects it."""
+
+    name = Mode.VIEW
+    help = "Click a point to see x y z, DT, thinness and bone; click a bone to select it."
+
+    def __init__(self, doc: Document):
+        self.doc = doc
+
+    def enter(self) -> None:
+        self.doc.message(self.help)
+
+    def leave(self) -> None:
+        pass
+
+    def press(self, ev: PickEvent) -> None:
+        if ev.button != "left":
+            return
+        if ev.point is not None:
+            self.doc.pick_point(ev.point)
+        if ev.bone is not None:
+            self.doc.select_bones([ev.bone])
+
+    def key(self, name: str) -> None:
+        pass
+
+
+class ViewMode(ModeHandler):
+    pass
+
+
+class BonesMode(ModeHandler):
+    """Build chains: click A, click B -> bone A-B; the next click continues from B.
+
+    Esc or a right click ends the chain; clicking an existing joint starts from
+    it. With ``remove`` on, clicking a bone deletes it; Delete removes the
+    selected bones.
+    """
+
+    name = Mode.BONES
+    help = ("Bones: click a point to start, click another to add a bone; keep clicking to continue the chain. "
+            "Esc or right-click ends the chain. Delete removes the selected bone.")
+
+    def __init__(self, doc: Document):
+        super().__init__(doc)
+        self.pending: str | np.ndarray | None = None  # joint name or position where the next bone starts
+        self.remove = False
+
+    def leave(self) -> None:
+        self.pending = None
+
+    def _target(self, ev: PickEvent):
+        if ev.joint is not None:
+            return ev.joint
+        if ev.point is not None:
+            return self.doc.skeleton.points[ev.point].astype(np.float64)
+        return None
+
+    def press(self, ev: PickEvent) -> None:
+        if ev.button == "right":
+            self.end_chain()
+            return
+        if ev.point is not None:
+            self.doc.pick_point(ev.point)
+        if self.remove:
+            if ev.bone is not None:
+                self.doc.remove_bones([ev.bone])
+            return
+        target = self._target(ev)
+        if target is None:
+            self.doc.message("No skeleton point or joint under the cursor.")
+            return
+        if self.pending is None:
+            self.pending = target
+            where = target if isinstance(target, str) else " ".join(str(int(v)) for v in target)
+            self.doc.message(f"Chain starts at {where}: click the next point.")
+            return
+        try:
+            index = self.doc.add_bone(self.pending, target)
+        except ValueError as exc:
+            self.doc.message(str(exc))
+            return
+        self.pending = self.doc.bones.bones[index].distal
+        self.doc.select_bones([index])
+        self.doc.message(f"Added bone {self.doc.bones.bones[index].label}; click to continue, Esc to end.")
+
+    def end_chain(self) -> None:
+        if self.pending is not None:
+            self.pending = None
+            self.doc.message("Chain ended.")
+
+    def key(self, name: str) -> None:
+        if name == "Escape":
+            self.end_chain()
+        elif name == "Delete" and self.doc.selected_bones:
+            self.doc.remove_bones(self.doc.selected_bones)
+
+
+class RootOrderMode(ModeHandler):
+    """Click bones in sequence: the first becomes root 0, the next root 1, ...
+
+    Bones not clicked yet keep their relative order after the clicked ones.
+    Each click is one undo step; Esc starts the sequence again.
+    """
+
+    name = Mode.ROOT_ORDER
+    help = "Root order: click bones in the order you want them (root 0, 1, ...). Esc starts again."
+
+    def __init__(self, doc: Document):
+        super().__init__(doc)
+        self.assigned: list[tuple[str, str]] = []
+
+    def enter(self) -> None:
+        self.assigned = []
+        super().enter()
+
+    def press(self, ev: PickEvent) -> None:
+        if ev.button != "left" or ev.bone is None:
+            return
+        bones = self.doc.bones.bones
+        keys = [(b.proximal, b.distal) for b in bones]
+        self.assigned = [k for k in self.assigned if k in keys]
+        key = keys[ev.bone]
+        if key in self.assigned:
+            self.doc.message(f"{bones[ev.bone].label} is already root {self.assigned.index(key)}.")
+            return
+        self.assigned.append(key)
+        order = [keys.index(k) for k in self.assigned] + [i for i, k in enumerate(keys) if k not in self.assigned]
+        self.doc.set_root_order(order)
+        n = len(self.assigned) - 1
+        self.doc.select_bones([n])
+        self.doc.message(f"{bones[ev.bone].label} is root {n}; click the next bone.")
+
+    def key(self, name: str) -> None:
+        if name == "Escape":
+            self.assigned = []
+            self.doc.message("Root order: start again from root 0.")
+
+
+HANDLERS = {Mode.VIEW: ViewMode, Mode.BONES: BonesMode, Mode.ROOT_ORDER: RootOrderMode}
