@@ -10,7 +10,7 @@ APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxc
 	libfontconfig1 libdbus-1-3
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test install install-test system-deps lint bench clean
+.PHONY: demo test install install-test system-deps lint bench screenshots clean
 
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -36,18 +36,32 @@ system-deps:
 		echo "  sudo apt-get install -y $$missing"; exit 1; \
 	fi
 
+# The headless pipeline always runs; then the studio opens on the mannequin when
+# there is a display (and not under CI).
 demo: install
 	$(VENV)/bin/volanim demo -o $(DEMO_OUT)
+	@if [ -n "$${DISPLAY}$${WAYLAND_DISPLAY}" ] && [ -z "$${CI}" ]; then \
+		echo "opening the studio on the mannequin (close the window to finish)"; \
+		$(VENV)/bin/volanim-studio --demo mannequin; \
+	else \
+		echo "no display: ran the pipeline headless; on a desktop run .venv/bin/volanim-studio --demo mannequin"; \
+	fi
 
 test: install-test system-deps
+	$(VENV)/bin/ruff check src tests benchmarks assets docs
 	$(PY) -m pytest
 
 lint: install-test
 	$(VENV)/bin/ruff check src tests benchmarks
 
-bench: install
+bench: install-test system-deps
 	$(PY) benchmarks/bench_skeleton.py
 	$(PY) benchmarks/bench_reconstruct.py
+	$(PY) benchmarks/thesis_tables.py
+	xvfb-run -a $(PY) benchmarks/bench_studio.py
+
+screenshots: install-test system-deps
+	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py
 
 clean:
 	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache

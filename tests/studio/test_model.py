@@ -53,7 +53,8 @@ def test_bones_mode_builds_a_chain_and_undo_redo(doc):
     j = doc.bones.joints
     b0, b1 = doc.bones.bones
     assert b0.distal == b1.proximal  # A-B-C: the chain continues from B
-    assert np.array_equal(j[b0.proximal], doc.skeleton.points[a]) and np.array_equal(j[b1.distal], doc.skeleton.points[c])
+    assert np.array_equal(j[b0.proximal], doc.skeleton.points[a])
+    assert np.array_equal(j[b1.distal], doc.skeleton.points[c])
     assert all(n.startswith("L_") for n in j)  # x > mid-plane: named as left
     mode.key("Escape")
     mode.press(PickEvent(point=point_near(doc, (79, 50, 140))))

@@ -10,14 +10,14 @@ mode with plain objects and assert on the document.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 
 import numpy as np
 
 from .document import Document
 
 
-class Mode(str, Enum):
+class Mode(StrEnum):
     VIEW = "view"
     BONES = "bones"
     ROOT_ORDER = "root_order"

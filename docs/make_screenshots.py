@@ -1,0 +1,67 @@
+"""Screenshots of the studio for the README, taken from real widgets under Xvfb.
+
+Run: make screenshots   (xvfb-run -a .venv/bin/python docs/make_screenshots.py)
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).parent
+ROOT = HERE.parent
+
+
+def grab(window, path: Path) -> None:
+    """The whole window: Qt widgets from grab(), the 3D view from VTK (grab() cannot read GL)."""
+    from PySide6.QtCore import QPoint
+    from PySide6.QtGui import QImage, QPainter
+
+    pix = window.grab()
+    shot = np.ascontiguousarray(window.plotter.screenshot(return_img=True)[:, :, :3])
+    h, w, _ = shot.shape
+    img = QImage(shot.data, w, h, 3 * w, QImage.Format_RGB888).scaled(window.plotter.size())
+    painter = QPainter(pix)
+    painter.drawImage(window.plotter.mapTo(window, QPoint(0, 0)), img)
+    painter.end()
+    pix.save(str(path))
+    print(f"wrote {path}")
+
+
+def main() -> None:
+    from PySide6.QtWidgets import QApplication
+
+    from volanim_core import samples
+    from volanim_studio.model.modes import Mode
+    from volanim_studio.qt_main_window import MainWindow
+
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    w = MainWindow()
+    w.resize(1500, 900)
+    w.show()
+    w.load_demo("mannequin")
+    while w.busy:
+        app.processEvents()
+    w.open_bones(ROOT / "assets" / "mannequin.bones")
+    w.scene.front_view()
+    w.set_mode(Mode.BONES)
+    w.doc.select_bones([w.doc.bones.index("L_UPPERARM")])
+    pts = w.doc.skeleton.points[: w.doc.visible_count]
+    w.doc.pick_point(int(np.argmin(((pts - samples.mannequin_bones().joints["L_ELBOW"]) ** 2).sum(1))))
+    w.doc.message("Bones: click a point to start, click another to add a bone; keep clicking to continue the chain.")
+    for _ in range(5):
+        app.processEvents()
+    grab(w, HERE / "studio-bones.png")
+    w.panel_tabs.setCurrentIndex(1)
+    w.display_panel.thinness_slider.setValue(700)
+    w.display_panel.colour_by.setCurrentText("dt")
+    for _ in range(5):
+        app.processEvents()
+    grab(w, HERE / "studio-thinness.png")
+    w.close()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,402 @@
+"""The studio's main window: 3D view in the centre, modes, panels, menus, status.
+
+    QtInteractor --SceneView.pick--> PickEvent --> active mode handler --> Document
+    Document events --> SceneView (actors), DisplayPanel, BonePanel, status bar
+    File menu --> volanim_core readers (errors: a dialog naming the file and line)
+    Open volume --> ThresholdDialog --> Worker(tasks.prepare_volume) with progress/cancel
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QActionGroup, QKeySequence
+from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressDialog, QTabWidget
+from pyvistaqt import QtInteractor
+
+from volanim_core import io
+from volanim_core.errors import FormatError
+
+from . import tasks
+from .model.document import Document, read_project
+from .model.modes import HANDLERS, Mode, PickEvent
+from .qt_panels import BonePanel, DisplayPanel
+from .qt_scene import SceneView
+from .qt_threshold_dialog import ThresholdDialog
+from .qt_worker import Worker
+
+SHORTCUTS = [
+    ("V", "View mode: click points to inspect them"),
+    ("B", "Bones mode: click point A, then B to add a bone; keep clicking to chain"),
+    ("R", "Root order mode: click bones in order"),
+    ("Esc", "End the bone chain / restart the root order"),
+    ("Right click", "End the bone chain"),
+    ("Delete", "Remove the selected bones"),
+    ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
+    ("Ctrl+Z / Ctrl+Shift+Z", "Undo / redo"),
+    ("Ctrl+O", "Open a volume"),
+    ("Ctrl+S", "Save the project"),
+    ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
+]
+
+
+class MainWindow(QMainWindow):
+    def __init__(self, doc: Document | None = None):
+        super().__init__()
+        self.doc = doc or Document()
+        self.setWindowTitle("volanim studio")
+        self.resize(1400, 900)
+        self.plotter = QtInteractor(self)
+        self.setCentralWidget(self.plotter.interactor if hasattr(self.plotter, "interactor") else self.plotter)
+        self.scene = SceneView(self.plotter, self.doc, on_pick=self.handle_pick)
+        self.handlers = {m: cls(self.doc) for m, cls in HANDLERS.items()}
+        self.mode = Mode.VIEW
+        self.worker: Worker | None = None
+        self.progress: QProgressDialog | None = None
+        self.last_error: str | None = None
+        self._error_box: QMessageBox | None = None
+
+        self.display_panel = DisplayPanel(self.doc, self.scene)
+        self.bone_panel = BonePanel(self.doc)
+        tabs = self.panel_tabs = QTabWidget()
+        tabs.addTab(self.bone_panel, "Bones")
+        tabs.addTab(self.display_panel, "Display")
+        tabs.setMinimumWidth(420)
+        dock = QDockWidget("Panels", self)
+        dock.setWidget(tabs)
+        dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
+        self.addDockWidget(Qt.RightDockWidgetArea, dock)
+        self.point_label = QLabel("")
+        self.statusBar().addPermanentWidget(self.point_label)
+        self._build_actions()
+        self.doc.events.message.connect(lambda text: self.statusBar().showMessage(text, 15000))
+        self.doc.events.picked.connect(self._on_picked_changed)
+        self.doc.undo.events.changed.connect(self._on_undo_changed)
+        self.doc.events.project.connect(lambda path: self.setWindowTitle(f"volanim studio — {Path(path).name}"))
+        self.set_mode(Mode.VIEW)
+
+    # ------------------------------------------------------------- actions
+    def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:
+        a = QAction(text, self)
+        if shortcut:
+            a.setShortcut(QKeySequence(shortcut))
+            a.setShortcutContext(Qt.WindowShortcut)
+        a.setCheckable(checkable)
+        a.triggered.connect(slot)
+        self.addAction(a)
+        if menu is not None:
+            menu.addAction(a)
+        return a
+
+    def _build_actions(self) -> None:
+        bar = self.menuBar()
+        file = bar.addMenu("&File")
+        self._action("Open &volume…", lambda: self.open_volume_dialog(), "Ctrl+O", menu=file)
+        self._action("Open &skeleton (.mskel)…", lambda: self._open_dialog("mskel"), menu=file)
+        self._action("Open &bones…", lambda: self._open_dialog("bones"), menu=file)
+        self._action("Open &project…", lambda: self._open_dialog("project"), menu=file)
+        file.addSeparator()
+        self._action("&Save project", self.save_project, "Ctrl+S", menu=file)
+        self._action("Save project &as…", lambda: self.save_project(ask=True), "Ctrl+Shift+S", menu=file)
+        self._action("Save bones…", lambda: self._save_dialog("bones"), menu=file)
+        self._action("Save connections…", lambda: self._save_dialog("connections"), menu=file)
+        self._action("Screenshot…", lambda: self._save_dialog("png"), menu=file)
+        file.addSeparator()
+        self._action("&Quit", self.close, "Ctrl+Q", menu=file)
+        edit = bar.addMenu("&Edit")
+        self.undo_action = self._action("Undo", self.undo, "Ctrl+Z", menu=edit)
+        self.redo_action = self._action("Redo", self.redo, "Ctrl+Shift+Z", menu=edit)
+        self._action("Delete selected bones", lambda: self.key("Delete"), "Delete", menu=edit)
+        self._action("Symmetrize selected bones", self.symmetrize, "M", menu=edit)
+        self._action("End chain", lambda: self.key("Escape"), "Esc")
+        modes = bar.addMenu("&Mode")
+        toolbar = self.addToolBar("Modes")
+        group = QActionGroup(self)
+        self.mode_actions = {}
+        for mode, text, key in ((Mode.VIEW, "View", "V"), (Mode.BONES, "Bones", "B"),
+                                (Mode.ROOT_ORDER, "Root order", "R")):
+            a = self._action(text, lambda _=False, m=mode: self.set_mode(m), key, checkable=True, menu=modes)
+            group.addAction(a)
+            toolbar.addAction(a)
+            self.mode_actions[mode] = a
+        toolbar.addSeparator()
+        self.remove_action = self._action("Remove bones", self._toggle_remove, checkable=True)
+        toolbar.addAction(self.remove_action)
+        sym = self._action("Symmetrize", self.symmetrize)
+        toolbar.addAction(sym)
+        help_menu = bar.addMenu("&Help")
+        self._action("&Shortcuts", self.show_shortcuts, "F1", menu=help_menu)
+        self._on_undo_changed()
+
+    def set_mode(self, mode: Mode) -> None:
+        self.handlers[self.mode].leave()
+        self.mode = Mode(mode)
+        self.mode_actions[self.mode].setChecked(True)
+        self.handlers[self.mode].enter()
+
+    def _toggle_remove(self, on: bool) -> None:
+        self.handlers[Mode.BONES].remove = on
+        if on:
+            self.set_mode(Mode.BONES)
+            self.doc.message("Remove: click a bone to delete it (toggle off to add bones again).")
+
+    def handle_pick(self, ev: PickEvent) -> None:
+        try:
+            self.handlers[self.mode].press(ev)
+        except ValueError as exc:
+            self.doc.message(str(exc))
+
+    def key(self, name: str) -> None:
+        if name == "Delete" and self.mode != Mode.BONES and self.doc.selected_bones:
+            self.doc.remove_bones(self.doc.selected_bones)
+            return
+        self.handlers[self.mode].key(name)
+
+    def undo(self) -> None:
+        label = self.doc.undo.undo()
+        self.doc.message(f"Undid: {label}" if label else "Nothing to undo.")
+
+    def redo(self) -> None:
+        label = self.doc.undo.redo()
+        self.doc.message(f"Redid: {label}" if label else "Nothing to redo.")
+
+    def _on_undo_changed(self, **_) -> None:
+        u = self.doc.undo
+        self.undo_action.setEnabled(u.can_undo)
+        self.undo_action.setText(f"Undo {u.undo_label}" if u.can_undo else "Undo")
+        self.redo_action.setEnabled(u.can_redo)
+        self.redo_action.setText(f"Redo {u.redo_label}" if u.can_redo else "Redo")
+
+    def symmetrize(self) -> None:
+        try:
+            written = self.doc.symmetrize()
+        except ValueError as exc:
+            self.show_error("Symmetrize", str(exc))
+            return
+        self.doc.message(f"Mirrored to {', '.join(written)} across x = {self.doc.symmetry_x:g}.")
+
+    def _on_picked_changed(self, index=None, **_) -> None:
+        if index is None:
+            self.point_label.setText("")
+            return
+        i = self.doc.point_info(index)
+        self.point_label.setText(f"x {i['x']}  y {i['y']}  z {i['z']}   DT {i['dt']:.3f}   "
+                                 f"thinness {i['thinness']:.3f}   bone {i['bone'] or '—'}")
+
+    def show_shortcuts(self) -> None:
+        rows = "".join(f"<tr><td><b>{k}</b></td><td>{v}</td></tr>" for k, v in SHORTCUTS)
+        box = QMessageBox(QMessageBox.Information, "Shortcuts", f"<table cellspacing=6>{rows}</table>",
+                          QMessageBox.Close, self)
+        box.setTextFormat(Qt.RichText)
+        self._shortcut_box = box
+        box.open()
+
+    # -------------------------------------------------------------- errors
+    def show_error(self, title: str, message: str) -> None:
+        """A non-blocking error dialog; the document is untouched."""
+        self.last_error = message
+        box = QMessageBox(QMessageBox.Warning, title, message, QMessageBox.Ok, self)
+        self._error_box = box
+        box.open()
+
+    # -------------------------------------------------------------- loading
+    def run_task(self, label: str, task, on_done) -> Worker:
+        """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel."""
+        if self.worker is not None:
+            raise RuntimeError("another job is running")
+        dialog = QProgressDialog(label, "Cancel", 0, 100, self)
+        dialog.setWindowModality(Qt.WindowModal)
+        dialog.setMinimumDuration(300)
+        worker = Worker(task, self)
+        worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
+        dialog.canceled.connect(worker.cancel)
+
+        def finish():
+            dialog.reset()
+            self.worker = None
+            self.progress = None
+
+        worker.succeeded.connect(lambda result: (finish(), on_done(result)))
+        worker.failed.connect(lambda msg: (finish(), self.show_error(label, msg)))
+        worker.was_cancelled.connect(lambda: (finish(), self.doc.message(f"{label}: cancelled.")))
+        self.worker, self.progress = worker, dialog
+        worker.start()
+        return worker
+
+    @property
+    def busy(self) -> bool:
+        return self.worker is not None
+
+    def _apply_prepared(self, result: dict, path=None, threshold=None, spacing=None, dims=None) -> None:
+        self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),
+                            path=path, threshold=threshold, dims=dims)
+        self.doc.set_skeleton(result["skeleton"])
+        self.doc.set_hull(*result["hull"])
+        self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
+
+    def load_demo(self, name: str) -> Worker:
+        return self.run_task(f"Preparing the {name} demo", lambda progress, cancel: tasks.load_demo(
+            name, progress=progress, cancel=cancel), lambda r: self._apply_prepared(r, spacing=r["spacing"]))
+
+    def open_volume(self, path, *, dims=None, params: dict | None = None) -> Worker | None:
+        """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
+        try:
+            loaded = tasks.load_volume_file(str(path), dims)
+        except FormatError as exc:
+            self.show_error("Open volume", str(exc))
+            return None
+        if params is None:
+            dialog = ThresholdDialog(loaded["volume"], Path(path).name, self)
+            if dialog.exec() != ThresholdDialog.Accepted:
+                return None
+            params = dialog.parameters()
+        vol = loaded["volume"]
+        return self.run_task(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
+            vol, progress=progress, cancel=cancel, **params), lambda r: self._apply_prepared(
+            r, path=path, threshold=(params["lo"], params["hi"]), spacing=loaded["spacing"], dims=dims))
+
+    def open_volume_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Open volume", "", "Volumes (*.vol *.VOL *.vti *.nrrd *.nii "
+                                              "*.nii.gz *.mha *.mhd);;All files (*)")
+        if path:
+            self.open_volume(path)
+
+    def open_mskel(self, path) -> bool:
+        try:
+            skel = io.read_mskel(path)
+        except FormatError as exc:
+            self.show_error("Open skeleton", str(exc))
+            return False
+        self.doc.set_skeleton(skel, path)
+        self.doc.message(f"Loaded {len(skel)} points from {Path(path).name}.")
+        return True
+
+    def open_bones(self, path) -> bool:
+        try:
+            self.doc.load_bones(path)
+        except FormatError as exc:
+            self.show_error("Open bones", str(exc))
+            return False
+        self.doc.message(f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.")
+        return True
+
+    def open_project(self, path) -> Worker | None:
+        try:
+            data = read_project(path)
+        except FormatError as exc:
+            self.show_error("Open project", str(exc))
+            return None
+
+        def rest(_=None):
+            if data.get("mskel") and (self.doc.skeleton is None or data.get("volume") is None):
+                self.open_mskel(data["mskel"])
+            elif data.get("mskel"):
+                self.doc.mskel_path = data["mskel"]
+            if data.get("bones"):
+                self.open_bones(data["bones"])
+            if data.get("symmetry_x") is not None:
+                self.doc.symmetry_x = data["symmetry_x"]
+            if data.get("thinness") is not None:
+                self.doc.thinness = data["thinness"]
+            self.doc.project_path = str(path)
+            self.doc.events.project.emit(path=str(path))
+            if data.get("camera"):
+                self.set_camera(data["camera"])
+
+        if data.get("volume"):
+            lo, hi = data.get("threshold") or (1, None)
+            params = {"lo": lo, "hi": hi, "fill": False}
+            worker = self.open_volume(data["volume"], dims=data.get("volume_dims"), params=params)
+            if worker is not None:
+                worker.succeeded.connect(rest)
+            return worker
+        rest()
+        return None
+
+    def _open_dialog(self, kind: str) -> None:
+        filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)"}
+        path, _ = QFileDialog.getOpenFileName(self, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
+        if path:
+            {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project}[kind](path)
+
+    # -------------------------------------------------------------- saving
+    def camera(self) -> dict:
+        cam = self.plotter.renderer.GetActiveCamera()
+        return {"position": list(cam.GetPosition()), "focal_point": list(cam.GetFocalPoint()),
+                "view_up": list(cam.GetViewUp())}
+
+    def set_camera(self, data: dict) -> None:
+        cam = self.plotter.renderer.GetActiveCamera()
+        cam.SetPosition(*data["position"])
+        cam.SetFocalPoint(*data["focal_point"])
+        cam.SetViewUp(*data["view_up"])
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.scene.render()
+
+    def save_project(self, ask: bool = False, path=None) -> Path | None:
+        if path is None:
+            path = self.doc.project_path
+            if ask or not path:
+                path, _ = QFileDialog.getSaveFileName(self, "Save project", "session.volanim",
+                                                      "Projects (*.volanim)")
+                if not path:
+                    return None
+        try:
+            saved = self.doc.save_project(path, camera=self.camera())
+        except (OSError, ValueError) as exc:
+            self.show_error("Save project", str(exc))
+            return None
+        self.doc.message(f"Saved {saved}.")
+        return saved
+
+    def save_bones(self, path) -> bool:
+        try:
+            self.doc.save_bones(path)
+        except (OSError, ValueError) as exc:
+            self.show_error("Save bones", str(exc))
+            return False
+        self.doc.message(f"Saved {len(self.doc.bones)} bones to {path}.")
+        return True
+
+    def _save_dialog(self, kind: str) -> None:
+        filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
+        path, _ = QFileDialog.getSaveFileName(self, f"Save {kind}", f"untitled.{kind}", filters[kind])
+        if not path:
+            return
+        if kind == "bones":
+            self.save_bones(path)
+        elif kind == "connections":
+            self.doc.save_connections(path)
+        else:
+            self.plotter.screenshot(path)
+
+    def screenshot(self, path) -> None:
+        self.plotter.screenshot(str(path))
+
+    def closeEvent(self, event):  # noqa: N802 (Qt name)
+        if self.worker is not None:
+            self.worker.cancel()
+            self.worker.wait(5000)
+        self.plotter.close()
+        super().closeEvent(event)
+
+
+def main_window_for(args) -> MainWindow:
+    """A window loaded as the command line asks (see ``app.main``)."""
+    w = MainWindow()
+    if args.project:
+        w.open_project(args.project)
+    elif args.demo:
+        w.load_demo(args.demo)
+    elif args.volume:
+        w.open_volume(args.volume)
+    if args.mskel:
+        w.open_mskel(args.mskel)
+    if args.bones:
+        w.open_bones(args.bones)
+    return w
+
+
+__all__ = ["MainWindow", "main_window_for", "np"]

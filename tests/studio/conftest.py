@@ -1,0 +1,59 @@
+"""Fixtures for GUI tests: a real MainWindow on the demo mannequin, under Xvfb (pytest-xvfb)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+
+def front_view(window) -> None:
+    """Look at the mannequin from the front (-y), z up, so tests click known places."""
+    r = window.plotter.renderer
+    cam = r.GetActiveCamera()
+    b = r.ComputeVisiblePropBounds()
+    c = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
+    cam.SetFocalPoint(*c)
+    cam.SetPosition(c[0], c[1] - 900, c[2])
+    cam.SetViewUp(0, 0, 1)
+    r.ResetCamera()
+    window.plotter.render()
+
+
+def click(qtbot, window, display_xy, button=Qt.LeftButton) -> None:
+    """Click at VTK display coordinates (device pixels, origin bottom-left) through Qt."""
+    w = window.plotter
+    s = w.devicePixelRatioF()
+    qx = int(round(display_xy[0] / s))
+    qy = int(round(w.height() - 1 - display_xy[1] / s))
+    qtbot.mouseClick(w, button, pos=QPoint(qx, qy))
+
+
+def clickable_point(window, near_voxel) -> int:
+    """A shown skeleton point close to ``near_voxel`` that a click on its projection picks."""
+    doc, scene = window.doc, window.scene
+    n = doc.visible_count
+    order = np.argsort(((doc.skeleton.points[:n] - np.asarray(near_voxel)) ** 2).sum(1))
+    for i in order[:200]:
+        xy = scene.display_of_point(int(i))
+        if scene.pick(*xy).point == i:
+            return int(i)
+    raise AssertionError(f"no clickable point near {near_voxel}")
+
+
+@pytest.fixture
+def window(qtbot):
+    from volanim_studio.qt_main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.resize(1200, 800)
+    w.show()
+    qtbot.waitExposed(w)
+    w.activateWindow()  # window shortcuts need an active window; Xvfb has no window manager to do it
+    qtbot.waitUntil(w.isActiveWindow, timeout=5000)
+    w.load_demo("mannequin")
+    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    front_view(w)
+    yield w
+    w.close()
