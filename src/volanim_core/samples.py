@@ -76,6 +76,20 @@ def mannequin_bones() -> BoneSkeleton:
     return BoneSkeleton(j, bones)
 
 
+def mannequin_limb(bone_label: str) -> str:
+    """The limb a mannequin bone belongs to: TORSO, HEAD, L_ARM, R_ARM, L_LEG or R_LEG.
+
+    Scoring connectivity by limb ignores the arbitrary split of the torso into
+    spine, clavicle and pelvis parts and counts what breaks a pose: a point on
+    the wrong limb.
+    """
+    if bone_label == "SPINE" or bone_label.endswith(("CLAVICLE", "PELVIS")):
+        return "TORSO"
+    if bone_label == "HEAD":
+        return "HEAD"
+    return bone_label[:2] + ("ARM" if bone_label.endswith(("UPPERARM", "FOREARM", "HAND")) else "LEG")
+
+
 # (bone name, start, end, radius at start, radius at end, y squash, bone-rod radius)
 def _mannequin_parts(bones: BoneSkeleton):
     J = bones.joints
