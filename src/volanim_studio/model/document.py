@@ -28,6 +28,7 @@ from volanim_core.io._atomic import atomic_write_text
 from volanim_core.skeleton import Skeleton
 
 from . import symmetry
+from .attachments import Attachments
 from .events import EventEmitter
 from .undo import Command, UndoStack
 
@@ -40,7 +41,8 @@ class Document:
 
     def __init__(self):
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
-                                   "symmetry", "message", "project")
+                                   "symmetry", "message", "project", "attachments", "filter", "cube",
+                                   "point_selection")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -59,6 +61,12 @@ class Document:
         self._symmetry_x: float | None = None
         self.project_path: str | None = None
         self._joint_counter = 0
+        self.attachments = Attachments(self)
+        self.only_unconnected = False
+        self.only_working = False
+        self.cube_centre: np.ndarray | None = None
+        self.cube_size = 10.0
+        self.point_selection = np.zeros(0, np.int64)  # the last cube / lasso selection
 
     # ------------------------------------------------------------------ data
     def set_volume(self, volume, mask=None, *, spacing=(1.0, 1.0, 1.0), path=None, threshold=None, dims=None):
@@ -71,17 +79,26 @@ class Document:
         self.events.volume.emit()
         self.events.symmetry.emit()
 
-    def set_skeleton(self, skeleton: Skeleton | None, path=None) -> None:
+    def set_skeleton(self, skeleton: Skeleton | None, path=None, keep_attachments=None) -> None:
+        """Replace the cloud; attachments start empty unless ``keep_attachments`` (one per point)."""
         if skeleton is not None and not skeleton.is_sorted():
+            if keep_attachments is not None:
+                raise ValueError("pass a sorted skeleton with its attachments")
             skeleton = skeleton.sorted()
         self.skeleton = skeleton
         self.mskel_path = str(path) if path else None
         self.picked_point = None
+        n = 0 if skeleton is None else len(skeleton)
+        if keep_attachments is not None:
+            self.attachments.bone = np.asarray(keep_attachments, np.int32).copy()
+        else:
+            self.attachments.bone = np.full(n, -1, np.int32)
         if skeleton is not None and len(skeleton):
             lo, hi = float(skeleton.thinness.min()), float(skeleton.thinness.max())
             self._thinness = float(np.clip(self._thinness, lo, hi))
         self.events.skeleton.emit()
         self.events.thinness.emit(value=self._thinness)
+        self.events.attachments.emit(indices=None)
 
     def set_hull(self, vertices, faces) -> None:
         self.hull = None if vertices is None else (np.asarray(vertices), np.asarray(faces))
@@ -149,8 +166,48 @@ class Document:
                 "thinness": float(s.thinness[index]), "bone": self.bone_of_point(index)}
 
     def bone_of_point(self, index: int) -> str | None:
-        """The bone a point is attached to (connectivity arrives with the Connect modes)."""
-        return None
+        """The bone a point is attached to, or None."""
+        return self.attachments.label_of(index)
+
+    @property
+    def working_bone(self) -> int | None:
+        """The bone Connect and Remove act on: the first selected bone."""
+        return self.selected_bones[0] if self.selected_bones else None
+
+    def set_filter(self, *, only_unconnected=None, only_working=None) -> None:
+        """Show only unconnected points, or only the working bone's (not both)."""
+        if only_unconnected is not None:
+            self.only_unconnected = bool(only_unconnected)
+            if self.only_unconnected:
+                self.only_working = False
+        if only_working is not None:
+            self.only_working = bool(only_working)
+            if self.only_working:
+                self.only_unconnected = False
+        self.events.filter.emit()
+
+    def set_cube(self, centre, size: float | None = None) -> None:
+        """Place (or move) the selection cube; ``centre`` None hides it."""
+        self.cube_centre = None if centre is None else np.asarray(centre, np.float64)
+        if size is not None:
+            if not size > 0:
+                raise ValueError(f"cube size must be positive, got {size}")
+            self.cube_size = float(size)
+        self.events.cube.emit()
+
+    def set_point_selection(self, indices) -> None:
+        self.point_selection = np.asarray(indices, np.int64)
+        self.events.point_selection.emit()
+
+    def shown_indices(self) -> np.ndarray:
+        """Skeleton points on screen: the thinness prefix, then the filters."""
+        idx = np.arange(self.visible_count)
+        if self.only_unconnected:
+            idx = idx[self.attachments.bone[idx] < 0]
+        elif self.only_working:
+            w = self.working_bone
+            idx = idx[self.attachments.bone[idx] == (-2 if w is None else w)]
+        return idx
 
     def select_bones(self, indices) -> None:
         indices = tuple(sorted({int(i) for i in indices}))
@@ -165,16 +222,27 @@ class Document:
         self.events.message.emit(text=text)
 
     # ------------------------------------------------------------ bone edits
-    def _apply_bones(self, label: str, new: BoneSkeleton) -> None:
+    def _apply_bones(self, label: str, new: BoneSkeleton, remap: np.ndarray | None = None) -> None:
+        """One undo step: the new bone skeleton and, when bones are renumbered
+        (``remap[old index] = new index`` or -1), the attachments that follow."""
         old = copy.deepcopy(self.bones)
         new = copy.deepcopy(new)
         new.validate()
+        changed = old_vals = new_vals = None
+        if remap is not None and len(self.attachments.bone):
+            after = self.attachments.remapped(np.asarray(remap, np.int32))
+            changed = np.flatnonzero(after != self.attachments.bone)
+            old_vals, new_vals = self.attachments.bone[changed].copy(), after[changed]
 
         def redo():
             self._set_bones(copy.deepcopy(new))
+            if changed is not None and len(changed):
+                self.attachments._write(changed, new_vals)
 
         def undo():
             self._set_bones(copy.deepcopy(old))
+            if changed is not None and len(changed):
+                self.attachments._write(changed, old_vals)
 
         self.undo.push(Command(label, redo, undo))
 
@@ -244,8 +312,11 @@ class Document:
         new.bones = [b for i, b in enumerate(new.bones) if i not in indices]
         used = {j for b in new.bones for j in (b.proximal, b.distal)}
         new.joints = {k: v for k, v in new.joints.items() if k in used}
+        remap = np.full(len(self.bones), -1, np.int32)
+        kept = [i for i in range(len(self.bones)) if i not in indices]
+        remap[kept] = np.arange(len(kept))
         self.selected_bones = ()
-        self._apply_bones(f"Remove {len(indices)} bone(s)", new)
+        self._apply_bones(f"Remove {len(indices)} bone(s)", new, remap)
 
     def rename_joint(self, old: str, new_name: str) -> None:
         new_name = new_name.strip()
@@ -284,10 +355,15 @@ class Document:
             return
         new = self._edited()
         new.bones = [new.bones[i] for i in order]
-        self._apply_bones("Reorder bones", new)
+        remap = np.empty(len(order), np.int32)
+        remap[order] = np.arange(len(order))
+        self._apply_bones("Reorder bones", new, remap)
 
     def set_bones(self, bones: BoneSkeleton, label: str = "Load bones") -> None:
-        self._apply_bones(label, bones)
+        """Replace the bone skeleton; attachments follow bones with the same joints, others are cleared."""
+        keys = {(b.proximal, b.distal): i for i, b in enumerate(bones.bones)}
+        remap = np.array([keys.get((b.proximal, b.distal), -1) for b in self.bones.bones], np.int32)
+        self._apply_bones(label, bones, remap)
 
     def symmetrize(self, indices=None) -> list[str]:
         """Mirror bones (default: the selection) to the other side by their L_/R_ names.

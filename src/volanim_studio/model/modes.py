@@ -14,6 +14,7 @@ from enum import StrEnum
 
 import numpy as np
 
+from . import selection
 from .document import Document
 
 
@@ -21,6 +22,8 @@ class Mode(StrEnum):
     VIEW = "view"
     BONES = "bones"
     ROOT_ORDER = "root_order"
+    CUBE = "cube"
+    LASSO = "lasso"
 
 
 @dataclass(frozen=True)
@@ -172,4 +175,104 @@ class RootOrderMode(ModeHandler):
             self.doc.message("Root order: start again from root 0.")
 
 
-HANDLERS = {Mode.VIEW: ViewMode, Mode.BONES: BonesMode, Mode.ROOT_ORDER: RootOrderMode}
+def _working(doc: Document, remove: bool) -> int | None:
+    """The bone to attach to (-1 to detach), or None with a message when no bone is chosen."""
+    if remove:
+        return -1
+    if doc.working_bone is None:
+        doc.message("Choose the working bone first: click a bone in the view or in the list.")
+        return None
+    return doc.working_bone
+
+
+class CubeMode(ModeHandler):
+    """Click a point to centre the cube on it; Connect / Remove act on the shown points inside.
+
+    Arrow keys nudge it along x and z, Page Up / Page Down along y; + / - resize.
+    """
+
+    name = Mode.CUBE
+    help = ("Cube: click a point to place the cube (arrows, PgUp/PgDn nudge; +/- size), then Connect (C) "
+            "or Remove (X) the shown points inside it for the working bone.")
+    NUDGE = {"Left": (-1, 0, 0), "Right": (1, 0, 0), "Up": (0, 0, 1), "Down": (0, 0, -1),
+             "PageUp": (0, 1, 0), "PageDown": (0, -1, 0)}
+
+    def press(self, ev: PickEvent) -> None:
+        if ev.button != "left":
+            return
+        if ev.point is not None:
+            self.doc.pick_point(ev.point)
+            self.doc.set_cube(self.doc.skeleton.points[ev.point])
+        elif ev.bone is not None:
+            self.doc.select_bones([ev.bone])
+
+    def inside(self) -> np.ndarray:
+        doc = self.doc
+        if doc.cube_centre is None:
+            return np.zeros(0, np.int64)
+        shown = doc.shown_indices()
+        return shown[selection.in_cube(doc.skeleton.points[shown], doc.cube_centre, doc.cube_size)]
+
+    def apply(self, remove: bool = False) -> int:
+        if self.doc.cube_centre is None:
+            self.doc.message("Place the cube first: click a point.")
+            return 0
+        bone = _working(self.doc, remove)
+        if bone is None:
+            return 0
+        idx = self.inside()
+        self.doc.set_point_selection(idx)
+        n = self.doc.attachments.assign(idx, bone)
+        self.doc.message(f"{'Removed' if remove else 'Connected'} {n} of {len(idx)} points in the cube.")
+        return n
+
+    def key(self, name: str) -> None:
+        doc = self.doc
+        if doc.cube_centre is None:
+            return
+        if name in self.NUDGE:
+            doc.set_cube(np.asarray(doc.cube_centre) + self.NUDGE[name])
+        elif name in ("Plus", "Equal"):
+            doc.set_cube(doc.cube_centre, doc.cube_size + 2)
+        elif name == "Minus":
+            doc.set_cube(doc.cube_centre, max(1.0, doc.cube_size - 2))
+        elif name == "C":
+            self.apply()
+        elif name == "X":
+            self.apply(remove=True)
+
+
+class LassoMode(ModeHandler):
+    """Draw an outline over the view; the shown points under it are connected (or removed).
+
+    The depth mode decides which of them: 'through', 'visible' or 'slab' (see
+    ``selection``). Holding Ctrl while drawing, or the remove toggle, removes.
+    """
+
+    name = Mode.LASSO
+    help = ("Lasso: drag an outline around points to connect them to the working bone (Ctrl: remove). "
+            "Depth: through / visible / slab.")
+
+    def __init__(self, doc: Document):
+        super().__init__(doc)
+        self.depth_mode = "visible"
+        self.slab = 10.0
+        self.remove = False
+
+    def finish(self, polygon, xy, depth, view_depth, shown, remove: bool | None = None) -> int:
+        """Apply a closed outline: ``xy``/``depth``/``view_depth`` are the projections of ``shown`` points."""
+        remove = self.remove if remove is None else remove
+        picked = selection.select_lasso(xy, depth, view_depth, polygon, mode=self.depth_mode, slab=self.slab)
+        idx = np.asarray(shown)[picked]
+        self.doc.set_point_selection(idx)
+        bone = _working(self.doc, remove)
+        if bone is None:
+            return 0
+        n = self.doc.attachments.assign(idx, bone)
+        self.doc.message(f"{'Removed' if remove else 'Connected'} {n} of {len(idx)} points under the lasso "
+                         f"({self.depth_mode}).")
+        return n
+
+
+HANDLERS = {Mode.VIEW: ViewMode, Mode.BONES: BonesMode, Mode.ROOT_ORDER: RootOrderMode, Mode.CUBE: CubeMode,
+            Mode.LASSO: LassoMode}
