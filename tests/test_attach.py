@@ -51,6 +51,12 @@ def test_reports_what_it_could_not_attach(two_limbs):
     out, report = auto_connect(pts, bones, mask)
     assert out.tolist() == [-1, 0] and report.unattached == 1
     assert "outside the segmented volume" in str(report) and "left 1 unattached" in str(report)
+    from volanim_core.attach import attach_nearest_bone
+
+    lone = np.array([[5, 4, 20]])
+    out, report = auto_connect(lone, bones, mask & False, method="path-or-nearest")
+    assert out.tolist() == attach_nearest_bone(lone, bones).tolist()
+    assert report.fallback == 1 and "went to the nearest bone" in str(report)
     with pytest.raises(ValueError, match="method"):
         auto_connect(pts, bones, mask, method="heat")
     with pytest.raises(ValueError, match="no bones"):

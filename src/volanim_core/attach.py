@@ -8,6 +8,9 @@ Three rules, measured against the mannequin's ground-truth limb membership
 * ``auto_connect(method="path")`` -- the nearest segment whose straight path
   from the point to the segment's closest point stays inside the segmented
   volume (sampled every half voxel); otherwise the next nearest. The default.
+* ``auto_connect(method="path-or-nearest")`` -- the same, and points with no
+  such path (an object made of separate parts, like the frog's organs) go to
+  the nearest bone; the report counts them.
 * ``auto_connect(method="geodesic")`` -- the seed pipeline's graph idea done
   as shortest paths: a k-nearest-neighbour graph of the skeleton points (edges
   inside the mask), seeded by the points nearest to each bone; every point
@@ -67,12 +70,15 @@ class AutoConnectReport:
     attached: int = 0
     kept: int = 0  # already attached and not overwritten
     unattached: int = 0
+    fallback: int = 0  # path-or-nearest: attached to the nearest bone for want of a path
     reasons: dict = field(default_factory=dict)
 
     def __str__(self) -> str:
         text = f"attached {self.attached} points"
         if self.kept:
             text += f", kept {self.kept} existing attachments"
+        if self.fallback:
+            text += f" ({self.fallback} with no straight path inside the volume went to the nearest bone)"
         if self.unattached:
             why = "; ".join(f"{n}: {r}" for r, n in self.reasons.items())
             text += f", left {self.unattached} unattached ({why})"
@@ -133,7 +139,7 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     points : (N, 3) int ndarray, voxel coordinates
     bones : BoneSkeleton
     mask : (X, Y, Z) bool ndarray, the segmented object
-    method : {'path', 'geodesic', 'nearest'}
+    method : {'path', 'path-or-nearest', 'geodesic', 'nearest'}
     current : (N,) int ndarray, optional
         Existing attachments (-1 = none); kept unless ``overwrite``.
     which : (N,) bool ndarray, optional
@@ -157,12 +163,16 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     sub = points[todo]
     if method == "nearest":
         found = attach_nearest_bone(sub, bones)
-    elif method == "path":
+    elif method in ("path", "path-or-nearest"):
         found = _path_method(sub, bones, mask)
+        if method == "path-or-nearest":
+            lost = found == UNATTACHED
+            found[lost] = attach_nearest_bone(sub[lost], bones)
+            report.fallback = int(lost.sum())
     elif method == "geodesic":
         found = _geodesic_method(sub, bones, mask)
     else:
-        raise ValueError(f"method must be 'path', 'geodesic' or 'nearest', got {method!r}")
+        raise ValueError(f"method must be 'path', 'path-or-nearest', 'geodesic' or 'nearest', got {method!r}")
     if mask is not None and method != "nearest":
         outside = ~mask[tuple(sub.T)]
         if outside.any():

@@ -23,7 +23,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--volume", help="a volume to segment and skeletonize")
     p.add_argument("--mskel", help="a multi-resolution skeleton")
     p.add_argument("--bones", help="a .bones file")
-    p.add_argument("--connect", help="a .connect file (connection modes come with the next release)")
+    p.add_argument("--connect", help="a .connect file to continue connecting")
     return p
 
 

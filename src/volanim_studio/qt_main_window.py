@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressDialog, QTabWidget
 from pyvistaqt import QtInteractor
@@ -20,8 +20,10 @@ from volanim_core import io
 from volanim_core.errors import FormatError
 
 from . import tasks
+from .model import autosave
 from .model.document import Document, read_project
 from .model.modes import HANDLERS, Mode, PickEvent
+from .qt_connect_panel import ConnectPanel
 from .qt_panels import BonePanel, DisplayPanel
 from .qt_scene import SceneView
 from .qt_threshold_dialog import ThresholdDialog
@@ -31,6 +33,9 @@ SHORTCUTS = [
     ("V", "View mode: click points to inspect them"),
     ("B", "Bones mode: click point A, then B to add a bone; keep clicking to chain"),
     ("R", "Root order mode: click bones in order"),
+    ("K", "Cube mode: click a point to place the cube; arrows / PgUp / PgDn nudge, +/- size, C connect, X remove"),
+    ("L", "Lasso mode: drag an outline to connect the points under it to the working bone (Ctrl: remove)"),
+    ("Ctrl+A", "Auto-connect"),
     ("Esc", "End the bone chain / restart the root order"),
     ("Right click", "End the bone chain"),
     ("Delete", "Remove the selected bones"),
@@ -43,7 +48,8 @@ SHORTCUTS = [
 
 
 class MainWindow(QMainWindow):
-    def __init__(self, doc: Document | None = None):
+    def __init__(self, doc: Document | None = None, *, autosave_every_edits: int = 5,
+                 autosave_seconds: float = 60.0):
         super().__init__()
         self.doc = doc or Document()
         self.setWindowTitle("volanim studio")
@@ -60,8 +66,11 @@ class MainWindow(QMainWindow):
 
         self.display_panel = DisplayPanel(self.doc, self.scene)
         self.bone_panel = BonePanel(self.doc)
+        self.connect_panel = ConnectPanel(self.doc, self.handlers[Mode.CUBE], self.handlers[Mode.LASSO])
+        self.scene.on_lasso = self.handle_lasso
         tabs = self.panel_tabs = QTabWidget()
         tabs.addTab(self.bone_panel, "Bones")
+        tabs.addTab(self.connect_panel, "Connect")
         tabs.addTab(self.display_panel, "Display")
         tabs.setMinimumWidth(420)
         dock = QDockWidget("Panels", self)
@@ -75,7 +84,61 @@ class MainWindow(QMainWindow):
         self.doc.events.picked.connect(self._on_picked_changed)
         self.doc.undo.events.changed.connect(self._on_undo_changed)
         self.doc.events.project.connect(lambda path: self.setWindowTitle(f"volanim studio — {Path(path).name}"))
+        self.autosaver = autosave.Autosaver(self.doc, every_edits=autosave_every_edits,
+                                            every_seconds=autosave_seconds)
+        self.doc.undo.events.changed.connect(self._autosave_after_edit)
+        self.autosave_timer = QTimer(self)
+        self.autosave_timer.timeout.connect(self._autosave_tick)
+        self.autosave_timer.start(int(1000 * min(autosave_seconds, 60.0)))
         self.set_mode(Mode.VIEW)
+
+    # ------------------------------------------------------------ autosave
+    def _autosave_after_edit(self, **_) -> None:
+        try:
+            self.autosaver.edited()
+        except (OSError, ValueError) as exc:
+            self.doc.message(f"Autosave failed: {exc}")
+
+    def _autosave_tick(self) -> None:
+        try:
+            self.autosaver.tick()
+        except (OSError, ValueError) as exc:
+            self.doc.message(f"Autosave failed: {exc}")
+
+    def offer_recovery(self, ask=None) -> Worker | None:
+        """If an earlier session crashed, offer to restore its last autosave.
+
+        ``ask(path) -> bool`` replaces the question dialog (tests).
+        """
+        found = autosave.find_recoveries()
+        if not found:
+            return None
+        latest = found[0]
+        if ask is None:
+            answer = QMessageBox.question(
+                self, "Restore unsaved work?", f"volanim studio did not close properly last time.\n"
+                f"Restore the session autosaved at {latest.parent.name}?", QMessageBox.Yes | QMessageBox.No)
+            restore = answer == QMessageBox.Yes
+        else:
+            restore = ask(latest)
+        if not restore:
+            for f in found:
+                autosave.discard(f)
+            return None
+        worker = self.open_project(latest)
+
+        def cleanup(_=None):
+            self.doc.project_path = None  # a restored session saves where the user says, not into the cache
+            self.setWindowTitle("volanim studio — restored")
+            for f in found:
+                autosave.discard(f)
+            self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones).")
+
+        if worker is not None:
+            worker.succeeded.connect(cleanup)
+        else:
+            cleanup()
+        return worker
 
     # ------------------------------------------------------------- actions
     def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:
@@ -116,7 +179,8 @@ class MainWindow(QMainWindow):
         group = QActionGroup(self)
         self.mode_actions = {}
         for mode, text, key in ((Mode.VIEW, "View", "V"), (Mode.BONES, "Bones", "B"),
-                                (Mode.ROOT_ORDER, "Root order", "R")):
+                                (Mode.ROOT_ORDER, "Root order", "R"), (Mode.CUBE, "Cube", "K"),
+                                (Mode.LASSO, "Lasso", "L")):
             a = self._action(text, lambda _=False, m=mode: self.set_mode(m), key, checkable=True, menu=modes)
             group.addAction(a)
             toolbar.addAction(a)
@@ -126,6 +190,19 @@ class MainWindow(QMainWindow):
         toolbar.addAction(self.remove_action)
         sym = self._action("Symmetrize", self.symmetrize)
         toolbar.addAction(sym)
+        # cube keys: live only in cube mode, so arrows still move through lists elsewhere
+        self.cube_actions = [
+            self._action(f"Cube {name}", lambda _=False, n=name: self.key(n), key)
+            for name, key in (("Left", "Left"), ("Right", "Right"), ("Up", "Up"), ("Down", "Down"),
+                              ("PageUp", "PgUp"), ("PageDown", "PgDown"), ("Plus", "+"), ("Minus", "-"),
+                              ("C", "C"), ("X", "X"))]
+        connect_menu = bar.addMenu("&Connect")
+        self._action("Auto-connect", self.auto_connect, "Ctrl+A", menu=connect_menu)
+        self._action("Mirror connectivity of selected bones", self.mirror_connectivity, menu=connect_menu)
+        self._action("Save .connect…", lambda: self._save_dialog("connect"), menu=connect_menu)
+        self._action("Open .connect…", lambda: self._open_dialog("connect"), menu=connect_menu)
+        self.connect_panel.auto_button.clicked.connect(self.auto_connect)
+        self.connect_panel.mirror_button.clicked.connect(self.mirror_connectivity)
         help_menu = bar.addMenu("&Help")
         self._action("&Shortcuts", self.show_shortcuts, "F1", menu=help_menu)
         self._on_undo_changed()
@@ -134,7 +211,42 @@ class MainWindow(QMainWindow):
         self.handlers[self.mode].leave()
         self.mode = Mode(mode)
         self.mode_actions[self.mode].setChecked(True)
+        self.scene.set_lasso_enabled(self.mode == Mode.LASSO)
+        for a in getattr(self, "cube_actions", []):
+            a.setEnabled(self.mode == Mode.CUBE)
+        if self.mode in (Mode.CUBE, Mode.LASSO):
+            self.panel_tabs.setCurrentWidget(self.connect_panel)
+            if self.scene.colour_by != "bone":
+                self.display_panel.colour_by.setCurrentText("bone")
         self.handlers[self.mode].enter()
+
+    def handle_lasso(self, polygon, ctrl: bool) -> None:
+        shown, xy, depth, view_depth = self.scene.shown_projection()
+        lasso = self.handlers[Mode.LASSO]
+        lasso.finish(polygon, xy, depth, view_depth, shown, remove=True if ctrl else None)
+
+    def auto_connect(self) -> None:
+        p = self.connect_panel
+        try:
+            report = self.doc.attachments.auto(scope=p.scope.currentText(), overwrite=p.overwrite.isChecked(),
+                                               selection=self.doc.point_selection, method=p.method.currentText())
+        except ValueError as exc:
+            self.show_error("Auto-connect", str(exc))
+            return
+        self.doc.message(f"Auto-connect: {report}.")
+        if report.unattached:
+            self.show_error("Auto-connect", f"Auto-connect {report}. Connect the rest with the cube or lasso.")
+
+    def mirror_connectivity(self) -> None:
+        try:
+            copied, lonely = self.doc.attachments.mirror()
+        except ValueError as exc:
+            self.show_error("Mirror connectivity", str(exc))
+            return
+        text = f"Mirrored {copied} attachments"
+        if lonely:
+            text += f"; {lonely} points found no partner on the other side (connect them by hand)"
+        self.doc.message(text + ".")
 
     def _toggle_remove(self, on: bool) -> None:
         self.handlers[Mode.BONES].remove = on
@@ -217,6 +329,7 @@ class MainWindow(QMainWindow):
             dialog.reset()
             self.worker = None
             self.progress = None
+            self.activateWindow()  # give keyboard focus back (window managers differ; Xvfb has none)
 
         worker.succeeded.connect(lambda result: (finish(), on_done(result)))
         worker.failed.connect(lambda msg: (finish(), self.show_error(label, msg)))
@@ -237,8 +350,12 @@ class MainWindow(QMainWindow):
         self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
 
     def load_demo(self, name: str) -> Worker:
+        def done(r):
+            self._apply_prepared(r, spacing=r["spacing"])
+            self.doc.demo_name = name
+
         return self.run_task(f"Preparing the {name} demo", lambda progress, cancel: tasks.load_demo(
-            name, progress=progress, cancel=cancel), lambda r: self._apply_prepared(r, spacing=r["spacing"]))
+            name, progress=progress, cancel=cancel), done)
 
     def open_volume(self, path, *, dims=None, params: dict | None = None) -> Worker | None:
         """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
@@ -290,12 +407,14 @@ class MainWindow(QMainWindow):
             return None
 
         def rest(_=None):
-            if data.get("mskel") and (self.doc.skeleton is None or data.get("volume") is None):
+            if data.get("mskel") and (self.doc.skeleton is None or not (data.get("volume") or data.get("demo"))):
                 self.open_mskel(data["mskel"])
             elif data.get("mskel"):
                 self.doc.mskel_path = data["mskel"]
             if data.get("bones"):
                 self.open_bones(data["bones"])
+            if data.get("connect"):
+                self.open_connect(data["connect"])
             if data.get("symmetry_x") is not None:
                 self.doc.symmetry_x = data["symmetry_x"]
             if data.get("thinness") is not None:
@@ -305,6 +424,10 @@ class MainWindow(QMainWindow):
             if data.get("camera"):
                 self.set_camera(data["camera"])
 
+        if data.get("demo") and not data.get("volume"):
+            worker = self.load_demo(data["demo"])
+            worker.succeeded.connect(rest)
+            return worker
         if data.get("volume"):
             lo, hi = data.get("threshold") or (1, None)
             params = {"lo": lo, "hi": hi, "fill": False}
@@ -315,11 +438,40 @@ class MainWindow(QMainWindow):
         rest()
         return None
 
+    def open_connect(self, path) -> bool:
+        try:
+            warnings = self.doc.attachments.load(path)
+        except (FormatError, ValueError) as exc:
+            self.show_error("Open connectivity", str(exc))
+            return False
+        if warnings:
+            self.show_error("Open connectivity", "\n".join(warnings))
+        per_bone, unconnected = self.doc.attachments.counts()
+        self.doc.message(f"Loaded {int(per_bone.sum())} attachments from {Path(path).name}.")
+        return True
+
+    def save_connect(self, path=None) -> Path | None:
+        if path is None:
+            stem = Path(self.doc.project_path or "untitled").with_suffix("").name
+            path, _ = QFileDialog.getSaveFileName(self, "Save connectivity", self.doc.attachments.default_filename(
+                stem), "Connectivity (*.connect)")
+            if not path:
+                return None
+        try:
+            n = self.doc.attachments.save(path)
+        except (OSError, ValueError) as exc:
+            self.show_error("Save connectivity", str(exc))
+            return None
+        self.doc.message(f"Saved {n} attached points (thinness ≥ {self.doc.thinness:.2f}) to {path}.")
+        return Path(path)
+
     def _open_dialog(self, kind: str) -> None:
-        filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)"}
+        filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
+                   "connect": "Connectivity (*.connect)"}
         path, _ = QFileDialog.getOpenFileName(self, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
         if path:
-            {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project}[kind](path)
+            {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project,
+             "connect": self.open_connect}[kind](path)
 
     # -------------------------------------------------------------- saving
     def camera(self) -> dict:
@@ -361,6 +513,9 @@ class MainWindow(QMainWindow):
         return True
 
     def _save_dialog(self, kind: str) -> None:
+        if kind == "connect":
+            self.save_connect()
+            return
         filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
         path, _ = QFileDialog.getSaveFileName(self, f"Save {kind}", f"untitled.{kind}", filters[kind])
         if not path:
@@ -379,6 +534,8 @@ class MainWindow(QMainWindow):
         if self.worker is not None:
             self.worker.cancel()
             self.worker.wait(5000)
+        self.autosave_timer.stop()
+        self.autosaver.close()
         self.plotter.close()
         super().closeEvent(event)
 
@@ -386,16 +543,30 @@ class MainWindow(QMainWindow):
 def main_window_for(args) -> MainWindow:
     """A window loaded as the command line asks (see ``app.main``)."""
     w = MainWindow()
-    if args.project:
-        w.open_project(args.project)
+    worker = None
+    if not (args.project or args.demo or args.volume or args.mskel or args.connect):
+        worker = w.offer_recovery()
+    if worker is not None:
+        pass
+    elif args.project:
+        worker = w.open_project(args.project)
     elif args.demo:
-        w.load_demo(args.demo)
+        worker = w.load_demo(args.demo)
     elif args.volume:
-        w.open_volume(args.volume)
-    if args.mskel:
-        w.open_mskel(args.mskel)
-    if args.bones:
-        w.open_bones(args.bones)
+        worker = w.open_volume(args.volume)
+
+    def then(_=None):  # files that build on the loaded skeleton, after any background load
+        if args.mskel:
+            w.open_mskel(args.mskel)
+        if args.bones:
+            w.open_bones(args.bones)
+        if args.connect:
+            w.open_connect(args.connect)
+
+    if worker is not None:
+        worker.succeeded.connect(then)
+    else:
+        then()
     return w
 
 

@@ -135,7 +135,7 @@ class BoneTree(QTreeWidget):
 class BonePanel(QWidget):
     """The bone list (root order, colour, name, joints) and the symmetry plane."""
 
-    COLUMNS = ["#", "Bone", "Proximal", "Distal"]
+    COLUMNS = ["#", "Bone", "Proximal", "Distal", "Points"]
 
     def __init__(self, doc: Document, parent=None):
         super().__init__(parent)
@@ -149,10 +149,12 @@ class BonePanel(QWidget):
         self.tree.setEditTriggers(QAbstractItemView.DoubleClicked | QAbstractItemView.EditKeyPressed)
         self.tree.invisibleRootItem().setFlags(Qt.ItemIsDropEnabled | Qt.ItemIsEnabled)
         self.symmetry = QDoubleSpinBox(decimals=1, minimum=-1e5, maximum=1e5)
+        self.unconnected = QLabel("")
         hint = QLabel("Name joints L_… / R_… so Symmetrize can mirror them. Drag rows to set the root order.")
         hint.setWordWrap(True)
         layout = QVBoxLayout(self)
         layout.addWidget(self.tree)
+        layout.addWidget(self.unconnected)
         form = QFormLayout()
         form.addRow("Symmetry plane x =", self.symmetry)
         layout.addLayout(form)
@@ -165,22 +167,37 @@ class BonePanel(QWidget):
         doc.events.selection.connect(self._on_selection_changed)
         doc.events.symmetry.connect(self._on_symmetry_changed)
         doc.events.skeleton.connect(self._on_symmetry_changed)
+        doc.events.attachments.connect(self._on_counts_changed)
+        doc.events.thinness.connect(self._on_counts_changed)
 
     def _on_bones_changed(self, **_) -> None:
         self.tree.blockSignals(True)
         self.tree.clear()
         for i, b in enumerate(self.doc.bones.bones):
-            item = QTreeWidgetItem([str(i), b.label, b.proximal, b.distal])
+            item = QTreeWidgetItem([str(i), b.label, b.proximal, b.distal, ""])
             pix = QPixmap(14, 14)
             pix.fill(QColor(bone_colour(i)))
             item.setIcon(1, QIcon(pix))
             item.setData(0, Qt.UserRole, i)
             item.setFlags(Qt.ItemIsSelectable | Qt.ItemIsEnabled | Qt.ItemIsEditable | Qt.ItemIsDragEnabled)
             self.tree.addTopLevelItem(item)
+        self.tree.blockSignals(False)
+        self._on_counts_changed()
         for c in range(len(self.COLUMNS)):
             self.tree.resizeColumnToContents(c)
-        self.tree.blockSignals(False)
         self._on_selection_changed()
+
+    def _on_counts_changed(self, **_) -> None:
+        """Points attached per bone, and how many shown points are still unconnected."""
+        if self.doc.skeleton is None:
+            self.unconnected.setText("")
+            return
+        per_bone, unconnected = self.doc.attachments.counts()
+        self.tree.blockSignals(True)
+        for i in range(min(self.tree.topLevelItemCount(), len(per_bone))):
+            self.tree.topLevelItem(i).setText(4, str(int(per_bone[i])))
+        self.tree.blockSignals(False)
+        self.unconnected.setText(f"{unconnected} of {self.doc.visible_count} shown points unconnected")
 
     def _on_selection_changed(self, **_) -> None:
         self.tree.blockSignals(True)

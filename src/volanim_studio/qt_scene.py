@@ -19,7 +19,7 @@ from matplotlib import colormaps
 
 from .model.document import Document
 from .model.modes import PickEvent
-from .model.palette import bone_colour, rgb
+from .model.palette import UNCONNECTED, bone_colour, rgb
 from .scene_projection import nearest_in_radius, project, segment_distance_2d
 
 LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
@@ -50,6 +50,13 @@ class SceneView:
         self._world = np.zeros((0, 3), np.float32)
         self._colours = np.zeros((0, 3), np.uint8)
         self._press = None
+        self._shown = np.zeros(0, np.int64)
+        self._lasso: list | None = None  # display points of the outline being drawn
+        self.lasso_enabled = False
+        self.on_lasso = None  # callback(polygon, ctrl)
+        self._lasso_actor = None
+        self._cube_actor = None
+        self._trackball = None
         self.dragging = False  # the thinness slider is held: draw a level-of-detail subset
         self._render_pending = False
         plotter.set_background("#1e1f24")
@@ -67,6 +74,13 @@ class SceneView:
         ev.bones.connect(self._on_bones_changed)
         ev.selection.connect(self._on_selection_changed)
         ev.picked.connect(self._on_picked_changed)
+        ev.attachments.connect(self._on_attachments_changed)
+        ev.filter.connect(self._on_thinness_changed)
+        ev.cube.connect(self._on_cube_changed)
+        raw = plotter.iren.interactor  # raw VTK observers: they run before the camera style
+        raw.AddObserver("LeftButtonPressEvent", self._lasso_press, 10.0)
+        raw.AddObserver("MouseMoveEvent", self._lasso_move, 10.0)
+        raw.AddObserver("LeftButtonReleaseEvent", self._lasso_release, 10.0)
 
     def _fix_pixel_ratio(self) -> None:
         # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen
@@ -108,10 +122,11 @@ class SceneView:
         """What is under display position ``(x, y)``: point, joint and bone (each may be None)."""
         radius = PICK_RADIUS * self.pixel_ratio()
         point = joint = bone = None
-        n = self.doc.visible_count
-        if n:
-            xy, depth = self.project_world(self._world[:n])
-            point = nearest_in_radius(xy, depth, (x, y), radius)
+        shown = self._shown
+        if len(shown):
+            xy, depth = self.project_world(self._world[shown])
+            k = nearest_in_radius(xy, depth, (x, y), radius)
+            point = None if k is None else int(shown[k])
         names = list(self.doc.bones.joints)
         if names:
             jw = self.world(np.array([self.doc.bones.joints[k] for k in names]))
@@ -132,6 +147,8 @@ class SceneView:
         return self.plotter.iren.interactor.GetEventPosition()
 
     def _on_press(self, obj, event) -> None:
+        if self.lasso_enabled and event.startswith("Left"):
+            return
         self._press = self._event_position()
 
     def _on_release(self, obj, event) -> None:
@@ -231,13 +248,25 @@ class SceneView:
         """RGB per skeleton point for the current colour-by setting."""
         s = self.doc.skeleton
         if self.colour_by == "bone":
-            grey = np.array(rgb("#8c8c8c")) * 255
-            return np.tile(grey.astype(np.uint8), (len(s), 1))
+            return self._bone_rgb()[self.doc.attachments.bone + 1]
         values = s.dt if self.colour_by == "dt" else s.thinness
         lo, hi = float(values.min()), float(values.max())
         t = (values - lo) / (hi - lo) if hi > lo else np.zeros(len(values))
         cmap = colormaps["viridis" if self.colour_by == "dt" else "plasma"]
         return (cmap(t)[:, :3] * 255).astype(np.uint8)
+
+    def _bone_rgb(self) -> np.ndarray:
+        """Row 0: unconnected grey; row b + 1: bone b's colour."""
+        cols = [rgb(UNCONNECTED)] + [rgb(bone_colour(i)) for i in range(len(self.doc.bones))]
+        return (np.array(cols) * 255).astype(np.uint8)
+
+    def _on_attachments_changed(self, indices=None, **_) -> None:
+        if self.colour_by == "bone" and self.doc.skeleton is not None:
+            if indices is None or len(self._colours) != len(self.doc.skeleton):
+                self._recolour()
+            else:
+                self._colours[indices] = self._bone_rgb()[self.doc.attachments.bone[indices] + 1]
+        self._update_cloud()
 
     def set_cloud_style(self, *, colour_by=None, point_size=None, spheres=None) -> None:
         if colour_by is not None:
@@ -255,14 +284,17 @@ class SceneView:
         self._update_cloud()
 
     def _drawn(self) -> tuple[np.ndarray, np.ndarray]:
-        n = self.doc.visible_count
-        if self.dragging and n > LOD_POINTS:
-            idx = np.linspace(0, n - 1, LOD_POINTS).astype(np.int64)
-            return self._world[idx], self._colours[idx]
-        return self._world[:n], self._colours[:n]
+        shown = self._shown
+        if self.dragging and len(shown) > LOD_POINTS:
+            shown = shown[np.linspace(0, len(shown) - 1, LOD_POINTS).astype(np.int64)]
+        elif len(shown) == self.doc.visible_count:  # the plain prefix: slices, no copies
+            n = len(shown)
+            return self._world[:n], self._colours[:n]
+        return self._world[shown], self._colours[shown]
 
     def _update_cloud(self) -> None:
-        n = self.doc.visible_count
+        self._shown = self.doc.shown_indices() if self.doc.skeleton is not None else np.zeros(0, np.int64)
+        n = len(self._shown)
         world, colours = self._drawn()
         if self._cloud_actor is None:
             if not n:
@@ -286,6 +318,11 @@ class SceneView:
         self._update_cloud()
 
     @property
+    def shown(self) -> np.ndarray:
+        """Indices of the skeleton points on screen (thinness prefix, then filters)."""
+        return self._shown
+
+    @property
     def shown_points(self) -> int:
         """How many points the cloud actor draws right now."""
         if self._cloud_actor is None:
@@ -294,6 +331,9 @@ class SceneView:
 
     # ---------------------------------------------------------------- bones
     def _on_bones_changed(self, **_) -> None:
+        if self.colour_by == "bone" and self.doc.skeleton is not None:
+            self._recolour()
+            self._update_cloud()
         for name in ("bones", "joints", "selected"):
             self.plotter.remove_actor(name, render=False)
         self._bones_actor = self._joints_actor = self._selected_actor = None
@@ -315,6 +355,8 @@ class SceneView:
         self._on_selection_changed()
 
     def _on_selection_changed(self, **_) -> None:
+        if self.doc.only_working:
+            self._update_cloud()
         self.plotter.remove_actor("selected", render=False)
         self._selected_actor = None
         sel = [i for i in self.doc.selected_bones if i < len(self.doc.bones)]
@@ -334,6 +376,92 @@ class SceneView:
                 pv.PolyData(self._world[index : index + 1]), color="#00ffff", point_size=self.point_size * 2.5,
                 render_points_as_spheres=True, name="picked", render=False, reset_camera=False)
         self.render()
+
+    # ---------------------------------------------------------------- cube
+    def _on_cube_changed(self, **_) -> None:
+        self.plotter.remove_actor("cube", render=False)
+        self._cube_actor = None
+        if self.doc.cube_centre is not None:
+            c = self.world(self.doc.cube_centre)
+            size = self.doc.cube_size * self.spacing
+            box = pv.Box(bounds=(c[0] - size[0] / 2, c[0] + size[0] / 2, c[1] - size[1] / 2, c[1] + size[1] / 2,
+                                 c[2] - size[2] / 2, c[2] + size[2] / 2))
+            self._cube_actor = self.plotter.add_mesh(box, style="wireframe", color="#00ffff", line_width=2,
+                                                     name="cube", render=False, reset_camera=False, pickable=False)
+        self.render()
+
+    # ---------------------------------------------------------------- lasso
+    def set_lasso_enabled(self, on: bool) -> None:
+        """In lasso mode a left drag draws an outline; the camera keeps the wheel only."""
+        import vtk
+
+        iren = self.plotter.iren.interactor
+        if on and not self.lasso_enabled:
+            self._trackball = iren.GetInteractorStyle()
+            iren.SetInteractorStyle(vtk.vtkInteractorStyleUser())
+        elif not on and self.lasso_enabled and self._trackball is not None:
+            iren.SetInteractorStyle(self._trackball)
+        self.lasso_enabled = bool(on)
+
+    def _lasso_press(self, obj, event) -> None:
+        if self.lasso_enabled:
+            self._lasso = [self._event_position()]
+
+    def _lasso_move(self, obj, event) -> None:
+        if self.lasso_enabled and self._lasso is not None:
+            self._lasso.append(self._event_position())
+            self._draw_lasso()
+
+    def _lasso_release(self, obj, event) -> None:
+        if not self.lasso_enabled or self._lasso is None:
+            return
+        polygon = np.asarray(self._lasso + [self._event_position()], np.float64)
+        self._lasso = None
+        self._draw_lasso()
+        ctrl = bool(self.plotter.iren.interactor.GetControlKey())
+        if self.on_lasso is not None and len(polygon) >= 3:
+            self.on_lasso(polygon, ctrl)
+
+    def _draw_lasso(self) -> None:
+        import vtk
+
+        ren = self.plotter.renderer
+        if self._lasso_actor is not None:
+            ren.RemoveViewProp(self._lasso_actor)
+            self._lasso_actor = None
+        if self._lasso and len(self._lasso) > 1:
+            pts = vtk.vtkPoints()
+            for x, y in self._lasso:
+                pts.InsertNextPoint(x, y, 0)
+            line = vtk.vtkPolyLine()
+            line.GetPointIds().SetNumberOfIds(len(self._lasso) + 1)
+            for i in range(len(self._lasso)):
+                line.GetPointIds().SetId(i, i)
+            line.GetPointIds().SetId(len(self._lasso), 0)
+            cells = vtk.vtkCellArray()
+            cells.InsertNextCell(line)
+            poly = vtk.vtkPolyData()
+            poly.SetPoints(pts)
+            poly.SetLines(cells)
+            mapper = vtk.vtkPolyDataMapper2D()
+            mapper.SetInputData(poly)
+            actor = vtk.vtkActor2D()
+            actor.SetMapper(mapper)
+            actor.GetProperty().SetColor(1.0, 0.85, 0.2)
+            actor.GetProperty().SetLineWidth(2)
+            ren.AddViewProp(actor)
+            self._lasso_actor = actor
+        self.render()
+
+    def shown_projection(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(shown indices, display xy, normalised depth, distance along the view)`` of the shown points."""
+        shown = self._shown
+        world = self._world[shown].astype(np.float64)
+        xy, depth = self.project_world(world)
+        cam = self.plotter.renderer.GetActiveCamera()
+        pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
+        direction = (focal - pos) / max(np.linalg.norm(focal - pos), 1e-12)
+        return shown, xy, depth, (world - pos) @ direction
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once.

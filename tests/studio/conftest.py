@@ -41,6 +41,14 @@ def clickable_point(window, near_voxel) -> int:
     raise AssertionError(f"no clickable point near {near_voxel}")
 
 
+@pytest.fixture(autouse=True)
+def recovery_dir(tmp_path, monkeypatch):
+    """Autosaves go to a test folder, never to the user's cache."""
+    folder = tmp_path / "recovery"
+    monkeypatch.setenv("VOLANIM_RECOVERY_DIR", str(folder))
+    return folder
+
+
 @pytest.fixture
 def window(qtbot):
     from volanim_studio.qt_main_window import MainWindow
@@ -54,6 +62,7 @@ def window(qtbot):
     qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     w.load_demo("mannequin")
     qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     front_view(w)
     yield w
     w.close()

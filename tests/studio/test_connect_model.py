@@ -84,10 +84,11 @@ def test_lasso_mode_connects_working_bone(doc):
     doc.select_bones([0])
     shown = doc.shown_indices()
     xy = doc.skeleton.points[shown][:, [0, 2]].astype(float)  # a front view: x across, z up
-    n = mode.finish([(-1, 199.5), (300, 199.5), (300, 400), (-1, 400)], xy, np.zeros(len(xy)), np.zeros(len(xy)), shown)
+    outline = [(-1, 199.5), (300, 199.5), (300, 400), (-1, 400)]
+    zeros = np.zeros(len(xy))
+    n = mode.finish(outline, xy, zeros, zeros, shown)
     assert n == int((doc.skeleton.points[shown][:, 2] >= 200).sum())
-    n2 = mode.finish([(-1, 199.5), (300, 199.5), (300, 400), (-1, 400)], xy, np.zeros(len(xy)), np.zeros(len(xy)), shown,
-                     remove=True)
+    n2 = mode.finish(outline, xy, zeros, zeros, shown, remove=True)
     assert n2 == n and (doc.attachments.bone == -1).all()
 
 

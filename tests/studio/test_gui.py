@@ -194,6 +194,22 @@ for p in pts:
     QTest.mouseClick(w.plotter, Qt.LeftButton, Qt.NoModifier, pos)
 a, b = w.doc.bones.segment(0)
 assert np.array_equal(a, w.doc.skeleton.points[pts[0]]) and np.array_equal(b, w.doc.skeleton.points[pts[1]])
+# the lasso at DPR 2: an outline drawn with the mouse around one point's projection selects it
+w.doc.select_bones([0])
+w.set_mode("lasso")
+w.connect_panel.depth.setCurrentText("through")
+target = clickable_point(w, J["L_ANKLE"])
+vx, vy = w.scene.display_of_point(target)
+s = w.plotter.devicePixelRatioF()
+r = 6.0  # device pixels: tighter than the points' spacing on screen
+ring = [(vx + r * np.cos(t), vy + r * np.sin(t)) for t in np.linspace(0, 2 * np.pi, 12)]
+q = [QPoint(round(x / s), round(w.plotter.height() - 1 - y / s)) for x, y in ring]
+QTest.mousePress(w.plotter, Qt.LeftButton, Qt.NoModifier, q[0])
+for p in q[1:]:
+    QTest.mouseMove(w.plotter, p)
+QTest.mouseRelease(w.plotter, Qt.LeftButton, Qt.NoModifier, q[-1])
+got = np.flatnonzero(w.doc.attachments.bone == 0)
+assert target in got and len(got) <= 4, got
 print("HIDPI-OK")
 w.close()
 """

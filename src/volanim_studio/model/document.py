@@ -60,6 +60,7 @@ class Document:
         self.picked_point: int | None = None
         self._symmetry_x: float | None = None
         self.project_path: str | None = None
+        self.demo_name: str | None = None  # a session opened on a demo dataset reopens it
         self._joint_counter = 0
         self.attachments = Attachments(self)
         self.only_unconnected = False
@@ -415,17 +416,37 @@ class Document:
     def save_project(self, path, camera: dict | None = None) -> Path:
         """Write ``NAME.volanim`` (JSON) plus the data it names that exists only in memory.
 
-        The bone skeleton is written to ``NAME.bones``; a skeleton computed in
+        The bone skeleton goes to ``NAME.bones``, the attachments (all of them,
+        whatever the slider) to ``NAME.connect``, and a skeleton computed in
         this session (no ``.mskel`` on disk yet) to ``NAME.mskel``.
         """
         path = Path(path)
         if path.suffix != ".volanim":
             path = path.with_suffix(".volanim")
+        written = self.write_project(path, camera)
+        self.bones_path = written["bones"]
+        self.mskel_path = written["mskel"]
+        self.project_path = str(path)
+        self.events.project.emit(path=str(path))
+        return path
+
+    def write_project(self, path, camera: dict | None = None, *, mskel: str | None = None) -> dict:
+        """Write the project files without adopting their paths (autosave uses this).
+
+        ``mskel``: a skeleton file to name instead of writing one.
+        """
+        path = Path(path)
         stem = path.with_suffix("")
-        self.save_bones(f"{stem}.bones")
-        if self.skeleton is not None and not self.mskel_path:
-            io.write_mskel(f"{stem}.mskel", self.skeleton)
-            self.mskel_path = f"{stem}.mskel"
+        bones_path = f"{stem}.bones"
+        io.write_bones(bones_path, self.bones)
+        mskel_path = mskel or self.mskel_path
+        if self.skeleton is not None and not mskel_path:
+            mskel_path = f"{stem}.mskel"
+            io.write_mskel(mskel_path, self.skeleton)
+        connect = None
+        if len(self.attachments.bone) and (self.attachments.bone >= 0).any():
+            connect = f"{stem}.connect"
+            io.write_connect(connect, self.attachments.to_connectivity())
 
         def rel(p):
             if not p:
@@ -436,16 +457,14 @@ class Document:
                 return str(Path(p).resolve())
 
         data = {
-            "format": PROJECT_FORMAT, "version": 1,
+            "format": PROJECT_FORMAT, "version": 1, "demo": self.demo_name,
             "volume": rel(self.volume_path), "volume_dims": list(self.volume_dims) if self.volume_dims else None,
             "threshold": list(self.threshold) if self.threshold else None,
-            "mskel": rel(self.mskel_path), "bones": rel(self.bones_path),
+            "mskel": rel(mskel_path), "bones": rel(bones_path), "connect": rel(connect),
             "thinness": self._thinness, "symmetry_x": self._symmetry_x, "camera": camera,
         }
         atomic_write_text(path, json.dumps(data, indent=2) + "\n")
-        self.project_path = str(path)
-        self.events.project.emit(path=str(path))
-        return path
+        return {"project": str(path), "bones": bones_path, "mskel": mskel_path, "connect": connect}
 
 
 def read_project(path) -> dict:

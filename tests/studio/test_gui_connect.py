@@ -1,0 +1,184 @@
+"""Studio II with real widgets: cube, lasso (real mouse drags), mirror, autosave, crash recovery."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+from volanim_core import io, samples
+from volanim_core.skeleton import Skeleton
+from volanim_studio.model.modes import Mode
+from volanim_studio.model.palette import bone_colour, rgb
+
+from .conftest import click, clickable_point
+
+pytestmark = pytest.mark.gui
+ASSETS = Path(__file__).parents[2] / "assets"
+J = samples.mannequin_bones().joints
+
+
+def qpos(window, xy) -> QPoint:
+    w = window.plotter
+    s = w.devicePixelRatioF()
+    return QPoint(int(round(xy[0] / s)), int(round(w.height() - 1 - xy[1] / s)))
+
+
+def drag_lasso(qtbot, window, polygon, modifier=Qt.NoModifier) -> None:
+    """Press, move through the outline and release, as a user's mouse would."""
+    w = window.plotter
+    pts = [qpos(window, p) for p in polygon]
+    qtbot.mousePress(w, Qt.LeftButton, modifier, pts[0])
+    for p in pts[1:]:
+        qtbot.mouseMove(w, p)
+    qtbot.mouseRelease(w, Qt.LeftButton, modifier, pts[0])
+
+
+def test_cube_connect_changes_colours_and_counts(qtbot, window):
+    assert window.open_bones(ASSETS / "mannequin.bones")
+    qtbot.keyClick(window, Qt.Key_K)
+    assert window.mode == Mode.CUBE and window.scene.colour_by == "bone"
+    p = clickable_point(window, J["L_ELBOW"])
+    click(qtbot, window, window.scene.display_of_point(p))
+    assert np.array_equal(window.doc.cube_centre, window.doc.skeleton.points[p])
+    forearm = window.doc.bones.index("L_FOREARM")
+    window.bone_panel.tree.topLevelItem(forearm).setSelected(True)
+    assert window.doc.working_bone == forearm and "L_FOREARM" in window.connect_panel.working.text()
+    qtbot.mouseClick(window.connect_panel.cube_connect, Qt.LeftButton)
+    inside = np.flatnonzero(window.doc.attachments.bone == forearm)
+    assert len(inside) > 0 and p in inside
+    want = (np.array(rgb(bone_colour(forearm))) * 255).astype(np.uint8)
+    assert (window.scene._colours[inside] == want).all()
+    assert window.bone_panel.tree.topLevelItem(forearm).text(4) == str(len(inside))
+    unconnected = window.doc.visible_count - len(inside)
+    assert window.bone_panel.unconnected.text().startswith(f"{unconnected} of")
+    qtbot.keyClick(window, Qt.Key_Right)  # nudge, then remove with X
+    qtbot.keyClick(window, Qt.Key_X)
+    assert (window.doc.attachments.bone == forearm).sum() < len(inside)
+    qtbot.keyClick(window, Qt.Key_Z, Qt.ControlModifier)
+    assert (window.doc.attachments.bone == forearm).sum() == len(inside)
+
+
+@pytest.fixture
+def depth_scene(window):
+    """Front block F (y=10), back block B right behind it (y=60) and a side block S (y=40) not behind F."""
+    g = np.stack(np.meshgrid(np.arange(0, 10, 2), [0], np.arange(0, 10, 2), indexing="ij"), -1).reshape(-1, 3)
+    front, back = g + [40, 10, 140], g + [40, 60, 140]
+    side = g[:5] + [60, 40, 140]
+    pts = np.vstack([front, back, side]).astype(np.int32)
+    doc = window.doc
+    doc.set_skeleton(Skeleton(pts, np.ones(len(pts)), np.ones(len(pts))))
+    doc.set_hull(None, None)
+    doc.add_bone((45, 30, 120), (45, 30, 160))
+    doc.select_bones([0])
+    window.plotter.enable_parallel_projection()
+    window.scene.front_view()
+    window.set_mode(Mode.LASSO)
+    window.display_panel.point_size.setValue(10)
+    n = len(front)
+    return window, (set(range(n)), set(range(n, 2 * n)), set(range(2 * n, len(pts))))
+
+
+@pytest.mark.parametrize("mode", ["through", "visible", "slab"])
+def test_lasso_depth_modes(qtbot, depth_scene, mode):
+    window, (front, back, side) = depth_scene
+    window.connect_panel.depth.setCurrentText(mode)
+    window.connect_panel.slab.setValue(15)
+    xy, _ = window.scene.project_world(window.scene._world)
+    lo, hi = xy.min(0) - 15, xy.max(0) + 15
+    drag_lasso(qtbot, window, [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])])
+    got = set(np.flatnonzero(window.doc.attachments.bone == 0).tolist())
+    want = {"through": front | back | side, "visible": front | side, "slab": front}[mode]
+    assert got == want
+    drag_lasso(qtbot, window, [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])],
+               Qt.ControlModifier)  # Ctrl removes
+    assert (window.doc.attachments.bone == -1).all()
+
+
+def test_auto_connect_and_mirror_in_the_gui(qtbot, window):
+    assert window.open_bones(ASSETS / "mannequin.bones")
+    window.connect_panel.scope.setCurrentText("all")
+    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    doc = window.doc
+    assert (doc.attachments.bone[: doc.visible_count] >= 0).all()
+    left, right = doc.bones.index("L_FOREARM"), doc.bones.index("R_FOREARM")
+    n_left = int((doc.attachments.bone == left).sum())
+    doc.attachments.assign(np.flatnonzero(doc.attachments.bone == right), -1)
+    window.bone_panel.tree.topLevelItem(left).setSelected(True)
+    qtbot.mouseClick(window.connect_panel.mirror_button, Qt.LeftButton)
+    assert int((doc.attachments.bone == right).sum()) == n_left
+    window.connect_panel.only_unconnected.setChecked(True)
+    assert window.scene.shown_points == int((doc.attachments.bone[: doc.visible_count] < 0).sum())
+
+
+def test_save_connect_quit_reopen_and_continue(qtbot, window, tmp_path):
+    assert window.open_bones(ASSETS / "mannequin.bones")
+    window.doc.attachments.auto(scope="all")
+    path = window.save_project(path=tmp_path / "man.volanim")
+    saved = window.save_connect(tmp_path / window.doc.attachments.default_filename("man"))
+    assert saved.name.startswith("man.") and saved.suffix == ".connect"
+    before = window.doc.attachments.bone.copy()
+    from volanim_studio.qt_main_window import MainWindow
+
+    other = MainWindow()
+    qtbot.addWidget(other)
+    other.open_project(path)
+    qtbot.waitUntil(lambda: not other.busy, timeout=60000)
+    assert np.array_equal(other.doc.attachments.bone, before)
+    other.close()
+
+
+def test_autosave_file_appears(qtbot, window, recovery_dir):
+    assert window.open_bones(ASSETS / "mannequin.bones")
+    for i in range(5):
+        window.doc.attachments.assign([i], 0)
+    files = list(recovery_dir.glob("*/recovery.volanim"))
+    assert len(files) == 1
+    assert io.read_bones(files[0].with_suffix(".bones")) == window.doc.bones
+    window.close()
+    assert not list(recovery_dir.glob("*/recovery.volanim"))  # a clean exit leaves nothing to recover
+
+
+CRASH = """
+import os, sys
+from PySide6.QtWidgets import QApplication
+app = QApplication([])
+from volanim_studio.qt_main_window import MainWindow
+w = MainWindow(autosave_every_edits=1)
+w.show()
+w.load_demo("mannequin")
+while w.busy:
+    app.processEvents()
+w.open_bones(sys.argv[1])
+w.doc.attachments.auto(scope="all")
+print("EDITED", int((w.doc.attachments.bone >= 0).sum()), flush=True)
+os._exit(3)  # a crash: no close, no cleanup
+"""
+
+
+def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
+    script = tmp_path / "crash.py"
+    script.write_text(textwrap.dedent(CRASH))
+    out = subprocess.run([sys.executable, str(script), str(ASSETS / "mannequin.bones")], capture_output=True,
+                         text=True, timeout=300, env=dict(os.environ))
+    assert out.returncode == 3 and "EDITED" in out.stdout, (out.returncode, out.stdout, out.stderr[-2000:])
+    attached = int(out.stdout.split("EDITED")[1].split()[0])
+    listing = sorted(str(p.relative_to(recovery_dir)) for p in recovery_dir.rglob("*"))
+    from volanim_studio.qt_main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    asked = []
+    w.offer_recovery(ask=lambda p: asked.append(p) or True)
+    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    assert asked, listing
+    assert len(w.doc.bones) == 18, (listing, w.last_error)
+    assert int((w.doc.attachments.bone >= 0).sum()) == attached, (listing, w.last_error)
+    assert len(list(recovery_dir.glob("*/recovery.volanim"))) == 0  # the crashed session's copy is gone
+    w.close()
