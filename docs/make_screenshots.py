@@ -60,6 +60,19 @@ def main() -> None:
     for _ in range(5):
         app.processEvents()
     grab(w, HERE / "studio-thinness.png")
+
+    # Connect: auto-connect, then a lasso being drawn over the left shoulder
+    w.display_panel.thinness_slider.setValue(0)
+    w.doc.attachments.auto(scope="all")
+    w.doc.select_bones([w.doc.bones.index("L_UPPERARM")])
+    w.set_mode(Mode.LASSO)
+    w.display_panel.point_size.setValue(5)
+    c = w.scene.project_world(w.scene.world(np.array([samples.mannequin_bones().joints["L_SHOULDER"]])))[0][0]
+    w.scene._lasso = [(c[0] + 40 * np.cos(t), c[1] + 30 * np.sin(t)) for t in np.linspace(0, 2 * np.pi, 40)]
+    w.scene._draw_lasso()
+    for _ in range(5):
+        app.processEvents()
+    grab(w, HERE / "studio-connect.png")
     w.close()
 
 

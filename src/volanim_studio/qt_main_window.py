@@ -82,6 +82,8 @@ class MainWindow(QMainWindow):
         self._build_actions()
         self.doc.events.message.connect(lambda text: self.statusBar().showMessage(text, 15000))
         self.doc.events.picked.connect(self._on_picked_changed)
+        self.doc.events.attachments.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
+        self.doc.events.bones.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.undo.events.changed.connect(self._on_undo_changed)
         self.doc.events.project.connect(lambda path: self.setWindowTitle(f"volanim studio — {Path(path).name}"))
         self.autosaver = autosave.Autosaver(self.doc, every_edits=autosave_every_edits,
@@ -290,7 +292,7 @@ class MainWindow(QMainWindow):
         self.doc.message(f"Mirrored to {', '.join(written)} across x = {self.doc.symmetry_x:g}.")
 
     def _on_picked_changed(self, index=None, **_) -> None:
-        if index is None:
+        if index is None or self.doc.skeleton is None or index >= len(self.doc.skeleton):
             self.point_label.setText("")
             return
         i = self.doc.point_info(index)

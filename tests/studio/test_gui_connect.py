@@ -56,6 +56,7 @@ def test_cube_connect_changes_colours_and_counts(qtbot, window):
     want = (np.array(rgb(bone_colour(forearm))) * 255).astype(np.uint8)
     assert (window.scene._colours[inside] == want).all()
     assert window.bone_panel.tree.topLevelItem(forearm).text(4) == str(len(inside))
+    assert window.point_label.text().endswith("bone L_FOREARM")  # the status bar follows the attachment
     unconnected = window.doc.visible_count - len(inside)
     assert window.bone_panel.unconnected.text().startswith(f"{unconnected} of")
     qtbot.keyClick(window, Qt.Key_Right)  # nudge, then remove with X
