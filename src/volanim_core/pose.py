@@ -53,7 +53,7 @@ def _order(parents: list[int | None]) -> list[int]:
     return done
 
 
-def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None) -> np.ndarray:
+def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None, translations: dict | None = None) -> np.ndarray:
     """Forward kinematics: ``(B, 4, 4)`` matrices, rest voxel coordinates -> posed.
 
     Parameters
@@ -62,6 +62,9 @@ def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None) -> np.ndar
     rotations : dict, optional
         Bone index or name -> 3x3 rotation matrix (column convention) or three
         Euler angles in degrees, applied about the bone's proximal joint.
+    translations : dict, optional
+        Bone index or name -> a shift (voxels) applied after its rotation; its
+        children move with it (a root's walk in motion data).
     """
     n = len(bones)
     local = [np.eye(3) for _ in range(n)]
@@ -73,12 +76,44 @@ def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None) -> np.ndar
         local[i] = euler(rot) if rot.shape == (3,) else rot
         if local[i].shape != (3, 3):
             raise ValueError(f"rotation of bone {key!r} must be 3x3 or three angles")
+    shift = [np.zeros(3) for _ in range(n)]
+    for key, t in (translations or {}).items():
+        i = key if isinstance(key, int | np.integer) else bones.index(key)
+        shift[i] = np.asarray(t, np.float64).reshape(3)
     parents = bones.parents()
     out = np.zeros((n, 4, 4))
     for i in _order(parents):
         m = rotation_about(bones.joints[bones.bones[i].proximal], local[i])
+        m[3, :3] += shift[i]
         out[i] = m if parents[i] is None else m @ out[parents[i]]
     return out
+
+
+def local_motion(bones: BoneSkeleton, matrices: np.ndarray) -> tuple[dict, dict]:
+    """Invert :func:`pose_matrices`: per bone, Euler angles (degrees) and the shift that give ``matrices``.
+
+    Loading a ``.trans`` into the pose sliders uses this; for matrices made
+    by FK it round-trips exactly (up to float rounding).
+    """
+    parents = bones.parents()
+    angles, shifts = {}, {}
+    for i, b in enumerate(bones.bones):
+        m = np.asarray(matrices[i], np.float64)
+        local = m if parents[i] is None else m @ np.linalg.inv(matrices[parents[i]])
+        r = local[:3, :3].T  # row-vector matrix -> column-convention rotation
+        u, _, vt = np.linalg.svd(r)  # nearest rotation, in case of float drift
+        r = u @ vt
+        angles[i] = Rotation.from_matrix(r).as_euler("xyz", degrees=True)
+        j = bones.joints[b.proximal]
+        shifts[i] = local[3, :3] - (j - j @ r.T)
+    return angles, shifts
+
+
+def scaled(matrices: np.ndarray, factor: float) -> np.ndarray:
+    """Matrices followed by a uniform scale 1/factor: a ``factor``-times coarser output grid (previews)."""
+    s = np.eye(4)
+    s[:3, :3] /= factor
+    return np.asarray(matrices) @ s
 
 
 def root_bones(bones: BoneSkeleton) -> list[RootBone]:

@@ -23,8 +23,10 @@ from . import tasks
 from .model import autosave
 from .model.document import Document, read_project
 from .model.modes import HANDLERS, Mode, PickEvent
+from .model.preview import make_preview
 from .qt_connect_panel import ConnectPanel
 from .qt_panels import BonePanel, DisplayPanel
+from .qt_pose_panel import PosePanel, ReconstructPanel
 from .qt_scene import SceneView
 from .qt_threshold_dialog import ThresholdDialog
 from .qt_worker import Worker
@@ -36,6 +38,8 @@ SHORTCUTS = [
     ("K", "Cube mode: click a point to place the cube; arrows / PgUp / PgDn nudge, +/- size, C connect, X remove"),
     ("L", "Lasso mode: drag an outline to connect the points under it to the working bone (Ctrl: remove)"),
     ("Ctrl+A", "Auto-connect"),
+    ("P", "Pose mode: click a bone, turn it with the Pose sliders; the preview follows live"),
+    ("F5", "Preview the reconstruction at full resolution, with the breakage report"),
     ("Esc", "End the bone chain / restart the root order"),
     ("Right click", "End the bone chain"),
     ("Delete", "Remove the selected bones"),
@@ -67,11 +71,18 @@ class MainWindow(QMainWindow):
         self.display_panel = DisplayPanel(self.doc, self.scene)
         self.bone_panel = BonePanel(self.doc)
         self.connect_panel = ConnectPanel(self.doc, self.handlers[Mode.CUBE], self.handlers[Mode.LASSO])
+        self.pose_panel = PosePanel(self.doc)
+        self.reconstruct_panel = ReconstructPanel(self.doc)
         self.scene.on_lasso = self.handle_lasso
         tabs = self.panel_tabs = QTabWidget()
         tabs.addTab(self.bone_panel, "Bones")
         tabs.addTab(self.connect_panel, "Connect")
+        tabs.addTab(self.pose_panel, "Pose")
+        tabs.addTab(self.reconstruct_panel, "Reconstruct")
         tabs.addTab(self.display_panel, "Display")
+        self._posing_drag = False
+        self._rest_preview = None
+        self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
         tabs.setMinimumWidth(420)
         dock = QDockWidget("Panels", self)
         dock.setWidget(tabs)
@@ -182,7 +193,7 @@ class MainWindow(QMainWindow):
         self.mode_actions = {}
         for mode, text, key in ((Mode.VIEW, "View", "V"), (Mode.BONES, "Bones", "B"),
                                 (Mode.ROOT_ORDER, "Root order", "R"), (Mode.CUBE, "Cube", "K"),
-                                (Mode.LASSO, "Lasso", "L")):
+                                (Mode.LASSO, "Lasso", "L"), (Mode.POSE, "Pose", "P")):
             a = self._action(text, lambda _=False, m=mode: self.set_mode(m), key, checkable=True, menu=modes)
             group.addAction(a)
             toolbar.addAction(a)
@@ -203,6 +214,32 @@ class MainWindow(QMainWindow):
         self._action("Mirror connectivity of selected bones", self.mirror_connectivity, menu=connect_menu)
         self._action("Save .connect…", lambda: self._save_dialog("connect"), menu=connect_menu)
         self._action("Open .connect…", lambda: self._open_dialog("connect"), menu=connect_menu)
+        pose = bar.addMenu("&Pose")
+        self._action("Preview reconstruction", lambda: self.preview(), "F5", menu=pose)
+        self._action("Reset pose", lambda: self.doc.pose.reset(), menu=pose)
+        self._action("Load pose (.trans)…", lambda: self._open_dialog("trans"), menu=pose)
+        self._action("Save pose (.trans)…", lambda: self._save_dialog("trans"), menu=pose)
+        self._action("Save frame (.tskel)…", lambda: self._save_dialog("tskel"), menu=pose)
+        self._action("Export reconstruction…", lambda: self._save_dialog("volume"), menu=pose)
+        self.pose_panel.drag_started.connect(self._pose_drag_started)
+        self.pose_panel.drag_finished.connect(self._pose_drag_finished)
+        self.pose_panel.load_trans.clicked.connect(lambda: self._open_dialog("trans"))
+        self.pose_panel.save_trans.clicked.connect(lambda: self._save_dialog("trans"))
+        self.pose_panel.save_tskel.clicked.connect(lambda: self._save_dialog("tskel"))
+        rp = self.reconstruct_panel
+        rp.preview_button.clicked.connect(lambda: self.preview())
+        rp.show_rest.toggled.connect(lambda _: self._draw_preview())
+        rp.slices.toggled.connect(self._slices_toggled)
+        rp.export_button.clicked.connect(lambda: self._save_dialog("volume"))
+        rp.joint_clicked.connect(self.jump_to_joint)
+        self.doc.events.pose.connect(self._on_pose_changed)
+        self.doc.events.preview.connect(lambda **_: self._draw_preview())
+        self.doc.events.attachments.connect(self._forget_rest)
+        self.doc.events.bones.connect(self._forget_rest)
+        self._live_timer = QTimer(self)
+        self._live_timer.setSingleShot(True)
+        self._live_timer.setInterval(0)
+        self._live_timer.timeout.connect(self.live_preview)
         self.connect_panel.auto_button.clicked.connect(self.auto_connect)
         self.connect_panel.mirror_button.clicked.connect(self.mirror_connectivity)
         help_menu = bar.addMenu("&Help")
@@ -214,6 +251,9 @@ class MainWindow(QMainWindow):
         self.mode = Mode(mode)
         self.mode_actions[self.mode].setChecked(True)
         self.scene.set_lasso_enabled(self.mode == Mode.LASSO)
+        self.scene.set_posing(self.mode == Mode.POSE)
+        if self.mode == Mode.POSE:
+            self.panel_tabs.setCurrentWidget(self.pose_panel)
         for a in getattr(self, "cube_actions", []):
             a.setEnabled(self.mode == Mode.CUBE)
         if self.mode in (Mode.CUBE, Mode.LASSO):
@@ -226,6 +266,120 @@ class MainWindow(QMainWindow):
         shown, xy, depth, view_depth = self.scene.shown_projection()
         lasso = self.handlers[Mode.LASSO]
         lasso.finish(polygon, xy, depth, view_depth, shown, remove=True if ctrl else None)
+
+    # -------------------------------------------------------------- posing
+    def _pose_drag_started(self) -> None:
+        self._posing_drag = True
+        if self.worker is not None and getattr(self.worker, "is_preview", False):
+            self.worker.cancel()  # a newer pose is coming
+
+    def _pose_drag_finished(self) -> None:
+        self._posing_drag = False
+        if self.mode == Mode.POSE and len(self.doc.attachments.bone) and (self.doc.attachments.bone >= 0).any():
+            self.preview()
+
+    def _on_pose_changed(self, **_) -> None:
+        if self._posing_drag and self.reconstruct_panel.live.isChecked():
+            self._live_timer.start()  # coalesced: one live preview per event-loop pass
+
+    def live_preview(self) -> None:
+        """Half-resolution binary or bone preview on the GUI thread (tens of ms on the mannequin)."""
+        import time
+
+        t0 = time.perf_counter()
+        mode = self.reconstruct_panel.mode.currentText()
+        mode = mode if mode in ("binary", "bone") else "bone"
+        try:
+            p = make_preview(self.doc.pose.tskel(), mode=mode, factor=2, padding=2)
+        except ValueError as exc:
+            self.doc.message(str(exc))
+            return
+        self.doc.set_preview(p)
+        self.plotter.render()
+        self.live_timings.append(time.perf_counter() - t0)
+
+    def preview(self, *, report: bool = True) -> Worker | None:
+        """Full-resolution reconstruction with the breakage report, in the background."""
+        settings = self.reconstruct_panel.settings()
+        if self.worker is not None:
+            self.doc.message("A job is running; preview again when it ends.")
+            return None
+        if settings["mode"] == "sampled" and self.doc.volume is None:
+            self.show_error("Preview", "sampled mode needs the volume: open it (File → Open volume)")
+            return None
+        try:
+            tskel = self.doc.pose.tskel()
+            if not len(tskel):
+                raise ValueError("no attached points to reconstruct: connect points to bones first (Connect tab)")
+        except ValueError as exc:
+            self.show_error("Preview", str(exc))
+            return None
+        joints = dict(self.doc.bones.joints)
+        posed = self.doc.pose.posed_joints()
+        source = self.doc.volume if settings["mode"] == "sampled" else None
+        worker = self.run_task("Reconstructing", lambda progress, cancel: make_preview(
+            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report,
+            progress=progress, cancel=cancel), self.doc.set_preview)
+        worker.is_preview = True
+        return worker
+
+    def _forget_rest(self, **_) -> None:
+        self._rest_preview = None
+
+    def _draw_preview(self) -> None:
+        p = self.doc.preview
+        if self.reconstruct_panel.show_rest.isChecked():
+            if self._rest_preview is None and len(self.doc.attachments.bone):
+                from volanim_core.tskel import identity_tskel
+
+                try:
+                    rest = identity_tskel(self.doc.pose.tskel().connectivity)
+                    mode = p.mode if p is not None else "bone"
+                    self._rest_preview = make_preview(rest, mode=mode, source=self.doc.volume)
+                except ValueError as exc:
+                    self.doc.message(str(exc))
+                    return
+            p = self._rest_preview
+        if p is None:
+            self.scene.clear_volume()
+            return
+        self.scene.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+
+    def _slices_toggled(self, on: bool) -> None:
+        self.scene.slices = on
+        self._draw_preview()
+
+    def jump_to_joint(self, name: str) -> None:
+        posed = self.doc.pose.posed_joints()
+        if name in posed:
+            self.scene.jump_to(posed[name])
+            self.doc.message(f"Centred on {name}. Fix the points there (Lasso, L), then preview again (F5).")
+
+    def export_preview(self, path) -> bool:
+        p = self.doc.preview
+        if p is None:
+            self.show_error("Export", "nothing to export: preview first (F5)")
+            return False
+        vol = p.reconstruction.volume
+        if str(path).lower().endswith(".vol") and vol.dtype != np.uint8:
+            vol = np.minimum(vol, 255).astype(np.uint8)
+        try:
+            io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing)
+        except (OSError, ValueError) as exc:
+            self.show_error("Export", str(exc))
+            return False
+        self.doc.message(f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; "
+                         f"origin {tuple(int(v) for v in p.origin_voxels)}.")
+        return True
+
+    def load_trans(self, path) -> bool:
+        try:
+            self.doc.pose.load_trans(path)
+        except (FormatError, ValueError) as exc:
+            self.show_error("Load pose", str(exc))
+            return False
+        self.doc.message(f"Loaded the pose from {Path(path).name}.")
+        return True
 
     def auto_connect(self) -> None:
         p = self.connect_panel
@@ -469,11 +623,11 @@ class MainWindow(QMainWindow):
 
     def _open_dialog(self, kind: str) -> None:
         filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
-                   "connect": "Connectivity (*.connect)"}
+                   "connect": "Connectivity (*.connect)", "trans": "Poses (*.trans)"}
         path, _ = QFileDialog.getOpenFileName(self, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
         if path:
             {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project,
-             "connect": self.open_connect}[kind](path)
+             "connect": self.open_connect, "trans": self.load_trans}[kind](path)
 
     # -------------------------------------------------------------- saving
     def camera(self) -> dict:
@@ -517,6 +671,26 @@ class MainWindow(QMainWindow):
     def _save_dialog(self, kind: str) -> None:
         if kind == "connect":
             self.save_connect()
+            return
+        if kind in ("trans", "tskel", "volume"):
+            filters = {"trans": "Poses (*.trans)", "tskel": "Frames (*.tskel)",
+                       "volume": "Volumes (*.vti *.nrrd *.VOL *.vol)"}
+            default = {"trans": "pose.trans", "tskel": "pose.tskel", "volume": "preview.vti"}[kind]
+            path, _ = QFileDialog.getSaveFileName(self, f"Save {kind}", default, filters[kind])
+            if not path:
+                return
+            if kind == "volume":
+                self.export_preview(path)
+                return
+            try:
+                if kind == "trans":
+                    self.doc.pose.save_trans(path)
+                else:
+                    self.doc.pose.save_tskel(path)
+            except (OSError, ValueError) as exc:
+                self.show_error(f"Save {kind}", str(exc))
+                return
+            self.doc.message(f"Saved {path}.")
             return
         filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
         path, _ = QFileDialog.getSaveFileName(self, f"Save {kind}", f"untitled.{kind}", filters[kind])

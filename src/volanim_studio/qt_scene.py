@@ -16,10 +16,12 @@ from collections.abc import Callable
 import numpy as np
 import pyvista as pv
 from matplotlib import colormaps
+from matplotlib.colors import ListedColormap
 
 from .model.document import Document
 from .model.modes import PickEvent
 from .model.palette import UNCONNECTED, bone_colour, rgb
+from .scene_preview import apply_labels, binary_view, rgb255, volume_style
 from .scene_projection import nearest_in_radius, project, segment_distance_2d
 
 LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
@@ -57,6 +59,10 @@ class SceneView:
         self._lasso_actor = None
         self._cube_actor = None
         self._trackball = None
+        self._preview_actor = None
+        self._preview_key = None
+        self.posing = False
+        self.slices = False
         self.dragging = False  # the thinness slider is held: draw a level-of-detail subset
         self._render_pending = False
         plotter.set_background("#1e1f24")
@@ -77,6 +83,7 @@ class SceneView:
         ev.attachments.connect(self._on_attachments_changed)
         ev.filter.connect(self._on_thinness_changed)
         ev.cube.connect(self._on_cube_changed)
+        ev.pose.connect(self._on_pose_changed)
         raw = plotter.iren.interactor  # raw VTK observers: they run before the camera style
         raw.AddObserver("LeftButtonPressEvent", self._lasso_press, 10.0)
         raw.AddObserver("MouseMoveEvent", self._lasso_move, 10.0)
@@ -179,6 +186,7 @@ class SceneView:
             mesh, color="#d8c8b0", opacity=self.hull_opacity, pickable=False, smooth_shading=True,
             name="hull", render=False, reset_camera=False)
         self._apply_hull_state()
+        self._apply_stage()
         self.front_view()
 
     def _apply_hull_state(self) -> None:
@@ -312,6 +320,7 @@ class SceneView:
             prop = self._cloud_actor.GetProperty()
             prop.SetPointSize(self.point_size)
             prop.SetRenderPointsAsSpheres(self.spheres)
+        self._apply_stage()
         self.render()
 
     def _on_thinness_changed(self, **_) -> None:
@@ -366,6 +375,7 @@ class SceneView:
             self._selected_actor = self.plotter.add_mesh(
                 pv.PolyData(segs.astype(np.float32), lines=lines), color="white", line_width=12,
                 render_lines_as_tubes=True, opacity=0.5, name="selected", render=False, reset_camera=False)
+        self._apply_stage()
         self.render()
 
     def _on_picked_changed(self, index=None, **_) -> None:
@@ -375,6 +385,7 @@ class SceneView:
             self._picked_actor = self.plotter.add_mesh(
                 pv.PolyData(self._world[index : index + 1]), color="#00ffff", point_size=self.point_size * 2.5,
                 render_points_as_spheres=True, name="picked", render=False, reset_camera=False)
+        self._apply_stage()
         self.render()
 
     # ---------------------------------------------------------------- cube
@@ -388,6 +399,7 @@ class SceneView:
                                  c[2] - size[2] / 2, c[2] + size[2] / 2))
             self._cube_actor = self.plotter.add_mesh(box, style="wireframe", color="#00ffff", line_width=2,
                                                      name="cube", render=False, reset_camera=False, pickable=False)
+        self._apply_stage()
         self.render()
 
     # ---------------------------------------------------------------- lasso
@@ -462,6 +474,96 @@ class SceneView:
         pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
         direction = (focal - pos) / max(np.linalg.norm(focal - pos), 1e-12)
         return shown, xy, depth, (world - pos) @ direction
+
+    # ------------------------------------------------------------- posing
+    def set_posing(self, on: bool) -> None:
+        """Pose stage: the preview and the posed bones; edit stage: hull, cloud and rest bones."""
+        self.posing = bool(on)
+        self._apply_stage()
+        if self.posing:
+            self._on_pose_changed()
+        self.render()
+
+    EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube")
+    POSE_ACTORS = ("preview", "posed_bones", "slices")
+
+    def _apply_stage(self) -> None:
+        """Show the edit stage's actors or the pose stage's, whichever is current."""
+        actors = self.plotter.renderer.actors
+        for name in self.EDIT_ACTORS:
+            if name in actors:
+                actors[name].SetVisibility(not self.posing)
+        if "hull" in actors:
+            actors["hull"].SetVisibility(not self.posing and self.hull_visible)
+        for name in self.POSE_ACTORS:
+            if name in actors:
+                actors[name].SetVisibility(self.posing)
+
+    def _on_pose_changed(self, **_) -> None:
+        if not self.posing:
+            return
+        self.plotter.remove_actor("posed_bones", render=False)
+        bones = self.doc.bones
+        if len(bones):
+            pj = self.doc.pose.posed_joints()
+            segs = self.world(np.array([[pj[b.proximal], pj[b.distal]] for b in bones.bones]).reshape(-1, 3))
+            lines = np.hstack([np.full((len(bones), 1), 2), np.arange(2 * len(bones)).reshape(-1, 2)]).ravel()
+            poly = pv.PolyData(segs.astype(np.float32), lines=lines)
+            poly.cell_data["rgb"] = np.array([rgb255(bone_colour(i)) for i in range(len(bones))])
+            self.plotter.add_mesh(poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True,
+                                  name="posed_bones", render=False, reset_camera=False)
+        self.render()
+
+    def show_volume(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
+        """Draw a reconstruction; a live update with the same grid and mode only swaps the data."""
+        n_bones = len(self.doc.bones)
+        if mode in ("binary",):
+            volume = binary_view(volume)
+        world_origin = self.world(origin_voxels)
+        world_spacing = np.asarray(spacing_voxels, np.float64) * self.spacing
+        img = pv.ImageData(dimensions=volume.shape, origin=world_origin, spacing=world_spacing)
+        img.point_data["values"] = np.asarray(volume).ravel(order="F")
+        key = (mode, volume.shape, tuple(world_origin), tuple(world_spacing), n_bones,
+               float(volume.max()) if mode == "hotspot" else 0)
+        if self._preview_actor is not None and key == self._preview_key:
+            self._preview_actor.mapper.SetInputData(img)
+        else:
+            self.plotter.remove_actor("preview", render=False)
+            self.plotter.remove_scalar_bar() if self.plotter.scalar_bars else None
+            style = volume_style(mode, volume, n_bones)
+            labels = style.pop("categories", None)
+            self._preview_actor = self.plotter.add_volume(img, scalars="values", name="preview", render=False,
+                                                          reset_camera=False, **style)
+            if labels is not None:
+                apply_labels(self._preview_actor, labels)
+            self._preview_key = key
+        self._preview_actor.SetVisibility(self.posing)
+        self.plotter.remove_actor("slices", render=False)
+        if self.slices:
+            style = volume_style(mode, volume, n_bones)
+            labels = style.get("categories")
+            cmap = style["cmap"] if labels is None else ListedColormap(np.vstack([[0.1, 0.1, 0.1], labels]))
+            clim = style["clim"] if labels is None else (0, len(labels))
+            self.plotter.add_mesh(img.slice_orthogonal(), scalars="values", cmap=cmap, clim=clim,
+                                  n_colors=256 if labels is None else len(labels) + 1, show_scalar_bar=False,
+                                  name="slices", render=False, reset_camera=False)
+        self.render()
+
+    def clear_volume(self) -> None:
+        self.plotter.remove_actor("preview", render=False)
+        self.plotter.remove_actor("slices", render=False)
+        self._preview_actor = self._preview_key = None
+        self.render()
+
+    def jump_to(self, voxel_xyz) -> None:
+        """Centre the view on a point and move closer."""
+        cam = self.plotter.renderer.GetActiveCamera()
+        target = self.world(voxel_xyz)
+        pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
+        cam.SetFocalPoint(*target)
+        cam.SetPosition(*(target + 0.5 * (pos - focal)))
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.render()
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once.

@@ -30,6 +30,7 @@ from volanim_core.skeleton import Skeleton
 from . import symmetry
 from .attachments import Attachments
 from .events import EventEmitter
+from .posing import PoseState
 from .undo import Command, UndoStack
 
 PROJECT_FORMAT = "volanim project"
@@ -42,7 +43,7 @@ class Document:
     def __init__(self):
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
-                                   "point_selection")
+                                   "point_selection", "pose", "preview")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -63,6 +64,8 @@ class Document:
         self.demo_name: str | None = None  # a session opened on a demo dataset reopens it
         self._joint_counter = 0
         self.attachments = Attachments(self)
+        self.pose = PoseState(self)
+        self.preview = None  # the last preview.Preview shown
         self.only_unconnected = False
         self.only_working = False
         self.cube_centre: np.ndarray | None = None
@@ -195,6 +198,10 @@ class Document:
                 raise ValueError(f"cube size must be positive, got {size}")
             self.cube_size = float(size)
         self.events.cube.emit()
+
+    def set_preview(self, preview) -> None:
+        self.preview = preview
+        self.events.preview.emit()
 
     def set_point_selection(self, indices) -> None:
         self.point_selection = np.asarray(indices, np.int64)

@@ -24,6 +24,7 @@ class Mode(StrEnum):
     ROOT_ORDER = "root_order"
     CUBE = "cube"
     LASSO = "lasso"
+    POSE = "pose"
 
 
 @dataclass(frozen=True)
@@ -274,5 +275,13 @@ class LassoMode(ModeHandler):
         return n
 
 
+class PoseMode(ModeHandler):
+    """Click a bone to pose it with the sliders of the Pose tab."""
+
+    name = Mode.POSE
+    help = ("Pose: click a bone, turn it with the sliders (children follow); the preview updates live. "
+            "Then read the breakage report.")
+
+
 HANDLERS = {Mode.VIEW: ViewMode, Mode.BONES: BonesMode, Mode.ROOT_ORDER: RootOrderMode, Mode.CUBE: CubeMode,
-            Mode.LASSO: LassoMode}
+            Mode.LASSO: LassoMode, Mode.POSE: PoseMode}

@@ -18,6 +18,7 @@ class Command:
     label: str
     redo: Callable[[], None]
     undo: Callable[[], None]
+    merge_key: str | None = None  # consecutive commands with this key become one step (a slider drag)
 
 
 class UndoStack:
@@ -31,6 +32,12 @@ class UndoStack:
         self.edits = 0  # monotonically counts pushes, undos and redos (autosave watches it)
 
     def push(self, command: Command) -> None:
+        top = self._done[-1] if self._done else None
+        if command.merge_key and top is not None and top.merge_key == command.merge_key and not self._undone:
+            command.redo()
+            self._done[-1] = Command(command.label, command.redo, top.undo, command.merge_key)
+            self._changed()
+            return
         command.redo()
         self._done.append(command)
         del self._done[: -self.limit]
@@ -54,6 +61,12 @@ class UndoStack:
         self._done.append(cmd)
         self._changed()
         return cmd.label
+
+    def seal(self) -> None:
+        """End merging: the next command starts a new step (a slider was released)."""
+        if self._done and self._done[-1].merge_key:
+            top = self._done[-1]
+            self._done[-1] = Command(top.label, top.redo, top.undo, None)
 
     def clear(self) -> None:
         self._done.clear()

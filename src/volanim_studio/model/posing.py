@@ -1,0 +1,102 @@
+"""The pose being previewed: per-bone rotations (and shifts) driving FK.
+
+Keyed by the bone's joint names, not its index, so reordering bones keeps the
+pose. Slider drags merge into one undo step (``UndoStack`` merge keys).
+
+    angles[(proximal, distal)] = (rx, ry, rz) degrees about the proximal joint
+    matrices() -> volanim_core.pose.pose_matrices -> (B, 4, 4)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volanim_core import io
+from volanim_core.connectivity import Trans, Tskel
+from volanim_core.pose import local_motion, pose_matrices, posed_joints, root_bones
+from volanim_core.tskel import check_root_order
+
+from .undo import Command
+
+
+class PoseState:
+    def __init__(self, doc):
+        self.doc = doc
+        self.angles: dict[tuple[str, str], np.ndarray] = {}
+        self.shifts: dict[tuple[str, str], np.ndarray] = {}
+
+    def _key(self, bone: int) -> tuple[str, str]:
+        b = self.doc.bones.bones[bone]
+        return (b.proximal, b.distal)
+
+    def angles_of(self, bone: int) -> np.ndarray:
+        return self.angles.get(self._key(bone), np.zeros(3)).copy()
+
+    @property
+    def is_rest(self) -> bool:
+        return not any(np.any(v) for v in self.angles.values()) and not any(np.any(v) for v in self.shifts.values())
+
+    def matrices(self) -> np.ndarray:
+        keys = [self._key(i) for i in range(len(self.doc.bones))]
+        rot = {i: self.angles[k] for i, k in enumerate(keys) if k in self.angles}
+        shift = {i: self.shifts[k] for i, k in enumerate(keys) if k in self.shifts}
+        return pose_matrices(self.doc.bones, rot, shift)
+
+    def posed_joints(self) -> dict[str, np.ndarray]:
+        return posed_joints(self.doc.bones, self.matrices())
+
+    # ----------------------------------------------------------------- edits
+    def _write(self, angles: dict, shifts: dict) -> None:
+        self.angles = {k: np.array(v) for k, v in angles.items()}
+        self.shifts = {k: np.array(v) for k, v in shifts.items()}
+        self.doc.events.pose.emit()
+
+    def _push(self, label: str, angles: dict, shifts: dict, merge_key: str | None = None) -> None:
+        old = ({k: v.copy() for k, v in self.angles.items()}, {k: v.copy() for k, v in self.shifts.items()})
+        new = ({k: np.array(v) for k, v in angles.items()}, {k: np.array(v) for k, v in shifts.items()})
+        self.doc.undo.push(Command(label, lambda: self._write(*new), lambda: self._write(*old), merge_key))
+
+    def set_angles(self, bone: int, angles, *, merge: bool = True) -> None:
+        """Rotate ``bone`` about its proximal joint (x, y, z degrees); children follow."""
+        angles = np.asarray(angles, np.float64).reshape(3)
+        if not np.isfinite(angles).all():
+            raise ValueError(f"angles must be finite numbers, got {angles}")
+        new = dict(self.angles)
+        new[self._key(bone)] = angles
+        label = f"Pose {self.doc.bones.bones[bone].label}"
+        self._push(label, new, self.shifts, merge_key=f"pose:{self._key(bone)}" if merge else None)
+
+    def reset(self, bone: int | None = None) -> None:
+        """Reset one bone (or, with None, the whole pose) to rest."""
+        if bone is None:
+            self._push("Reset pose", {}, {})
+            return
+        k = self._key(bone)
+        self._push(f"Reset {self.doc.bones.bones[bone].label}", {a: v for a, v in self.angles.items() if a != k},
+                   {a: v for a, v in self.shifts.items() if a != k})
+
+    # ----------------------------------------------------------------- files
+    def load_trans(self, path) -> None:
+        """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order)."""
+        trans = io.read_trans(path)
+        check_root_order(root_bones(self.doc.bones), trans.bones, ".trans")
+        angles, shifts = local_motion(self.doc.bones, trans.matrices)
+        keys = [self._key(i) for i in range(len(self.doc.bones))]
+        self._push(f"Load pose {path}", {keys[i]: a for i, a in angles.items() if np.any(np.abs(a) > 1e-9)},
+                   {keys[i]: t for i, t in shifts.items() if np.any(np.abs(t) > 1e-9)})
+
+    def save_trans(self, path) -> None:
+        io.write_trans(path, Trans(root_bones(self.doc.bones), self.matrices()))
+
+    def tskel(self, thinness: float | None = None) -> Tskel:
+        """The posed frame of the attached points with thinness >= ``thinness`` (default: the slider)."""
+        conn = self.doc.attachments.to_connectivity()
+        t = self.doc.thinness if thinness is None else thinness
+        keep = ~(conn.thinness < t)
+        return Tskel(conn.bones, self.matrices(), conn.points[keep], conn.dt[keep], conn.thinness[keep],
+                     conn.bone[keep], conn.metric)
+
+    def save_tskel(self, path) -> int:
+        t = self.tskel()
+        io.write_tskel(path, t)
+        return len(t)

@@ -1,0 +1,58 @@
+"""Preview reconstructions for the studio: full or reduced resolution, plus the report. Qt-free.
+
+A reduced preview reconstructs on a ``factor``-times coarser grid: the bone
+matrices are followed by a 1/factor scale and radii shrink alike, so the
+voxel count (the cost) drops by factor^3 while the shape stays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from volanim_core.breakage import BreakageReport, breakage_report
+from volanim_core.connectivity import Tskel
+from volanim_core.pose import scaled
+from volanim_core.reconstruct import Reconstruction, reconstruct
+from volanim_core.tskel import identity_tskel
+
+
+@dataclass
+class Preview:
+    reconstruction: Reconstruction
+    factor: int
+    mode: str
+    report: BreakageReport | None = None
+
+    @property
+    def spacing(self) -> tuple[float, float, float]:
+        return (float(self.factor),) * 3
+
+    @property
+    def origin_voxels(self) -> np.ndarray:
+        """Where voxel [0, 0, 0] of the preview sits, in full-resolution voxel coordinates."""
+        return np.asarray(self.reconstruction.origin, np.float64) * self.factor
+
+
+def coarse(tskel: Tskel, factor: int) -> Tskel:
+    if factor == 1:
+        return tskel
+    return Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
+                 tskel.bone, tskel.metric)
+
+
+def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,
+                 factor: int = 1, joints=None, posed_joints=None, report: bool = False, progress=None,
+                 cancel=None) -> Preview:
+    """Reconstruct the frame (and, when asked, the breakage report at full resolution)."""
+    if not len(tskel):
+        raise ValueError("no attached points to reconstruct: connect points to bones first")
+    r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel,
+                    padding=max(1, padding // factor), progress=progress, cancel=cancel)
+    out = Preview(r, factor, mode)
+    if report:
+        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone")
+        rest = reconstruct(identity_tskel(tskel.connectivity), mode="bone")
+        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone, rest_bone=rest)
+    return out
