@@ -85,10 +85,18 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     main = order[0] + 1
     out = [(int(sizes[order[0]]), np.asarray(ndimage.center_of_mass(labels == main)))]
     if n > 1:
-        dist = ndimage.distance_transform_edt(labels != main)
-        for k in order[1:]:
-            idx = np.argwhere(labels == k + 1)
-            out.append((int(sizes[k]), idx[int(np.argmin(dist[tuple(idx.T)]))].astype(np.float64)))
+        import edt
+
+        # distance to the main body (the edt package: ~10x scipy's on large grids), then the
+        # nearest voxel of every piece in one sort (the frog's organs are ~130 pieces)
+        dist = edt.edt(np.ascontiguousarray((labels != main).T).view(np.uint8), parallel=2).T
+        flat = labels.ravel(order="F")
+        idx = np.flatnonzero((flat > 0) & (flat != main))
+        lab, d = flat[idx], dist.ravel(order="F")[idx]
+        o = np.lexsort((d, lab))
+        first = o[np.r_[True, lab[o][1:] != lab[o][:-1]]]
+        where = {int(lab[f]): np.array(np.unravel_index(idx[f], labels.shape, order="F"), np.float64) for f in first}
+        out += [(int(sizes[k]), where[int(k) + 1]) for k in order[1:]]
     return out
 
 
@@ -123,11 +131,14 @@ def cracks(tskel: Tskel, min_gap: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
     if len(tskel) < 2:
         return np.zeros((0, 3)), np.zeros(0)
     p = tskel.points.astype(np.float64)
-    reach = 2.0 * float(np.percentile(tskel.dt, 99.5))
-    pairs = cKDTree(p).query_pairs(reach, output_type="ndarray")
-    if not len(pairs):
-        return np.zeros((0, 3)), np.zeros(0)
-    i, j = pairs[:, 0], pairs[:, 1]
+    # cracks are local: each sphere against its nearest neighbours (all pairs would be
+    # ~10^8 on the frog's 137 k spheres)
+    k = min(17, len(p))
+    _, nn = cKDTree(p).query(p, k=k)
+    i = np.repeat(np.arange(len(p)), k - 1)
+    j = nn[:, 1:].ravel()
+    keep = (j < len(p)) & (i < j)
+    i, j = i[keep], j[keep]
     keep = tskel.bone[i] != tskel.bone[j]
     i, j = i[keep], j[keep]
     touch = tskel.dt[i] + tskel.dt[j]

@@ -294,8 +294,7 @@ class MainWindow(QMainWindow):
         except ValueError as exc:
             self.doc.message(str(exc))
             return
-        self.doc.set_preview(p)
-        self.plotter.render()
+        self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
         self.live_timings.append(time.perf_counter() - t0)
 
     def preview(self, *, report: bool = True) -> Worker | None:
@@ -343,7 +342,10 @@ class MainWindow(QMainWindow):
         if p is None:
             self.scene.clear_volume()
             return
-        self.scene.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+        if p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
+            self.scene.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+        else:
+            self.scene.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
 
     def _slices_toggled(self, on: bool) -> None:
         self.scene.slices = on

@@ -48,11 +48,14 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     """Reconstruct the frame (and, when asked, the breakage report at full resolution)."""
     if not len(tskel):
         raise ValueError("no attached points to reconstruct: connect points to bones first")
-    r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel,
+    from volanim_core.reconstruct import sphere_neighbours
+
+    nbrs = sphere_neighbours(tskel)  # pose-independent: shared by every reconstruction below
+    r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,
                     padding=max(1, padding // factor), progress=progress, cancel=cancel)
     out = Preview(r, factor, mode)
     if report:
-        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone")
-        rest = reconstruct(identity_tskel(tskel.connectivity), mode="bone")
+        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", neighbours=nbrs)
+        rest = reconstruct(identity_tskel(tskel.connectivity), mode="bone", neighbours=nbrs)
         out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone, rest_bone=rest)
     return out
