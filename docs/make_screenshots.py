@@ -42,8 +42,11 @@ def main() -> None:
     w.resize(1500, 900)
     w.show()
     w.load_demo("mannequin")
-    while w.busy:
+    import time
+
+    while w.busy:  # (sleep: every processEvents() call from Python costs; see tests/studio/test_qt_binding.py)
         app.processEvents()
+        time.sleep(0.01)
     w.open_bones(ROOT / "assets" / "mannequin.bones")
     w.scene.front_view()
     w.set_mode(Mode.BONES)
@@ -73,6 +76,48 @@ def main() -> None:
     for _ in range(5):
         app.processEvents()
     grab(w, HERE / "studio-connect.png")
+    w.scene._lasso = None
+    w.scene._draw_lasso()
+
+    # Pose: a deliberate mistake (the shoulder's points on the torso), the break, the fix
+    import time
+
+    from volanim_studio.model.modes import Mode as M
+
+    doc = w.doc
+    ua, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")
+    shoulder = samples.mannequin_bones().joints["L_SHOULDER"]
+    stump = np.flatnonzero((np.linalg.norm(doc.skeleton.points - shoulder, axis=1) < 20)
+                           & (doc.attachments.bone == ua))
+    doc.attachments.assign(stump, spine)
+    w.set_mode(M.POSE)
+    doc.select_bones([ua])
+    doc.pose.set_angles(ua, (0, -90, 0), merge=False)
+
+    def preview_and_wait():
+        w.preview()
+        while w.busy:
+            app.processEvents()
+            time.sleep(0.01)
+        for _ in range(5):
+            app.processEvents()
+
+    preview_and_wait()
+    w.panel_tabs.setCurrentWidget(w.reconstruct_panel)
+    grab(w, HERE / "studio-pose-broken.png")
+    # the fix: back in Lasso mode, an outline over the stump connects it to L_UPPERARM
+    w.set_mode(M.LASSO)
+    w.scene.front_view()
+    shown, xy, depth, view_depth = w.scene.shown_projection()
+    sel = np.isin(shown, stump)
+    lo, hi = xy[sel].min(0) - 4, xy[sel].max(0) + 4
+    w.handlers[M.LASSO].depth_mode = "through"
+    w.handlers[M.LASSO].finish([(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])], xy, depth,
+                               view_depth, shown)
+    w.set_mode(M.POSE)
+    preview_and_wait()
+    w.panel_tabs.setCurrentWidget(w.reconstruct_panel)
+    grab(w, HERE / "studio-pose-fixed.png")
     w.close()
 
 
