@@ -57,20 +57,6 @@ def slice_lists(zlo, zhi, nz):
 
 
 @njit(cache=True, inline="always")
-def _inside(metric, dx, dy, dz, dy2, dz2, r2, r):
-    if metric == EUCLID:
-        return (dx * dx + dy2) + dz2 < r2
-    a, b, c = abs(dx), abs(dy), abs(dz)
-    if a < b:
-        a, b = b, a
-    if b < c:
-        b, c = c, b
-    if a < b:
-        a, b = b, a
-    return 3.0 * a + b + c < r
-
-
-@njit(cache=True, inline="always")
 def _distance(metric, dx, dy, dz, dy2, dz2):
     if metric == EUCLID:
         return (dx * dx + dy2) + dz2
@@ -82,6 +68,13 @@ def _distance(metric, dx, dy, dz, dy2, dz2):
     if a < b:
         a, b = b, a
     return 3.0 * a + b + c
+
+
+@njit(cache=True, inline="always")
+def _inside(metric, dx, dy, dz, dy2, dz2, r2, r):
+    """The oracle's predicate: squared distance < r2 (Euclid) or chamfer distance < r."""
+    d = _distance(metric, dx, dy, dz, dy2, dz2)
+    return d < r2 if metric == EUCLID else d < r
 
 
 @njit(cache=True, inline="always")

@@ -80,11 +80,7 @@ def write_mesh(path, vertices: np.ndarray, faces: np.ndarray) -> None:
     suffix = path.suffix.lower()
     if suffix not in (".ply", ".vtp", ".obj", ".stl"):
         raise ValueError(f"cannot write a mesh as {suffix!r}: use .ply, .vtp, .obj or .stl")
+    from .io._atomic import atomic_vtk_save
+
     cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
-    mesh = pv.PolyData(np.asarray(vertices, np.float32), cells)
-    tmp = path.with_name(f".{path.stem}.tmp{suffix}")
-    try:
-        mesh.save(str(tmp))
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    atomic_vtk_save(path, pv.PolyData(np.asarray(vertices, np.float32), cells))

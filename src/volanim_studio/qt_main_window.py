@@ -10,25 +10,20 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
-from PySide6.QtWidgets import QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressDialog, QTabWidget
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMessageBox, QProgressDialog, QTabWidget
 from pyvistaqt import QtInteractor
 
-from volanim_core import io
-from volanim_core.errors import FormatError
-
-from . import tasks
 from .model import autosave
-from .model.document import Document, read_project
+from .model.document import Document
 from .model.modes import HANDLERS, Mode, PickEvent
-from .model.preview import make_preview
 from .qt_connect_panel import ConnectPanel
 from .qt_panels import BonePanel, DisplayPanel
 from .qt_pose_panel import PosePanel, ReconstructPanel
 from .qt_scene import SceneView
-from .qt_threshold_dialog import ThresholdDialog
+from .qt_window_files import FilesWindowMixin
+from .qt_window_pose import PoseWindowMixin
 from .qt_worker import Worker
 
 SHORTCUTS = [
@@ -51,7 +46,7 @@ SHORTCUTS = [
 ]
 
 
-class MainWindow(QMainWindow):
+class MainWindow(FilesWindowMixin, PoseWindowMixin, QMainWindow):
     def __init__(self, doc: Document | None = None, *, autosave_every_edits: int = 5,
                  autosave_seconds: float = 60.0):
         super().__init__()
@@ -267,122 +262,6 @@ class MainWindow(QMainWindow):
         lasso = self.handlers[Mode.LASSO]
         lasso.finish(polygon, xy, depth, view_depth, shown, remove=True if ctrl else None)
 
-    # -------------------------------------------------------------- posing
-    def _pose_drag_started(self) -> None:
-        self._posing_drag = True
-        if self.worker is not None and getattr(self.worker, "is_preview", False):
-            self.worker.cancel()  # a newer pose is coming
-
-    def _pose_drag_finished(self) -> None:
-        self._posing_drag = False
-        if self.mode == Mode.POSE and len(self.doc.attachments.bone) and (self.doc.attachments.bone >= 0).any():
-            self.preview()
-
-    def _on_pose_changed(self, **_) -> None:
-        if self._posing_drag and self.reconstruct_panel.live.isChecked():
-            self._live_timer.start()  # coalesced: one live preview per event-loop pass
-
-    def live_preview(self) -> None:
-        """Half-resolution binary or bone preview on the GUI thread (tens of ms on the mannequin)."""
-        import time
-
-        t0 = time.perf_counter()
-        mode = self.reconstruct_panel.mode.currentText()
-        mode = mode if mode in ("binary", "bone") else "bone"
-        try:
-            p = make_preview(self.doc.pose.tskel(), mode=mode, factor=2, padding=2)
-        except ValueError as exc:
-            self.doc.message(str(exc))
-            return
-        self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
-        self.live_timings.append(time.perf_counter() - t0)
-
-    def preview(self, *, report: bool = True) -> Worker | None:
-        """Full-resolution reconstruction with the breakage report, in the background."""
-        settings = self.reconstruct_panel.settings()
-        if self.worker is not None:
-            self.doc.message("A job is running; preview again when it ends.")
-            return None
-        if settings["mode"] == "sampled" and self.doc.volume is None:
-            self.show_error("Preview", "sampled mode needs the volume: open it (File → Open volume)")
-            return None
-        try:
-            tskel = self.doc.pose.tskel()
-            if not len(tskel):
-                raise ValueError("no attached points to reconstruct: connect points to bones first (Connect tab)")
-        except ValueError as exc:
-            self.show_error("Preview", str(exc))
-            return None
-        joints = dict(self.doc.bones.joints)
-        posed = self.doc.pose.posed_joints()
-        source = self.doc.volume if settings["mode"] == "sampled" else None
-        worker = self.run_task("Reconstructing", lambda progress, cancel: make_preview(
-            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report,
-            progress=progress, cancel=cancel), self.doc.set_preview)
-        worker.is_preview = True
-        return worker
-
-    def _forget_rest(self, **_) -> None:
-        self._rest_preview = None
-
-    def _draw_preview(self) -> None:
-        p = self.doc.preview
-        if self.reconstruct_panel.show_rest.isChecked():
-            if self._rest_preview is None and len(self.doc.attachments.bone):
-                from volanim_core.tskel import identity_tskel
-
-                try:
-                    rest = identity_tskel(self.doc.pose.tskel().connectivity)
-                    mode = p.mode if p is not None else "bone"
-                    self._rest_preview = make_preview(rest, mode=mode, source=self.doc.volume)
-                except ValueError as exc:
-                    self.doc.message(str(exc))
-                    return
-            p = self._rest_preview
-        if p is None:
-            self.scene.clear_volume()
-            return
-        if p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
-            self.scene.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
-        else:
-            self.scene.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
-
-    def _slices_toggled(self, on: bool) -> None:
-        self.scene.slices = on
-        self._draw_preview()
-
-    def jump_to_joint(self, name: str) -> None:
-        posed = self.doc.pose.posed_joints()
-        if name in posed:
-            self.scene.jump_to(posed[name])
-            self.doc.message(f"Centred on {name}. Fix the points there (Lasso, L), then preview again (F5).")
-
-    def export_preview(self, path) -> bool:
-        p = self.doc.preview
-        if p is None:
-            self.show_error("Export", "nothing to export: preview first (F5)")
-            return False
-        vol = p.reconstruction.volume
-        if str(path).lower().endswith(".vol") and vol.dtype != np.uint8:
-            vol = np.minimum(vol, 255).astype(np.uint8)
-        try:
-            io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing)
-        except (OSError, ValueError) as exc:
-            self.show_error("Export", str(exc))
-            return False
-        self.doc.message(f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; "
-                         f"origin {tuple(int(v) for v in p.origin_voxels)}.")
-        return True
-
-    def load_trans(self, path) -> bool:
-        try:
-            self.doc.pose.load_trans(path)
-        except (FormatError, ValueError) as exc:
-            self.show_error("Load pose", str(exc))
-            return False
-        self.doc.message(f"Loaded the pose from {Path(path).name}.")
-        return True
-
     def auto_connect(self) -> None:
         p = self.connect_panel
         try:
@@ -471,240 +350,6 @@ class MainWindow(QMainWindow):
         self._error_box = box
         box.open()
 
-    # -------------------------------------------------------------- loading
-    def run_task(self, label: str, task, on_done) -> Worker:
-        """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel."""
-        if self.worker is not None:
-            raise RuntimeError("another job is running")
-        dialog = QProgressDialog(label, "Cancel", 0, 100, self)
-        dialog.setWindowModality(Qt.WindowModal)
-        dialog.setMinimumDuration(300)
-        worker = Worker(task, self)
-        worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
-        dialog.canceled.connect(worker.cancel)
-
-        def finish():
-            dialog.reset()
-            self.worker = None
-            self.progress = None
-            self.activateWindow()  # give keyboard focus back (window managers differ; Xvfb has none)
-
-        worker.succeeded.connect(lambda result: (finish(), on_done(result)))
-        worker.failed.connect(lambda msg: (finish(), self.show_error(label, msg)))
-        worker.was_cancelled.connect(lambda: (finish(), self.doc.message(f"{label}: cancelled.")))
-        self.worker, self.progress = worker, dialog
-        worker.start()
-        return worker
-
-    @property
-    def busy(self) -> bool:
-        return self.worker is not None
-
-    def _apply_prepared(self, result: dict, path=None, threshold=None, spacing=None, dims=None) -> None:
-        self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),
-                            path=path, threshold=threshold, dims=dims)
-        self.doc.set_skeleton(result["skeleton"])
-        self.doc.set_hull(*result["hull"])
-        self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
-
-    def load_demo(self, name: str) -> Worker:
-        def done(r):
-            self._apply_prepared(r, spacing=r["spacing"])
-            self.doc.demo_name = name
-
-        return self.run_task(f"Preparing the {name} demo", lambda progress, cancel: tasks.load_demo(
-            name, progress=progress, cancel=cancel), done)
-
-    def open_volume(self, path, *, dims=None, params: dict | None = None) -> Worker | None:
-        """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
-        try:
-            loaded = tasks.load_volume_file(str(path), dims)
-        except FormatError as exc:
-            self.show_error("Open volume", str(exc))
-            return None
-        if params is None:
-            dialog = ThresholdDialog(loaded["volume"], Path(path).name, self)
-            if dialog.exec() != ThresholdDialog.Accepted:
-                return None
-            params = dialog.parameters()
-        vol = loaded["volume"]
-        return self.run_task(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
-            vol, progress=progress, cancel=cancel, **params), lambda r: self._apply_prepared(
-            r, path=path, threshold=(params["lo"], params["hi"]), spacing=loaded["spacing"], dims=dims))
-
-    def open_volume_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Open volume", "", "Volumes (*.vol *.VOL *.vti *.nrrd *.nii "
-                                              "*.nii.gz *.mha *.mhd);;All files (*)")
-        if path:
-            self.open_volume(path)
-
-    def open_mskel(self, path) -> bool:
-        try:
-            skel = io.read_mskel(path)
-        except FormatError as exc:
-            self.show_error("Open skeleton", str(exc))
-            return False
-        self.doc.set_skeleton(skel, path)
-        self.doc.message(f"Loaded {len(skel)} points from {Path(path).name}.")
-        return True
-
-    def open_bones(self, path) -> bool:
-        try:
-            self.doc.load_bones(path)
-        except FormatError as exc:
-            self.show_error("Open bones", str(exc))
-            return False
-        self.doc.message(f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.")
-        return True
-
-    def open_project(self, path) -> Worker | None:
-        try:
-            data = read_project(path)
-        except FormatError as exc:
-            self.show_error("Open project", str(exc))
-            return None
-
-        def rest(_=None):
-            if data.get("mskel") and (self.doc.skeleton is None or not (data.get("volume") or data.get("demo"))):
-                self.open_mskel(data["mskel"])
-            elif data.get("mskel"):
-                self.doc.mskel_path = data["mskel"]
-            if data.get("bones"):
-                self.open_bones(data["bones"])
-            if data.get("connect"):
-                self.open_connect(data["connect"])
-            if data.get("symmetry_x") is not None:
-                self.doc.symmetry_x = data["symmetry_x"]
-            if data.get("thinness") is not None:
-                self.doc.thinness = data["thinness"]
-            self.doc.project_path = str(path)
-            self.doc.events.project.emit(path=str(path))
-            if data.get("camera"):
-                self.set_camera(data["camera"])
-
-        if data.get("demo") and not data.get("volume"):
-            worker = self.load_demo(data["demo"])
-            worker.succeeded.connect(rest)
-            return worker
-        if data.get("volume"):
-            lo, hi = data.get("threshold") or (1, None)
-            params = {"lo": lo, "hi": hi, "fill": False}
-            worker = self.open_volume(data["volume"], dims=data.get("volume_dims"), params=params)
-            if worker is not None:
-                worker.succeeded.connect(rest)
-            return worker
-        rest()
-        return None
-
-    def open_connect(self, path) -> bool:
-        try:
-            warnings = self.doc.attachments.load(path)
-        except (FormatError, ValueError) as exc:
-            self.show_error("Open connectivity", str(exc))
-            return False
-        if warnings:
-            self.show_error("Open connectivity", "\n".join(warnings))
-        per_bone, unconnected = self.doc.attachments.counts()
-        self.doc.message(f"Loaded {int(per_bone.sum())} attachments from {Path(path).name}.")
-        return True
-
-    def save_connect(self, path=None) -> Path | None:
-        if path is None:
-            stem = Path(self.doc.project_path or "untitled").with_suffix("").name
-            path, _ = QFileDialog.getSaveFileName(self, "Save connectivity", self.doc.attachments.default_filename(
-                stem), "Connectivity (*.connect)")
-            if not path:
-                return None
-        try:
-            n = self.doc.attachments.save(path)
-        except (OSError, ValueError) as exc:
-            self.show_error("Save connectivity", str(exc))
-            return None
-        self.doc.message(f"Saved {n} attached points (thinness ≥ {self.doc.thinness:.2f}) to {path}.")
-        return Path(path)
-
-    def _open_dialog(self, kind: str) -> None:
-        filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
-                   "connect": "Connectivity (*.connect)", "trans": "Poses (*.trans)"}
-        path, _ = QFileDialog.getOpenFileName(self, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
-        if path:
-            {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project,
-             "connect": self.open_connect, "trans": self.load_trans}[kind](path)
-
-    # -------------------------------------------------------------- saving
-    def camera(self) -> dict:
-        cam = self.plotter.renderer.GetActiveCamera()
-        return {"position": list(cam.GetPosition()), "focal_point": list(cam.GetFocalPoint()),
-                "view_up": list(cam.GetViewUp())}
-
-    def set_camera(self, data: dict) -> None:
-        cam = self.plotter.renderer.GetActiveCamera()
-        cam.SetPosition(*data["position"])
-        cam.SetFocalPoint(*data["focal_point"])
-        cam.SetViewUp(*data["view_up"])
-        self.plotter.renderer.ResetCameraClippingRange()
-        self.scene.render()
-
-    def save_project(self, ask: bool = False, path=None) -> Path | None:
-        if path is None:
-            path = self.doc.project_path
-            if ask or not path:
-                path, _ = QFileDialog.getSaveFileName(self, "Save project", "session.volanim",
-                                                      "Projects (*.volanim)")
-                if not path:
-                    return None
-        try:
-            saved = self.doc.save_project(path, camera=self.camera())
-        except (OSError, ValueError) as exc:
-            self.show_error("Save project", str(exc))
-            return None
-        self.doc.message(f"Saved {saved}.")
-        return saved
-
-    def save_bones(self, path) -> bool:
-        try:
-            self.doc.save_bones(path)
-        except (OSError, ValueError) as exc:
-            self.show_error("Save bones", str(exc))
-            return False
-        self.doc.message(f"Saved {len(self.doc.bones)} bones to {path}.")
-        return True
-
-    def _save_dialog(self, kind: str) -> None:
-        if kind == "connect":
-            self.save_connect()
-            return
-        if kind in ("trans", "tskel", "volume"):
-            filters = {"trans": "Poses (*.trans)", "tskel": "Frames (*.tskel)",
-                       "volume": "Volumes (*.vti *.nrrd *.VOL *.vol)"}
-            default = {"trans": "pose.trans", "tskel": "pose.tskel", "volume": "preview.vti"}[kind]
-            path, _ = QFileDialog.getSaveFileName(self, f"Save {kind}", default, filters[kind])
-            if not path:
-                return
-            if kind == "volume":
-                self.export_preview(path)
-                return
-            try:
-                if kind == "trans":
-                    self.doc.pose.save_trans(path)
-                else:
-                    self.doc.pose.save_tskel(path)
-            except (OSError, ValueError) as exc:
-                self.show_error(f"Save {kind}", str(exc))
-                return
-            self.doc.message(f"Saved {path}.")
-            return
-        filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
-        path, _ = QFileDialog.getSaveFileName(self, f"Save {kind}", f"untitled.{kind}", filters[kind])
-        if not path:
-            return
-        if kind == "bones":
-            self.save_bones(path)
-        elif kind == "connections":
-            self.doc.save_connections(path)
-        else:
-            self.plotter.screenshot(path)
-
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
 
@@ -748,4 +393,4 @@ def main_window_for(args) -> MainWindow:
     return w
 
 
-__all__ = ["MainWindow", "main_window_for", "np"]
+__all__ = ["MainWindow", "main_window_for"]

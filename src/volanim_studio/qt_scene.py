@@ -16,12 +16,12 @@ from collections.abc import Callable
 import numpy as np
 import pyvista as pv
 from matplotlib import colormaps
-from matplotlib.colors import ListedColormap
 
 from .model.document import Document
 from .model.modes import PickEvent
 from .model.palette import UNCONNECTED, bone_colour, rgb
-from .scene_preview import apply_labels, binary_view, rgb255, volume_style
+from .qt_scene_pose import ScenePoseMixin
+from .qt_scene_select import SceneSelectionMixin
 from .scene_projection import nearest_in_radius, project, segment_distance_2d
 
 LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
@@ -33,7 +33,7 @@ def _vtk_matrix(m) -> np.ndarray:
     return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
 
 
-class SceneView:
+class SceneView(SceneSelectionMixin, ScenePoseMixin):
     """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor``."""
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
@@ -386,208 +386,6 @@ class SceneView:
                 pv.PolyData(self._world[index : index + 1]), color="#00ffff", point_size=self.point_size * 2.5,
                 render_points_as_spheres=True, name="picked", render=False, reset_camera=False)
         self._apply_stage()
-        self.render()
-
-    # ---------------------------------------------------------------- cube
-    def _on_cube_changed(self, **_) -> None:
-        self.plotter.remove_actor("cube", render=False)
-        self._cube_actor = None
-        if self.doc.cube_centre is not None:
-            c = self.world(self.doc.cube_centre)
-            size = self.doc.cube_size * self.spacing
-            box = pv.Box(bounds=(c[0] - size[0] / 2, c[0] + size[0] / 2, c[1] - size[1] / 2, c[1] + size[1] / 2,
-                                 c[2] - size[2] / 2, c[2] + size[2] / 2))
-            self._cube_actor = self.plotter.add_mesh(box, style="wireframe", color="#00ffff", line_width=2,
-                                                     name="cube", render=False, reset_camera=False, pickable=False)
-        self._apply_stage()
-        self.render()
-
-    # ---------------------------------------------------------------- lasso
-    def set_lasso_enabled(self, on: bool) -> None:
-        """In lasso mode a left drag draws an outline; the camera keeps the wheel only."""
-        import vtk
-
-        iren = self.plotter.iren.interactor
-        if on and not self.lasso_enabled:
-            self._trackball = iren.GetInteractorStyle()
-            iren.SetInteractorStyle(vtk.vtkInteractorStyleUser())
-        elif not on and self.lasso_enabled and self._trackball is not None:
-            iren.SetInteractorStyle(self._trackball)
-        self.lasso_enabled = bool(on)
-
-    def _lasso_press(self, obj, event) -> None:
-        if self.lasso_enabled:
-            self._lasso = [self._event_position()]
-
-    def _lasso_move(self, obj, event) -> None:
-        if self.lasso_enabled and self._lasso is not None:
-            self._lasso.append(self._event_position())
-            self._draw_lasso()
-
-    def _lasso_release(self, obj, event) -> None:
-        if not self.lasso_enabled or self._lasso is None:
-            return
-        polygon = np.asarray(self._lasso + [self._event_position()], np.float64)
-        self._lasso = None
-        self._draw_lasso()
-        ctrl = bool(self.plotter.iren.interactor.GetControlKey())
-        if self.on_lasso is not None and len(polygon) >= 3:
-            self.on_lasso(polygon, ctrl)
-
-    def _draw_lasso(self) -> None:
-        import vtk
-
-        ren = self.plotter.renderer
-        if self._lasso_actor is not None:
-            ren.RemoveViewProp(self._lasso_actor)
-            self._lasso_actor = None
-        if self._lasso and len(self._lasso) > 1:
-            pts = vtk.vtkPoints()
-            for x, y in self._lasso:
-                pts.InsertNextPoint(x, y, 0)
-            line = vtk.vtkPolyLine()
-            line.GetPointIds().SetNumberOfIds(len(self._lasso) + 1)
-            for i in range(len(self._lasso)):
-                line.GetPointIds().SetId(i, i)
-            line.GetPointIds().SetId(len(self._lasso), 0)
-            cells = vtk.vtkCellArray()
-            cells.InsertNextCell(line)
-            poly = vtk.vtkPolyData()
-            poly.SetPoints(pts)
-            poly.SetLines(cells)
-            mapper = vtk.vtkPolyDataMapper2D()
-            mapper.SetInputData(poly)
-            actor = vtk.vtkActor2D()
-            actor.SetMapper(mapper)
-            actor.GetProperty().SetColor(1.0, 0.85, 0.2)
-            actor.GetProperty().SetLineWidth(2)
-            ren.AddViewProp(actor)
-            self._lasso_actor = actor
-        self.render()
-
-    def shown_projection(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(shown indices, display xy, normalised depth, distance along the view)`` of the shown points."""
-        shown = self._shown
-        world = self._world[shown].astype(np.float64)
-        xy, depth = self.project_world(world)
-        cam = self.plotter.renderer.GetActiveCamera()
-        pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
-        direction = (focal - pos) / max(np.linalg.norm(focal - pos), 1e-12)
-        return shown, xy, depth, (world - pos) @ direction
-
-    # ------------------------------------------------------------- posing
-    def set_posing(self, on: bool) -> None:
-        """Pose stage: the preview and the posed bones; edit stage: hull, cloud and rest bones."""
-        self.posing = bool(on)
-        self._apply_stage()
-        if self.posing:
-            self._on_pose_changed()
-        self.render()
-
-    EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube")
-    POSE_ACTORS = ("preview", "posed_bones", "slices")
-
-    def _apply_stage(self) -> None:
-        """Show the edit stage's actors or the pose stage's, whichever is current."""
-        actors = self.plotter.renderer.actors
-        for name in self.EDIT_ACTORS:
-            if name in actors:
-                actors[name].SetVisibility(not self.posing)
-        if "hull" in actors:
-            actors["hull"].SetVisibility(not self.posing and self.hull_visible)
-        for name in self.POSE_ACTORS:
-            if name in actors:
-                actors[name].SetVisibility(self.posing)
-
-    def _on_pose_changed(self, **_) -> None:
-        if not self.posing:
-            return
-        self.plotter.remove_actor("posed_bones", render=False)
-        bones = self.doc.bones
-        if len(bones):
-            pj = self.doc.pose.posed_joints()
-            segs = self.world(np.array([[pj[b.proximal], pj[b.distal]] for b in bones.bones]).reshape(-1, 3))
-            lines = np.hstack([np.full((len(bones), 1), 2), np.arange(2 * len(bones)).reshape(-1, 2)]).ravel()
-            poly = pv.PolyData(segs.astype(np.float32), lines=lines)
-            poly.cell_data["rgb"] = np.array([rgb255(bone_colour(i)) for i in range(len(bones))])
-            self.plotter.add_mesh(poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True,
-                                  name="posed_bones", render=False, reset_camera=False)
-        self.render()
-
-    def show_volume(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
-        """Draw a reconstruction; a live update with the same grid and mode only swaps the data."""
-        n_bones = len(self.doc.bones)
-        if mode in ("binary",):
-            volume = binary_view(volume)
-        world_origin = self.world(origin_voxels)
-        world_spacing = np.asarray(spacing_voxels, np.float64) * self.spacing
-        img = pv.ImageData(dimensions=volume.shape, origin=world_origin, spacing=world_spacing)
-        img.point_data["values"] = np.asarray(volume).ravel(order="F")
-        key = (mode, volume.shape, tuple(world_origin), tuple(world_spacing), n_bones,
-               float(volume.max()) if mode == "hotspot" else 0)
-        if self._preview_actor is not None and key == self._preview_key:
-            self._preview_actor.mapper.SetInputData(img)
-        else:
-            self.plotter.remove_actor("preview", render=False)
-            self.plotter.remove_scalar_bar() if self.plotter.scalar_bars else None
-            style = volume_style(mode, volume, n_bones)
-            labels = style.pop("categories", None)
-            self._preview_actor = self.plotter.add_volume(img, scalars="values", name="preview", render=False,
-                                                          reset_camera=False, **style)
-            if labels is not None:
-                apply_labels(self._preview_actor, labels)
-            self._preview_key = key
-        self._preview_actor.SetVisibility(self.posing)
-        self.plotter.remove_actor("slices", render=False)
-        if self.slices:
-            style = volume_style(mode, volume, n_bones)
-            labels = style.get("categories")
-            cmap = style["cmap"] if labels is None else ListedColormap(np.vstack([[0.1, 0.1, 0.1], labels]))
-            clim = style["clim"] if labels is None else (0, len(labels))
-            self.plotter.add_mesh(img.slice_orthogonal(), scalars="values", cmap=cmap, clim=clim,
-                                  n_colors=256 if labels is None else len(labels) + 1, show_scalar_bar=False,
-                                  name="slices", render=False, reset_camera=False)
-        self.render()
-
-    def show_surface(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
-        """A live preview: the reconstruction's surface coloured by label (software GL draws a
-        surface far faster than it ray-casts a volume)."""
-        world_origin = self.world(origin_voxels)
-        world_spacing = np.asarray(spacing_voxels, np.float64) * self.spacing
-        img = pv.ImageData(dimensions=volume.shape, origin=world_origin, spacing=world_spacing)
-        img.point_data["values"] = (np.asarray(volume) > 0).astype(np.uint8).ravel(order="F")
-        surf = img.contour([0.5], scalars="values", method="flying_edges")
-        self.plotter.remove_actor("preview", render=False)
-        self.plotter.remove_actor("slices", render=False)
-        self._preview_actor = self._preview_key = None
-        if surf.n_points:
-            idx = np.rint((np.asarray(surf.points) - world_origin) / world_spacing).astype(np.int64)
-            idx = np.clip(idx, 0, np.array(volume.shape) - 1)
-            labels = np.asarray(volume)[tuple(idx.T)].astype(np.int64)
-            if mode == "bone":
-                table = np.vstack([[140, 140, 140], [rgb255(bone_colour(i)) for i in range(len(self.doc.bones))]])
-                surf.point_data["rgb"] = table[np.clip(labels, 0, len(table) - 1)].astype(np.uint8)
-                self.plotter.add_mesh(surf, scalars="rgb", rgb=True, name="preview", render=False,
-                                      reset_camera=False)
-            else:
-                self.plotter.add_mesh(surf, color="#e8c9a0", name="preview", render=False, reset_camera=False)
-        self._apply_stage()
-        self.render()
-
-    def clear_volume(self) -> None:
-        self.plotter.remove_actor("preview", render=False)
-        self.plotter.remove_actor("slices", render=False)
-        self._preview_actor = self._preview_key = None
-        self.render()
-
-    def jump_to(self, voxel_xyz) -> None:
-        """Centre the view on a point and move closer."""
-        cam = self.plotter.renderer.GetActiveCamera()
-        target = self.world(voxel_xyz)
-        pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
-        cam.SetFocalPoint(*target)
-        cam.SetPosition(*(target + 0.5 * (pos - focal)))
-        self.plotter.renderer.ResetCameraClippingRange()
         self.render()
 
     def render(self) -> None:

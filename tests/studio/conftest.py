@@ -41,6 +41,28 @@ def clickable_point(window, near_voxel) -> int:
     raise AssertionError(f"no clickable point near {near_voxel}")
 
 
+@pytest.fixture(scope="module")
+def mannequin():
+    """The demo mannequin and its default skeleton (computed once per module)."""
+    from volanim_core import samples
+    from volanim_core.skeletonize import skeletonize
+
+    s = samples.mannequin()
+    return s, skeletonize(s.mask)
+
+
+@pytest.fixture
+def doc(mannequin):
+    """A document holding the mannequin's volume and skeleton, no bones."""
+    from volanim_studio.model import Document
+
+    s, skel = mannequin
+    d = Document()
+    d.set_volume(s.volume, s.mask)
+    d.set_skeleton(skel)
+    return d
+
+
 @pytest.fixture(autouse=True)
 def recovery_dir(tmp_path, monkeypatch):
     """Autosaves go to a test folder, never to the user's cache."""

@@ -6,26 +6,15 @@ import numpy as np
 import pytest
 
 from volanim_core import io, samples
-from volanim_core.skeletonize import skeletonize
 from volanim_studio.model import Document
 from volanim_studio.model.modes import CubeMode, LassoMode, PickEvent
 from volanim_studio.model.selection import in_cube, in_polygon, select_lasso, visible_mask
 
 
-@pytest.fixture(scope="module")
-def mannequin():
-    s = samples.mannequin()
-    return s, skeletonize(s.mask)
-
-
 @pytest.fixture
-def doc(mannequin):
-    s, skel = mannequin
-    d = Document()
-    d.set_volume(s.volume, s.mask)
-    d.set_skeleton(skel)
-    d.set_bones(s.bones)
-    return d
+def doc(doc):
+    doc.set_bones(samples.mannequin_bones())
+    return doc
 
 
 def test_selection_math():

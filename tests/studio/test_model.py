@@ -7,25 +7,8 @@ import pytest
 
 from volanim_core import io, samples
 from volanim_core.errors import FormatError
-from volanim_core.skeletonize import skeletonize
-from volanim_studio.model import Document
 from volanim_studio.model.document import read_project
 from volanim_studio.model.modes import BonesMode, PickEvent, RootOrderMode
-
-
-@pytest.fixture(scope="module")
-def mannequin():
-    s = samples.mannequin()
-    return s, skeletonize(s.mask)
-
-
-@pytest.fixture
-def doc(mannequin):
-    s, skel = mannequin
-    d = Document()
-    d.set_volume(s.volume, s.mask)
-    d.set_skeleton(skel)
-    return d
 
 
 def point_near(doc, xyz):

@@ -51,3 +51,15 @@ def atomic_write_bytes(path: str | Path, data: bytes | memoryview) -> None:
     """Write ``data`` to ``path`` atomically."""
     with atomic_open(path, "wb") as fh:
         fh.write(data)
+
+
+def atomic_vtk_save(path: str | Path, dataset) -> None:
+    """Save a pyvista dataset atomically: VTK writes by file name, so write a
+    temporary name beside the target (same suffix, so VTK picks the writer), then rename."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    try:
+        dataset.save(str(tmp))
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import FormatError
 from . import raw_volumes
+from ._atomic import atomic_vtk_save
 from .nrrd_files import read_nrrd, write_nrrd
 
 VTK_SUFFIXES = (".vti", ".mha", ".mhd", ".nii", ".nii.gz", ".vtk")
@@ -137,13 +138,7 @@ def _write_vti(path: Path, vol: np.ndarray, origin, spacing) -> None:
 
     img = pv.ImageData(dimensions=vol.shape, origin=origin, spacing=spacing)
     img.point_data["values"] = vol.ravel(order="F")
-    # VTK writes by file name: write a temporary name beside it, then rename.
-    tmp_path = path.with_name(f".{path.name}.tmp.vti")
-    try:
-        img.save(str(tmp_path))
-        tmp_path.replace(path)
-    finally:
-        tmp_path.unlink(missing_ok=True)
+    atomic_vtk_save(path, img)
 
 
 def write_volume(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)) -> None:

@@ -17,23 +17,21 @@ simpler and safer than hand-written inverse operations.
 from __future__ import annotations
 
 import copy
-import json
 from pathlib import Path
 
 import numpy as np
 
 from volanim_core import io
 from volanim_core.bones import Bone, BoneSkeleton
-from volanim_core.io._atomic import atomic_write_text
 from volanim_core.skeleton import Skeleton
 
 from . import symmetry
 from .attachments import Attachments
 from .events import EventEmitter
 from .posing import PoseState
+from .project import read_project  # noqa: F401  (re-exported: the window opens projects through the document module)
 from .undo import Command, UndoStack
 
-PROJECT_FORMAT = "volanim project"
 SNAP_DISTANCE = 0.5  # voxels: a click this close to a joint reuses it
 
 
@@ -438,56 +436,8 @@ class Document:
         return path
 
     def write_project(self, path, camera: dict | None = None, *, mskel: str | None = None) -> dict:
-        """Write the project files without adopting their paths (autosave uses this).
+        """Write the project files without adopting their paths (autosave uses this)."""
+        from .project import write_project
 
-        ``mskel``: a skeleton file to name instead of writing one.
-        """
-        path = Path(path)
-        stem = path.with_suffix("")
-        bones_path = f"{stem}.bones"
-        io.write_bones(bones_path, self.bones)
-        mskel_path = mskel or self.mskel_path
-        if self.skeleton is not None and not mskel_path:
-            mskel_path = f"{stem}.mskel"
-            io.write_mskel(mskel_path, self.skeleton)
-        connect = None
-        if len(self.attachments.bone) and (self.attachments.bone >= 0).any():
-            connect = f"{stem}.connect"
-            io.write_connect(connect, self.attachments.to_connectivity())
+        return write_project(self, path, camera, mskel=mskel)
 
-        def rel(p):
-            if not p:
-                return None
-            try:
-                return str(Path(p).resolve().relative_to(path.parent.resolve()))
-            except ValueError:
-                return str(Path(p).resolve())
-
-        data = {
-            "format": PROJECT_FORMAT, "version": 1, "demo": self.demo_name,
-            "volume": rel(self.volume_path), "volume_dims": list(self.volume_dims) if self.volume_dims else None,
-            "threshold": list(self.threshold) if self.threshold else None,
-            "mskel": rel(mskel_path), "bones": rel(bones_path), "connect": rel(connect),
-            "thinness": self._thinness, "symmetry_x": self._symmetry_x, "camera": camera,
-        }
-        atomic_write_text(path, json.dumps(data, indent=2) + "\n")
-        return {"project": str(path), "bones": bones_path, "mskel": mskel_path, "connect": connect}
-
-
-def read_project(path) -> dict:
-    """A ``.volanim`` file's content with paths made absolute; FormatError when it is not one."""
-    from volanim_core.errors import FormatError
-
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FormatError(path, f"cannot read project: {exc}") from exc
-    except json.JSONDecodeError as exc:
-        raise FormatError(path, f"not a volanim project (JSON error: {exc.msg})", exc.lineno) from exc
-    if not isinstance(data, dict) or data.get("format") != PROJECT_FORMAT:
-        raise FormatError(path, f"not a volanim project: expected \"format\": \"{PROJECT_FORMAT}\"")
-    for key in ("volume", "mskel", "bones", "connect"):
-        if data.get(key):
-            data[key] = str((path.parent / data[key]).resolve())
-    return data
