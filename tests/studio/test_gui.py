@@ -222,3 +222,19 @@ def test_picking_at_device_pixel_ratio_2(tmp_path):
     out = subprocess.run([sys.executable, str(script), str(Path(__file__).parent)], env=env, capture_output=True,
                          text=True, timeout=180)
     assert "HIDPI-OK" in out.stdout, out.stderr[-3000:]
+
+
+def test_threshold_dialog_histogram_and_parameters(qtbot):
+    from volanim_studio.qt_threshold_dialog import ThresholdDialog
+
+    vol = samples.mannequin().volume
+    dialog = ThresholdDialog(vol, "mannequin.VOL")
+    qtbot.addWidget(dialog)
+    assert dialog.histogram.counts.shape == (256,) and dialog.histogram.counts.max() > 0
+    dialog.lo.setValue(100)
+    dialog.hi.setValue(240)
+    assert (dialog.histogram.lo, dialog.histogram.hi) == (100, 240)  # the highlighted band follows
+    dialog.fill.setChecked(False)
+    dialog.metric.setCurrentText("345")
+    assert dialog.parameters() == {"lo": 100, "hi": 240, "fill": False, "metric": "345",
+                                   "min_thinness": 0.5}
