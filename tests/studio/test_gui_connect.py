@@ -183,3 +183,19 @@ def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
     assert int((w.doc.attachments.bone >= 0).sum()) == attached, (listing, w.last_error)
     assert len(list(recovery_dir.glob("*/recovery.volanim"))) == 0  # the crashed session's copy is gone
     w.close()
+
+
+def test_dead_sessions_without_autosave_are_pruned(tmp_path):
+    import json
+
+    from volanim_studio.model import autosave
+
+    dead = tmp_path / "999999999-1"
+    dead.mkdir()
+    (dead / "session.json").write_text(json.dumps({"pid": 999999999}))
+    kept = tmp_path / "999999999-2"
+    kept.mkdir()
+    (kept / "session.json").write_text(json.dumps({"pid": 999999999}))
+    (kept / autosave.RECOVERY_FILE).write_text("{}")
+    assert autosave.prune(tmp_path) == 1
+    assert not dead.exists() and kept.exists()  # a crashed session with work stays for restore

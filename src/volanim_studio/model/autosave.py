@@ -51,6 +51,21 @@ def find_recoveries(root: Path | None = None) -> list[Path]:
     return sorted(found, key=lambda p: p.stat().st_mtime, reverse=True)
 
 
+def prune(root: Path | None = None) -> int:
+    """Remove folders of dead sessions that never autosaved (nothing to recover); returns how many."""
+    root = root or recovery_root()
+    removed = 0
+    for folder in root.glob("*") if root.is_dir() else []:
+        try:
+            info = json.loads((folder / "session.json").read_text())
+        except (OSError, ValueError):
+            continue
+        if not (folder / RECOVERY_FILE).exists() and not _alive(int(info.get("pid", -1))):
+            shutil.rmtree(folder, ignore_errors=True)
+            removed += 1
+    return removed
+
+
 def discard(recovery: Path) -> None:
     shutil.rmtree(Path(recovery).parent, ignore_errors=True)
 
@@ -63,6 +78,7 @@ class Autosaver:
         self.every_seconds = every_seconds
         self.clock = clock
         root = root or recovery_root()
+        prune(root)
         self.folder = root / f"{os.getpid()}-{int(time.time() * 1000)}"
         self.folder.mkdir(parents=True, exist_ok=True)
         (self.folder / "session.json").write_text(json.dumps({"pid": os.getpid(), "started": time.time()}))
