@@ -167,6 +167,7 @@ class MainWindow(FilesWindowMixin, PoseWindowMixin, QMainWindow):
         self._action("Open &volume…", lambda: self.open_volume_dialog(), "Ctrl+O", menu=file)
         self._action("Open &skeleton (.mskel)…", lambda: self._open_dialog("mskel"), menu=file)
         self._action("Open &bones…", lambda: self._open_dialog("bones"), menu=file)
+        self._action("Open connections…", lambda: self._open_dialog("connections"), menu=file)
         self._action("Open &project…", lambda: self._open_dialog("project"), menu=file)
         file.addSeparator()
         self._action("&Save project", self.save_project, "Ctrl+S", menu=file)

@@ -107,6 +107,15 @@ class FilesWindowMixin:
         self.doc.message(f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.")
         return True
 
+    def open_connections(self, path) -> bool:
+        try:
+            self.doc.load_connections(path)
+        except (FormatError, ValueError) as exc:
+            self.show_error("Open connections", str(exc))
+            return False
+        self.doc.message(f"{len(self.doc.bones)} bones in the root order of {Path(path).name}.")
+        return True
+
     def open_project(self, path) -> Worker | None:
         try:
             data = read_project(path)
@@ -175,11 +184,12 @@ class FilesWindowMixin:
 
     def _open_dialog(self, kind: str) -> None:
         filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
-                   "connect": "Connectivity (*.connect)", "trans": "Poses (*.trans)"}
+                   "connect": "Connectivity (*.connect)", "trans": "Poses (*.trans)",
+                   "connections": "Connections (*.connections)"}
         path, _ = QFileDialog.getOpenFileName(self, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
         if path:
             {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project,
-             "connect": self.open_connect, "trans": self.load_trans}[kind](path)
+             "connect": self.open_connect, "trans": self.load_trans, "connections": self.open_connections}[kind](path)
 
     # -------------------------------------------------------------- saving
     def camera(self) -> dict:

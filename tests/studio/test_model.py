@@ -133,3 +133,18 @@ def test_project_round_trip(tmp_path, doc):
     (tmp_path / "bad.volanim").write_text("{nope")
     with pytest.raises(FormatError, match="bad.volanim:1: not a volanim project"):
         read_project(tmp_path / "bad.volanim")
+
+
+def test_load_connections_sets_bones_in_root_order(tmp_path, doc):
+    s = samples.mannequin()
+    doc.set_bones(s.bones)
+    doc.attachments.assign([0, 1], doc.bones.index("L_THIGH"))
+    (tmp_path / "a.connections").write_text("L_HIP L_KNEE\nPELVIS NECK\n")
+    doc.load_connections(tmp_path / "a.connections")
+    assert [b.label for b in doc.bones.bones] == ["L_THIGH", "SPINE"]
+    assert doc.bone_of_point(0) == "L_THIGH"  # attachments follow their bone
+    (tmp_path / "b.connections").write_text("L_HIP L_WING\n")
+    with pytest.raises(ValueError, match="not loaded: L_WING"):
+        doc.load_connections(tmp_path / "b.connections")
+    doc.undo.undo()
+    assert len(doc.bones) == 18

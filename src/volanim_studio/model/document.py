@@ -411,6 +411,20 @@ class Document:
         self.set_bones(bones, f"Load {Path(path).name}")
         self.bones_path = str(path)
 
+    def load_connections(self, path) -> None:
+        """Take the bone list (root order) from a ``.connections`` file over the loaded joints.
+
+        Bones that stay keep their names and attachments. One undo step.
+        """
+        pairs = io.read_connections(path)
+        missing = sorted({j for pair in pairs for j in pair} - set(self.bones.joints))
+        if missing:
+            raise ValueError(f"{Path(path).name} names joints that are not loaded: {', '.join(missing)}; "
+                             "open the .bones file with those joints first")
+        names = {(b.proximal, b.distal): b.name for b in self.bones.bones}
+        new = BoneSkeleton(copy.deepcopy(self.bones.joints), [Bone(a, b, names.get((a, b), "")) for a, b in pairs])
+        self.set_bones(new, f"Load {Path(path).name}")
+
     def save_bones(self, path) -> None:
         io.write_bones(path, self.bones)
         self.bones_path = str(path)
