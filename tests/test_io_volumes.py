@@ -174,3 +174,13 @@ def test_bad_nrrd_headers(tmp_path, header):
     (tmp_path / "b.nrrd").write_bytes(header + b"\0" * 8)
     with pytest.raises(FormatError, match="b.nrrd"):
         io.read_volume(tmp_path / "b.nrrd")
+
+
+def test_saturate_for_raw_clips_counts_and_says_so():
+    counts = np.array([0, 7, 300], np.uint16).reshape(3, 1, 1)
+    out, note = io.saturate_for_raw("hot.VOL", counts)
+    assert out.dtype == np.uint8 and out.ravel().tolist() == [0, 7, 255] and "max 300" in note
+    out, note = io.saturate_for_raw("hot.vti", counts)
+    assert out is counts and note is None
+    out, note = io.saturate_for_raw("ok.vol", np.array([1, 2], np.uint16).reshape(2, 1, 1))
+    assert out.dtype == np.uint8 and note is None

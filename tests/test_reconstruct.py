@@ -211,3 +211,39 @@ def test_cropped_source_with_origin(rng):
     # every voxel sampled from inside the crop agrees; outside the crop reads 0
     differ = full.volume != crop.volume
     assert (crop.volume[differ] == 0).all()
+
+
+def test_concurrent_reconstructions_do_not_share_scratch_memory(rng):
+    """The studio reconstructs on the GUI thread (live) while a worker makes the full preview."""
+    import threading
+
+    frames = [random_tskel(np.random.default_rng(s), n=600, size=40, nbones=3) for s in (1, 2)]
+    want = [reconstruct(t, mode="mottled", bounds=Bounds((-20,) * 3, (60,) * 3)).volume for t in frames]
+    errors = []
+
+    def work(k):
+        for _ in range(15):
+            got = reconstruct(frames[k], mode="mottled", bounds=Bounds((-20,) * 3, (60,) * 3), threads=1).volume
+            if not np.array_equal(got, want[k]):
+                errors.append(k)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+
+
+def test_neighbours_refer_to_the_callers_order(rng, monkeypatch):
+    """reconstruct() groups points by bone; neighbours the caller computed on its own order must follow."""
+    from volanim_core import reconstruct as rec
+    from volanim_core.reconstruct import sphere_neighbours
+
+    monkeypatch.setattr(rec, "CUT_MIN_RADIUS", 0.0)
+    t = random_tskel(rng, n=500, size=30)
+    mixed_order = rng.permutation(len(t))
+    mixed = Tskel(t.bones, t.matrices, t.points[mixed_order], t.dt[mixed_order], None, t.bone[mixed_order])
+    cut = reconstruct(mixed, mode="mottled", neighbours=sphere_neighbours(mixed))
+    plain = reconstruct(mixed, mode="mottled", neighbours=False)
+    assert np.array_equal(cut.volume, plain.volume)

@@ -21,7 +21,7 @@ as float32 (squared Euclidean, or integer 3-4-5 chamfer).
 
 from __future__ import annotations
 
-import os
+import threading
 import time
 from dataclasses import dataclass, field
 
@@ -104,17 +104,29 @@ def posed_centres(tskel: Tskel) -> np.ndarray:
     return c
 
 
-def file_ordered(tskel: Tskel) -> Tskel:
-    """Points grouped by bone in root order (stable), the order a ``.tskel`` file lists them.
+def file_ordered(tskel: Tskel) -> tuple[Tskel, np.ndarray | None]:
+    """Points grouped by bone in root order (stable), the order a ``.tskel`` file lists them,
+    and the permutation applied (None when the frame already was).
 
     Ties go to the sphere first in file order, so a frame built in memory must
     reconstruct exactly like the same frame written out and read back.
     """
     if len(tskel) < 2 or bool(np.all(tskel.bone[:-1] <= tskel.bone[1:])):
-        return tskel
+        return tskel, None
     o = np.argsort(tskel.bone, kind="stable")
     return Tskel(tskel.bones, tskel.matrices, tskel.points[o], tskel.dt[o], tskel.thinness[o], tskel.bone[o],
-                 tskel.metric)
+                 tskel.metric), o
+
+
+def _reorder_neighbours(neighbours: np.ndarray, order: np.ndarray | None) -> np.ndarray:
+    """Neighbour lists given in the caller's point order, re-expressed after ``order`` was applied."""
+    neighbours = np.asarray(neighbours, np.int32)
+    if order is None:
+        return neighbours
+    new_index = np.empty(len(order), np.int32)
+    new_index[order] = np.arange(len(order), dtype=np.int32)
+    moved = neighbours[order]
+    return np.where(moved >= 0, new_index[np.maximum(moved, 0)], -1).astype(np.int32)
 
 
 def _extent(tskel: Tskel) -> np.ndarray:
@@ -173,14 +185,16 @@ def sphere_neighbours(tskel: Tskel, k: int = HALFSPACES) -> np.ndarray:
     return out
 
 
-class _Workspace:
-    """The stencil of the last call, kept for the next one.
+class _Workspace(threading.local):
+    """The stencil of this thread's last call, kept for its next one.
 
     Page faults on fresh memory are the largest cost after the kernel itself
     on a sparse grid (the posed frog: 36 M voxels, 1.1 M filled) and they do
     not parallelise here, so the stencil -- a temporary -- is reused between
     calls of the same grid size (rows are re-initialised lazily by the
-    kernel, so only the small row-flag array is cleared).
+    kernel, so only the small row-flag array is cleared). One per thread: the
+    studio reconstructs on the GUI thread (live) while a worker makes the full
+    preview, and they must not write each other's scratch memory.
     """
 
     def __init__(self):
@@ -199,7 +213,7 @@ _WORKSPACE = _Workspace()
 
 
 def release_workspace() -> None:
-    """Free the stencil kept between calls (up to 4 bytes per output voxel)."""
+    """Free this thread's stencil kept between calls (up to 4 bytes per output voxel)."""
     _WORKSPACE.release()
 
 
@@ -290,7 +304,7 @@ def reconstruct(
     t0 = time.perf_counter()
     report = Reporter(progress, cancel)
     minv_rest = check_matrices(tskel)
-    tskel = file_ordered(tskel)
+    tskel, order = file_ordered(tskel)
     posed = posed_centres(tskel)
     if bounds is None:
         bounds = grid_bounds(tskel, padding, centres=[posed]) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
@@ -344,7 +358,7 @@ def reconstruct(
     half = kernel // 2 if mode == "sampled" else 0
 
     if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
-        nbrs = sphere_neighbours(tskel) if neighbours is None else np.asarray(neighbours, np.int32)
+        nbrs = sphere_neighbours(tskel) if neighbours is None else _reorder_neighbours(neighbours, order)
         plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 4))
@@ -387,7 +401,3 @@ def reconstruct(
         stats["hotspot_mean"] = float(visits.sum() / n_filled) if n_filled else 0.0
     stats["seconds"] = time.perf_counter() - t0
     return Reconstruction(volume, tuple(int(v) for v in bounds.lo), stats)
-
-
-def default_threads() -> int:
-    return os.cpu_count() or 1

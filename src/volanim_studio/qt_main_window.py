@@ -368,11 +368,7 @@ def main_window_for(args) -> MainWindow:
     """A window loaded as the command line asks (see ``app.main``)."""
     w = MainWindow()
     worker = None
-    if not (args.project or args.demo or args.volume or args.mskel or args.connect):
-        worker = w.offer_recovery()
-    if worker is not None:
-        pass
-    elif args.project:
+    if args.project:
         worker = w.open_project(args.project)
     elif args.demo:
         worker = w.load_demo(args.demo)
@@ -391,6 +387,8 @@ def main_window_for(args) -> MainWindow:
         worker.succeeded.connect(then)
     else:
         then()
+    if not (args.project or args.demo or args.volume or args.mskel or args.connect or args.bones):
+        w.offer_recovery()  # a plain start: offer a crashed session's autosave
     return w
 
 

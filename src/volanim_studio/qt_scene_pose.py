@@ -70,7 +70,8 @@ class ScenePoseMixin:
             self._preview_actor.mapper.SetInputData(img)
         else:
             self.plotter.remove_actor("preview", render=False)
-            self.plotter.remove_scalar_bar() if self.plotter.scalar_bars else None
+            if self.plotter.scalar_bars:
+                self.plotter.remove_scalar_bar()
             style = volume_style(mode, volume, n_bones)
             labels = style.pop("categories", None)
             self._preview_actor = self.plotter.add_volume(img, scalars="values", name="preview", render=False,

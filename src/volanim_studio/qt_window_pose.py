@@ -10,8 +10,6 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import numpy as np
-
 from volanim_core import io
 from volanim_core.errors import FormatError
 
@@ -41,7 +39,8 @@ class PoseWindowMixin:
         mode = self.reconstruct_panel.mode.currentText()
         mode = mode if mode in ("binary", "bone") else "bone"
         try:
-            p = make_preview(self.doc.pose.tskel(), mode=mode, factor=2, padding=2)
+            tskel = self.doc.pose.tskel()
+            p = make_preview(tskel, mode=mode, factor=2, padding=2, neighbours=self.doc.pose.neighbours(tskel))
         except ValueError as exc:
             self.doc.message(str(exc))
             return
@@ -67,8 +66,9 @@ class PoseWindowMixin:
         joints = dict(self.doc.bones.joints)
         posed = self.doc.pose.posed_joints()
         source = self.doc.volume if settings["mode"] == "sampled" else None
+        nbrs = self.doc.pose.neighbours(tskel, compute=False)  # None: the worker computes them
         worker = self.run_task("Reconstructing", lambda progress, cancel: make_preview(
-            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report,
+            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report, neighbours=nbrs,
             progress=progress, cancel=cancel), self.doc.set_preview)
         worker.is_preview = True
         return worker
@@ -113,16 +113,14 @@ class PoseWindowMixin:
         if p is None:
             self.show_error("Export", "nothing to export: preview first (F5)")
             return False
-        vol = p.reconstruction.volume
-        if str(path).lower().endswith(".vol") and vol.dtype != np.uint8:
-            vol = np.minimum(vol, 255).astype(np.uint8)
+        vol, note = io.saturate_for_raw(path, p.reconstruction.volume)
         try:
             io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing)
         except (OSError, ValueError) as exc:
             self.show_error("Export", str(exc))
             return False
         self.doc.message(f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; "
-                         f"origin {tuple(int(v) for v in p.origin_voxels)}.")
+                         f"origin {tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {note}." if note else ""))
         return True
 
     def load_trans(self, path) -> bool:

@@ -76,3 +76,16 @@ def test_preview_equals_the_core_and_reduced_preview_is_coarser(doc):
     assert all(abs(a * 2 - b) <= 4 for a, b in zip(half.reconstruction.volume.shape, direct.volume.shape))
     with pytest.raises(ValueError, match="connect points"):
         make_preview(type(t)(t.bones, t.matrices, np.zeros((0, 3)), [], None, []))
+
+
+def test_neighbour_lists_are_cached_until_the_frame_changes(doc):
+    t = doc.pose.tskel()
+    first = doc.pose.neighbours(t)
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -30, 0), merge=False)
+    assert doc.pose.neighbours(doc.pose.tskel()) is first  # a pose change keeps them
+    doc.attachments.assign([0], doc.bones.index("HEAD"))
+    assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None  # an edit drops them
+    t = doc.pose.tskel()
+    assert doc.pose.neighbours(t) is not first
+    doc.thinness = 0.8
+    assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None

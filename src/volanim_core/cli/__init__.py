@@ -11,7 +11,7 @@ import argparse
 import sys
 
 from ..errors import Cancelled, FormatError
-from . import demo_command, volume_commands
+from . import demo_command, reconstruct_commands, skeleton_commands, volume_commands
 
 EPILOG = """examples:
   volanim samples mannequin -o data/          write the demo mannequin
@@ -33,26 +33,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in _modules():
+    for module in (volume_commands, skeleton_commands, reconstruct_commands, demo_command):
         module.register(sub)
     return parser
-
-
-def _modules():
-    mods = [volume_commands, demo_command]
-    try:
-        from . import skeleton_commands
-
-        mods.insert(1, skeleton_commands)
-    except ImportError:  # pragma: no cover - only while a module is being added
-        pass
-    try:
-        from . import reconstruct_commands
-
-        mods.insert(2, reconstruct_commands)
-    except ImportError:  # pragma: no cover
-        pass
-    return mods
 
 
 def main(argv: list[str] | None = None) -> int:

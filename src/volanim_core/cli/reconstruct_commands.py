@@ -16,6 +16,7 @@ from ..io import (
     read_trans,
     read_tskel,
     read_volume_grid,
+    saturate_for_raw,
     write_connect,
     write_trans,
     write_tskel,
@@ -108,12 +109,9 @@ def _reconstruct(args):
     bar = TextProgress("reconstruct")
     r = reconstruct(t, mode=args.mode, source=source, source_origin=source_origin, kernel=args.kernel,
                     bounds=bounds, padding=args.padding, threads=args.threads, progress=bar)
-    volume = r.volume
-    if args.output.lower().endswith(".vol") and volume.dtype != np.uint8:
-        if volume.max() > 255:
-            print(f"note: values above 255 (max {int(volume.max())}) are clipped to 255 in {args.output}; "
-                  "write .vti or .nrrd to keep them")
-        volume = np.minimum(volume, 255).astype(np.uint8)
+    volume, note = saturate_for_raw(args.output, r.volume)
+    if note:
+        print(f"note: {note}")
     write_volume(args.output, volume, origin=r.origin)
     s = r.stats
     print(f"{s['spheres']} spheres -> {s['filled']} voxels filled in {s['seconds']:.3f} s "

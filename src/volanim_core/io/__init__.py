@@ -24,7 +24,14 @@ from .raw_volumes import (
     write_raw,
 )
 from .skeleton_files import read_mskel, read_skel, write_mskel, write_skel
-from .volume_files import float_to_uint8, read_image_folder, read_volume, read_volume_grid, write_volume
+from .volume_files import (
+    float_to_uint8,
+    read_image_folder,
+    read_volume,
+    read_volume_grid,
+    saturate_for_raw,
+    write_volume,
+)
 
 __all__ = [
     "FormatError",
@@ -45,6 +52,7 @@ __all__ = [
     "read_volume",
     "read_volume_grid",
     "remove_header",
+    "saturate_for_raw",
     "write_bones",
     "write_connect",
     "write_connections",

@@ -141,6 +141,20 @@ def _write_vti(path: Path, vol: np.ndarray, origin, spacing) -> None:
     atomic_vtk_save(path, img)
 
 
+def saturate_for_raw(path: str | Path, vol: np.ndarray) -> tuple[np.ndarray, str | None]:
+    """``.vol``/``.VOL`` hold bytes: integer counts above 255 (hotspot, >255 bones) saturate at 255.
+
+    Returns the volume to write and, when values were clipped, a note for the user.
+    Other formats keep their type and get the volume unchanged.
+    """
+    if Path(path).suffix.lower() != ".vol" or vol.dtype == np.uint8 or vol.dtype.kind not in "ui":
+        return vol, None
+    top = int(vol.max()) if vol.size else 0
+    note = None if top <= 255 else (f"values above 255 (max {top}) are clipped to 255 in {Path(path).name}; "
+                                    "write .vti or .nrrd to keep them")
+    return np.minimum(vol, 255).astype(np.uint8), note
+
+
 def write_volume(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)) -> None:
     """Write a volume as ``.vol``, ``.VOL``, ``.vti`` or ``.nrrd``, atomically.
 

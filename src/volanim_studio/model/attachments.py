@@ -97,7 +97,6 @@ class Attachments:
             if selection is None or not len(selection):
                 raise ValueError("select points with the cube or lasso first")
             which[np.asarray(selection)] = True
-            overwrite = True if overwrite is None else overwrite
         elif scope in ("all", "unconnected"):
             which[:n] = True
             overwrite = overwrite if scope == "all" else False

@@ -24,6 +24,26 @@ class PoseState:
         self.doc = doc
         self.angles: dict[tuple[str, str], np.ndarray] = {}
         self.shifts: dict[tuple[str, str], np.ndarray] = {}
+        self._neighbours = None  # (thinness, neighbour lists) of the current attachments
+        doc.events.attachments.connect(self._forget_neighbours)
+
+    def _forget_neighbours(self, **_) -> None:
+        self._neighbours = None
+
+    def neighbours(self, tskel: Tskel, *, compute: bool = True) -> np.ndarray | None:
+        """``sphere_neighbours`` of :meth:`tskel`'s frame, cached: it depends on the attachments
+        and the slider, not on the pose, so live previews must not recompute it (0.7 s on the frog).
+
+        With ``compute=False`` a missing cache gives None (the caller computes it off the GUI thread).
+        """
+        from volanim_core.reconstruct import sphere_neighbours
+
+        key = (self.doc.thinness, len(tskel))
+        if self._neighbours is None or self._neighbours[0] != key:
+            if not compute:
+                return None
+            self._neighbours = (key, sphere_neighbours(tskel))
+        return self._neighbours[1]
 
     def _key(self, bone: int) -> tuple[str, str]:
         b = self.doc.bones.bones[bone]

@@ -43,14 +43,17 @@ def coarse(tskel: Tskel, factor: int) -> Tskel:
 
 
 def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,
-                 factor: int = 1, joints=None, posed_joints=None, report: bool = False, progress=None,
-                 cancel=None) -> Preview:
-    """Reconstruct the frame (and, when asked, the breakage report at full resolution)."""
+                 factor: int = 1, joints=None, posed_joints=None, report: bool = False, neighbours=None,
+                 progress=None, cancel=None) -> Preview:
+    """Reconstruct the frame (and, when asked, the breakage report at full resolution).
+
+    ``neighbours``: the frame's ``sphere_neighbours`` if the caller has them (computed when None).
+    """
     if not len(tskel):
         raise ValueError("no attached points to reconstruct: connect points to bones first")
     from volanim_core.reconstruct import sphere_neighbours
 
-    nbrs = sphere_neighbours(tskel)  # pose-independent: shared by every reconstruction below
+    nbrs = sphere_neighbours(tskel) if neighbours is None else neighbours  # pose-independent: shared below
     r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,
                     padding=max(1, padding // factor), progress=progress, cancel=cancel)
     out = Preview(r, factor, mode)
