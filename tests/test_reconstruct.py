@@ -247,3 +247,25 @@ def test_neighbours_refer_to_the_callers_order(rng, monkeypatch):
     cut = reconstruct(mixed, mode="mottled", neighbours=sphere_neighbours(mixed))
     plain = reconstruct(mixed, mode="mottled", neighbours=False)
     assert np.array_equal(cut.volume, plain.volume)
+
+
+def test_cancel_is_checked_while_sampling_not_only_while_filling():
+    """The sampled pass used to run in one uninterruptible call after the last progress report."""
+    mask = np.zeros((20, 20, 40), bool)
+    mask[5:15, 5:15, 2:38] = True
+    pts = np.argwhere(mask)
+    t = Tskel([RootBone((10, 10, 2), (10, 10, 38))], np.eye(4)[None], pts, np.full(len(pts), 1.5), None,
+              np.zeros(len(pts), int))
+    source = mask.astype(np.uint8) * 100
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+
+    reconstruct(t, mode="sampled", source=source, progress=progress)
+    nz = calls[0][1] // 2
+    assert [d for d, _ in calls if d > nz], "progress is reported during the sampling pass"
+    calls.clear()
+    with pytest.raises(Cancelled):
+        reconstruct(t, mode="sampled", source=source, progress=lambda d, t: calls.append((d, t)),
+                    cancel=lambda: len(calls) and calls[-1][0] > nz)

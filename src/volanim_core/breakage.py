@@ -21,6 +21,7 @@ import numpy as np
 from scipy import ndimage
 
 from .connectivity import Tskel
+from .progress import Reporter
 from .reconstruct import Reconstruction, reconstruct
 from .tskel import identity_tskel
 
@@ -153,7 +154,7 @@ def cracks(tskel: Tskel, min_gap: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
 
 def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: dict[str, np.ndarray], *,
                     posed: Reconstruction | None = None, rest_bone: Reconstruction | None = None,
-                    top: int = 5) -> BreakageReport:
+                    top: int = 5, cancel=None) -> BreakageReport:
     """The breakage report of one posed frame.
 
     Parameters
@@ -161,14 +162,19 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     tskel : the posed frame
     joints, posed_joints : joint name -> rest / posed position
     posed, rest_bone : reconstructions already made (bone or any mode; rest in bone mode), reused
+    cancel : callable, optional
+        ``cancel() -> True`` raises :class:`~volanim_core.errors.Cancelled` between phases.
     """
+    check = Reporter(None, cancel)
     if posed is None:
-        posed = reconstruct(tskel, mode="bone")
+        posed = reconstruct(tskel, mode="bone", cancel=cancel)
     if rest_bone is None:
-        rest_bone = reconstruct(identity_tskel(tskel.connectivity), mode="bone")
-    hot = reconstruct(tskel, mode="hotspot", bounds=posed.bounds)
+        rest_bone = reconstruct(identity_tskel(tskel.connectivity), mode="bone", cancel=cancel)
+    hot = reconstruct(tskel, mode="hotspot", bounds=posed.bounds, cancel=cancel)
+    check(0, 1)
     lost = lost_voxels(rest_bone, posed, tskel.matrices)
     where, gaps = cracks(tskel)
+    check(0, 1)
     parts = _components(posed.volume)
     report = BreakageReport([n for n, _ in parts], int(posed.stats["filled"]), int(rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),

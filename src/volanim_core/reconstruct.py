@@ -376,18 +376,22 @@ def reconstruct(
     numba.set_num_threads(nthreads)
     try:
         chunk = max(nthreads * 8, nz // 8)  # few calls: each parallel launch costs
-        report(0, nz)
+        total = 2 * nz if mode == "sampled" else nz  # sampling is a second pass: report and cancel in it too
+        report(0, total)
         for z0 in range(0, nz, chunk):
             z1 = min(nz, z0 + chunk)
             K.fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric,
                           _MODE_CODE[mode], plane_start, planes,
                           row_ready, filled, visits)
-            report(z1, nz)
+            report(z1, total)
         if mode == "sampled":
             src = np.ascontiguousarray(source.T)  # [z, y, x]; free for an F-ordered source
             owner = out
             out = owner if src.dtype == owner.dtype else np.zeros((nz, ny, nx), src.dtype)
-            K.sample_rows(owner, out, 0, nz, nthreads, row_ready, minv, src, weights, half)
+            for z0 in range(0, nz, chunk):
+                z1 = min(nz, z0 + chunk)
+                K.sample_rows(owner, out, z0, z1, nthreads, row_ready, minv, src, weights, half)
+                report(nz + z1, total)
     finally:
         numba.set_num_threads(previous)
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMessageBox, QProgressDialog, QTabWidget
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMessageBox, QTabWidget
 from pyvistaqt import QtInteractor
 
 from .model import autosave
@@ -24,7 +24,7 @@ from .qt_pose_panel import PosePanel, ReconstructPanel
 from .qt_scene import SceneView
 from .qt_window_files import FilesWindowMixin
 from .qt_window_pose import PoseWindowMixin
-from .qt_worker import Worker
+from .qt_worker import JobRunner, Worker
 
 SHORTCUTS = [
     ("V", "View mode: click points to inspect them"),
@@ -58,8 +58,8 @@ class MainWindow(FilesWindowMixin, PoseWindowMixin, QMainWindow):
         self.scene = SceneView(self.plotter, self.doc, on_pick=self.handle_pick)
         self.handlers = {m: cls(self.doc) for m, cls in HANDLERS.items()}
         self.mode = Mode.VIEW
-        self.worker: Worker | None = None
-        self.progress: QProgressDialog | None = None
+        self.jobs = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text),
+                              on_idle=self.activateWindow)  # focus back after a job (Xvfb has no WM to do it)
         self.last_error: str | None = None
         self._error_box: QMessageBox | None = None
 
@@ -355,9 +355,7 @@ class MainWindow(FilesWindowMixin, PoseWindowMixin, QMainWindow):
         self.plotter.screenshot(str(path))
 
     def closeEvent(self, event):  # noqa: N802 (Qt name)
-        if self.worker is not None:
-            self.worker.cancel()
-            self.worker.wait(5000)
+        self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
         self.autosave_timer.stop()
         self.autosaver.close()
         self.plotter.close()

@@ -136,8 +136,9 @@ class ReconstructPanel(QWidget):
         self.live.setChecked(True)
         self.slices = QCheckBox("Orthogonal slices")
         self.show_rest = QCheckBox("Show the rest pose instead (compare)")
-        self.metric = QLabel("euclid")
-        self.metric.setToolTip("The distance metric of the skeleton's DT (set when skeletonizing); radii are in it")
+        self.metric_label = QLabel("euclid")
+        self.metric_label.setToolTip("The distance metric of the skeleton's DT (set when skeletonizing); "
+                                     "radii are in it")
         self.preview_button = QPushButton("Preview")
         self.export_button = QPushButton("Export volume…")
         self.report = QLabel("No preview yet.")
@@ -148,7 +149,7 @@ class ReconstructPanel(QWidget):
         form.addRow("Mode", self.mode)
         form.addRow("Kernel (sampled)", self.kernel)
         form.addRow("Padding", self.padding)
-        form.addRow("Metric (from the skeleton)", self.metric)
+        form.addRow("Metric (from the skeleton)", self.metric_label)
         form.addRow(self.live)
         form.addRow(self.preview_button)
         view = QGroupBox("View")
@@ -166,7 +167,7 @@ class ReconstructPanel(QWidget):
             layout.addWidget(w)
         self.joints.itemClicked.connect(lambda item: self.joint_clicked.emit(item.data(Qt.UserRole)))
         doc.events.skeleton.connect(
-            lambda **_: self.metric.setText(doc.skeleton.metric if doc.skeleton is not None else "euclid"))
+            lambda **_: self.metric_label.setText(doc.skeleton.metric if doc.skeleton is not None else "euclid"))
         doc.events.preview.connect(self._on_preview_changed)
 
     def settings(self) -> dict:

@@ -63,15 +63,15 @@ class ThresholdDialog(QDialog):
         self.hi.setValue(vmax)
         self.fill = QCheckBox("Fill enclosed cavities")
         self.fill.setChecked(True)
-        self.metric = QComboBox()
-        self.metric.addItems(["euclid", "345"])
+        self.metric_box = QComboBox()
+        self.metric_box.addItems(["euclid", "345"])
         self.min_thinness = QDoubleSpinBox(decimals=2, minimum=-10.0, maximum=10.0, singleStep=0.05)
         self.min_thinness.setValue(DEFAULT_MIN_THINNESS)
         form = QFormLayout()
         form.addRow("Object from", self.lo)
         form.addRow("to", self.hi)
         form.addRow(self.fill)
-        form.addRow("Distance metric", self.metric)
+        form.addRow("Distance metric", self.metric_box)
         form.addRow("Keep thinness ≥", self.min_thinness)
         buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
         buttons.accepted.connect(self.accept)
@@ -92,4 +92,4 @@ class ThresholdDialog(QDialog):
 
     def parameters(self) -> dict:
         return {"lo": self.lo.value(), "hi": self.hi.value(), "fill": self.fill.isChecked(),
-                "metric": self.metric.currentText(), "min_thinness": self.min_thinness.value()}
+                "metric": self.metric_box.currentText(), "min_thinness": self.min_thinness.value()}

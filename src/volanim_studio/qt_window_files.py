@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QFileDialog, QProgressDialog
 
 from volanim_core import io
@@ -23,32 +22,20 @@ from .qt_worker import Worker
 class FilesWindowMixin:
     # -------------------------------------------------------------- loading
     def run_task(self, label: str, task, on_done) -> Worker:
-        """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel."""
-        if self.worker is not None:
-            raise RuntimeError("another job is running")
-        dialog = QProgressDialog(label, "Cancel", 0, 100, self)
-        dialog.setWindowModality(Qt.WindowModal)
-        dialog.setMinimumDuration(300)
-        worker = Worker(task, self)
-        worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
-        dialog.canceled.connect(worker.cancel)
-
-        def finish():
-            dialog.reset()
-            self.worker = None
-            self.progress = None
-            self.activateWindow()  # give keyboard focus back (window managers differ; Xvfb has none)
-
-        worker.succeeded.connect(lambda result: (finish(), on_done(result)))
-        worker.failed.connect(lambda msg: (finish(), self.show_error(label, msg)))
-        worker.was_cancelled.connect(lambda: (finish(), self.doc.message(f"{label}: cancelled.")))
-        self.worker, self.progress = worker, dialog
-        worker.start()
-        return worker
+        """Run ``task(progress, cancel)`` in the background (see :class:`JobRunner`)."""
+        return self.jobs.run(label, task, on_done)
 
     @property
     def busy(self) -> bool:
-        return self.worker is not None
+        return self.jobs.busy
+
+    @property
+    def worker(self) -> Worker | None:
+        return self.jobs.worker
+
+    @property
+    def progress(self) -> QProgressDialog | None:
+        return self.jobs.dialog
 
     def _apply_prepared(self, result: dict, path=None, threshold=None, spacing=None, dims=None) -> None:
         self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),

@@ -1,16 +1,27 @@
 """Background work with progress and cancel; results come back on the GUI thread.
 
-    task(progress, cancel) runs in a QThread
-        progress(done, total) --Signal--> QProgressDialog
-        Cancel button --> cancel() returns True --> Cancelled --> cancelled signal
-        return value --succeeded(object)--> handler on the GUI thread
+    JobRunner.run(label, task, on_done)
+        task(progress, cancel) runs in a Worker (a QThread)
+            progress(done, total) --Signal--> QProgressDialog
+            Cancel button --> cancel() returns True --> Cancelled --> was_cancelled
+            return value --succeeded(object)--> on_done on the GUI thread
+    JobRunner.shutdown()   (window close) cancel, show "Finishing…", wait as long as it takes
+
+Why ``shutdown`` never gives up: a QThread object destroyed while its thread
+runs aborts the whole process ("QThread: Destroyed while thread is still
+running"). A numba kernel cannot be interrupted, and its first compile or a
+large frame can take longer than any fixed timeout, so the window waits
+(keeping the UI painted) until the task has seen its cancel flag and returned.
+For the same reason a job counts as running until its thread has really ended,
+not merely until it emitted its result.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from PySide6.QtCore import QThread, Signal
+from PySide6.QtCore import QCoreApplication, QEventLoop, QObject, Qt, QThread, Signal
+from PySide6.QtWidgets import QProgressDialog
 
 from volanim_core.errors import Cancelled, FormatError
 
@@ -31,6 +42,10 @@ class Worker(QThread):
     def cancel(self) -> None:
         self._cancel = True
 
+    @property
+    def cancel_requested(self) -> bool:
+        return self._cancel
+
     def run(self) -> None:
         try:
             result = self._task(progress=self.progressed.emit, cancel=lambda: self._cancel)
@@ -43,3 +58,72 @@ class Worker(QThread):
             raise
         else:
             self.succeeded.emit(result)
+
+
+class JobRunner(QObject):
+    """One background job at a time for a window: progress dialog, Cancel, clean shutdown.
+
+    ``show_error(title, text)`` and ``message(text)`` report failures and
+    cancellations; ``on_idle()`` runs after every job (e.g. to give keyboard
+    focus back to the window).
+    """
+
+    def __init__(self, window, *, show_error: Callable, message: Callable, on_idle: Callable | None = None):
+        super().__init__(window)
+        self._window = window
+        self._show_error = show_error
+        self._message = message
+        self._on_idle = on_idle or (lambda: None)
+        self.worker: Worker | None = None
+        self.dialog: QProgressDialog | None = None
+        self.finishing = False
+
+    @property
+    def busy(self) -> bool:
+        return self.worker is not None
+
+    def run(self, label: str, task: Callable, on_done: Callable) -> Worker:
+        """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel."""
+        if self.worker is not None:
+            raise RuntimeError("another job is running")
+        dialog = QProgressDialog(label, "Cancel", 0, 100, self._window)
+        dialog.setWindowModality(Qt.WindowModal)
+        dialog.setMinimumDuration(300)
+        worker = Worker(task, self._window)
+        worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
+        dialog.canceled.connect(worker.cancel)
+
+        def finish():
+            worker.wait()  # run() is returning: make "not busy" mean the thread has ended
+            dialog.reset()
+            self.worker = None
+            self.dialog = None
+            self._on_idle()
+
+        worker.succeeded.connect(lambda result: (finish(), on_done(result)))
+        worker.failed.connect(lambda msg: (finish(), self._show_error(label, msg)))
+        worker.was_cancelled.connect(lambda: (finish(), self._message(f"{label}: cancelled.")))
+        self.worker, self.dialog = worker, dialog
+        worker.start()
+        return worker
+
+    def cancel(self) -> None:
+        if self.worker is not None:
+            self.worker.cancel()
+
+    def shutdown(self) -> None:
+        """Cancel the running job and wait until its thread has ended, however long that takes."""
+        worker = self.worker
+        if worker is None:
+            return
+        self.finishing = True
+        worker.cancel()
+        self._message("Finishing the running job before closing…")
+        if self.dialog is not None:
+            self.dialog.setLabelText("Finishing the running job before closing…")
+            self.dialog.setCancelButton(None)
+            self.dialog.show()
+        while not worker.wait(50):
+            QCoreApplication.processEvents(QEventLoop.ExcludeUserInputEvents)
+        QCoreApplication.processEvents(QEventLoop.ExcludeUserInputEvents)  # its last signals
+        self.finishing = False

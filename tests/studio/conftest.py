@@ -41,6 +41,24 @@ def clickable_point(window, near_voxel) -> int:
     raise AssertionError(f"no clickable point near {near_voxel}")
 
 
+#: How long a test waits for a background job. Generous on purpose: tests wait on a *state*
+#: (the job ended), so a passing test never sleeps this long, while a shared machine that is
+#: 2x slower some hours (or busy with a benchmark) must not turn a slow job into a failure.
+JOB_TIMEOUT_MS = 600_000
+
+
+@pytest.fixture(scope="session", autouse=True)
+def compiled_kernels():
+    """Compile every numba kernel before any GUI test waits on one.
+
+    A fresh clone has no numba cache: compiling all variants takes ~25 s, and
+    it used to happen inside whichever GUI test ran a reconstruction first.
+    """
+    from volanim_core.warmup import compile_kernels
+
+    compile_kernels()
+
+
 @pytest.fixture(scope="module")
 def mannequin():
     """The demo mannequin and its default skeleton (computed once per module)."""
@@ -83,8 +101,9 @@ def window(qtbot):
     w.activateWindow()  # window shortcuts need an active window; Xvfb has no window manager to do it
     qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     w.load_demo("mannequin")
-    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     front_view(w)
     yield w
-    w.close()
+    w.close()  # cancels and waits for any running job (JobRunner.shutdown)
+    assert not w.busy, "closing the window must leave no worker thread running"

@@ -14,7 +14,7 @@ from PySide6.QtCore import Qt
 from volanim_core import io, samples
 from volanim_studio.model.modes import Mode
 
-from .conftest import click, clickable_point, front_view
+from .conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
@@ -127,7 +127,7 @@ def test_rename_in_panel_and_save_reopen_identical(qtbot, window, tmp_path):
     other = MainWindow()
     qtbot.addWidget(other)
     other.open_project(path)
-    qtbot.waitUntil(lambda: not other.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not other.busy, timeout=JOB_TIMEOUT_MS)
     assert other.doc.bones == doc.bones and len(other.doc.skeleton) == len(doc.skeleton)
     other.close()
 
@@ -155,7 +155,7 @@ def test_cancel_leaves_the_gui_responsive(qtbot, window, tmp_path):
     from PySide6.QtWidgets import QPushButton
 
     window.progress.findChild(QPushButton).click()  # the progress dialog's Cancel button
-    qtbot.waitUntil(lambda: not window.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert worker.isFinished() and any("cancelled" in m for m in messages)
     assert len(window.doc.skeleton) < 10000  # still the mannequin
     window.display_panel.thinness_slider.setValue(100)  # and the GUI still works
@@ -197,7 +197,7 @@ assert np.array_equal(a, w.doc.skeleton.points[pts[0]]) and np.array_equal(b, w.
 # the lasso at DPR 2: an outline drawn with the mouse around one point's projection selects it
 w.doc.select_bones([0])
 w.set_mode("lasso")
-w.connect_panel.depth.setCurrentText("through")
+w.connect_panel.depth_mode.setCurrentText("through")
 target = clickable_point(w, J["L_ANKLE"])
 vx, vy = w.scene.display_of_point(target)
 s = w.plotter.devicePixelRatioF()
@@ -235,6 +235,34 @@ def test_threshold_dialog_histogram_and_parameters(qtbot):
     dialog.hi.setValue(240)
     assert (dialog.histogram.lo, dialog.histogram.hi) == (100, 240)  # the highlighted band follows
     dialog.fill.setChecked(False)
-    dialog.metric.setCurrentText("345")
+    dialog.metric_box.setCurrentText("345")
     assert dialog.parameters() == {"lo": 100, "hi": 240, "fill": False, "metric": "345",
                                    "min_thinness": 0.5}
+    dialog.show()
+    image = dialog.grab().toImage()  # painting asks QPaintDevice.metric(): it segfaulted while shadowed
+    assert image.width() == dialog.width() * image.devicePixelRatio()
+
+
+def test_close_while_a_job_runs_waits_for_it_instead_of_aborting(qtbot):
+    """Closing used to wait 5 s and then destroy the running QThread: SIGABRT for the whole app."""
+    import time
+
+    from volanim_studio.qt_main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.show()
+    seen = {}
+
+    def stubborn(progress, cancel):  # a first numba compile: it cannot look at the cancel flag for a while
+        time.sleep(5.5)
+        seen["cancel"] = cancel()
+        return "done"
+
+    worker = w.run_task("A long job", stubborn, lambda result: seen.setdefault("result", result))
+    messages = []
+    w.doc.events.message.connect(lambda text: messages.append(text))
+    w.close()
+    assert worker.isFinished() and not w.busy
+    assert seen["cancel"] is True  # close asked the job to stop
+    assert any("Finishing" in m for m in messages)  # and said what it was waiting for

@@ -17,7 +17,7 @@ from volanim_core.skeleton import Skeleton
 from volanim_studio.model.modes import Mode
 from volanim_studio.model.palette import bone_colour, rgb
 
-from .conftest import click, clickable_point
+from .conftest import JOB_TIMEOUT_MS, click, clickable_point
 
 pytestmark = pytest.mark.gui
 ASSETS = Path(__file__).parents[2] / "assets"
@@ -89,7 +89,7 @@ def depth_scene(window):
 @pytest.mark.parametrize("mode", ["through", "visible", "slab"])
 def test_lasso_depth_modes(qtbot, depth_scene, mode):
     window, (front, back, side) = depth_scene
-    window.connect_panel.depth.setCurrentText(mode)
+    window.connect_panel.depth_mode.setCurrentText(mode)
     window.connect_panel.slab.setValue(15)
     xy, _ = window.scene.project_world(window.scene._world)
     lo, hi = xy.min(0) - 15, xy.max(0) + 15
@@ -130,7 +130,7 @@ def test_save_connect_quit_reopen_and_continue(qtbot, window, tmp_path):
     other = MainWindow()
     qtbot.addWidget(other)
     other.open_project(path)
-    qtbot.waitUntil(lambda: not other.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not other.busy, timeout=JOB_TIMEOUT_MS)
     assert np.array_equal(other.doc.attachments.bone, before)
     other.close()
 
@@ -177,7 +177,7 @@ def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
     qtbot.addWidget(w)
     asked = []
     w.offer_recovery(ask=lambda p: asked.append(p) or True)
-    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert asked, listing
     assert len(w.doc.bones) == 18, (listing, w.last_error)
     assert int((w.doc.attachments.bone >= 0).sum()) == attached, (listing, w.last_error)

@@ -13,7 +13,7 @@ from volanim_core import samples
 from volanim_core.reconstruct import reconstruct
 from volanim_studio.model.modes import Mode
 
-from .conftest import front_view
+from .conftest import JOB_TIMEOUT_MS, front_view
 
 pytestmark = pytest.mark.gui
 ASSETS = Path(__file__).parents[2] / "assets"
@@ -47,7 +47,7 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     drag(qtbot, w, 1, range(0, -46, -5))
     assert w.live_timings, "the live preview ran during the drag"
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.report is not None,
-                    timeout=60000)
+                    timeout=JOB_TIMEOUT_MS)
     p = w.doc.preview
     assert p.mode == "bone" and p.factor == 1
     direct = reconstruct(w.doc.pose.tskel(), mode="bone")  # the worker made what the core makes
@@ -70,7 +70,7 @@ def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
     doc.attachments.assign(near, spine)  # the mistake: the shoulder's points on the torso
     doc.select_bones([ua])
     drag(qtbot, w, 1, range(0, -91, -10))
-    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
     assert "BROKEN" in w.reconstruct_panel.report.text()
     first = w.reconstruct_panel.joints.item(0)
     assert "detached piece" in first.text() and "L_SHOULDER" in first.text()
@@ -79,7 +79,7 @@ def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
     assert np.allclose(focal, w.doc.pose.posed_joints()["L_SHOULDER"])
     doc.attachments.assign(near, ua)  # the fix (the lasso does this in the GUI tests of Connect)
     w.preview()
-    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert "healthy: one piece" in w.reconstruct_panel.report.text()
 
 
@@ -90,11 +90,11 @@ def test_cancel_preview_leaves_the_gui_responsive(qtbot, posed_window):
     worker = w.preview()
     assert worker is not None and w.busy
     w.progress.findChild(QPushButton).click()
-    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert worker.isFinished()
     w.reconstruct_panel.mode.setCurrentText("bone")
     w.preview()
-    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert w.doc.preview is not None and w.doc.preview.mode == "bone"
 
 
@@ -102,7 +102,7 @@ def test_compare_export_and_slices(qtbot, posed_window, tmp_path):
     w = posed_window
     w.doc.pose.set_angles(w.doc.bones.index("R_THIGH"), (30, 0, 0), merge=False)
     w.preview()
-    qtbot.waitUntil(lambda: not w.busy, timeout=60000)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     posed_shape = w.scene._preview_key[1]
     w.reconstruct_panel.show_rest.setChecked(True)
     assert w.scene._preview_key[1] != posed_shape  # the rest reconstruction is shown

@@ -57,8 +57,10 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,
                     padding=max(1, padding // factor), progress=progress, cancel=cancel)
     out = Preview(r, factor, mode)
-    if report:
-        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", neighbours=nbrs)
-        rest = reconstruct(identity_tskel(tskel.connectivity), mode="bone", neighbours=nbrs)
-        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone, rest_bone=rest)
+    if report:  # three more reconstructions: each checks ``cancel`` between its chunks
+        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", neighbours=nbrs,
+                                                                              cancel=cancel)
+        rest = reconstruct(identity_tskel(tskel.connectivity), mode="bone", neighbours=nbrs, cancel=cancel)
+        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone, rest_bone=rest,
+                                     cancel=cancel)
     return out

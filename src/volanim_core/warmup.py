@@ -1,0 +1,71 @@
+"""Compile every numba kernel once, on tiny inputs, so the first real call is fast.
+
+    compile_kernels()
+        skeletonize (euclid, 345) --> auto_connect (path) --> reconstruct
+        (every mode x metric, sampled with kernel 1 and 3) --> breakage report
+
+The kernels are ``@njit(cache=True)``: the machine code lands in the package's
+``__pycache__`` and later processes load it in well under a second. A fresh
+install compiles them all in ~20 s the first time; doing it here, up front and
+with a message (``volanim warmup``, ``make demo``, the test session), keeps
+that cost out of anything a user -- or a test with a timeout -- is waiting on.
+Types matter to numba, so the inputs use the dtypes real calls use (uint8
+labels and sources, uint16 hotspot counts, float64 geometry).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+
+def _tiny_body() -> np.ndarray:
+    """A 24x12x12 bar with a thinner bar on top: two bones' worth of shape."""
+    mask = np.zeros((24, 12, 12), bool)
+    mask[2:22, 3:9, 3:9] = True
+    mask[10:14, 4:8, 8:11] = True
+    return mask
+
+
+def compile_kernels(progress=None) -> float:
+    """Run every kernel variant the library uses once; returns the seconds it took.
+
+    ``progress(done, total)`` is called after each step (for a message or a bar).
+    """
+    from .attach import auto_connect
+    from .bones import Bone, BoneSkeleton
+    from .breakage import breakage_report
+    from .connectivity import Connectivity, RootBone, Tskel
+    from .pose import pose_matrices
+    from .reconstruct import MODES, reconstruct
+    from .skeletonize import skeletonize
+
+    t0 = time.perf_counter()
+    mask = _tiny_body()
+    source = np.where(mask, 200, 0).astype(np.uint8)
+    bones = BoneSkeleton({"A": (3.0, 6.0, 6.0), "B": (12.0, 6.0, 6.0), "C": (21.0, 6.0, 6.0)},
+                         [Bone("A", "B"), Bone("B", "C")])
+    steps = [("345", None), ("euclid", None)] + [(m, mode) for m in ("euclid", "345") for mode in MODES]
+    total = len(steps) + 1
+    done = 0
+    skel = None
+    for metric, mode in steps:
+        if mode is None:
+            skel = skeletonize(mask, metric=metric, min_thinness=-np.inf)
+        else:
+            roots = [RootBone(*bones.segment(i), bones.bones[i].label) for i in range(len(bones))]
+            bone_of, _ = auto_connect(skel.points, bones, mask, method="path")
+            conn = Connectivity(roots, skel.points, skel.dt, skel.thinness, np.maximum(bone_of, 0)).grouped()
+            matrices = pose_matrices(bones, {1: np.array([0.0, 0.0, 30.0])})
+            tskel = Tskel(conn.bones, matrices, conn.points, conn.dt, conn.thinness, conn.bone, metric)
+            for kernel in ((1, 3) if mode == "sampled" else (1,)):
+                reconstruct(tskel, mode=mode, source=source if mode == "sampled" else None, kernel=kernel)
+        done += 1
+        if progress is not None:
+            progress(done, total)
+    breakage_report(tskel, dict(bones.joints), dict(bones.joints))
+    done += 1
+    if progress is not None:
+        progress(done, total)
+    return time.perf_counter() - t0
