@@ -11,8 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from volanim_core import io, samples
-from volanim_core.attach import connect_nearest
-from volanim_core.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
+from volanim_core.rig.attach import connect_nearest
+from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
 HERE = Path(__file__).parent
 

@@ -50,8 +50,9 @@ def cube_scan(out, stencil, nthreads, offsets, ids, centres, r2s, minv, bone, so
 
 
 def prepare(tskel, bounds):
-    from volanim_core import _reconstruct_kernels as K
-    from volanim_core.reconstruct import check_matrices, posed_centres, radius_squared
+    from volanim_core.reconstruct import _kernels as K
+    from volanim_core.reconstruct.engine import check_matrices, posed_centres
+    from volanim_core.reconstruct.radii import radius_squared
 
     origin = np.asarray(bounds.lo, float)
     centres = np.ascontiguousarray(posed_centres(tskel) - origin)
@@ -80,7 +81,8 @@ def run_cube_scan(tskel, bounds, source, sampled, threads):
 
 
 def numpy_per_sphere(tskel, bounds, source, sampled):
-    from volanim_core.reconstruct import check_matrices, posed_centres, radius_squared
+    from volanim_core.reconstruct.engine import check_matrices, posed_centres
+    from volanim_core.reconstruct.radii import radius_squared
 
     lo = np.asarray(bounds.lo)
     shape = np.asarray(bounds.shape)

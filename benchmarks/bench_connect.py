@@ -18,11 +18,11 @@ sys.path.insert(0, str(Path(__file__).parent))
 from _harness import table  # noqa: E402
 
 from volanim_core import samples  # noqa: E402
-from volanim_core.attach import auto_connect  # noqa: E402
-from volanim_core.skeletonize import skeletonize  # noqa: E402
+from volanim_core.rig.attach import auto_connect  # noqa: E402
+from volanim_core.skeleton.skeletonize import skeletonize  # noqa: E402
 from volanim_studio.model import Document  # noqa: E402
 from volanim_studio.model.modes import CubeMode, LassoMode  # noqa: E402
-from volanim_studio.scene_projection import project  # noqa: E402
+from volanim_studio.scene.projection import project  # noqa: E402
 
 
 def timed(fn, repeats=5):
@@ -59,7 +59,7 @@ def main() -> None:
     doc = Document()
     doc.set_volume(frog.volume, frog.mask)
     doc.set_skeleton(skeletonize(frog.mask, min_thinness=0.25))
-    doc.set_bones(frog.bones)
+    doc.bone_edits.set_bones(frog.bones)
     doc.thinness = float(doc.skeleton.thinness[200_000])
     doc.select_bones([1])
     shown = doc.shown_indices()
@@ -67,7 +67,8 @@ def main() -> None:
     rows = []
 
     cube = CubeMode(doc)
-    doc.set_cube(np.median(pts, axis=0), 120.0)
+    doc.settings.cube_size = 120.0
+    doc.set_cube(np.median(pts, axis=0))
 
     def cube_connect():
         cube.apply()
@@ -83,7 +84,7 @@ def main() -> None:
     lasso = LassoMode(doc)
     rows.append(["projection of the shown points", f"{1e3 * timed(lambda: project(pts, matrix, viewport)):.1f}"])
     for mode in ("through", "visible", "slab"):
-        lasso.depth_mode = mode
+        doc.settings.lasso_depth = mode
 
         def lasso_connect():
             xy2, d2 = project(pts, matrix, viewport)

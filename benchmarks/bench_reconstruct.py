@@ -27,12 +27,13 @@ from _harness import child, measure, table  # noqa: E402
 @cache
 def load(dataset: str):
     from volanim_core import samples
-    from volanim_core.attach import connect_nearest
-    from volanim_core.connectivity import Trans
-    from volanim_core.pose import pose_matrices, root_bones
-    from volanim_core.reconstruct import grid_bounds, sphere_neighbours
-    from volanim_core.skeletonize import skeletonize
-    from volanim_core.tskel import connect_to_tskel, identity_tskel
+    from volanim_core.reconstruct.engine import grid_bounds
+    from volanim_core.reconstruct.neighbours import sphere_neighbours
+    from volanim_core.rig.attach import connect_nearest
+    from volanim_core.rig.connectivity import Trans
+    from volanim_core.rig.pose import pose_matrices, root_bones
+    from volanim_core.rig.tskel import connect_to_tskel, identity_tskel
+    from volanim_core.skeleton.skeletonize import skeletonize
 
     s = samples.load(dataset)
     conn = connect_nearest(skeletonize(s.mask), s.bones)
@@ -44,7 +45,7 @@ def load(dataset: str):
 
 
 def _ours(frame, mode, threads, cached=True, reuse_out=False):
-    from volanim_core.reconstruct import reconstruct
+    from volanim_core.reconstruct.engine import reconstruct
 
     def run(d):
         r = reconstruct(d[frame], mode=mode, source=d["source"], threads=threads,
@@ -100,7 +101,7 @@ def floor_seconds(dataset: str, frame: str) -> float:
 def main() -> None:
     dataset = sys.argv[sys.argv.index("--dataset") + 1] if "--dataset" in sys.argv else "frog"
     repeats = int(sys.argv[sys.argv.index("--repeats") + 1]) if "--repeats" in sys.argv else 5
-    from volanim_core.reconstruct import reconstruct
+    from volanim_core.reconstruct.engine import reconstruct
 
     d = load(dataset)
     stats = {f: reconstruct(d[f], mode="sampled", source=d["source"], neighbours=d["neighbours"]).stats

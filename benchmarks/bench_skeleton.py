@@ -28,7 +28,7 @@ def load(dataset: str) -> np.ndarray:
 
 
 def _ours(m):
-    from volanim_core.skeletonize import skeletonize
+    from volanim_core.skeleton.skeletonize import skeletonize
 
     skeletonize(m)
 
@@ -52,13 +52,13 @@ def _scipy(m):
 
 
 def _iso_vtk(m):
-    from volanim_core.isosurface import isosurface
+    from volanim_core.skeleton.hull import isosurface
 
     isosurface(m, engine="vtk")
 
 
 def _iso_skimage(m):
-    from volanim_core.isosurface import isosurface
+    from volanim_core.skeleton.hull import isosurface
 
     isosurface(m, engine="skimage")
 

@@ -24,8 +24,8 @@ def main() -> None:
     from PySide6.QtWidgets import QApplication
 
     from volanim_core import samples
-    from volanim_core.skeletonize import skeletonize
-    from volanim_studio.qt_main_window import MainWindow
+    from volanim_core.skeleton.skeletonize import skeletonize
+    from volanim_studio.qt.main_window import MainWindow
 
     app = QApplication.instance() or QApplication([])
     w = MainWindow()
@@ -40,7 +40,7 @@ def main() -> None:
     rows = []
     for spheres in (False, True):
         for dragging in (False, True):
-            w.scene.set_cloud_style(spheres=spheres)
+            w.doc.settings.spheres = spheres
             w.scene.set_dragging(dragging)
             app.processEvents()
             update, frame, counts = [], [], []
@@ -66,9 +66,9 @@ def main() -> None:
 def bench_preview(app) -> None:
     """Pose changed -> preview drawn: live (half resolution, GUI thread) and full (worker + report)."""
     from volanim_core import samples
-    from volanim_core.attach import auto_connect
+    from volanim_core.rig.attach import auto_connect
     from volanim_studio.model.modes import Mode
-    from volanim_studio.qt_main_window import MainWindow
+    from volanim_studio.qt.main_window import MainWindow
 
     root = Path(__file__).resolve().parents[1]
     rows = []
@@ -76,23 +76,23 @@ def bench_preview(app) -> None:
         w = MainWindow()
         w.resize(1200, 800)
         w.show()
-        w.load_demo(name)
+        w.files.load_demo(name)
         while w.busy:
             app.processEvents()
             time.sleep(0.005)
         if name == "mannequin":
-            w.open_bones(root / "assets" / "mannequin.bones")
-            w.open_connect(root / "assets" / "mannequin.0.50.connect")
+            w.files.open_bones(root / "assets" / "mannequin.bones")
+            w.files.open_connect(root / "assets" / "mannequin.0.50.connect")
             bone = w.doc.bones.index("L_UPPERARM")
         else:
-            w.doc.set_bones(samples.frog().bones)
+            w.doc.bone_edits.set_bones(samples.frog().bones)
             out, _ = auto_connect(w.doc.skeleton.points, w.doc.bones, w.doc.mask, method="path-or-nearest")
             w.doc.attachments.assign_many(np.arange(len(out)), out, "auto")
             bone = w.doc.bones.index("LEGS")
         w.set_mode(Mode.POSE)
         w.doc.select_bones([bone])
         w._posing_drag = True
-        w.live_timings.clear()
+        w.previews.live_timings.clear()
         t0 = time.perf_counter()
         steps = list(range(0, -46, -3))
         for a in steps:
@@ -100,10 +100,10 @@ def bench_preview(app) -> None:
             app.processEvents()
         elapsed = time.perf_counter() - t0
         w._posing_drag = False
-        live = statistics.median(w.live_timings) if w.live_timings else float("nan")
-        rate = len(w.live_timings) / elapsed
+        live = statistics.median(w.previews.live_timings) if w.previews.live_timings else float("nan")
+        rate = len(w.previews.live_timings) / elapsed
         t0 = time.perf_counter()
-        w.preview()
+        w.previews.preview()
         while w.busy:
             app.processEvents()
             time.sleep(0.002)

@@ -22,12 +22,13 @@ sys.path.insert(0, str(Path(__file__).parent))
 from _harness import table  # noqa: E402
 
 from volanim_core import samples  # noqa: E402
-from volanim_core.attach import connect_nearest  # noqa: E402
-from volanim_core.connectivity import Trans  # noqa: E402
-from volanim_core.pose import pose_matrices, root_bones  # noqa: E402
-from volanim_core.reconstruct import reconstruct, sphere_neighbours  # noqa: E402
-from volanim_core.skeletonize import skeletonize  # noqa: E402
-from volanim_core.tskel import connect_to_tskel, identity_tskel  # noqa: E402
+from volanim_core.reconstruct.engine import reconstruct  # noqa: E402
+from volanim_core.reconstruct.neighbours import sphere_neighbours  # noqa: E402
+from volanim_core.rig.attach import connect_nearest  # noqa: E402
+from volanim_core.rig.connectivity import Trans  # noqa: E402
+from volanim_core.rig.pose import pose_matrices, root_bones  # noqa: E402
+from volanim_core.rig.tskel import connect_to_tskel, identity_tskel  # noqa: E402
+from volanim_core.skeleton.skeletonize import skeletonize  # noqa: E402
 
 THINNESS = (1.0, 0.75, 0.5, 0.25, 0.0, -np.inf)
 POSE = {"mannequin": ("L_UPPERARM", (0, -45, 0)), "frog": ("LEGS", (0, 0, 45))}

@@ -35,19 +35,19 @@ def main() -> None:
 
     from volanim_core import samples
     from volanim_studio.model.modes import Mode
-    from volanim_studio.qt_main_window import MainWindow
+    from volanim_studio.qt.main_window import MainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     w = MainWindow()
     w.resize(1500, 900)
     w.show()
-    w.load_demo("mannequin")
+    w.files.load_demo("mannequin")
     import time
 
     while w.busy:  # (sleep: every processEvents() call from Python costs; see tests/studio/test_qt_binding.py)
         app.processEvents()
         time.sleep(0.01)
-    w.open_bones(ROOT / "assets" / "mannequin.bones")
+    w.files.open_bones(ROOT / "assets" / "mannequin.bones")
     w.scene.front_view()
     w.set_mode(Mode.BONES)
     w.doc.select_bones([w.doc.bones.index("L_UPPERARM")])
@@ -95,7 +95,7 @@ def main() -> None:
     doc.pose.set_angles(ua, (0, -90, 0), merge=False)
 
     def preview_and_wait():
-        w.preview()
+        w.previews.preview()
         while w.busy:
             app.processEvents()
             time.sleep(0.01)
@@ -111,7 +111,7 @@ def main() -> None:
     shown, xy, depth, view_depth = w.scene.shown_projection()
     sel = np.isin(shown, stump)
     lo, hi = xy[sel].min(0) - 4, xy[sel].max(0) + 4
-    w.handlers[M.LASSO].depth_mode = "through"
+    w.doc.settings.lasso_depth = "through"
     w.handlers[M.LASSO].finish([(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])], xy, depth,
                                view_depth, shown)
     w.set_mode(M.POSE)

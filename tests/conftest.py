@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from volanim_core.bones import Bone, BoneSkeleton
-from volanim_core.connectivity import Connectivity, RootBone
-from volanim_core.skeleton import Skeleton
+from volanim_core.rig.bones import Bone, BoneSkeleton
+from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.skeleton.points import Skeleton
 
 
 @pytest.fixture

@@ -14,10 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import samples, volume
-from .attach import connect_nearest
-from .connectivity import Trans
-from .io import (
+from volanim_core.io import (
     connect_filename,
     read_connect,
     write_bones,
@@ -29,12 +26,17 @@ from .io import (
     write_tskel,
     write_volume,
 )
-from .isosurface import isosurface, write_mesh
-from .pose import pose_matrices, root_bones
-from .progress import TextProgress
-from .reconstruct import reconstruct, sphere_neighbours
-from .skeletonize import DEFAULT_MIN_THINNESS, skeletonize
-from .tskel import check_root_order, connect_to_tskel, identity_tskel
+from volanim_core.progress import TextProgress
+from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.reconstruct.neighbours import sphere_neighbours
+from volanim_core.rig.attach import connect_nearest
+from volanim_core.rig.connectivity import Trans
+from volanim_core.rig.pose import pose_matrices, root_bones
+from volanim_core.rig.tskel import check_root_order, connect_to_tskel, identity_tskel
+from volanim_core.skeleton.hull import isosurface, write_mesh
+from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
+
+from . import samples, volume
 
 POSES = {"mannequin": ("L_UPPERARM", (0.0, -45.0, 0.0)), "frog": ("LEGS", (0.0, 0.0, 45.0))}
 

@@ -15,7 +15,7 @@ import sys
 import time
 from collections.abc import Callable
 
-from .errors import Cancelled
+from volanim_core.errors import Cancelled
 
 ProgressFn = Callable[[int, int], None]
 CancelFn = Callable[[], bool]

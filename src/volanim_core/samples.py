@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .bones import Bone, BoneSkeleton
+from volanim_core.rig.bones import Bone, BoneSkeleton
 
 NAMES = ("mannequin", "aliascube", "frog")
 
@@ -224,7 +224,7 @@ def load(name: str) -> Sample:
 
 def write_sample(name: str, folder: str | Path) -> list[Path]:
     """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``)."""
-    from .io import write_bones, write_connections, write_raw
+    from volanim_core.io import write_bones, write_connections, write_raw
 
     sample = load(name)
     folder = Path(folder)

@@ -33,13 +33,13 @@ def compile_kernels(progress=None) -> float:
 
     ``progress(done, total)`` is called after each step (for a message or a bar).
     """
-    from .attach import auto_connect
-    from .bones import Bone, BoneSkeleton
-    from .breakage import breakage_report
-    from .connectivity import Connectivity, RootBone, Tskel
-    from .pose import pose_matrices
-    from .reconstruct import MODES, reconstruct
-    from .skeletonize import skeletonize
+    from volanim_core.reconstruct.breakage import breakage_report
+    from volanim_core.reconstruct.engine import MODES, reconstruct
+    from volanim_core.rig.attach import auto_connect
+    from volanim_core.rig.bones import Bone, BoneSkeleton
+    from volanim_core.rig.connectivity import Connectivity, RootBone, Tskel
+    from volanim_core.rig.pose import pose_matrices
+    from volanim_core.skeleton.skeletonize import skeletonize
 
     t0 = time.perf_counter()
     mask = _tiny_body()

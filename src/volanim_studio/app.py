@@ -31,7 +31,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     from PySide6.QtWidgets import QApplication
 
-    from .qt_main_window import main_window_for
+    from .qt.main_window import main_window_for
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("volanim studio")

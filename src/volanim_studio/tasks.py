@@ -10,16 +10,21 @@ from __future__ import annotations
 import numpy as np
 
 from volanim_core import samples
-from volanim_core.io import read_volume_grid
-from volanim_core.isosurface import isosurface
+from volanim_core.io import read_mskel, read_volume_grid
 from volanim_core.progress import Reporter
-from volanim_core.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
+from volanim_core.skeleton.hull import isosurface
+from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 from volanim_core.volume import fill_cavities, threshold
 
 
 def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: bool, metric: str = "euclid",
-                   min_thinness: float = DEFAULT_MIN_THINNESS, progress=None, cancel=None) -> dict:
-    """Segment, skeletonize and isosurface a loaded volume."""
+                   min_thinness: float = DEFAULT_MIN_THINNESS, skeleton_path=None, progress=None,
+                   cancel=None) -> dict:
+    """Segment, skeletonize and isosurface a loaded volume.
+
+    ``skeleton_path``: a saved ``.mskel`` of this segmentation (a reopened
+    project) is read instead of skeletonizing again.
+    """
     report = Reporter(progress, cancel)
     report(0, 100)
     mask = threshold(volume, lo, hi).view(bool)
@@ -32,11 +37,15 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     def sub(done, total):  # skeletonize's progress mapped onto 10..80 %
         report(10 + int(70 * done / max(total, 1)), 100)
 
-    skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, progress=sub, cancel=cancel)
+    if skeleton_path:
+        skel = read_mskel(skeleton_path)
+    else:
+        skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, progress=sub, cancel=cancel)
     report(80, 100)
     verts, faces = isosurface(mask)
     report(100, 100)
-    return {"volume": volume, "mask": mask, "skeleton": skel, "hull": (verts, faces)}
+    return {"volume": volume, "mask": mask, "skeleton": skel, "hull": (verts, faces), "skeleton_path": skeleton_path,
+            "segmentation": {"lo": lo, "hi": hi, "fill": fill, "metric": metric, "min_thinness": min_thinness}}
 
 
 def load_volume_file(path: str, dims=None) -> dict:
@@ -45,9 +54,10 @@ def load_volume_file(path: str, dims=None) -> dict:
     return {"volume": data, "spacing": spacing, "path": path}
 
 
-def load_demo(name: str, *, progress=None, cancel=None) -> dict:
-    """A demo dataset, segmented, skeletonized and with its hull."""
+def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> dict:
+    """A demo dataset, segmented, skeletonized (or its saved ``.mskel`` read) and with its hull."""
     s = samples.load(name)
-    out = prepare_volume(s.volume, lo=s.mask_level, hi=None, fill=False, progress=progress, cancel=cancel)
+    out = prepare_volume(s.volume, lo=s.mask_level, hi=None, fill=False, skeleton_path=skeleton_path,
+                         progress=progress, cancel=cancel)
     out.update(spacing=s.spacing, sample=s)
     return out

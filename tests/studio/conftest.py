@@ -63,7 +63,7 @@ def compiled_kernels():
 def mannequin():
     """The demo mannequin and its default skeleton (computed once per module)."""
     from volanim_core import samples
-    from volanim_core.skeletonize import skeletonize
+    from volanim_core.skeleton.skeletonize import skeletonize
 
     s = samples.mannequin()
     return s, skeletonize(s.mask)
@@ -91,7 +91,7 @@ def recovery_dir(tmp_path, monkeypatch):
 
 @pytest.fixture
 def window(qtbot):
-    from volanim_studio.qt_main_window import MainWindow
+    from volanim_studio.qt.main_window import MainWindow
 
     w = MainWindow()
     qtbot.addWidget(w)
@@ -100,7 +100,7 @@ def window(qtbot):
     qtbot.waitExposed(w)
     w.activateWindow()  # window shortcuts need an active window; Xvfb has no window manager to do it
     qtbot.waitUntil(w.isActiveWindow, timeout=5000)
-    w.load_demo("mannequin")
+    w.files.load_demo("mannequin")
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     front_view(w)

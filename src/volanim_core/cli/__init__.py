@@ -10,7 +10,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..errors import Cancelled, FormatError
+from volanim_core.errors import Cancelled, FormatError
+
 from . import demo_command, reconstruct_commands, skeleton_commands, volume_commands
 
 EPILOG = """examples:

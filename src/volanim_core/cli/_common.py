@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..io import read_volume, write_volume
-from ..volume import Bounds
+from volanim_core.io import read_volume, write_volume
+from volanim_core.volume import Bounds
 
 
 def add_command(sub, name: str, help: str, example: str, func) -> argparse.ArgumentParser:

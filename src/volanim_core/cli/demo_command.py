@@ -8,7 +8,7 @@ from ._common import add_command
 
 
 def _demo(args) -> int:
-    from ..pipeline_demo import run_demo
+    from volanim_core.pipeline_demo import run_demo
 
     run_demo(Path(args.output), sample=args.sample)
     return 0

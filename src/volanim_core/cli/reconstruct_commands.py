@@ -7,9 +7,7 @@ import argparse
 
 import numpy as np
 
-from ..attach import connect_nearest
-from ..connectivity import Trans
-from ..io import (
+from volanim_core.io import (
     read_bones,
     read_connect,
     read_mskel,
@@ -22,10 +20,13 @@ from ..io import (
     write_tskel,
     write_volume,
 )
-from ..pose import pose_matrices, root_bones
-from ..progress import TextProgress
-from ..reconstruct import MODES, grid_bounds, reconstruct
-from ..tskel import connect_to_tskel, identity_tskel, sort_tskel
+from volanim_core.progress import TextProgress
+from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
+from volanim_core.rig.attach import connect_nearest
+from volanim_core.rig.connectivity import Trans
+from volanim_core.rig.pose import pose_matrices, root_bones
+from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
+
 from ._common import add_command, bounds_arg
 
 

@@ -6,11 +6,12 @@ import time
 
 import numpy as np
 
+from volanim_core.io import write_mskel
+from volanim_core.progress import TextProgress
+from volanim_core.skeleton.hull import isosurface, write_mesh
+from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
+
 from .. import volume
-from ..io import write_mskel
-from ..isosurface import isosurface, write_mesh
-from ..progress import TextProgress
-from ..skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 from ._common import add_command, add_dims, add_volume_in, load, parse_range
 
 

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.io import add_header, float_to_uint8, histogram_file, remove_header
+
 from .. import samples, volume
-from ..io import add_header, float_to_uint8, histogram_file, remove_header
 from ..io._text import parse_int, read_records
 from ..io.raw_volumes import raw_layout
 from ._common import add_command, add_dims, add_volume_in, bounds_arg, load, parse_range, save

@@ -4,7 +4,8 @@ All readers raise :class:`volanim_core.errors.FormatError` (and nothing else)
 for a bad file; all writers are atomic.
 """
 
-from ..errors import FormatError
+from volanim_core.errors import FormatError
+
 from .bones_files import read_bones, read_connections, write_bones, write_connections
 from .connect_files import (
     connect_filename,

@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import FormatError
+from volanim_core.errors import FormatError
 
 _HEADER = re.compile(r"^#\s*([A-Za-z_][\w ]*?)\s*:\s*(\S.*?)\s*$")
 

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..bones import Bone, BoneSkeleton
+from volanim_core.rig.bones import Bone, BoneSkeleton
+
 from ._atomic import atomic_write_text
 from ._text import fmt_float, parse_float, read_records
 

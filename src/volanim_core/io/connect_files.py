@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..connectivity import Connectivity, RootBone, Trans, Tskel
+from volanim_core.rig.connectivity import Connectivity, RootBone, Trans, Tskel
+
 from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
 from ._text import TextRecords, fmt_float, parse_float, parse_metric, read_records

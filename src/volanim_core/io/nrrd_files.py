@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FormatError
+from volanim_core.errors import FormatError
+
 from ._atomic import atomic_open
 
 _TYPES = {

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..skeleton import Skeleton
+from volanim_core.skeleton.points import Skeleton
+
 from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
 from ._text import parse_metric, read_records

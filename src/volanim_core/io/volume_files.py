@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FormatError
+from volanim_core.errors import FormatError
+
 from . import raw_volumes
 from ._atomic import atomic_vtk_save
 from .nrrd_files import read_nrrd, write_nrrd

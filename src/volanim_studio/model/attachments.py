@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core import io
-from volanim_core.attach import UNATTACHED, auto_connect
-from volanim_core.bones import Bone, BoneSkeleton
-from volanim_core.connectivity import Connectivity, RootBone
-from volanim_core.skeleton import Skeleton
+from volanim_core.rig.attach import UNATTACHED, auto_connect
+from volanim_core.rig.bones import Bone, BoneSkeleton
+from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.skeleton.points import Skeleton
 
 from . import symmetry
 from .undo import Command
@@ -216,7 +216,7 @@ class Attachments:
 
             for r in conn.bones:
                 bones.append(Bone(joint_for(r.proximal), joint_for(r.distal), r.name))
-            doc.set_bones(BoneSkeleton(joints, bones), f"Bones from {name}")
+            doc.bone_edits.set_bones(BoneSkeleton(joints, bones), f"Bones from {name}")
             return np.arange(len(conn.bones), dtype=np.int32)
         segs = doc.bones.segments()
         remap = np.empty(len(conn.bones), np.int32)

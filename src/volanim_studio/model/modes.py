@@ -103,7 +103,7 @@ class BonesMode(ModeHandler):
             self.doc.pick_point(ev.point)
         if self.remove:
             if ev.bone is not None:
-                self.doc.remove_bones([ev.bone])
+                self.doc.bone_edits.remove_bones([ev.bone])
             return
         target = self._target(ev)
         if target is None:
@@ -115,7 +115,7 @@ class BonesMode(ModeHandler):
             self.doc.message(f"Chain starts at {where}: click the next point.")
             return
         try:
-            index = self.doc.add_bone(self.pending, target)
+            index = self.doc.bone_edits.add_bone(self.pending, target)
         except ValueError as exc:
             self.doc.message(str(exc))
             return
@@ -132,7 +132,7 @@ class BonesMode(ModeHandler):
         if name == "Escape":
             self.end_chain()
         elif name == "Delete" and self.doc.selected_bones:
-            self.doc.remove_bones(self.doc.selected_bones)
+            self.doc.bone_edits.remove_bones(self.doc.selected_bones)
 
 
 class RootOrderMode(ModeHandler):
@@ -165,7 +165,7 @@ class RootOrderMode(ModeHandler):
             return
         self.assigned.append(key)
         order = [keys.index(k) for k in self.assigned] + [i for i, k in enumerate(keys) if k not in self.assigned]
-        self.doc.set_root_order(order)
+        self.doc.bone_edits.set_root_order(order)
         n = len(self.assigned) - 1
         self.doc.select_bones([n])
         self.doc.message(f"{bones[ev.bone].label} is root {n}; click the next bone.")
@@ -212,7 +212,7 @@ class CubeMode(ModeHandler):
         if doc.cube_centre is None:
             return np.zeros(0, np.int64)
         shown = doc.shown_indices()
-        return shown[selection.in_cube(doc.skeleton.points[shown], doc.cube_centre, doc.cube_size)]
+        return shown[selection.in_cube(doc.skeleton.points[shown], doc.cube_centre, doc.settings.cube_size)]
 
     def apply(self, remove: bool = False) -> int:
         if self.doc.cube_centre is None:
@@ -234,9 +234,9 @@ class CubeMode(ModeHandler):
         if name in self.NUDGE:
             doc.set_cube(np.asarray(doc.cube_centre) + self.NUDGE[name])
         elif name in ("Plus", "Equal"):
-            doc.set_cube(doc.cube_centre, doc.cube_size + 2)
+            doc.settings.cube_size = min(200.0, doc.settings.cube_size + 2)
         elif name == "Minus":
-            doc.set_cube(doc.cube_centre, max(1.0, doc.cube_size - 2))
+            doc.settings.cube_size = max(1.0, doc.settings.cube_size - 2)
         elif name == "C":
             self.apply()
         elif name == "X":
@@ -247,23 +247,20 @@ class LassoMode(ModeHandler):
     """Draw an outline over the view; the shown points under it are connected (or removed).
 
     The depth mode decides which of them: 'through', 'visible' or 'slab' (see
-    ``selection``). Holding Ctrl while drawing, or the remove toggle, removes.
+    ``selection``). Holding Ctrl while drawing, or the remove setting, removes.
+    Depth, slab and remove are ``doc.settings.lasso_*``.
     """
 
     name = Mode.LASSO
     help = ("Lasso: drag an outline around points to connect them to the working bone (Ctrl: remove). "
             "Depth: through / visible / slab.")
 
-    def __init__(self, doc: Document):
-        super().__init__(doc)
-        self.depth_mode = "visible"
-        self.slab = 10.0
-        self.remove = False
-
     def finish(self, polygon, xy, depth, view_depth, shown, remove: bool | None = None) -> int:
         """Apply a closed outline: ``xy``/``depth``/``view_depth`` are the projections of ``shown`` points."""
-        remove = self.remove if remove is None else remove
-        picked = selection.select_lasso(xy, depth, view_depth, polygon, mode=self.depth_mode, slab=self.slab)
+        settings = self.doc.settings
+        remove = settings.lasso_remove if remove is None else remove
+        picked = selection.select_lasso(xy, depth, view_depth, polygon, mode=settings.lasso_depth,
+                                        slab=settings.lasso_slab)
         idx = np.asarray(shown)[picked]
         self.doc.set_point_selection(idx)
         bone = _working(self.doc, remove)
@@ -271,7 +268,7 @@ class LassoMode(ModeHandler):
             return 0
         n = self.doc.attachments.assign(idx, bone)
         self.doc.message(f"{'Removed' if remove else 'Connected'} {n} of {len(idx)} points under the lasso "
-                         f"({self.depth_mode}).")
+                         f"({settings.lasso_depth}).")
         return n
 
 

@@ -4,7 +4,7 @@ Keyed by the bone's joint names, not its index, so reordering bones keeps the
 pose. Slider drags merge into one undo step (``UndoStack`` merge keys).
 
     angles[(proximal, distal)] = (rx, ry, rz) degrees about the proximal joint
-    matrices() -> volanim_core.pose.pose_matrices -> (B, 4, 4)
+    matrices() -> volanim_core.rig.pose.pose_matrices -> (B, 4, 4)
 """
 
 from __future__ import annotations
@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from volanim_core import io
-from volanim_core.connectivity import Trans, Tskel
-from volanim_core.pose import local_motion, pose_matrices, posed_joints, root_bones
-from volanim_core.tskel import check_root_order
+from volanim_core.rig.connectivity import Trans, Tskel
+from volanim_core.rig.pose import local_motion, pose_matrices, posed_joints, root_bones
+from volanim_core.rig.tskel import check_root_order
 
 from .undo import Command
 
@@ -36,7 +36,7 @@ class PoseState:
 
         With ``compute=False`` a missing cache gives None (the caller computes it off the GUI thread).
         """
-        from volanim_core.reconstruct import sphere_neighbours
+        from volanim_core.reconstruct.neighbours import sphere_neighbours
 
         key = (self.doc.thinness, len(tskel))
         if self._neighbours is None or self._neighbours[0] != key:

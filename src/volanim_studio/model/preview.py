@@ -11,11 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volanim_core.breakage import BreakageReport, breakage_report
-from volanim_core.connectivity import Tskel
-from volanim_core.pose import scaled
-from volanim_core.reconstruct import Reconstruction, reconstruct
-from volanim_core.tskel import identity_tskel
+from volanim_core.reconstruct.breakage import BreakageReport, breakage_report
+from volanim_core.reconstruct.engine import Reconstruction, reconstruct
+from volanim_core.rig.connectivity import Tskel
+from volanim_core.rig.pose import scaled
+from volanim_core.rig.tskel import identity_tskel
 
 
 @dataclass
@@ -51,7 +51,7 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     """
     if not len(tskel):
         raise ValueError("no attached points to reconstruct: connect points to bones first")
-    from volanim_core.reconstruct import sphere_neighbours
+    from volanim_core.reconstruct.neighbours import sphere_neighbours
 
     nbrs = sphere_neighbours(tskel) if neighbours is None else neighbours  # pose-independent: shared below
     r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,

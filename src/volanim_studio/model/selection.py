@@ -10,7 +10,7 @@
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.path import Path as MplPath
+from skimage.measure import points_in_poly
 
 DEPTH_MODES = ("through", "visible", "slab")
 
@@ -26,7 +26,7 @@ def in_polygon(xy: np.ndarray, polygon) -> np.ndarray:
     polygon = np.asarray(polygon, np.float64)
     if len(polygon) < 3 or not len(xy):
         return np.zeros(len(xy), bool)
-    return MplPath(polygon).contains_points(np.asarray(xy, np.float64))
+    return points_in_poly(np.asarray(xy, np.float64), polygon)
 
 
 def visible_mask(xy: np.ndarray, depth: np.ndarray, *, cell: float = 3.0, tolerance: float = 0.0) -> np.ndarray:

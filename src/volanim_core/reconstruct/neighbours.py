@@ -1,0 +1,59 @@
+"""Same-bone neighbour lists: which larger spheres may clip each sphere (the overdraw cut).
+
+    connectivity --sphere_neighbours (cKDTree per bone)--> (N, k) indices, -1 padded
+    reconstruct() --reorder_neighbours--> the same lists after it grouped points by bone
+
+Same-bone neighbours keep their distances under any pose (a bone moves
+rigidly), so the lists depend only on the connectivity: compute them once and
+pass them to every frame.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volanim_core.reconstruct.radii import radius_squared
+from volanim_core.rig.connectivity import Connectivity
+
+HALFSPACES = 8  # larger neighbours per sphere whose bisector planes clip it
+CUT_MIN_RADIUS = 6.0  # below it, clipping rows costs more than the visits it saves (bench_reconstruct.py)
+
+
+def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES) -> np.ndarray:
+    """For each sphere, up to ``k`` nearby spheres of the same bone with radius >= its own.
+
+    ``(N, k)`` int32, -1 where there are fewer. Same-bone neighbours keep their
+    distances under any pose (a bone moves rigidly), so this depends only on
+    the connectivity: compute it once and pass it to :func:`reconstruct` for
+    every frame (the studio does).
+    """
+    from scipy.spatial import cKDTree
+
+    n = len(tskel)
+    out = np.full((n, k), -1, np.int32)
+    r2 = radius_squared(tskel.dt)
+    for b in np.unique(tskel.bone):
+        idx = np.flatnonzero(tskel.bone == b)
+        if len(idx) < 2:
+            continue
+        q = min(len(idx), 4 * k + 1)
+        _, nn = cKDTree(tskel.points[idx]).query(tskel.points[idx], k=q)
+        nn = idx[nn]  # global indices, nearest first (self included)
+        ok = (r2[nn] >= r2[idx][:, None]) & (nn != idx[:, None])
+        rank = np.cumsum(ok, axis=1) - 1
+        keep = ok & (rank < k)
+        rows, cols = np.nonzero(keep)
+        out[idx[rows], rank[rows, cols]] = nn[rows, cols]
+    return out
+
+
+
+def reorder_neighbours(neighbours: np.ndarray, order: np.ndarray | None) -> np.ndarray:
+    """Neighbour lists given in the caller's point order, re-expressed after ``order`` was applied."""
+    neighbours = np.asarray(neighbours, np.int32)
+    if order is None:
+        return neighbours
+    new_index = np.empty(len(order), np.int32)
+    new_index[order] = np.arange(len(order), dtype=np.int32)
+    moved = neighbours[order]
+    return np.where(moved >= 0, new_index[np.maximum(moved, 0)], -1).astype(np.int32)

@@ -1,0 +1,40 @@
+"""Label-coloured isosurfaces: the look of the studio's live preview.
+
+Software OpenGL draws a surface far faster than it ray-casts a volume, so a
+preview that must follow a slider is the boundary of the filled voxels, each
+surface point coloured by the label of the voxel it came from.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def label_surface(volume: np.ndarray, origin, spacing, table: np.ndarray | None = None):
+    """The surface around the non-zero voxels of ``volume`` (indexed ``[x, y, z]``).
+
+    Parameters
+    ----------
+    volume : (X, Y, Z) ndarray of labels (0 = empty)
+    origin, spacing : world position of voxel [0, 0, 0] and the voxel size
+    table : (L, 3) uint8, optional
+        Colour of label value v at row v (e.g. :func:`~volanim_core.render.colours.label_table`);
+        without it the surface has no colours.
+
+    Returns
+    -------
+    pyvista.PolyData, with point data ``rgb`` when ``table`` is given (possibly empty).
+    """
+    import pyvista as pv
+
+    origin = np.asarray(origin, np.float64)
+    spacing = np.asarray(spacing, np.float64)
+    img = pv.ImageData(dimensions=volume.shape, origin=origin, spacing=spacing)
+    img.point_data["values"] = (np.asarray(volume) > 0).astype(np.uint8).ravel(order="F")
+    surf = img.contour([0.5], scalars="values", method="flying_edges")
+    if surf.n_points and table is not None:
+        idx = np.rint((np.asarray(surf.points) - origin) / spacing).astype(np.int64)
+        idx = np.clip(idx, 0, np.array(volume.shape) - 1)
+        labels = np.asarray(volume)[tuple(idx.T)].astype(np.int64)
+        surf.point_data["rgb"] = table[np.clip(labels, 0, len(table) - 1)].astype(np.uint8)
+    return surf

@@ -1,0 +1,66 @@
+"""How a reconstructed volume is drawn: one transfer function per reconstruction mode.
+
+    mode --volume_style--> add_volume keyword arguments (+ label colours for label modes)
+    label colours --apply_labels--> VTK colour/opacity steps at half-integers (no blending)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volanim_core.render.colours import SKIN, bone_colours, rgb
+
+LABEL_MODES = ("bone", "mottled", "binary")
+
+
+def volume_style(mode: str, volume: np.ndarray, n_bones: int) -> dict:
+    """Keyword arguments for ``pyvista.Plotter.add_volume``.
+
+    Labels (bone, mottled, binary) get categorical colours (key ``categories``,
+    for :func:`apply_labels`), nearest-neighbour interpolation and transparent 0;
+    sampled grey data a grey ramp; hotspot a hot colour map with a colour bar.
+    """
+    vmax = float(volume.max()) if volume.size else 1.0
+    if mode in LABEL_MODES:
+        return {"cmap": "gray", "clim": (0, max(vmax, 1.0)), "show_scalar_bar": False,
+                "categories": label_colours(mode, n_bones)}
+    if mode == "hotspot":
+        return {"cmap": "hot", "clim": (0, max(vmax, 1.0)), "opacity": "linear", "show_scalar_bar": True,
+                "scalar_bar_args": {"title": "spheres per voxel"}}
+    return {"cmap": "gray", "clim": (0, max(vmax, 1.0)), "opacity": "sigmoid_5", "show_scalar_bar": False}
+
+
+def label_colours(mode: str, n_bones: int) -> np.ndarray:
+    """RGB (0..1) per label value 1..N: bone colours, a per-sphere mottle, or one colour."""
+    if mode == "bone":
+        return bone_colours(max(n_bones, 1))
+    if mode == "mottled":
+        return np.random.default_rng(7).uniform(0.25, 1.0, (255, 3))
+    return np.array([rgb(SKIN)])
+
+
+def apply_labels(volume_actor, colours: np.ndarray, opacity: float = 0.85) -> None:
+    """Label transfer functions: value v (1..N) -> colours[v - 1], 0 transparent, no blending.
+
+    Set on VTK directly: steps at half-integers, so neighbouring labels never mix.
+    """
+    import vtk
+
+    ctf = vtk.vtkColorTransferFunction()
+    otf = vtk.vtkPiecewiseFunction()
+    otf.AddPoint(0.0, 0.0)
+    otf.AddPoint(0.5, 0.0)
+    for v, c in enumerate(colours, start=1):
+        ctf.AddRGBPoint(v - 0.49, *c)
+        ctf.AddRGBPoint(v + 0.49, *c)
+        otf.AddPoint(v - 0.49, opacity)
+        otf.AddPoint(v + 0.49, opacity)
+    prop = volume_actor.GetProperty()
+    prop.SetColor(ctf)
+    prop.SetScalarOpacity(otf)
+    prop.SetInterpolationTypeToNearest()
+
+
+def binary_view(volume: np.ndarray) -> np.ndarray:
+    """A binary-mode volume as labels 0/1 (one colour for every filled voxel)."""
+    return (volume > 0).astype(np.uint8)

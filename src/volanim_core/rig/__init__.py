@@ -1,0 +1,8 @@
+"""The rig: a bone skeleton and the skeleton points attached to it, posed frame by frame.
+
+    bones.py ........ joints and bones in root order (``.bones``), hierarchy
+    connectivity.py . points per bone (``.connect``), matrices per bone (``.trans``/``.tskel``)
+    attach.py ....... attach points to bones: nearest, path inside the volume, geodesic
+    pose.py ......... forward kinematics: rotations about joints -> one 4x4 matrix per bone
+    tskel.py ........ the old pipeline's little tools on frames (connect2tskel, sorttskel, ...)
+"""

@@ -1,0 +1,165 @@
+"""Skeleton points attached to bones, and frames of bone matrices.
+
+One flat layout serves ``.connect``, ``.trans`` and ``.tskel``::
+
+    bones[b]          RootBone(proximal xyz, distal xyz, name)   b in root order
+    points[i], dt[i], thinness[i], bone[i]                          i = point
+    matrices[b]       4x4, row-vector convention: [x y z 1] @ M     (frames only)
+
+Flat arrays with a bone index (rather than a list per bone) are what the numba
+kernels want and make "move point i to bone b" a single assignment.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from volanim_core.skeleton.points import check_metric
+
+
+@dataclass(eq=False)
+class RootBone:
+    """A bone as ``Root:`` lines name it: joint coordinates and an optional name."""
+
+    proximal: np.ndarray
+    distal: np.ndarray
+    name: str = ""
+
+    def __post_init__(self):
+        self.proximal = np.asarray(self.proximal, dtype=np.float64).reshape(3)
+        self.distal = np.asarray(self.distal, dtype=np.float64).reshape(3)
+
+    def __eq__(self, other) -> bool:
+        return (
+            isinstance(other, RootBone)
+            and self.name == other.name
+            and np.array_equal(self.proximal, other.proximal)
+            and np.array_equal(self.distal, other.distal)
+        )
+
+    def same_segment(self, other: RootBone, tol: float = 1e-6) -> bool:
+        return bool(
+            np.allclose(self.proximal, other.proximal, atol=tol)
+            and np.allclose(self.distal, other.distal, atol=tol)
+        )
+
+    @property
+    def label(self) -> str:
+        p = " ".join(f"{v:g}" for v in self.proximal)
+        d = " ".join(f"{v:g}" for v in self.distal)
+        return self.name or f"({p})-({d})"
+
+
+def _points_fields(points, dt, thinness, bone):
+    points = np.ascontiguousarray(points, dtype=np.int32).reshape(-1, 3)
+    n = len(points)
+    dt = np.ascontiguousarray(dt, dtype=np.float64).reshape(n)
+    thinness = np.full(n, np.nan) if thinness is None else thinness
+    thinness = np.ascontiguousarray(thinness, dtype=np.float64).reshape(n)
+    bone = np.ascontiguousarray(bone, dtype=np.int32).reshape(n)
+    return points, dt, thinness, bone
+
+
+@dataclass(eq=False)
+class Connectivity:
+    """Contents of a ``.connect`` file.
+
+    ``bone[i]`` is the root-order index of point i's bone (always >= 0: points
+    attached to no bone are not part of a ``.connect``).
+    """
+
+    bones: list[RootBone]
+    points: np.ndarray
+    dt: np.ndarray
+    thinness: np.ndarray | None
+    bone: np.ndarray
+    metric: str = "euclid"
+    thinness_threshold: float | None = None
+
+    def __post_init__(self):
+        self.points, self.dt, self.thinness, self.bone = _points_fields(
+            self.points, self.dt, self.thinness, self.bone
+        )
+        check_metric(self.metric)
+        if len(self.bone) and (self.bone.min() < 0 or self.bone.max() >= len(self.bones)):
+            raise ValueError("point bone index out of range of the bone list")
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def __eq__(self, other) -> bool:
+        return (
+            type(other) is type(self)
+            and self.bones == other.bones
+            and self.metric == other.metric
+            and np.array_equal(self.points, other.points)
+            and np.array_equal(self.dt, other.dt)
+            and np.array_equal(self.thinness, other.thinness, equal_nan=True)
+            and np.array_equal(self.bone, other.bone)
+        )
+
+    def take(self, order: np.ndarray) -> Connectivity:
+        """A copy holding the points in ``order`` (a permutation or a subset)."""
+        return Connectivity(self.bones, self.points[order], self.dt[order], self.thinness[order],
+                            self.bone[order], self.metric, self.thinness_threshold)
+
+    def is_grouped(self) -> bool:
+        """Whether points are grouped by bone in root order, as files list them."""
+        return len(self) < 2 or bool(np.all(self.bone[:-1] <= self.bone[1:]))
+
+    def grouped(self) -> Connectivity:
+        """A copy with points grouped by bone in root order (stable), as files list them."""
+        return self.take(np.argsort(self.bone, kind="stable"))
+
+
+def _check_matrices(matrices, nbones):
+    m = np.ascontiguousarray(matrices, dtype=np.float64).reshape(-1, 4, 4)
+    if len(m) != nbones:
+        raise ValueError(f"{len(m)} matrices for {nbones} bones")
+    return m
+
+
+@dataclass(eq=False)
+class Trans:
+    """Contents of a ``.trans`` file: one 4x4 matrix per bone, root order."""
+
+    bones: list[RootBone]
+    matrices: np.ndarray
+
+    def __post_init__(self):
+        self.matrices = _check_matrices(self.matrices, len(self.bones))
+
+    def __eq__(self, other) -> bool:
+        return (
+            isinstance(other, Trans)
+            and self.bones == other.bones
+            and np.array_equal(self.matrices, other.matrices)
+        )
+
+
+class Tskel(Connectivity):
+    """Contents of a ``.tskel`` file: a connectivity plus one matrix per bone (root order).
+
+    ``Tskel(bones, matrices, points, dt, thinness, bone, metric)``; a matrix maps
+    rest voxel coordinates to posed ones, ``[x y z 1] @ M``.
+    """
+
+    def __init__(self, bones, matrices, points, dt, thinness, bone, metric: str = "euclid"):
+        super().__init__(bones, points, dt, thinness, bone, metric)
+        self.matrices = _check_matrices(matrices, len(self.bones))
+
+    def __eq__(self, other) -> bool:
+        return super().__eq__(other) and np.array_equal(self.matrices, other.matrices)
+
+    def __repr__(self) -> str:
+        return f"Tskel({len(self.bones)} bones, {len(self)} points, metric={self.metric!r})"
+
+    def take(self, order: np.ndarray) -> Tskel:
+        return Tskel(self.bones, self.matrices, self.points[order], self.dt[order], self.thinness[order],
+                     self.bone[order], self.metric)
+
+    @property
+    def connectivity(self) -> Connectivity:
+        return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric)

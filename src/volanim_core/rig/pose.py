@@ -1,0 +1,146 @@
+"""Posing a bone skeleton: forward kinematics to one 4x4 matrix per bone.
+
+Each bone may rotate about its proximal joint; a child moves with its parent:
+
+    L_b = translate(-j_b) . R_b . translate(j_b)      local, rest frame
+    M_b = L_b . M_parent(b)                            row-vector order
+
+so ``[x y z 1] @ M_b`` first turns the point about the bone's own joint and
+then applies every ancestor's motion. Rigid motions keep bone lengths.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.connectivity import RootBone
+
+
+def rotation_about(joint, rotation: np.ndarray) -> np.ndarray:
+    """Row-vector 4x4 matrix turning points by ``rotation`` (3x3, column convention) about ``joint``."""
+    j = np.asarray(joint, np.float64)
+    m = np.eye(4)
+    m[:3, :3] = np.asarray(rotation, np.float64).T
+    m[3, :3] = j - j @ m[:3, :3]
+    return m
+
+
+def apply_matrices(points: np.ndarray, bone: np.ndarray, matrices: np.ndarray) -> np.ndarray:
+    """Each point moved by its bone's matrix, ``[x y z 1] @ M[bone]``: ``(N, 3)`` float64.
+
+    One product per bone rather than a matrix per point (the frog has 137 k points, ~10 bones).
+    """
+    p = np.asarray(points, np.float64).reshape(-1, 3)
+    out = np.empty_like(p)
+    for b in np.unique(bone):
+        sel = bone == b
+        m = matrices[b]
+        out[sel] = p[sel] @ m[:3, :3] + m[3, :3]
+    return out
+
+
+def euler(degrees) -> np.ndarray:
+    """3x3 rotation from x, y, z angles in degrees (extrinsic, applied x then y then z)."""
+    return Rotation.from_euler("xyz", np.asarray(degrees, np.float64), degrees=True).as_matrix()
+
+
+def _order(parents: list[int | None]) -> list[int]:
+    """Bone indices with every parent before its children (the forest may list them in any order)."""
+    done: list[int] = []
+    seen: set[int] = set()
+
+    def visit(i, stack=()):
+        if i in seen:
+            return
+        if i in stack:
+            raise ValueError(f"the bone hierarchy has a cycle through bone {i}")
+        p = parents[i]
+        if p is not None:
+            visit(p, (*stack, i))
+        seen.add(i)
+        done.append(i)
+
+    for i in range(len(parents)):
+        visit(i)
+    return done
+
+
+def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None, translations: dict | None = None) -> np.ndarray:
+    """Forward kinematics: ``(B, 4, 4)`` matrices, rest voxel coordinates -> posed.
+
+    Parameters
+    ----------
+    bones : BoneSkeleton
+    rotations : dict, optional
+        Bone index or name -> 3x3 rotation matrix (column convention) or three
+        Euler angles in degrees, applied about the bone's proximal joint.
+    translations : dict, optional
+        Bone index or name -> a shift (voxels) applied after its rotation; its
+        children move with it (a root's walk in motion data).
+    """
+    n = len(bones)
+    local = [np.eye(3) for _ in range(n)]
+    for key, rot in (rotations or {}).items():
+        i = key if isinstance(key, int | np.integer) else bones.index(key)
+        if not 0 <= i < n:
+            raise ValueError(f"no bone {key!r}")
+        rot = np.asarray(rot, np.float64)
+        local[i] = euler(rot) if rot.shape == (3,) else rot
+        if local[i].shape != (3, 3):
+            raise ValueError(f"rotation of bone {key!r} must be 3x3 or three angles")
+    shift = [np.zeros(3) for _ in range(n)]
+    for key, t in (translations or {}).items():
+        i = key if isinstance(key, int | np.integer) else bones.index(key)
+        shift[i] = np.asarray(t, np.float64).reshape(3)
+    parents = bones.parents()
+    out = np.zeros((n, 4, 4))
+    for i in _order(parents):
+        m = rotation_about(bones.joints[bones.bones[i].proximal], local[i])
+        m[3, :3] += shift[i]
+        out[i] = m if parents[i] is None else m @ out[parents[i]]
+    return out
+
+
+def local_motion(bones: BoneSkeleton, matrices: np.ndarray) -> tuple[dict, dict]:
+    """Invert :func:`pose_matrices`: per bone, Euler angles (degrees) and the shift that give ``matrices``.
+
+    Loading a ``.trans`` into the pose sliders uses this; for matrices made
+    by FK it round-trips exactly (up to float rounding).
+    """
+    parents = bones.parents()
+    angles, shifts = {}, {}
+    for i, b in enumerate(bones.bones):
+        m = np.asarray(matrices[i], np.float64)
+        local = m if parents[i] is None else m @ np.linalg.inv(matrices[parents[i]])
+        r = local[:3, :3].T  # row-vector matrix -> column-convention rotation
+        u, _, vt = np.linalg.svd(r)  # nearest rotation, in case of float drift
+        r = u @ vt
+        angles[i] = Rotation.from_matrix(r).as_euler("xyz", degrees=True)
+        j = bones.joints[b.proximal]
+        shifts[i] = local[3, :3] - (j - j @ r.T)
+    return angles, shifts
+
+
+def scaled(matrices: np.ndarray, factor: float) -> np.ndarray:
+    """Matrices followed by a uniform scale 1/factor: a ``factor``-times coarser output grid (previews)."""
+    s = np.eye(4)
+    s[:3, :3] /= factor
+    return np.asarray(matrices) @ s
+
+
+def root_bones(bones: BoneSkeleton) -> list[RootBone]:
+    """The ``Root:`` records of a bone skeleton, in root order."""
+    return [RootBone(*bones.segment(i), b.label) for i, b in enumerate(bones.bones)]
+
+
+def posed_joints(bones: BoneSkeleton, matrices: np.ndarray) -> dict[str, np.ndarray]:
+    """Where each joint goes: a bone's distal joint moves with the bone, a top-level proximal joint too."""
+    out = {}
+    for i, b in enumerate(bones.bones):
+        m = matrices[i]
+        for name in (b.proximal, b.distal):
+            if name == b.distal or name not in out:
+                out[name] = np.append(bones.joints[name], 1.0) @ m
+    return {k: v[:3] for k, v in out.items()}

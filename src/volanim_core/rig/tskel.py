@@ -1,0 +1,44 @@
+"""Tools on ``.connect``/``.trans``/``.tskel`` data (the old pipeline's little programs).
+
+    connect_to_tskel(conn, trans)   connect2tskel: attach a frame's matrices
+    identity_tskel(conn)            connect2identitytskel: every matrix the identity
+    sort_tskel(tskel)               sorttskel: points of each bone by decreasing DT
+    reconstruct.grid_bounds         tskelbounds
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volanim_core.rig.connectivity import Connectivity, Trans, Tskel
+
+
+def check_root_order(conn_bones, trans_bones, what: str = ".trans") -> None:
+    """Raise ValueError naming the first bone whose joints differ between two files."""
+    if len(conn_bones) != len(trans_bones):
+        raise ValueError(f"the .connect has {len(conn_bones)} bones but the {what} has {len(trans_bones)}")
+    for i, (a, b) in enumerate(zip(conn_bones, trans_bones)):
+        if not a.same_segment(b, tol=1e-3):
+            raise ValueError(f"root order differs at bone {i}: the .connect has {a.label} "
+                             f"({_coords(a)}), the {what} has {b.label} ({_coords(b)})")
+
+
+def _coords(b) -> str:
+    return " ".join(f"{v:g}" for v in b.proximal) + " :: " + " ".join(f"{v:g}" for v in b.distal)
+
+
+def connect_to_tskel(conn: Connectivity, trans: Trans) -> Tskel:
+    """One frame ready to reconstruct: the connectivity with the frame's matrices."""
+    check_root_order(conn.bones, trans.bones)
+    return Tskel(conn.bones, trans.matrices, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric)
+
+
+def identity_tskel(conn: Connectivity) -> Tskel:
+    """The rest frame: every matrix the identity (reconstructs the original shape)."""
+    mats = np.tile(np.eye(4), (len(conn.bones), 1, 1))
+    return Tskel(conn.bones, mats, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric)
+
+
+def sort_tskel(tskel: Tskel) -> Tskel:
+    """Points grouped by bone in root order, each bone's by decreasing DT (stable)."""
+    return tskel.take(np.lexsort((-tskel.dt, tskel.bone)))

@@ -1,0 +1,136 @@
+"""View and tool settings: one validated property and one event per setting (Qt-free).
+
+    panel widget --bind (signals blocked on write-back)--> settings.NAME = value
+        --validate, store--> settings.events.NAME(value=...) --> scene, panels, controllers
+
+Everything a panel used to keep in its widgets (colour-by, point size, hull,
+clipping, slices, preview mode/kernel/padding, lasso and cube tools,
+auto-connect options, the current frame) lives here, so the +/- keys and the
+cube-size slider, or a saved project and the Display tab, can never disagree.
+Settings are not undoable (they are view state), and a project saves them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from .events import EventEmitter
+from .selection import DEPTH_MODES
+
+COLOUR_BY = ("thinness", "dt", "bone")
+PREVIEW_MODES = ("bone", "binary", "mottled", "hotspot", "sampled")
+AUTO_SCOPES = ("unconnected", "all", "selection")
+AUTO_METHODS = ("path", "path-or-nearest", "nearest", "geodesic")
+
+
+def one_of(*choices) -> Callable[[str, Any], Any]:
+    def check(name, value):
+        if value not in choices:
+            raise ValueError(f"{name} must be one of {', '.join(map(str, choices))}, got {value!r}")
+        return value
+    return check
+
+
+def number(lo: float, hi: float, kind=float) -> Callable[[str, Any], Any]:
+    def check(name, value):
+        try:
+            v = kind(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a number, got {value!r}") from None
+        if not lo <= v <= hi:  # also refuses NaN
+            raise ValueError(f"{name} must be between {lo:g} and {hi:g}, got {value!r}")
+        return v
+    return check
+
+
+def flag(name, value) -> bool:
+    if not isinstance(value, bool | int):
+        raise ValueError(f"{name} must be true or false, got {value!r}")
+    return bool(value)
+
+
+def axis_or_none(name, value):
+    if value is None:
+        return None
+    return number(0, 2, int)(name, value)
+
+
+@dataclass(frozen=True)
+class Setting:
+    default: Any
+    check: Callable[[str, Any], Any]
+    doc: str
+
+
+SETTINGS: dict[str, Setting] = {
+    # display
+    "colour_by": Setting("thinness", one_of(*COLOUR_BY), "what colours the skeleton points"),
+    "point_size": Setting(6.0, number(1, 30), "skeleton point size, pixels"),
+    "spheres": Setting(True, flag, "draw points as shaded spheres"),
+    "hull_visible": Setting(True, flag, "show the translucent hull"),
+    "hull_opacity": Setting(0.15, number(0, 1), "hull opacity"),
+    "clip_axis": Setting(None, axis_or_none, "axis of the hull's clipping plane (None: no clipping)"),
+    "clip_position": Setting(0.5, number(0, 1), "clipping plane position along its axis, 0..1"),
+    "slices": Setting(False, flag, "orthogonal slices through the preview"),
+    # preview
+    "preview_mode": Setting("bone", one_of(*PREVIEW_MODES), "reconstruction mode of the preview"),
+    "preview_kernel": Setting(1, one_of(1, 3, 5), "sampled mode's kernel"),
+    "preview_padding": Setting(2, number(0, 64, int), "voxels around the posed spheres"),
+    "live_preview": Setting(True, flag, "half-resolution preview while a pose slider moves"),
+    "show_rest": Setting(False, flag, "show the rest pose's reconstruction instead (compare)"),
+    # connect tools
+    "lasso_depth": Setting("visible", one_of(*DEPTH_MODES), "which points under the lasso it takes"),
+    "lasso_slab": Setting(10.0, number(0.5, 1000), "slab depth behind the nearest point, voxels"),
+    "lasso_remove": Setting(False, flag, "the lasso removes attachments instead of adding"),
+    "cube_size": Setting(10.0, number(1, 200), "edge of the connect cube, voxels"),
+    "auto_scope": Setting("unconnected", one_of(*AUTO_SCOPES), "which points auto-connect considers"),
+    "auto_method": Setting("path", one_of(*AUTO_METHODS), "how auto-connect chooses a bone"),
+    "auto_overwrite": Setting(False, flag, "auto-connect may replace existing attachments"),
+    # timeline
+    "current_frame": Setting(0, number(0, 10**7, int), "the frame shown (motion and sequences)"),
+}
+
+
+class Settings:
+    """The studio's view and tool settings; ``settings.NAME`` reads, assignment validates and emits."""
+
+    def __init__(self):
+        self.events = EventEmitter(*SETTINGS)
+        self._values = {name: s.default for name, s in SETTINGS.items()}
+
+    def as_dict(self) -> dict:
+        return dict(self._values)
+
+    def update(self, values: dict) -> list[str]:
+        """Set every known, valid entry of ``values`` (a saved project); returns what was refused."""
+        refused = []
+        for name, value in values.items():
+            try:
+                if name not in SETTINGS:
+                    raise ValueError(f"unknown setting {name!r}")
+                setattr(self, name, value)
+            except ValueError as exc:
+                refused.append(str(exc))
+        return refused
+
+
+def _setting_property(name: str) -> property:
+    spec = SETTINGS[name]
+
+    def get(self):
+        return self._values[name]
+
+    def set_(self, value):
+        value = spec.check(name, value)
+        if value == self._values[name]:
+            return
+        self._values[name] = value
+        getattr(self.events, name).emit(value=value)
+
+    return property(get, set_, doc=spec.doc)
+
+
+for _name in SETTINGS:
+    setattr(Settings, _name, _setting_property(_name))

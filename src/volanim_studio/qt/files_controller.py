@@ -1,0 +1,212 @@
+"""Opening and saving for the main window: volumes (threshold dialog + background job),
+skeletons, bones, connectivity and projects.
+
+    File menu / buttons --> FilesController --> volanim_core readers / Document
+                                   |--> JobRunner (segmenting, skeletonizing) --> Document on the GUI thread
+    errors --> the window's error dialog naming the file and line; the document stays as it was
+
+Owned by :class:`~volanim_studio.qt.main_window.MainWindow` (composed, not
+inherited): it knows the document, the scene (for the camera), the job runner
+and the window as the parent of its dialogs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtWidgets import QFileDialog
+
+from volanim_core import io
+from volanim_core.errors import FormatError
+
+from .. import tasks
+from ..model.project import apply_project, read_project
+from .threshold_dialog import ThresholdDialog
+from .worker import Worker
+
+
+class FilesController:
+    def __init__(self, window):
+        self.window = window  # the parent of file dialogs
+        self.doc = window.doc
+        self.scene = window.scene
+        self.jobs = window.jobs
+        self.show_error = window.show_error
+
+    # -------------------------------------------------------------- loading
+    def _apply_prepared(self, result: dict, path=None, spacing=None, dims=None) -> None:
+        self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),
+                            path=path, segmentation=result["segmentation"], dims=dims)
+        self.doc.set_skeleton(result["skeleton"], result.get("skeleton_path"))
+        self.doc.set_hull(*result["hull"])
+        self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
+
+    def load_demo(self, name: str, *, skeleton_path=None) -> Worker:
+        def done(r):
+            self._apply_prepared(r, spacing=r["spacing"])
+            self.doc.demo_name = name
+
+        return self.jobs.run(f"Preparing the {name} demo", lambda progress, cancel: tasks.load_demo(
+            name, skeleton_path=skeleton_path, progress=progress, cancel=cancel), done)
+
+    def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None) -> Worker | None:
+        """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
+        try:
+            loaded = tasks.load_volume_file(str(path), dims)
+        except FormatError as exc:
+            self.show_error("Open volume", str(exc))
+            return None
+        if params is None:
+            dialog = ThresholdDialog(loaded["volume"], Path(path).name, self.window)
+            if dialog.exec() != ThresholdDialog.Accepted:
+                return None
+            params = dialog.parameters()
+        vol = loaded["volume"]
+        return self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
+            vol, skeleton_path=skeleton_path, progress=progress, cancel=cancel, **params),
+            lambda r: self._apply_prepared(r, path=path, spacing=loaded["spacing"], dims=dims))
+
+    def open_volume_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", "", "Volumes (*.vol *.VOL *.vti *.nrrd *.nii "
+                                              "*.nii.gz *.mha *.mhd);;All files (*)")
+        if path:
+            self.open_volume(path)
+
+    def open_mskel(self, path) -> bool:
+        try:
+            skel = io.read_mskel(path)
+        except FormatError as exc:
+            self.show_error("Open skeleton", str(exc))
+            return False
+        self.doc.set_skeleton(skel, path)
+        self.doc.message(f"Loaded {len(skel)} points from {Path(path).name}.")
+        return True
+
+    def open_bones(self, path) -> bool:
+        try:
+            self.doc.bone_edits.load_bones(path)
+        except FormatError as exc:
+            self.show_error("Open bones", str(exc))
+            return False
+        self.doc.message(f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.")
+        return True
+
+    def open_connections(self, path) -> bool:
+        try:
+            self.doc.bone_edits.load_connections(path)
+        except (FormatError, ValueError) as exc:
+            self.show_error("Open connections", str(exc))
+            return False
+        self.doc.message(f"{len(self.doc.bones)} bones in the root order of {Path(path).name}.")
+        return True
+
+    def open_project(self, path) -> Worker | None:
+        """Open a ``.volanim``: its volume segmented as saved (its ``.mskel`` read, not recomputed), then its files."""
+        try:
+            data = read_project(path)
+        except FormatError as exc:
+            self.show_error("Open project", str(exc))
+            return None
+
+        def rest(_=None):
+            try:
+                warnings = apply_project(self.doc, data, path)
+            except (FormatError, ValueError) as exc:
+                self.show_error("Open project", str(exc))
+                return
+            if warnings:
+                self.show_error("Open project", "\n".join(warnings))
+            if data.get("camera"):
+                self.scene.set_camera(data["camera"])
+            self.doc.message(f"Opened {Path(path).name}.")
+
+        worker = None
+        if data.get("volume"):
+            worker = self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
+                                      skeleton_path=data.get("mskel"))
+            if worker is None:
+                return None
+        elif data.get("demo"):
+            worker = self.load_demo(data["demo"], skeleton_path=data.get("mskel"))
+        if worker is not None:
+            worker.succeeded.connect(rest)
+            return worker
+        rest()
+        return None
+
+    def open_connect(self, path) -> bool:
+        try:
+            warnings = self.doc.attachments.load(path)
+        except (FormatError, ValueError) as exc:
+            self.show_error("Open connectivity", str(exc))
+            return False
+        if warnings:
+            self.show_error("Open connectivity", "\n".join(warnings))
+        per_bone, unconnected = self.doc.attachments.counts()
+        self.doc.message(f"Loaded {int(per_bone.sum())} attachments from {Path(path).name}.")
+        return True
+
+    def save_connect(self, path=None) -> Path | None:
+        if path is None:
+            stem = Path(self.doc.project_path or "untitled").with_suffix("").name
+            default = self.doc.attachments.default_filename(stem)
+            path, _ = QFileDialog.getSaveFileName(self.window, "Save connectivity", default, "Connectivity (*.connect)")
+            if not path:
+                return None
+        try:
+            n = self.doc.attachments.save(path)
+        except (OSError, ValueError) as exc:
+            self.show_error("Save connectivity", str(exc))
+            return None
+        self.doc.message(f"Saved {n} attached points (thinness ≥ {self.doc.thinness:.2f}) to {path}.")
+        return Path(path)
+
+    def open_dialog(self, kind: str) -> None:
+        filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
+                   "connect": "Connectivity (*.connect)", "connections": "Connections (*.connections)"}
+        path, _ = QFileDialog.getOpenFileName(self.window, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
+        if path:
+            {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project,
+             "connect": self.open_connect, "connections": self.open_connections}[kind](path)
+
+    # -------------------------------------------------------------- saving
+    def save_project(self, ask: bool = False, path=None) -> Path | None:
+        if path is None:
+            path = self.doc.project_path
+            if ask or not path:
+                path, _ = QFileDialog.getSaveFileName(self.window, "Save project", "session.volanim",
+                                                      "Projects (*.volanim)")
+                if not path:
+                    return None
+        try:
+            saved = self.doc.save_project(path, camera=self.scene.camera())
+        except (OSError, ValueError) as exc:
+            self.show_error("Save project", str(exc))
+            return None
+        self.doc.message(f"Saved {saved}.")
+        return saved
+
+    def save_bones(self, path) -> bool:
+        try:
+            self.doc.bone_edits.save_bones(path)
+        except (OSError, ValueError) as exc:
+            self.show_error("Save bones", str(exc))
+            return False
+        self.doc.message(f"Saved {len(self.doc.bones)} bones to {path}.")
+        return True
+
+    def save_dialog(self, kind: str) -> None:
+        """Ask where, then save: ``connect``, ``bones``, ``connections`` or a ``png`` screenshot."""
+        if kind == "connect":
+            self.save_connect()
+            return
+        filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
+        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", f"untitled.{kind}", filters[kind])
+        if not path:
+            return
+        if kind == "bones":
+            self.save_bones(path)
+        elif kind == "connections":
+            self.doc.bone_edits.save_connections(path)
+        else:
+            self.scene.plotter.screenshot(path)

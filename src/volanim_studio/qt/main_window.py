@@ -1,0 +1,392 @@
+"""The studio's main window: it composes the view, the panels and the controllers.
+
+    QtInteractor --SceneView.pick--> PickEvent --> active mode handler --> Document
+    Document / settings events --> SceneView (actors), panels, status bar
+    File menu --> FilesController --> volanim_core readers, JobRunner (errors: a dialog naming file and line)
+    Pose menu, pose sliders --> PreviewController --> live preview / JobRunner(make_preview)
+
+The window owns the controllers (it does not inherit them) and routes
+clicks and keys to the mode table; it keeps no view or tool state of its own.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtCore import Qt, QTimer
+from PySide6.QtGui import QAction, QActionGroup, QKeySequence
+from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMessageBox, QTabWidget
+from pyvistaqt import QtInteractor
+
+from ..model import autosave
+from ..model.document import Document
+from ..model.modes import HANDLERS, Mode, PickEvent
+from ..scene.view import SceneView
+from .bone_panel import BonePanel
+from .connect_panel import ConnectPanel
+from .display_panel import DisplayPanel
+from .files_controller import FilesController
+from .pose_panel import PosePanel
+from .preview_controller import PreviewController
+from .reconstruct_panel import ReconstructPanel
+from .worker import JobRunner, Worker
+
+SHORTCUTS = [
+    ("V", "View mode: click points to inspect them"),
+    ("B", "Bones mode: click point A, then B to add a bone; keep clicking to chain"),
+    ("R", "Root order mode: click bones in order"),
+    ("K", "Cube mode: click a point to place the cube; arrows / PgUp / PgDn nudge, +/- size, C connect, X remove"),
+    ("L", "Lasso mode: drag an outline to connect the points under it to the working bone (Ctrl: remove)"),
+    ("Ctrl+A", "Auto-connect"),
+    ("P", "Pose mode: click a bone, turn it with the Pose sliders; the preview follows live"),
+    ("F5", "Preview the reconstruction at full resolution, with the breakage report"),
+    ("Esc", "End the bone chain / restart the root order"),
+    ("Right click", "End the bone chain"),
+    ("Delete", "Remove the selected bones"),
+    ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
+    ("Ctrl+Z / Ctrl+Shift+Z", "Undo / redo"),
+    ("Ctrl+O", "Open a volume"),
+    ("Ctrl+S", "Save the project"),
+    ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
+]
+
+
+class MainWindow(QMainWindow):
+    def __init__(self, doc: Document | None = None, *, autosave_every_edits: int = 5,
+                 autosave_seconds: float = 60.0):
+        super().__init__()
+        self.doc = doc or Document()
+        self.setWindowTitle("volanim studio")
+        self.resize(1400, 900)
+        self.plotter = QtInteractor(self)
+        self.setCentralWidget(self.plotter.interactor if hasattr(self.plotter, "interactor") else self.plotter)
+        self.scene = SceneView(self.plotter, self.doc, on_pick=self.handle_pick)
+        self.handlers = {m: cls(self.doc) for m, cls in HANDLERS.items()}
+        self.mode = Mode.VIEW
+        self.jobs = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text),
+                              on_idle=self.activateWindow)  # focus back after a job (Xvfb has no WM to do it)
+        self.last_error: str | None = None
+        self._error_box: QMessageBox | None = None
+
+        self.files = FilesController(self)
+        self.previews = PreviewController(self)
+        self.previews.in_pose_mode = lambda: self.mode == Mode.POSE
+        self.display_panel = DisplayPanel(self.doc, self.scene)
+        self.bone_panel = BonePanel(self.doc)
+        self.connect_panel = ConnectPanel(self.doc, self.handlers[Mode.CUBE])
+        self.pose_panel = PosePanel(self.doc)
+        self.reconstruct_panel = ReconstructPanel(self.doc)
+        self.scene.on_lasso = self.handle_lasso
+        tabs = self.panel_tabs = QTabWidget()
+        tabs.addTab(self.bone_panel, "Bones")
+        tabs.addTab(self.connect_panel, "Connect")
+        tabs.addTab(self.pose_panel, "Pose")
+        tabs.addTab(self.reconstruct_panel, "Reconstruct")
+        tabs.addTab(self.display_panel, "Display")
+        tabs.setMinimumWidth(420)
+        dock = QDockWidget("Panels", self)
+        dock.setWidget(tabs)
+        dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
+        self.addDockWidget(Qt.RightDockWidgetArea, dock)
+        self.point_label = QLabel("")
+        self.statusBar().addPermanentWidget(self.point_label)
+        self._build_actions()
+        self.doc.events.message.connect(lambda text: self.statusBar().showMessage(text, 15000))
+        self.doc.events.picked.connect(self._on_picked_changed)
+        self.doc.events.attachments.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
+        self.doc.events.bones.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
+        self.doc.undo.events.changed.connect(self._on_undo_changed)
+        self.doc.events.project.connect(lambda path: self.setWindowTitle(f"volanim studio — {Path(path).name}"))
+        self.autosaver = autosave.Autosaver(self.doc, every_edits=autosave_every_edits,
+                                            every_seconds=autosave_seconds)
+        self.doc.undo.events.changed.connect(self._autosave_after_edit)
+        self.autosave_timer = QTimer(self)
+        self.autosave_timer.timeout.connect(self._autosave_tick)
+        self.autosave_timer.start(int(1000 * min(autosave_seconds, 60.0)))
+        self.set_mode(Mode.VIEW)
+
+    # ------------------------------------------------------------ autosave
+    def _autosave_after_edit(self, **_) -> None:
+        try:
+            self.autosaver.edited()
+        except (OSError, ValueError) as exc:
+            self.doc.message(f"Autosave failed: {exc}")
+
+    def _autosave_tick(self) -> None:
+        try:
+            self.autosaver.tick()
+        except (OSError, ValueError) as exc:
+            self.doc.message(f"Autosave failed: {exc}")
+
+    def offer_recovery(self, ask=None) -> Worker | None:
+        """If an earlier session crashed, offer to restore its last autosave.
+
+        ``ask(path) -> bool`` replaces the question dialog (tests).
+        """
+        found = autosave.find_recoveries()
+        if not found:
+            return None
+        latest = found[0]
+        if ask is None:
+            answer = QMessageBox.question(
+                self, "Restore unsaved work?", f"volanim studio did not close properly last time.\n"
+                f"Restore the session autosaved at {latest.parent.name}?", QMessageBox.Yes | QMessageBox.No)
+            restore = answer == QMessageBox.Yes
+        else:
+            restore = ask(latest)
+        if not restore:
+            for f in found:
+                autosave.discard(f)
+            return None
+        worker = self.files.open_project(latest)
+
+        def cleanup(_=None):
+            self.doc.project_path = None  # a restored session saves where the user says, not into the cache
+            self.setWindowTitle("volanim studio — restored")
+            for f in found:
+                autosave.discard(f)
+            self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones).")
+
+        if worker is not None:
+            worker.succeeded.connect(cleanup)
+        else:
+            cleanup()
+        return worker
+
+    # ------------------------------------------------------------- actions
+    def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:
+        a = QAction(text, self)
+        if shortcut:
+            a.setShortcut(QKeySequence(shortcut))
+            a.setShortcutContext(Qt.WindowShortcut)
+        a.setCheckable(checkable)
+        a.triggered.connect(slot)
+        self.addAction(a)
+        if menu is not None:
+            menu.addAction(a)
+        return a
+
+    def _build_actions(self) -> None:
+        bar = self.menuBar()
+        file = bar.addMenu("&File")
+        self._action("Open &volume…", lambda: self.files.open_volume_dialog(), "Ctrl+O", menu=file)
+        self._action("Open &skeleton (.mskel)…", lambda: self.files.open_dialog("mskel"), menu=file)
+        self._action("Open &bones…", lambda: self.files.open_dialog("bones"), menu=file)
+        self._action("Open connections…", lambda: self.files.open_dialog("connections"), menu=file)
+        self._action("Open &project…", lambda: self.files.open_dialog("project"), menu=file)
+        file.addSeparator()
+        self._action("&Save project", lambda: self.files.save_project(), "Ctrl+S", menu=file)
+        self._action("Save project &as…", lambda: self.files.save_project(ask=True), "Ctrl+Shift+S", menu=file)
+        self._action("Save bones…", lambda: self.files.save_dialog("bones"), menu=file)
+        self._action("Save connections…", lambda: self.files.save_dialog("connections"), menu=file)
+        self._action("Screenshot…", lambda: self.files.save_dialog("png"), menu=file)
+        file.addSeparator()
+        self._action("&Quit", self.close, "Ctrl+Q", menu=file)
+        edit = bar.addMenu("&Edit")
+        self.undo_action = self._action("Undo", self.undo, "Ctrl+Z", menu=edit)
+        self.redo_action = self._action("Redo", self.redo, "Ctrl+Shift+Z", menu=edit)
+        self._action("Delete selected bones", lambda: self.key("Delete"), "Delete", menu=edit)
+        self._action("Symmetrize selected bones", self.symmetrize, "M", menu=edit)
+        self._action("End chain", lambda: self.key("Escape"), "Esc")
+        modes = bar.addMenu("&Mode")
+        toolbar = self.addToolBar("Modes")
+        group = QActionGroup(self)
+        self.mode_actions = {}
+        for mode, text, key in ((Mode.VIEW, "View", "V"), (Mode.BONES, "Bones", "B"),
+                                (Mode.ROOT_ORDER, "Root order", "R"), (Mode.CUBE, "Cube", "K"),
+                                (Mode.LASSO, "Lasso", "L"), (Mode.POSE, "Pose", "P")):
+            a = self._action(text, lambda _=False, m=mode: self.set_mode(m), key, checkable=True, menu=modes)
+            group.addAction(a)
+            toolbar.addAction(a)
+            self.mode_actions[mode] = a
+        toolbar.addSeparator()
+        self.remove_action = self._action("Remove bones", self._toggle_remove, checkable=True)
+        toolbar.addAction(self.remove_action)
+        sym = self._action("Symmetrize", self.symmetrize)
+        toolbar.addAction(sym)
+        # cube keys: live only in cube mode, so arrows still move through lists elsewhere
+        self.cube_actions = [
+            self._action(f"Cube {name}", lambda _=False, n=name: self.key(n), key)
+            for name, key in (("Left", "Left"), ("Right", "Right"), ("Up", "Up"), ("Down", "Down"),
+                              ("PageUp", "PgUp"), ("PageDown", "PgDown"), ("Plus", "+"), ("Minus", "-"),
+                              ("C", "C"), ("X", "X"))]
+        connect_menu = bar.addMenu("&Connect")
+        self._action("Auto-connect", self.auto_connect, "Ctrl+A", menu=connect_menu)
+        self._action("Mirror connectivity of selected bones", self.mirror_connectivity, menu=connect_menu)
+        self._action("Save .connect…", lambda: self.files.save_dialog("connect"), menu=connect_menu)
+        self._action("Open .connect…", lambda: self.files.open_dialog("connect"), menu=connect_menu)
+        pose = bar.addMenu("&Pose")
+        self._action("Preview reconstruction", lambda: self.previews.preview(), "F5", menu=pose)
+        self._action("Reset pose", lambda: self.doc.pose.reset(), menu=pose)
+        self._action("Load pose (.trans)…", lambda: self.previews.load_trans_dialog(), menu=pose)
+        self._action("Save pose (.trans)…", lambda: self.previews.save_dialog("trans"), menu=pose)
+        self._action("Save frame (.tskel)…", lambda: self.previews.save_dialog("tskel"), menu=pose)
+        self._action("Export reconstruction…", lambda: self.previews.save_dialog("volume"), menu=pose)
+        self.pose_panel.drag_started.connect(self.previews.drag_started)
+        self.pose_panel.drag_finished.connect(self.previews.drag_finished)
+        self.pose_panel.load_trans.clicked.connect(lambda: self.previews.load_trans_dialog())
+        self.pose_panel.save_trans.clicked.connect(lambda: self.previews.save_dialog("trans"))
+        self.pose_panel.save_tskel.clicked.connect(lambda: self.previews.save_dialog("tskel"))
+        rp = self.reconstruct_panel
+        rp.preview_button.clicked.connect(lambda: self.previews.preview())
+        rp.export_button.clicked.connect(lambda: self.previews.save_dialog("volume"))
+        rp.joint_clicked.connect(self.previews.jump_to_joint)
+        self.connect_panel.auto_button.clicked.connect(self.auto_connect)
+        self.connect_panel.mirror_button.clicked.connect(self.mirror_connectivity)
+        help_menu = bar.addMenu("&Help")
+        self._action("&Shortcuts", self.show_shortcuts, "F1", menu=help_menu)
+        self._on_undo_changed()
+
+    def set_mode(self, mode: Mode) -> None:
+        self.handlers[self.mode].leave()
+        self.mode = Mode(mode)
+        self.mode_actions[self.mode].setChecked(True)
+        self.scene.set_lasso_enabled(self.mode == Mode.LASSO)
+        self.scene.set_posing(self.mode == Mode.POSE)
+        if self.mode == Mode.POSE:
+            self.panel_tabs.setCurrentWidget(self.pose_panel)
+        for a in getattr(self, "cube_actions", []):
+            a.setEnabled(self.mode == Mode.CUBE)
+        if self.mode in (Mode.CUBE, Mode.LASSO):
+            self.panel_tabs.setCurrentWidget(self.connect_panel)
+            self.doc.settings.colour_by = "bone"
+        self.handlers[self.mode].enter()
+
+    def handle_lasso(self, polygon, ctrl: bool) -> None:
+        shown, xy, depth, view_depth = self.scene.shown_projection()
+        lasso = self.handlers[Mode.LASSO]
+        lasso.finish(polygon, xy, depth, view_depth, shown, remove=True if ctrl else None)
+
+    def auto_connect(self) -> None:
+        st = self.doc.settings
+        try:
+            report = self.doc.attachments.auto(scope=st.auto_scope, overwrite=st.auto_overwrite,
+                                               selection=self.doc.point_selection, method=st.auto_method)
+        except ValueError as exc:
+            self.show_error("Auto-connect", str(exc))
+            return
+        self.doc.message(f"Auto-connect: {report}.")
+        if report.unattached:
+            self.show_error("Auto-connect", f"Auto-connect {report}. Connect the rest with the cube or lasso.")
+
+    def mirror_connectivity(self) -> None:
+        try:
+            copied, lonely = self.doc.attachments.mirror()
+        except ValueError as exc:
+            self.show_error("Mirror connectivity", str(exc))
+            return
+        text = f"Mirrored {copied} attachments"
+        if lonely:
+            text += f"; {lonely} points found no partner on the other side (connect them by hand)"
+        self.doc.message(text + ".")
+
+    def _toggle_remove(self, on: bool) -> None:
+        self.handlers[Mode.BONES].remove = on
+        if on:
+            self.set_mode(Mode.BONES)
+            self.doc.message("Remove: click a bone to delete it (toggle off to add bones again).")
+
+    def handle_pick(self, ev: PickEvent) -> None:
+        try:
+            self.handlers[self.mode].press(ev)
+        except ValueError as exc:
+            self.doc.message(str(exc))
+
+    def key(self, name: str) -> None:
+        if name == "Delete" and self.mode != Mode.BONES and self.doc.selected_bones:
+            self.doc.bone_edits.remove_bones(self.doc.selected_bones)
+            return
+        self.handlers[self.mode].key(name)
+
+    def undo(self) -> None:
+        label = self.doc.undo.undo()
+        self.doc.message(f"Undid: {label}" if label else "Nothing to undo.")
+
+    def redo(self) -> None:
+        label = self.doc.undo.redo()
+        self.doc.message(f"Redid: {label}" if label else "Nothing to redo.")
+
+    def _on_undo_changed(self, **_) -> None:
+        u = self.doc.undo
+        self.undo_action.setEnabled(u.can_undo)
+        self.undo_action.setText(f"Undo {u.undo_label}" if u.can_undo else "Undo")
+        self.redo_action.setEnabled(u.can_redo)
+        self.redo_action.setText(f"Redo {u.redo_label}" if u.can_redo else "Redo")
+
+    def symmetrize(self) -> None:
+        try:
+            written = self.doc.bone_edits.symmetrize()
+        except ValueError as exc:
+            self.show_error("Symmetrize", str(exc))
+            return
+        self.doc.message(f"Mirrored to {', '.join(written)} across x = {self.doc.symmetry_x:g}.")
+
+    def _on_picked_changed(self, index=None, **_) -> None:
+        if index is None or self.doc.skeleton is None or index >= len(self.doc.skeleton):
+            self.point_label.setText("")
+            return
+        i = self.doc.point_info(index)
+        self.point_label.setText(f"x {i['x']}  y {i['y']}  z {i['z']}   DT {i['dt']:.3f}   "
+                                 f"thinness {i['thinness']:.3f}   bone {i['bone'] or '—'}")
+
+    def show_shortcuts(self) -> None:
+        rows = "".join(f"<tr><td><b>{k}</b></td><td>{v}</td></tr>" for k, v in SHORTCUTS)
+        box = QMessageBox(QMessageBox.Information, "Shortcuts", f"<table cellspacing=6>{rows}</table>",
+                          QMessageBox.Close, self)
+        box.setTextFormat(Qt.RichText)
+        self._shortcut_box = box
+        box.open()
+
+    # -------------------------------------------------------------- errors
+    def show_error(self, title: str, message: str) -> None:
+        """A non-blocking error dialog; the document is untouched."""
+        self.last_error = message
+        box = QMessageBox(QMessageBox.Warning, title, message, QMessageBox.Ok, self)
+        self._error_box = box
+        box.open()
+
+    @property
+    def busy(self) -> bool:
+        """A background job is running (its thread has not ended yet)."""
+        return self.jobs.busy
+
+    def screenshot(self, path) -> None:
+        self.plotter.screenshot(str(path))
+
+    def closeEvent(self, event):  # noqa: N802 (Qt name)
+        self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
+        self.autosave_timer.stop()
+        self.autosaver.close()
+        self.plotter.close()
+        super().closeEvent(event)
+
+
+def main_window_for(args) -> MainWindow:
+    """A window loaded as the command line asks (see ``app.main``)."""
+    w = MainWindow()
+    worker = None
+    if args.project:
+        worker = w.files.open_project(args.project)
+    elif args.demo:
+        worker = w.files.load_demo(args.demo)
+    elif args.volume:
+        worker = w.files.open_volume(args.volume)
+
+    def then(_=None):  # files that build on the loaded skeleton, after any background load
+        if args.mskel:
+            w.files.open_mskel(args.mskel)
+        if args.bones:
+            w.files.open_bones(args.bones)
+        if args.connect:
+            w.files.open_connect(args.connect)
+
+    if worker is not None:
+        worker.succeeded.connect(then)
+    else:
+        then()
+    if not (args.project or args.demo or args.volume or args.mskel or args.connect or args.bones):
+        w.offer_recovery()  # a plain start: offer a crashed session's autosave
+    return w
+
+
+__all__ = ["MainWindow", "main_window_for"]

@@ -1,0 +1,109 @@
+"""The Pose tab: turn the working bone with three sliders. Widgets write the pose model;
+pose events write the widgets back with signals blocked."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (
+    QDoubleSpinBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSlider,
+    QVBoxLayout,
+    QWidget,
+)
+
+from ..model.document import Document
+
+
+class PosePanel(QWidget):
+    """Three angle sliders (degrees about x, y, z at the proximal joint) for the working bone."""
+
+    drag_started = Signal()
+    drag_finished = Signal()
+
+    def __init__(self, doc: Document, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        self.bone_label = QLabel()
+        self.sliders, self.spins = [], []
+        box = QGroupBox("Rotate about the proximal joint (children follow)")
+        form = QFormLayout(box)
+        for axis in "xyz":
+            slider = QSlider(Qt.Horizontal)
+            slider.setRange(-180, 180)
+            spin = QDoubleSpinBox(decimals=1, minimum=-180.0, maximum=180.0, singleStep=1.0)
+            row = QHBoxLayout()
+            row.addWidget(slider)
+            row.addWidget(spin)
+            form.addRow(f"{axis} °", row)
+            slider.valueChanged.connect(self._slider_changed)
+            slider.sliderPressed.connect(self.drag_started.emit)
+            slider.sliderReleased.connect(self._released)
+            spin.editingFinished.connect(self._spin_changed)
+            self.sliders.append(slider)
+            self.spins.append(spin)
+        self.reset_bone = QPushButton("Reset bone")
+        self.reset_all = QPushButton("Reset pose")
+        self.load_trans = QPushButton("Load .trans…")
+        self.save_trans = QPushButton("Save .trans…")
+        self.save_tskel = QPushButton("Save .tskel…")
+        buttons = QHBoxLayout()
+        buttons.addWidget(self.reset_bone)
+        buttons.addWidget(self.reset_all)
+        files = QHBoxLayout()
+        for b in (self.load_trans, self.save_trans, self.save_tskel):
+            files.addWidget(b)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.bone_label)
+        layout.addWidget(box)
+        layout.addLayout(buttons)
+        layout.addLayout(files)
+        layout.addStretch(1)
+        self.reset_bone.clicked.connect(self._reset_bone)
+        self.reset_all.clicked.connect(lambda: doc.pose.reset())
+        doc.events.selection.connect(self._refresh)
+        doc.events.pose.connect(self._refresh)
+        doc.events.bones.connect(self._refresh)
+        self._refresh()
+
+    def _angles(self) -> list[float]:
+        return [float(s.value()) for s in self.sliders]
+
+    def _slider_changed(self, _=None) -> None:
+        b = self.doc.working_bone
+        if b is not None:
+            self.doc.pose.set_angles(b, self._angles())
+
+    def _spin_changed(self) -> None:
+        b = self.doc.working_bone
+        if b is not None:
+            self.doc.pose.set_angles(b, [s.value() for s in self.spins], merge=False)
+            self.drag_finished.emit()
+
+    def _released(self) -> None:
+        self.doc.undo.seal()
+        self.drag_finished.emit()
+
+    def _reset_bone(self) -> None:
+        if self.doc.working_bone is not None:
+            self.doc.pose.reset(self.doc.working_bone)
+            self.drag_finished.emit()
+
+    def _refresh(self, **_) -> None:
+        b = self.doc.working_bone
+        enabled = b is not None
+        self.bone_label.setText("Click a bone to pose it." if not enabled else
+                                f"Posing <b>{self.doc.bones.bones[b].label}</b> (root {b})")
+        angles = self.doc.pose.angles_of(b) if enabled else [0.0, 0.0, 0.0]
+        for slider, spin, a in zip(self.sliders, self.spins, angles):
+            for w, v in ((slider, int(round(a))), (spin, float(a))):
+                w.blockSignals(True)
+                w.setValue(v)
+                w.blockSignals(False)
+            slider.setEnabled(enabled)
+            spin.setEnabled(enabled)
+        self.reset_bone.setEnabled(enabled)

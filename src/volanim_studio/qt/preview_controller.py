@@ -1,0 +1,187 @@
+"""Posing and previews: live and full previews, compare, slices, export, poses in and out.
+
+    pose slider drag --doc.events.pose--> live_preview (half resolution, GUI thread, coalesced)
+    drag released / F5 --> preview() --> JobRunner(make_preview + breakage report) --> doc.set_preview
+    doc.events.preview, settings.show_rest / slices --> draw() --> scene
+
+Owned by the main window (composed, not inherited). Preview mode, kernel and
+padding are read from ``doc.settings`` at the moment of use, never from widgets.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QFileDialog
+
+from volanim_core import io
+from volanim_core.errors import FormatError
+
+from ..model.preview import make_preview
+from .worker import Worker
+
+
+class PreviewController:
+    def __init__(self, window):
+        self.window = window  # the parent of dialogs
+        self.doc = window.doc
+        self.scene = window.scene
+        self.jobs = window.jobs
+        self.show_error = window.show_error
+        self.in_pose_mode = lambda: False  # the window sets it: full previews follow drags only in Pose mode
+        self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
+        self._posing_drag = False
+        self._rest_preview = None
+        self._live_timer = QTimer(window)
+        self._live_timer.setSingleShot(True)
+        self._live_timer.setInterval(0)
+        self._live_timer.timeout.connect(self.live_preview)
+        ev, st = self.doc.events, self.doc.settings.events
+        ev.pose.connect(self._on_pose_changed)
+        ev.preview.connect(lambda **_: self.draw())
+        ev.attachments.connect(self._forget_rest)
+        ev.bones.connect(self._forget_rest)
+        st.show_rest.connect(lambda **_: self.draw())
+        st.slices.connect(lambda **_: self.draw())
+
+    def drag_started(self) -> None:
+        self._posing_drag = True
+        worker = self.jobs.worker
+        if worker is not None and getattr(worker, "is_preview", False):
+            worker.cancel()  # a newer pose is coming
+
+    def drag_finished(self) -> None:
+        self._posing_drag = False
+        if self.in_pose_mode() and len(self.doc.attachments.bone) and (self.doc.attachments.bone >= 0).any():
+            self.preview()
+
+    def _on_pose_changed(self, **_) -> None:
+        if self._posing_drag and self.doc.settings.live_preview:
+            self._live_timer.start()  # coalesced: one live preview per event-loop pass
+
+    def live_preview(self) -> None:
+        """Half-resolution binary or bone preview on the GUI thread (tens of ms on the mannequin)."""
+        t0 = time.perf_counter()
+        mode = self.doc.settings.preview_mode
+        mode = mode if mode in ("binary", "bone") else "bone"
+        try:
+            tskel = self.doc.pose.tskel()
+            p = make_preview(tskel, mode=mode, factor=2, padding=2, neighbours=self.doc.pose.neighbours(tskel))
+        except ValueError as exc:
+            self.doc.message(str(exc))
+            return
+        self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
+        self.live_timings.append(time.perf_counter() - t0)
+
+    def preview(self, *, report: bool = True) -> Worker | None:
+        """Full-resolution reconstruction with the breakage report, in the background."""
+        st = self.doc.settings
+        settings = {"mode": st.preview_mode, "kernel": st.preview_kernel, "padding": st.preview_padding}
+        if self.jobs.busy:
+            self.doc.message("A job is running; preview again when it ends.")
+            return None
+        if settings["mode"] == "sampled" and self.doc.volume is None:
+            self.show_error("Preview", "sampled mode needs the volume: open it (File → Open volume)")
+            return None
+        try:
+            tskel = self.doc.pose.tskel()
+            if not len(tskel):
+                raise ValueError("no attached points to reconstruct: connect points to bones first (Connect tab)")
+        except ValueError as exc:
+            self.show_error("Preview", str(exc))
+            return None
+        joints = dict(self.doc.bones.joints)
+        posed = self.doc.pose.posed_joints()
+        source = self.doc.volume if settings["mode"] == "sampled" else None
+        nbrs = self.doc.pose.neighbours(tskel, compute=False)  # None: the worker computes them
+        worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
+            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report, neighbours=nbrs,
+            progress=progress, cancel=cancel), self.doc.set_preview)
+        worker.is_preview = True
+        return worker
+
+    def _forget_rest(self, **_) -> None:
+        self._rest_preview = None
+
+    def draw(self) -> None:
+        """Show the last preview (or the rest pose's, to compare) in the scene."""
+        p = self.doc.preview
+        if self.doc.settings.show_rest:
+            if self._rest_preview is None and len(self.doc.attachments.bone):
+                from volanim_core.rig.tskel import identity_tskel
+
+                try:
+                    rest = identity_tskel(self.doc.pose.tskel().connectivity)
+                    mode = p.mode if p is not None else "bone"
+                    self._rest_preview = make_preview(rest, mode=mode, source=self.doc.volume)
+                except ValueError as exc:
+                    self.doc.message(str(exc))
+                    return
+            p = self._rest_preview
+        if p is None:
+            self.scene.clear_volume()
+            return
+        if p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
+            self.scene.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+        else:
+            self.scene.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+
+    def jump_to_joint(self, name: str) -> None:
+        posed = self.doc.pose.posed_joints()
+        if name in posed:
+            self.scene.jump_to(posed[name])
+            self.doc.message(f"Centred on {name}. Fix the points there (Lasso, L), then preview again (F5).")
+
+    def export_preview(self, path) -> bool:
+        p = self.doc.preview
+        if p is None:
+            self.show_error("Export", "nothing to export: preview first (F5)")
+            return False
+        vol, note = io.saturate_for_raw(path, p.reconstruction.volume)
+        try:
+            io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing)
+        except (OSError, ValueError) as exc:
+            self.show_error("Export", str(exc))
+            return False
+        self.doc.message(f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; "
+                         f"origin {tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {note}." if note else ""))
+        return True
+
+    def load_trans(self, path) -> bool:
+        try:
+            self.doc.pose.load_trans(path)
+        except (FormatError, ValueError) as exc:
+            self.show_error("Load pose", str(exc))
+            return False
+        self.doc.message(f"Loaded the pose from {Path(path).name}.")
+        return True
+
+
+    # -------------------------------------------------------------- dialogs
+    def load_trans_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open pose", "", "Poses (*.trans);;All files (*)")
+        if path:
+            self.load_trans(path)
+
+    def save_dialog(self, kind: str) -> None:
+        """Ask where, then save the pose (``trans``), the frame (``tskel``) or the preview (``volume``)."""
+        filters = {"trans": "Poses (*.trans)", "tskel": "Frames (*.tskel)",
+                   "volume": "Volumes (*.vti *.nrrd *.VOL *.vol)"}
+        default = {"trans": "pose.trans", "tskel": "pose.tskel", "volume": "preview.vti"}[kind]
+        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", default, filters[kind])
+        if not path:
+            return
+        if kind == "volume":
+            self.export_preview(path)
+            return
+        try:
+            if kind == "trans":
+                self.doc.pose.save_trans(path)
+            else:
+                self.doc.pose.save_tskel(path)
+        except (OSError, ValueError) as exc:
+            self.show_error(f"Save {kind}", str(exc))
+            return
+        self.doc.message(f"Saved {path}.")

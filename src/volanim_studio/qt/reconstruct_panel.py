@@ -1,0 +1,97 @@
+"""The Reconstruct tab: preview settings (bound both ways to ``doc.settings``), compare,
+slices, export, and the breakage report of the last full preview."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QFormLayout,
+    QGroupBox,
+    QLabel,
+    QListWidget,
+    QListWidgetItem,
+    QPushButton,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from ..model.document import Document
+from ..model.settings import PREVIEW_MODES
+from .bindings import bind
+
+
+class ReconstructPanel(QWidget):
+    """Preview settings, the compare toggle, export, and the breakage report."""
+
+    joint_clicked = Signal(str)
+
+    def __init__(self, doc: Document, parent=None):
+        super().__init__(parent)
+        self.doc = doc
+        self.mode = QComboBox()
+        self.mode.addItems(PREVIEW_MODES)
+        self.kernel = QComboBox()
+        self.kernel.addItems(["1", "3", "5"])
+        self.padding = QSpinBox(minimum=0, maximum=64)
+        self.live = QCheckBox("Live preview while posing (half resolution)")
+        self.slices = QCheckBox("Orthogonal slices")
+        self.show_rest = QCheckBox("Show the rest pose instead (compare)")
+        s = doc.settings
+        for widget, name, conv in ((self.mode, "preview_mode", None), (self.kernel, "preview_kernel", int),
+                                   (self.padding, "preview_padding", None), (self.live, "live_preview", None),
+                                   (self.slices, "slices", None), (self.show_rest, "show_rest", None)):
+            bind(widget, s, name, to_value=conv, on_error=doc.message)
+        self.metric_label = QLabel("euclid")
+        self.metric_label.setToolTip("The distance metric of the skeleton's DT (set when skeletonizing); "
+                                     "radii are in it")
+        self.preview_button = QPushButton("Preview")
+        self.export_button = QPushButton("Export volume…")
+        self.report = QLabel("No preview yet.")
+        self.report.setWordWrap(True)
+        self.joints = QListWidget()
+        settings = QGroupBox("Reconstruction")
+        form = QFormLayout(settings)
+        form.addRow("Mode", self.mode)
+        form.addRow("Kernel (sampled)", self.kernel)
+        form.addRow("Padding", self.padding)
+        form.addRow("Metric (from the skeleton)", self.metric_label)
+        form.addRow(self.live)
+        form.addRow(self.preview_button)
+        view = QGroupBox("View")
+        vl = QVBoxLayout(view)
+        vl.addWidget(self.show_rest)
+        vl.addWidget(self.slices)
+        vl.addWidget(self.export_button)
+        report = QGroupBox("Breakage report")
+        rl = QVBoxLayout(report)
+        rl.addWidget(self.report)
+        rl.addWidget(QLabel("Breakage gathers near (click to go there):"))
+        rl.addWidget(self.joints)
+        layout = QVBoxLayout(self)
+        for w in (settings, view, report):
+            layout.addWidget(w)
+        self.joints.itemClicked.connect(lambda item: self.joint_clicked.emit(item.data(Qt.UserRole)))
+        doc.events.skeleton.connect(
+            lambda **_: self.metric_label.setText(doc.skeleton.metric if doc.skeleton is not None else "euclid"))
+        doc.events.preview.connect(self._on_preview_changed)
+
+    def _on_preview_changed(self, **_) -> None:
+        p = self.doc.preview
+        if p is None or p.report is None:
+            return
+        r = p.report
+        verdict = "healthy: one piece" if r.healthy else "BROKEN into pieces"
+        self.report.setText(f"<b>{verdict}</b><br>" + "<br>".join(r.lines()))
+        self.joints.clear()
+        for size, joint, _ in r.pieces:
+            item = QListWidgetItem(f"detached piece: {size} voxels near {joint}")
+            item.setData(Qt.UserRole, joint)
+            self.joints.addItem(item)
+        total = max(sum(j.gap for j in r.joints), 1e-9)
+        for j in r.joints:
+            item = QListWidgetItem(f"{j.name}: {j.lost} cracks ({100 * j.gap / total:.0f} % of the opening)")
+            item.setData(Qt.UserRole, j.name)
+            self.joints.addItem(item)

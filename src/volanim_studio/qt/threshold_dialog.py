@@ -1,0 +1,95 @@
+"""Threshold dialog: a histogram of the volume and the object's value range."""
+
+from __future__ import annotations
+
+import numpy as np
+from PySide6.QtCore import QRectF, Qt
+from PySide6.QtGui import QColor, QPainter
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QLabel,
+    QVBoxLayout,
+    QWidget,
+)
+
+from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
+
+
+class HistogramWidget(QWidget):
+    """Log-count bars of 256 bins; the selected range is highlighted."""
+
+    def __init__(self, counts: np.ndarray, edges: np.ndarray, parent=None):
+        super().__init__(parent)
+        self.counts = np.log1p(counts.astype(float))
+        self.edges = edges
+        self.lo, self.hi = float(edges[0]), float(edges[-1])
+        self.setMinimumSize(380, 140)
+
+    def set_range(self, lo: float, hi: float) -> None:
+        self.lo, self.hi = lo, hi
+        self.update()
+
+    def paintEvent(self, event):  # noqa: N802 (Qt name)
+        p = QPainter(self)
+        p.fillRect(self.rect(), QColor("#202124"))
+        w, h = self.width(), self.height()
+        n = len(self.counts)
+        top = self.counts.max() or 1.0
+        for i, c in enumerate(self.counts):
+            inside = self.lo <= self.edges[i + 1] and self.edges[i] <= self.hi
+            p.fillRect(QRectF(i * w / n, h - h * c / top, max(w / n, 1.0), h * c / top),
+                       QColor("#f0a030" if inside else "#707070"))
+        p.end()
+
+
+class ThresholdDialog(QDialog):
+    """Choose the object's value range, cavity filling and the skeleton's settings."""
+
+    def __init__(self, volume: np.ndarray, name: str, parent=None):
+        super().__init__(parent)
+        self.setWindowTitle(f"Segment {name}")
+        vmin, vmax = float(volume.min()), float(volume.max())
+        sample = volume.ravel()[:: max(1, volume.size // 2_000_000)]
+        counts, edges = np.histogram(sample, bins=256, range=(vmin, vmax if vmax > vmin else vmin + 1))
+        self.histogram = HistogramWidget(counts, edges)
+        self.lo = QDoubleSpinBox(decimals=2, minimum=vmin, maximum=vmax)
+        self.hi = QDoubleSpinBox(decimals=2, minimum=vmin, maximum=vmax)
+        self.lo.setValue(min(vmin + 1, vmax) if volume.dtype.kind in "ui" else (vmin + vmax) / 2)
+        self.hi.setValue(vmax)
+        self.fill = QCheckBox("Fill enclosed cavities")
+        self.fill.setChecked(True)
+        self.metric_box = QComboBox()
+        self.metric_box.addItems(["euclid", "345"])
+        self.min_thinness = QDoubleSpinBox(decimals=2, minimum=-10.0, maximum=10.0, singleStep=0.05)
+        self.min_thinness.setValue(DEFAULT_MIN_THINNESS)
+        form = QFormLayout()
+        form.addRow("Object from", self.lo)
+        form.addRow("to", self.hi)
+        form.addRow(self.fill)
+        form.addRow("Distance metric", self.metric_box)
+        form.addRow("Keep thinness ≥", self.min_thinness)
+        buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        layout = QVBoxLayout(self)
+        layout.addWidget(QLabel(f"{volume.shape[0]} × {volume.shape[1]} × {volume.shape[2]} voxels, "
+                                f"{volume.dtype}, values {vmin:g} … {vmax:g}"))
+        layout.addWidget(self.histogram)
+        layout.addLayout(form)
+        layout.addWidget(buttons)
+        self.lo.valueChanged.connect(self._sync)
+        self.hi.valueChanged.connect(self._sync)
+        self._sync()
+        self.setAttribute(Qt.WA_DeleteOnClose, False)
+
+    def _sync(self) -> None:
+        self.histogram.set_range(self.lo.value(), self.hi.value())
+
+    def parameters(self) -> dict:
+        return {"lo": self.lo.value(), "hi": self.hi.value(), "fill": self.fill.isChecked(),
+                "metric": self.metric_box.currentText(), "min_thinness": self.min_thinness.value()}

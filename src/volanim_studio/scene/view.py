@@ -1,0 +1,404 @@
+"""The rendering layer: owns the VTK actors and turns clicks into pick events.
+
+    Document events --> SceneView._on_<prop>_changed --> actors --> render()
+    VTK mouse press/release (no drag) --> pick(x, y) --> PickEvent --> on_pick callback
+
+The scene never edits the document; the main window routes pick events to
+the active mode. Picking projects the shown points with the renderer's own
+camera matrices (``projection``), so the translucent hull can never
+intercept a click and HiDPI scaling cannot offset it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pyvista as pv
+
+from volanim_core.render.colours import label_table, scalar_colours
+
+from ..model.document import Document
+from ..model.modes import PickEvent
+from .overlays import SceneSelectionMixin
+from .pose_layer import ScenePoseMixin
+from .projection import nearest_in_radius, project, segment_distance_2d
+
+LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
+PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
+CLICK_SLOP = 4.0  # a press and release further apart than this is a drag (camera), not a click
+
+
+def _vtk_matrix(m) -> np.ndarray:
+    return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
+
+
+class SceneView(SceneSelectionMixin, ScenePoseMixin):
+    """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor``."""
+
+    def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
+        self.plotter = plotter
+        self.doc = doc
+        self.on_pick = on_pick
+        self.settings = doc.settings
+        self._hull_actor = self._cloud_actor = self._bones_actor = self._joints_actor = None
+        self._selected_actor = self._picked_actor = None
+        self._world = np.zeros((0, 3), np.float32)
+        self._colours = np.zeros((0, 3), np.uint8)
+        self._press = None
+        self._shown = np.zeros(0, np.int64)
+        self._lasso: list | None = None  # display points of the outline being drawn
+        self.lasso_enabled = False
+        self.on_lasso = None  # callback(polygon, ctrl)
+        self._lasso_actor = None
+        self._cube_actor = None
+        self._trackball = None
+        self._preview_actor = None
+        self._preview_key = None
+        self.posing = False
+        self.dragging = False  # the thinness slider is held: draw a level-of-detail subset
+        self._render_pending = False
+        plotter.set_background("#1e1f24")
+        self._fix_pixel_ratio()
+        iren = plotter.iren
+        iren.add_observer("LeftButtonPressEvent", self._on_press)
+        iren.add_observer("LeftButtonReleaseEvent", self._on_release)
+        iren.add_observer("RightButtonPressEvent", self._on_press)
+        iren.add_observer("RightButtonReleaseEvent", self._on_release)
+        ev = doc.events
+        ev.volume.connect(self._on_hull_changed)
+        ev.hull.connect(self._on_hull_changed)
+        ev.skeleton.connect(self._on_skeleton_changed)
+        ev.thinness.connect(self._on_thinness_changed)
+        ev.bones.connect(self._on_bones_changed)
+        ev.selection.connect(self._on_selection_changed)
+        ev.picked.connect(self._on_picked_changed)
+        ev.attachments.connect(self._on_attachments_changed)
+        ev.filter.connect(self._on_thinness_changed)
+        ev.cube.connect(self._on_cube_changed)
+        ev.pose.connect(self._on_pose_changed)
+        st = doc.settings.events
+        st.colour_by.connect(self._on_colour_by_changed)
+        st.point_size.connect(lambda **_: self._update_cloud())
+        st.spheres.connect(lambda **_: self._update_cloud())
+        for name in ("hull_visible", "hull_opacity", "clip_axis", "clip_position"):
+            getattr(st, name).connect(self._on_hull_state_changed)
+        st.cube_size.connect(self._on_cube_changed)
+        raw = plotter.iren.interactor  # raw VTK observers: they run before the camera style
+        raw.AddObserver("LeftButtonPressEvent", self._lasso_press, 10.0)
+        raw.AddObserver("MouseMoveEvent", self._lasso_move, 10.0)
+        raw.AddObserver("LeftButtonReleaseEvent", self._lasso_release, 10.0)
+
+    def _fix_pixel_ratio(self) -> None:
+        # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen
+        # under the *cursor*, which is wrong on mixed-DPI desktops (pyvistaqt #20,
+        # VTK MR 4201); use the widget's own ratio for both size and events.
+        widget = self.plotter
+        if hasattr(widget, "_getPixelRatio"):
+            widget._getPixelRatio = lambda: float(widget.devicePixelRatioF())
+
+    # ---------------------------------------------------------- coordinates
+    @property
+    def spacing(self) -> np.ndarray:
+        return np.asarray(self.doc.spacing, np.float64)
+
+    def world(self, voxel_xyz) -> np.ndarray:
+        return np.asarray(voxel_xyz, np.float64) * self.spacing
+
+    def _camera(self):
+        ren = self.plotter.renderer
+        width, height = ren.GetSize()
+        x0, y0 = ren.GetOrigin()
+        m = ren.GetActiveCamera().GetCompositeProjectionTransformMatrix(width / max(height, 1), -1, 1)
+        return _vtk_matrix(m), (x0, y0, width, height)
+
+    def project_world(self, world_points) -> tuple[np.ndarray, np.ndarray]:
+        """Display pixels (device, bottom-left origin) and depth of world points."""
+        matrix, viewport = self._camera()
+        return project(world_points, matrix, viewport)
+
+    def display_of_point(self, index: int) -> np.ndarray:
+        """Where skeleton point ``index`` is drawn, in display pixels."""
+        return self.project_world(self.world(self.doc.skeleton.points[index])[None])[0][0]
+
+    def camera(self) -> dict:
+        """The view's camera as plain lists (saved in projects)."""
+        cam = self.plotter.renderer.GetActiveCamera()
+        return {"position": list(cam.GetPosition()), "focal_point": list(cam.GetFocalPoint()),
+                "view_up": list(cam.GetViewUp())}
+
+    def set_camera(self, data: dict) -> None:
+        cam = self.plotter.renderer.GetActiveCamera()
+        cam.SetPosition(*data["position"])
+        cam.SetFocalPoint(*data["focal_point"])
+        cam.SetViewUp(*data["view_up"])
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.render()
+
+    def pixel_ratio(self) -> float:
+        return float(self.plotter.devicePixelRatioF())
+
+    # ---------------------------------------------------------------- picks
+    def pick(self, x: float, y: float) -> PickEvent:
+        """What is under display position ``(x, y)``: point, joint and bone (each may be None)."""
+        radius = PICK_RADIUS * self.pixel_ratio()
+        point = joint = bone = None
+        shown = self._shown
+        if len(shown):
+            xy, depth = self.project_world(self._world[shown])
+            k = nearest_in_radius(xy, depth, (x, y), radius)
+            point = None if k is None else int(shown[k])
+        names = list(self.doc.bones.joints)
+        if names:
+            jw = self.world(np.array([self.doc.bones.joints[k] for k in names]))
+            jxy, jdepth = self.project_world(jw)
+            k = nearest_in_radius(jxy, jdepth, (x, y), radius)
+            joint = names[k] if k is not None else None
+            segs = self.doc.bones.segments()
+            if len(segs):
+                a, _ = self.project_world(self.world(segs[:, 0]))
+                b, _ = self.project_world(self.world(segs[:, 1]))
+                d = segment_distance_2d((x, y), a, b)
+                if d.min() <= radius:
+                    bone = int(np.argmin(d))
+        return PickEvent(point=point, joint=joint, bone=bone)
+
+    def _event_position(self) -> tuple[int, int]:
+        # pyvista hangs button observers on the interactor *style*; the position is the interactor's
+        return self.plotter.iren.interactor.GetEventPosition()
+
+    def _on_press(self, obj, event) -> None:
+        if self.lasso_enabled and event.startswith("Left"):
+            return
+        self._press = self._event_position()
+
+    def _on_release(self, obj, event) -> None:
+        if self._press is None:
+            return
+        x, y = self._event_position()
+        px, py = self._press
+        self._press = None
+        if abs(x - px) > CLICK_SLOP or abs(y - py) > CLICK_SLOP:
+            return  # a drag moved the camera
+        ev = self.pick(x, y)
+        button = "right" if event.startswith("Right") else "left"
+        if self.on_pick is not None:
+            self.on_pick(PickEvent(ev.point, ev.joint, ev.bone, button))
+
+    # ---------------------------------------------------------------- hull
+    def _on_hull_changed(self, **_) -> None:
+        if self._hull_actor is not None:
+            self.plotter.remove_actor(self._hull_actor, render=False)
+            self._hull_actor = None
+        if self.doc.hull is None:
+            self.render()
+            return
+        verts, faces = self.doc.hull
+        cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
+        mesh = pv.PolyData(self.world(verts).astype(np.float32), cells)
+        self._hull_actor = self.plotter.add_mesh(
+            mesh, color="#d8c8b0", opacity=self.settings.hull_opacity, pickable=False, smooth_shading=True,
+            name="hull", render=False, reset_camera=False)
+        self._apply_hull_state()
+        self._apply_stage()
+        self.front_view()
+
+    def _apply_hull_state(self) -> None:
+        a = self._hull_actor
+        if a is None:
+            return
+        a.SetVisibility(self.settings.hull_visible)
+        a.GetProperty().SetOpacity(self.settings.hull_opacity)
+        mapper = a.GetMapper()
+        mapper.RemoveAllClippingPlanes()
+        if self.settings.clip_axis is not None and self.doc.shape is not None:
+            import vtk
+
+            plane = vtk.vtkPlane()
+            origin = [0.0, 0.0, 0.0]
+            extent = (self.doc.shape[self.settings.clip_axis] - 1) * self.spacing[self.settings.clip_axis]
+            origin[self.settings.clip_axis] = self.settings.clip_position * extent
+            normal = [0.0, 0.0, 0.0]
+            normal[self.settings.clip_axis] = -1.0
+            plane.SetOrigin(origin)
+            plane.SetNormal(normal)
+            mapper.AddClippingPlane(plane)
+
+    def _on_hull_state_changed(self, **_) -> None:
+        self._apply_hull_state()
+        self._apply_stage()
+        self.render()
+
+    # ---------------------------------------------------------------- cloud
+    def _on_skeleton_changed(self, **_) -> None:
+        s = self.doc.skeleton
+        self._world = np.zeros((0, 3), np.float32) if s is None else self.world(s.points).astype(np.float32)
+        self._recolour()
+        self._update_cloud()
+        if self._hull_actor is None and len(self._world):
+            self.front_view()
+
+    def front_view(self) -> None:
+        """Look along +y (from the front of a figure facing -y), z up, everything in view."""
+        ren = self.plotter.renderer
+        b = ren.ComputeVisiblePropBounds()
+        if b[0] > b[1]:
+            return
+        c = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
+        cam = ren.GetActiveCamera()
+        cam.SetFocalPoint(*c)
+        cam.SetPosition(c[0], c[1] - 3 * max(b[1] - b[0], b[5] - b[4], 1.0), c[2])
+        cam.SetViewUp(0, 0, 1)
+        ren.ResetCamera()
+        self.render()
+
+    def _recolour(self) -> None:
+        s = self.doc.skeleton
+        if s is None or not len(s):
+            self._colours = np.zeros((0, 3), np.uint8)
+            return
+        self._colours = self.point_colours()
+
+    def point_colours(self) -> np.ndarray:
+        """RGB per skeleton point for the current colour-by setting."""
+        s = self.doc.skeleton
+        if self.settings.colour_by == "bone":
+            return self._bone_rgb()[self.doc.attachments.bone + 1]
+        if self.settings.colour_by == "dt":
+            return scalar_colours(s.dt, "viridis")
+        return scalar_colours(s.thinness, "plasma")
+
+    def _bone_rgb(self) -> np.ndarray:
+        """Row 0: unconnected grey; row b + 1: bone b's colour."""
+        return label_table(len(self.doc.bones))
+
+    def _on_attachments_changed(self, indices=None, **_) -> None:
+        if self.settings.colour_by == "bone" and self.doc.skeleton is not None:
+            if indices is None or len(self._colours) != len(self.doc.skeleton):
+                self._recolour()
+            else:
+                self._colours[indices] = self._bone_rgb()[self.doc.attachments.bone[indices] + 1]
+        self._update_cloud()
+
+    def _on_colour_by_changed(self, **_) -> None:
+        self._recolour()
+        self._update_cloud()
+
+    def set_dragging(self, on: bool) -> None:
+        """While the slider is held draw at most LOD_POINTS; the full prefix on release."""
+        self.dragging = bool(on)
+        self._update_cloud()
+
+    def _drawn(self) -> tuple[np.ndarray, np.ndarray]:
+        shown = self._shown
+        if self.dragging and len(shown) > LOD_POINTS:
+            shown = shown[np.linspace(0, len(shown) - 1, LOD_POINTS).astype(np.int64)]
+        elif len(shown) == self.doc.visible_count:  # the plain prefix: slices, no copies
+            n = len(shown)
+            return self._world[:n], self._colours[:n]
+        return self._world[shown], self._colours[shown]
+
+    def _update_cloud(self) -> None:
+        self._shown = self.doc.shown_indices() if self.doc.skeleton is not None else np.zeros(0, np.int64)
+        n = len(self._shown)
+        world, colours = self._drawn()
+        if self._cloud_actor is None:
+            if not n:
+                return
+            poly = pv.PolyData(world)
+            poly.point_data["rgb"] = colours
+            self._cloud_actor = self.plotter.add_mesh(
+                poly, scalars="rgb", rgb=True, point_size=self.settings.point_size,
+                render_points_as_spheres=self.settings.spheres, name="cloud", render=False, reset_camera=False)
+        else:
+            poly = pv.PolyData(world) if n else pv.PolyData()
+            if n:
+                poly.point_data["rgb"] = colours
+            self._cloud_actor.mapper.SetInputData(poly)
+            prop = self._cloud_actor.GetProperty()
+            prop.SetPointSize(self.settings.point_size)
+            prop.SetRenderPointsAsSpheres(self.settings.spheres)
+        self._apply_stage()
+        self.render()
+
+    def _on_thinness_changed(self, **_) -> None:
+        self._update_cloud()
+
+    @property
+    def shown(self) -> np.ndarray:
+        """Indices of the skeleton points on screen (thinness prefix, then filters)."""
+        return self._shown
+
+    @property
+    def shown_points(self) -> int:
+        """How many points the cloud actor draws right now."""
+        if self._cloud_actor is None:
+            return 0
+        return int(self._cloud_actor.mapper.GetInput().GetNumberOfPoints())
+
+    # ---------------------------------------------------------------- bones
+    def _on_bones_changed(self, **_) -> None:
+        if self.settings.colour_by == "bone" and self.doc.skeleton is not None:
+            self._recolour()
+            self._update_cloud()
+        for name in ("bones", "joints", "selected"):
+            self.plotter.remove_actor(name, render=False)
+        self._bones_actor = self._joints_actor = self._selected_actor = None
+        bones = self.doc.bones
+        if len(bones.joints):
+            jpos = self.world(np.array(list(bones.joints.values())))
+            self._joints_actor = self.plotter.add_mesh(
+                pv.PolyData(jpos.astype(np.float32)), color="white", point_size=14,
+                render_points_as_spheres=True, name="joints", render=False, reset_camera=False)
+        if len(bones):
+            segs = self.world(bones.segments().reshape(-1, 3))
+            lines = np.hstack([np.full((len(bones), 1), 2), np.arange(2 * len(bones)).reshape(-1, 2)]).ravel()
+            poly = pv.PolyData(segs.astype(np.float32), lines=lines)
+            poly.cell_data["rgb"] = label_table(len(bones))[1:]
+            self._bones_actor = self.plotter.add_mesh(
+                poly, scalars="rgb", rgb=True, line_width=6, render_lines_as_tubes=True, name="bones",
+                render=False, reset_camera=False)
+        self._on_selection_changed()
+
+    def _on_selection_changed(self, **_) -> None:
+        if self.doc.only_working:
+            self._update_cloud()
+        self.plotter.remove_actor("selected", render=False)
+        self._selected_actor = None
+        sel = [i for i in self.doc.selected_bones if i < len(self.doc.bones)]
+        if sel:
+            segs = self.world(self.doc.bones.segments()[sel].reshape(-1, 3))
+            lines = np.hstack([np.full((len(sel), 1), 2), np.arange(2 * len(sel)).reshape(-1, 2)]).ravel()
+            self._selected_actor = self.plotter.add_mesh(
+                pv.PolyData(segs.astype(np.float32), lines=lines), color="white", line_width=12,
+                render_lines_as_tubes=True, opacity=0.5, name="selected", render=False, reset_camera=False)
+        self._apply_stage()
+        self.render()
+
+    def _on_picked_changed(self, index=None, **_) -> None:
+        self.plotter.remove_actor("picked", render=False)
+        self._picked_actor = None
+        if index is not None:
+            self._picked_actor = self.plotter.add_mesh(
+                pv.PolyData(self._world[index : index + 1]), color="#00ffff", point_size=self.settings.point_size * 2.5,
+                render_points_as_spheres=True, name="picked", render=False, reset_camera=False)
+        self._apply_stage()
+        self.render()
+
+    def render(self) -> None:
+        """Request a frame; many model changes in one event-loop pass draw once.
+
+        Software GL (no GPU) takes 100-500 ms for a large cloud, so drawing on
+        every slider step would stall the drag.
+        """
+        if self._render_pending:
+            return
+        self._render_pending = True
+        from PySide6.QtCore import QTimer
+
+        QTimer.singleShot(0, self._render_now)
+
+    def _render_now(self) -> None:
+        self._render_pending = False
+        if not getattr(self.plotter, "_closed", False):
+            self.plotter.render()

@@ -1,0 +1,241 @@
+"""Round trips and malformed input for the text formats of FORMATS.md."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from volanim_core import io
+from volanim_core.errors import FormatError
+from volanim_core.rig.connectivity import Trans, Tskel
+from volanim_core.skeleton.points import Skeleton
+
+
+def test_skel_round_trip(tmp_path, small_skeleton):
+    path = tmp_path / "a.skel"
+    io.write_skel(path, small_skeleton)
+    back = io.read_skel(path)
+    assert np.array_equal(back.points, small_skeleton.points)
+    assert np.array_equal(back.dt, small_skeleton.dt)  # shortest repr is exact
+    assert np.isnan(back.thinness).all()
+
+
+def test_mskel_round_trip_and_sorted(tmp_path, small_skeleton):
+    shuffled = Skeleton(small_skeleton.points[::-1], small_skeleton.dt[::-1], small_skeleton.thinness[::-1])
+    path = tmp_path / "a.mskel"
+    io.write_mskel(path, shuffled)
+    lines = [ln for ln in path.read_text().splitlines() if not ln.startswith("#")]
+    thin = [float(ln.split()[4]) for ln in lines]
+    assert thin == sorted(thin, reverse=True)
+    assert io.read_mskel(path) == small_skeleton
+
+
+def test_mskel_345_metric_round_trip(tmp_path):
+    s = Skeleton([[1, 2, 3], [4, 5, 6]], [6.0, 3.0], [2.0, 1.0], metric="345")
+    io.write_mskel(tmp_path / "c.mskel", s)
+    assert io.read_mskel(tmp_path / "c.mskel") == s
+
+
+def test_reader_tolerates_comments_tabs_crlf_blank_lines(tmp_path):
+    path = tmp_path / "t.mskel"
+    path.write_bytes(b"# volanim mskel 1\r\n\r\n1\t2 3 1.5 0.7  # trailing comment\r\n\t\n4 5 6 1 0.2\r\n")
+    s = io.read_mskel(path)
+    assert s.points.tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert s.thinness.tolist() == [0.7, 0.2]
+
+
+def test_mskel_reader_does_not_rely_on_order(tmp_path):
+    path = tmp_path / "u.mskel"
+    path.write_text("1 1 1 1 0.1\n2 2 2 2 0.9\n3 3 3 3 0.5\n")
+    assert io.read_mskel(path).thinness.tolist() == [0.9, 0.5, 0.1]
+
+
+def test_bones_round_trip(tmp_path, small_bones):
+    io.write_bones(tmp_path / "b.bones", small_bones)
+    assert io.read_bones(tmp_path / "b.bones") == small_bones
+    text = (tmp_path / "b.bones").read_text()
+    assert "joint L_ANKLE 216.5 160 702" in text and "bone L_HIP L_KNEE L_THIGH" in text
+
+
+def test_bones_formats_md_example_parses(tmp_path):
+    (tmp_path / "x.bones").write_text(
+        "# volanim bones 1\njoint L_HIP 212 140 401\njoint L_KNEE 214 152 561\n"
+        "joint L_ANKLE 216 160 702\nbone L_HIP L_KNEE\nbone L_KNEE L_ANKLE\n"
+    )
+    b = io.read_bones(tmp_path / "x.bones")
+    assert [x.proximal for x in b.bones] == ["L_HIP", "L_KNEE"]
+    assert b.parent(1) == 0 and b.parent(0) is None
+
+
+def test_connections_round_trip(tmp_path, small_bones):
+    io.write_connections(tmp_path / "b.connections", small_bones)
+    assert io.read_connections(tmp_path / "b.connections") == [("L_HIP", "L_KNEE"), ("L_KNEE", "L_ANKLE")]
+
+
+def test_connect_round_trip(tmp_path, small_connect):
+    io.write_connect(tmp_path / "a.connect", small_connect)
+    assert io.read_connect(tmp_path / "a.connect") == small_connect
+
+
+def test_connect_formats_md_example(tmp_path):
+    (tmp_path / "m.1.40.connect").write_text(
+        "# volanim connect 1\n# thinness: 1.40\n# metric: euclid\n"
+        "Root: 212 140 401 :: 214 152 561 L_THIGH\n201 139 420 9.2 1.81\n"
+        "Root: 214 152 561 :: 216 160 702 L_SHIN\n"
+    )
+    c = io.read_connect(tmp_path / "m.1.40.connect")
+    assert c.thinness_threshold == 1.4
+    assert [b.name for b in c.bones] == ["L_THIGH", "L_SHIN"]
+    assert c.bone.tolist() == [0] and c.dt.tolist() == [9.2]
+
+
+def test_connect_written_at_thinness_keeps_only_points_at_or_above(tmp_path, small_connect):
+    t = 0.5
+    io.write_connect(tmp_path / "a.connect", small_connect, thinness=t)
+    back = io.read_connect(tmp_path / "a.connect")
+    assert (back.thinness >= t).all()
+    assert len(back) == int((small_connect.thinness >= t).sum())
+    assert back.thinness_threshold == t
+
+
+def test_connect_filename_convention():
+    assert io.connect_filename("man", 1.4) == "man.1.40.connect"
+
+
+def test_connect_empty_bone_is_root_line_alone(tmp_path, small_connect):
+    only_first = small_connect.bone == 0
+    from volanim_core.rig.connectivity import Connectivity
+
+    c = Connectivity(small_connect.bones, small_connect.points[only_first], small_connect.dt[only_first],
+                     small_connect.thinness[only_first], small_connect.bone[only_first])
+    io.write_connect(tmp_path / "e.connect", c)
+    assert (tmp_path / "e.connect").read_text().rstrip().splitlines()[-1].startswith("Root:")
+    assert io.read_connect(tmp_path / "e.connect") == c
+
+
+def _trans(small_connect, rng):
+    mats = np.tile(np.eye(4), (len(small_connect.bones), 1, 1))
+    mats[:, 3, :3] = rng.normal(size=(len(mats), 3))
+    mats[0, :3, :3] = [[0, 1, 0], [-1, 0, 0], [0, 0, 1]]
+    return mats
+
+
+def test_trans_round_trip(tmp_path, small_connect, rng):
+    t = Trans(small_connect.bones, _trans(small_connect, rng))
+    io.write_trans(tmp_path / "a.trans", t)
+    assert io.read_trans(tmp_path / "a.trans") == t
+
+
+def test_tskel_round_trip(tmp_path, small_connect, rng):
+    c = small_connect
+    t = Tskel(c.bones, _trans(c, rng), c.points, c.dt, c.thinness, c.bone, metric="345")
+    io.write_tskel(tmp_path / "a.tskel", t)
+    assert io.read_tskel(tmp_path / "a.tskel") == t
+
+
+def test_tskel_with_zero_points(tmp_path, small_connect):
+    t = Tskel(small_connect.bones, np.tile(np.eye(4), (2, 1, 1)), np.zeros((0, 3)), [], None, [])
+    io.write_tskel(tmp_path / "z.tskel", t)
+    assert len(io.read_tskel(tmp_path / "z.tskel")) == 0
+
+
+GOOD_TSKEL_HEAD = "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+
+
+@pytest.mark.parametrize(
+    ("reader", "text", "line", "words"),
+    [
+        (io.read_mskel, "1 2 3 1.5\n", 1, "expected 5 columns"),
+        (io.read_mskel, "1 2 3 1.5 0.1\n1 2 3 1.5 0.1 7\n", 2, "expected 5 columns"),
+        (io.read_mskel, "1 2 3 1.5 0.1\n1 2 x 1.5 0.1\n", 2, "integer coordinate z"),
+        (io.read_mskel, "1 2 3 abc 0.1\n", 1, "number for dt"),
+        (io.read_mskel, "1 2 3.5 1 0.1\n", 1, "integer coordinate z"),
+        (io.read_mskel, "1 2 3 -1 0.1\n", 1, "dt >= 0"),
+        (io.read_mskel, "1 2 3 nan 0.1\n", 1, "finite"),
+        (io.read_skel, "1 2 3 1.5 0.1\n", 1, "expected 4 columns"),
+        (io.read_bones, "joint A 1 2\n", 1, "joint NAME x y z"),
+        (io.read_bones, "joint A 1 2 3\njoint A 1 2 3\n", 2, "defined twice"),
+        (io.read_bones, "joint A 1 2 3\nbone A B\n", 2, "which no 'joint' line defines"),
+        (io.read_bones, "joint A 1 2 3\nlimb A A\n", 2, "'joint' or 'bone'"),
+        (io.read_bones, "joint A 1 two 3\n", 1, "number for joint A y"),
+        (io.read_connections, "A B C\n", 1, "two joint names"),
+        (io.read_connect, "Root: 1 2 3 4 5 6\n", 1, "no '::'"),
+        (io.read_connect, "Root: 1 2 :: 4 5 6\n", 1, "expected 'Root: x y z :: x y z"),
+        (io.read_connect, "1 2 3 4\n", 1, "before any data"),
+        (io.read_connect, "Root: 0 0 0 :: 1 1 1\n1 2 3\n", 2, "expected 4 or 5 columns"),
+        (io.read_connect, "Root: 0 0 0 :: 1 1 1\n1 2 3 1\nRoot: 1 1 1 :: 2 2 2\n1 2 3 1\n", 4, "listed twice"),
+        (io.read_connect, "# metric: 456\nRoot: 0 0 0 :: 1 1 1\n", None, "unknown '# metric"),
+        (io.read_trans, "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n", 1, "has 3 rows"),
+        (io.read_trans, "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\nRoot: 1 1 1 :: 2 2 2\n", 5, "has 3 rows"),
+        (io.read_trans, "Root: 0 0 0 :: 1 1 1\n1 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", 2, "matrix row 1 of 4"),
+        (io.read_trans, GOOD_TSKEL_HEAD + "1 2 3 4\n", 6, "expected a 'Root:"),
+        (io.read_tskel, "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n5 5 5 2\n", 2, "not affine"),
+        (io.read_tskel, GOOD_TSKEL_HEAD + "1 2 3\n", 6, "expected 4 or 5 columns"),
+    ],
+)
+def test_malformed_text_gives_one_error_type_naming_file_and_line(tmp_path, reader, text, line, words):
+    path = tmp_path / "bad.txt"
+    path.write_text(text)
+    with pytest.raises(FormatError) as err:
+        reader(path)
+    assert err.value.line == line
+    assert words in str(err.value)
+    assert str(path) in str(err.value)
+    if line is not None:
+        assert f"{path}:{line}:" in str(err.value)
+
+
+@pytest.mark.parametrize("reader", [io.read_skel, io.read_mskel, io.read_bones, io.read_connections,
+                                    io.read_connect, io.read_trans, io.read_tskel])
+@pytest.mark.parametrize("content", [b"", b"# only a comment\n\n", b"\x00\x01\x02\xff\xfe binary", b"\xff\xfe\xfd"])
+def test_empty_and_binary_files(tmp_path, reader, content):
+    path = tmp_path / "f"
+    path.write_bytes(content)
+    with pytest.raises(FormatError, match=str(path)):
+        reader(path)
+
+
+def test_truncated_file_is_an_error(tmp_path, small_connect):
+    path = tmp_path / "a.mskel"
+    io.write_mskel(path, Skeleton(small_connect.points, small_connect.dt, small_connect.thinness))
+    data = path.read_bytes()
+    path.write_bytes(data[: data.rindex(b" ")])  # the last line loses its thinness column
+    with pytest.raises(FormatError, match=r"a\.mskel:\d+: expected 5 columns"):
+        io.read_mskel(path)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(FormatError, match="cannot read file"):
+        io.read_bones(tmp_path / "nope.bones")
+
+
+def test_writer_is_atomic_keeps_old_file_on_failure(tmp_path, small_bones, monkeypatch):
+    path = tmp_path / "b.bones"
+    io.write_bones(path, small_bones)
+    before = path.read_bytes()
+
+    class Boom(Exception):
+        pass
+
+    def explode(*a, **k):
+        raise Boom
+
+    import volanim_core.io._atomic as atomic
+
+    monkeypatch.setattr(atomic.os, "fsync", explode)  # fail after writing, before rename
+    with pytest.raises(Boom):
+        io.write_bones(path, small_bones)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["b.bones"]  # no temporary left behind
+
+
+def test_written_files_get_normal_permissions(tmp_path, small_bones):
+    import os
+
+    io.write_bones(tmp_path / "a.bones", small_bones)
+    mask = os.umask(0)
+    os.umask(mask)
+    assert (tmp_path / "a.bones").stat().st_mode & 0o777 == 0o666 & ~mask
+    os.chmod(tmp_path / "a.bones", 0o640)
+    io.write_bones(tmp_path / "a.bones", small_bones)  # replacing keeps the old mode
+    assert (tmp_path / "a.bones").stat().st_mode & 0o777 == 0o640

@@ -1,0 +1,67 @@
+"""The breakage report: healthy poses, and a wrong shoulder attachment that it must point at."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import io, samples
+from volanim_core.reconstruct.breakage import breakage_report, components
+from volanim_core.rig.connectivity import Connectivity, Trans
+from volanim_core.rig.pose import local_motion, pose_matrices, posed_joints, root_bones, scaled
+from volanim_core.rig.tskel import connect_to_tskel
+
+
+@pytest.fixture(scope="module")
+def man():
+    return samples.mannequin(), io.read_connect(ASSETS / "mannequin.0.50.connect")
+
+
+def frame(s, conn, rotations):
+    m = pose_matrices(s.bones, rotations)
+    return connect_to_tskel(conn, Trans(root_bones(s.bones), m)), posed_joints(s.bones, m)
+
+
+def shoulder_on_torso(s, conn, radius=20.0):
+    """The deliberate mistake: upper-arm points near the shoulder attached to the SPINE."""
+    bone = conn.bone.copy()
+    near = np.linalg.norm(conn.points - s.bones.joints["L_SHOULDER"], axis=1) < radius
+    bone[near & (conn.bone == s.bones.index("L_UPPERARM"))] = s.bones.index("SPINE")
+    return Connectivity(conn.bones, conn.points, conn.dt, conn.thinness, bone)
+
+
+def test_rest_pose_is_healthy(man):
+    s, conn = man
+    t, pj = frame(s, conn, {})
+    r = breakage_report(t, s.bones.joints, pj)
+    assert r.healthy and r.cracks == 0 and r.lost_voxels == 0 and r.loss_percent == 0 and not r.pieces
+
+
+def test_wrong_shoulder_connectivity_is_reported_at_the_shoulder(man):
+    s, conn = man
+    good, pj = frame(s, conn, {"L_UPPERARM": (0, -90, 0)})
+    assert breakage_report(good, s.bones.joints, pj).healthy
+    bad, pj = frame(s, shoulder_on_torso(s, conn), {"L_UPPERARM": (0, -90, 0)})
+    r = breakage_report(bad, s.bones.joints, pj)
+    assert not r.healthy and len(r.components) == 2
+    assert r.pieces[0][1] == "L_SHOULDER" and "near L_SHOULDER" in "\n".join(r.lines())
+    assert r.joints[0].name == "L_SHOULDER"
+
+
+def test_components_counts_pieces():
+    v = np.zeros((10, 10, 10), np.uint8)
+    v[1:3, 1:3, 1:3] = 1
+    v[6:9, 6:9, 6:9] = 2
+    v[3, 3, 3] = 1  # touches the first block by a corner: 26-connected
+    assert components(v) == [27, 9]
+
+
+def test_local_motion_inverts_fk_and_scaled_preview(man):
+    s, _ = man
+    rot = {"L_UPPERARM": (10, -45, 5), "R_THIGH": (30, 0, 0)}
+    m = pose_matrices(s.bones, rot, {"SPINE": (0, 2, 0)})
+    angles, shifts = local_motion(s.bones, m)
+    assert np.allclose(pose_matrices(s.bones, angles, shifts), m, atol=1e-9)
+    p = np.array([100.0, 50.0, 200.0, 1.0])
+    assert np.allclose(p @ scaled(m, 2.0), (p @ m) * [0.5, 0.5, 0.5, 1.0])

@@ -1,0 +1,271 @@
+"""The numba reconstruction against the NumPy oracle (tests/naive.py), and its promises."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import naive
+from volanim_core import samples
+from volanim_core.errors import Cancelled
+from volanim_core.reconstruct.engine import grid_bounds, reconstruct
+from volanim_core.rig.connectivity import RootBone, Tskel
+from volanim_core.skeleton.skeletonize import skeletonize
+from volanim_core.volume import Bounds
+
+
+def random_rigid(rng, centre, quarter_turns=False):
+    m = np.eye(4)
+    if quarter_turns:
+        m[:3, :3] = Rotation.from_euler("xyz", rng.integers(0, 4, 3) * 90, degrees=True).as_matrix()
+    else:
+        m[:3, :3] = Rotation.random(random_state=rng.integers(1 << 30)).as_matrix()
+    c = np.asarray(centre, float)
+    m[3, :3] = c - c @ m[:3, :3] + rng.normal(0, 2, 3)  # rotate about centre, then shift
+    return m
+
+
+def random_tskel(rng, n=25, nbones=3, metric="euclid", size=14, quarter_turns=False, identity=False):
+    pts = rng.integers(2, size - 2, (n, 3))
+    pts = np.unique(pts, axis=0)
+    if metric == "euclid":
+        dt = np.sqrt(rng.integers(1, 14, len(pts)).astype(float))
+    else:
+        dt = rng.integers(3, 13, len(pts)).astype(float)
+    bone = np.sort(rng.integers(0, nbones, len(pts)))  # grouped by bone, as files list them
+    mats = np.array([np.eye(4) if identity else random_rigid(rng, (size / 2,) * 3, quarter_turns)
+                     for _ in range(nbones)])
+    bones = [RootBone((b, 0, 0), (b, 1, 0), f"B{b}") for b in range(nbones)]
+    return Tskel(bones, mats, pts, dt, None, bone, metric=metric)
+
+
+MODES = ["binary", "mottled", "bone", "hotspot", "sampled"]
+
+
+@pytest.mark.parametrize("metric", ["euclid", "345"])
+@pytest.mark.parametrize("mode", MODES)
+def test_kernel_equals_oracle_on_random_cases(rng, metric, mode):
+    source = rng.integers(1, 256, (14, 14, 14)).astype(np.uint8)
+    for case in range(12):
+        t = random_tskel(rng, metric=metric, quarter_turns=case % 3 == 0, identity=case % 4 == 1)
+        b = grid_bounds(t, padding=1)
+        if case % 5 == 2:  # given bounds that clip the spheres
+            b = Bounds(tuple(v + 3 for v in b.lo), tuple(v - 3 for v in b.hi))
+        r = reconstruct(t, mode=mode, source=source, bounds=b)
+        want, best, ties = naive.reconstruct(t, b, mode=mode, source=source)
+        assert r.volume.dtype == want.dtype
+        same = r.volume == want
+        assert same[~ties].all(), f"case {case}: {(~same & ~ties).sum()} voxels differ"
+        filled = np.isfinite(best).sum() if mode != "hotspot" else (want > 0).sum()
+        assert r.stats["filled"] == filled
+        if mode == "hotspot":
+            assert r.stats["hotspot_max"] == want.max()
+
+
+@pytest.mark.parametrize("kernel", [3, 5])
+def test_smoothed_sampling_equals_oracle(rng, kernel):
+    source = rng.integers(0, 256, (14, 14, 14)).astype(np.uint8)
+    for _ in range(4):
+        t = random_tskel(rng)
+        b = grid_bounds(t, padding=1)
+        r = reconstruct(t, mode="sampled", source=source, kernel=kernel, bounds=b)
+        want, _, ties = naive.reconstruct(t, b, mode="sampled", source=source, kernel=kernel)
+        assert (r.volume == want)[~ties].all()
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_one_and_two_threads_bit_identical(rng, mode):
+    source = rng.integers(0, 256, (20, 20, 20)).astype(np.uint8)
+    t = random_tskel(rng, n=300, size=20)
+    a = reconstruct(t, mode=mode, source=source, threads=1)
+    b = reconstruct(t, mode=mode, source=source, threads=2)
+    assert np.array_equal(a.volume, b.volume) and a.stats["filled"] == b.stats["filled"]
+
+
+def test_in_memory_order_reconstructs_like_the_written_file(tmp_path, rng):
+    from volanim_core import io
+
+    t = random_tskel(rng, n=80)
+    shuffled = rng.permutation(len(t))
+    mixed = Tskel(t.bones, t.matrices, t.points[shuffled], t.dt[shuffled], None, t.bone[shuffled])
+    io.write_tskel(tmp_path / "m.tskel", mixed)
+    back = io.read_tskel(tmp_path / "m.tskel")
+    for mode in ("mottled", "bone"):
+        assert np.array_equal(reconstruct(mixed, mode=mode).volume, reconstruct(back, mode=mode).volume)
+
+
+@pytest.mark.parametrize("mode", ["binary", "mottled", "bone", "sampled"])
+def test_overdraw_cut_changes_nothing_but_visits(rng, mode, monkeypatch):
+    from volanim_core.reconstruct import engine as rec
+
+    monkeypatch.setattr(rec, "CUT_MIN_RADIUS", 0.0)  # cut every sphere, however small
+    source = rng.integers(1, 256, (30, 30, 30)).astype(np.uint8)
+    t = random_tskel(rng, n=800, size=30, nbones=2)
+    cut = reconstruct(t, mode=mode, source=source)
+    full = reconstruct(t, mode=mode, source=source, neighbours=False)
+    assert np.array_equal(cut.volume, full.volume)
+    assert cut.stats["filled"] == full.stats["filled"]
+    assert cut.stats["visits"] < full.stats["visits"]
+
+
+def test_ties_go_to_the_first_sphere_in_file_order():
+    # two equal spheres, centres 2 apart: the mid-plane voxels are equidistant
+    bones = [RootBone((0, 0, 0), (1, 0, 0))]
+    t = Tskel(bones, np.eye(4)[None], [[5, 5, 5], [7, 5, 5]], [2.5, 2.5], None, [0, 0])
+    r = reconstruct(t, mode="mottled", bounds=Bounds((0, 0, 0), (12, 10, 10)))
+    first, second = r.volume[5, 5, 5], r.volume[7, 5, 5]
+    assert first != second and r.volume[6, 5, 5] == first and r.volume[6, 6, 5] == first
+
+
+def _all_voxel_tskel(mask, metric="euclid"):
+    s = skeletonize(mask, metric=metric, min_thinness=-np.inf)
+    bones = [RootBone((0, 0, 0), (1, 0, 0), "ALL")]
+    return Tskel(bones, np.eye(4)[None], s.points, s.dt, s.thinness, np.zeros(len(s), int), metric=metric)
+
+
+@pytest.mark.parametrize("metric", ["euclid", "345"])
+def test_identity_with_all_voxels_reproduces_source(metric):
+    s = samples.mannequin()
+    # a 60-voxel-high slab of the mannequin keeps the test quick
+    src = np.zeros_like(s.volume)
+    src[:, :, 150:210] = s.volume[:, :, 150:210]
+    t = _all_voxel_tskel(src > 0, metric)
+    full = Bounds((0, 0, 0), tuple(v - 1 for v in src.shape))
+    sampled = reconstruct(t, mode="sampled", source=src, bounds=full)
+    assert np.array_equal(sampled.volume, src)
+    binary = reconstruct(t, mode="binary", bounds=full, value=1)
+    assert np.array_equal(binary.volume, (src > 0).astype(np.uint8))
+
+
+def test_aliascube_rotated_45_stays_sharp():
+    cube = samples.aliascube().volume
+    s = skeletonize(cube > 0)  # its default skeleton (thinness >= 0.5)
+    t = Tskel([RootBone((0, 0, 0), (1, 0, 0))], np.eye(4)[None], s.points, s.dt, s.thinness, np.zeros(len(s), int))
+    rot = np.eye(4)
+    rot[:3, :3] = Rotation.from_euler("z", 45, degrees=True).as_matrix().T  # row-vector convention
+    c = np.array([63.5, 63.5, 63.5])
+    rot[3, :3] = c - c @ rot[:3, :3]
+    t.matrices[:] = rot
+    b = Bounds((0, 0, 0), (127, 127, 127))
+    r = reconstruct(t, mode="sampled", source=cube, bounds=b)
+    filled = r.volume > 0
+    q = np.argwhere(filled)
+    src = (q @ np.linalg.inv(rot)[:3, :3] + np.linalg.inv(rot)[3, :3])
+    near = np.floor(src + 0.5).astype(int)
+    tie = (np.abs(src - np.floor(src) - 0.5) < 1e-6).any(1)
+    assert (r.volume[tuple(q.T)] == cube[tuple(near.T)])[~tie].all()
+    assert set(np.unique(r.volume)) == {0, 50, 250}  # no blending: squares stay sharp
+    binary = reconstruct(t, mode="binary", bounds=b)
+    assert r.stats["filled"] == binary.stats["filled"] == (binary.volume > 0).sum()
+    assert r.stats["filled"] >= filled.sum() > 0.5 * (cube > 0).sum()
+
+
+def test_clipping_is_counted_not_fatal():
+    bones = [RootBone((0, 0, 0), (1, 0, 0))]
+    t = Tskel(bones, np.eye(4)[None], [[5, 5, 5]], [3.0], None, [0])
+    whole = reconstruct(t)
+    half = reconstruct(t, bounds=Bounds((5, 0, 0), (20, 20, 20)))
+    assert half.stats["filled"] + half.stats["clipped"] == whole.stats["filled"]
+    far = reconstruct(t, bounds=Bounds((50, 50, 50), (60, 60, 60)))
+    assert far.stats["filled"] == 0 and far.stats["clipped"] == whole.stats["filled"]
+
+
+def test_empty_bone_zero_points_and_singular_matrix():
+    bones = [RootBone((0, 0, 0), (1, 0, 0), "A"), RootBone((1, 0, 0), (2, 0, 0), "EMPTY")]
+    t = Tskel(bones, np.tile(np.eye(4), (2, 1, 1)), [[5, 5, 5]], [2.0], None, [0])
+    assert reconstruct(t, mode="bone").volume.max() == 1
+    none = Tskel(bones, np.tile(np.eye(4), (2, 1, 1)), np.zeros((0, 3)), [], None, [])
+    r = reconstruct(none)
+    assert r.stats["filled"] == 0 and r.volume.shape == (1, 1, 1)
+    t.matrices[1, 1, 1] = 0  # EMPTY becomes singular
+    with pytest.raises(ValueError, match="bone 1 \\(EMPTY\\) has a singular matrix"):
+        reconstruct(t)
+
+
+def test_bad_arguments():
+    t = random_tskel(np.random.default_rng(0))
+    with pytest.raises(ValueError, match="mode must be"):
+        reconstruct(t, mode="fancy")
+    with pytest.raises(ValueError, match="needs the source"):
+        reconstruct(t, mode="sampled")
+    with pytest.raises(ValueError, match="kernel"):
+        reconstruct(t, mode="sampled", source=np.zeros((2, 2, 2)), kernel=4)
+
+
+def test_progress_and_cancel():
+    t = random_tskel(np.random.default_rng(1), n=200, size=30)
+    seen = []
+    reconstruct(t, progress=lambda d, n: seen.append((d, n)))
+    assert seen[0][0] == 0 and seen[-1][0] == seen[-1][1]
+    with pytest.raises(Cancelled):
+        reconstruct(t, cancel=lambda: True)
+
+
+def test_cropped_source_with_origin(rng):
+    src = rng.integers(1, 256, (14, 14, 14)).astype(np.uint8)
+    t = random_tskel(rng)
+    b = grid_bounds(t)
+    full = reconstruct(t, mode="sampled", source=src, bounds=b)
+    crop = reconstruct(t, mode="sampled", source=src[2:, 3:, 1:], source_origin=(2, 3, 1), bounds=b)
+    # every voxel sampled from inside the crop agrees; outside the crop reads 0
+    differ = full.volume != crop.volume
+    assert (crop.volume[differ] == 0).all()
+
+
+def test_concurrent_reconstructions_do_not_share_scratch_memory(rng):
+    """The studio reconstructs on the GUI thread (live) while a worker makes the full preview."""
+    import threading
+
+    frames = [random_tskel(np.random.default_rng(s), n=600, size=40, nbones=3) for s in (1, 2)]
+    want = [reconstruct(t, mode="mottled", bounds=Bounds((-20,) * 3, (60,) * 3)).volume for t in frames]
+    errors = []
+
+    def work(k):
+        for _ in range(15):
+            got = reconstruct(frames[k], mode="mottled", bounds=Bounds((-20,) * 3, (60,) * 3), threads=1).volume
+            if not np.array_equal(got, want[k]):
+                errors.append(k)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in (0, 1)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+
+
+def test_neighbours_refer_to_the_callers_order(rng, monkeypatch):
+    """reconstruct() groups points by bone; neighbours the caller computed on its own order must follow."""
+    from volanim_core.reconstruct import engine as rec
+    from volanim_core.reconstruct.neighbours import sphere_neighbours
+
+    monkeypatch.setattr(rec, "CUT_MIN_RADIUS", 0.0)
+    t = random_tskel(rng, n=500, size=30)
+    mixed_order = rng.permutation(len(t))
+    mixed = Tskel(t.bones, t.matrices, t.points[mixed_order], t.dt[mixed_order], None, t.bone[mixed_order])
+    cut = reconstruct(mixed, mode="mottled", neighbours=sphere_neighbours(mixed))
+    plain = reconstruct(mixed, mode="mottled", neighbours=False)
+    assert np.array_equal(cut.volume, plain.volume)
+
+
+def test_cancel_is_checked_while_sampling_not_only_while_filling():
+    """The sampled pass used to run in one uninterruptible call after the last progress report."""
+    mask = np.zeros((20, 20, 40), bool)
+    mask[5:15, 5:15, 2:38] = True
+    pts = np.argwhere(mask)
+    t = Tskel([RootBone((10, 10, 2), (10, 10, 38))], np.eye(4)[None], pts, np.full(len(pts), 1.5), None,
+              np.zeros(len(pts), int))
+    source = mask.astype(np.uint8) * 100
+    calls = []
+
+    def progress(done, total):
+        calls.append((done, total))
+
+    reconstruct(t, mode="sampled", source=source, progress=progress)
+    nz = calls[0][1] // 2
+    assert [d for d, _ in calls if d > nz], "progress is reported during the sampling pass"
+    calls.clear()
+    with pytest.raises(Cancelled):
+        reconstruct(t, mode="sampled", source=source, progress=lambda d, t: calls.append((d, t)),
+                    cancel=lambda: len(calls) and calls[-1][0] > nz)

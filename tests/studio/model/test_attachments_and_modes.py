@@ -1,0 +1,173 @@
+"""Connectivity in the studio model: cube, lasso, auto-connect, mirror, .connect round trips."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from volanim_core import io, samples
+from volanim_studio.model import Document
+from volanim_studio.model.modes import CubeMode, LassoMode, PickEvent
+from volanim_studio.model.selection import in_cube, in_polygon, select_lasso, visible_mask
+
+
+@pytest.fixture
+def doc(doc):
+    doc.bone_edits.set_bones(samples.mannequin_bones())
+    return doc
+
+
+def test_selection_math():
+    pts = np.array([[0, 0, 0], [5, 5, 5], [10, 0, 0]])
+    assert in_cube(pts, (0, 0, 0), 10).tolist() == [True, True, False]
+    xy = np.array([[1.0, 1.0], [5.0, 5.0], [20.0, 1.0]])
+    assert in_polygon(xy, [(0, 0), (10, 0), (10, 10), (0, 10)]).tolist() == [True, True, False]
+    assert not in_polygon(xy, [(0, 0), (10, 0)]).any()  # two points are no outline
+    # a column of three points at one pixel, one point alone: the front one of the column is visible
+    xy = np.array([[5.0, 5.0], [5.2, 5.1], [5.1, 4.9], [50.0, 50.0]])
+    depth = np.array([0.5, 0.2, 0.9, 0.7])
+    assert visible_mask(xy, depth).tolist() == [False, True, False, True]
+
+
+def test_lasso_depth_modes_on_a_built_scene():
+    # a chest at depth 0..10 in front of an arm at depth 50..60, both under the outline
+    chest = np.column_stack([np.full(10, 5.0), np.linspace(1, 9, 10)])
+    arm = chest + [0.3, 0.2]
+    xy = np.vstack([chest, arm])
+    view = np.r_[np.linspace(0, 10, 10), np.linspace(50, 60, 10)]
+    depth = view / 100
+    poly = [(0, 0), (10, 0), (10, 10), (0, 10)]
+    assert len(select_lasso(xy, depth, view, poly, mode="through")) == 20
+    assert set(select_lasso(xy, depth, view, poly, mode="visible")) <= set(range(10))
+    assert select_lasso(xy, depth, view, poly, mode="slab", slab=15).tolist() == list(range(10))
+    with pytest.raises(ValueError, match="depth mode"):
+        select_lasso(xy, depth, view, poly, mode="xray")
+
+
+def test_cube_connect_remove_undo_and_counts(doc):
+    mode = CubeMode(doc)
+    elbow = samples.mannequin_bones().joints["L_ELBOW"]
+    i = int(np.argmin(((doc.skeleton.points[: doc.visible_count] - elbow) ** 2).sum(1)))
+    mode.press(PickEvent(point=i))
+    assert np.array_equal(doc.cube_centre, doc.skeleton.points[i])
+    assert mode.apply() == 0  # no working bone yet: nothing happens
+    doc.select_bones([doc.bones.index("L_UPPERARM")])
+    inside = mode.inside()
+    assert len(inside) > 0
+    assert mode.apply() == len(inside)
+    per_bone, unconnected = doc.attachments.counts()
+    assert per_bone[doc.bones.index("L_UPPERARM")] == len(inside)
+    assert unconnected == doc.visible_count - len(inside)
+    assert doc.bone_of_point(int(inside[0])) == "L_UPPERARM"
+    mode.key("Right")
+    assert doc.cube_centre[0] == doc.skeleton.points[i][0] + 1
+    mode.key("X")
+    doc.undo.undo()
+    doc.undo.undo()
+    assert (doc.attachments.bone == -1).all()
+
+
+def test_lasso_mode_connects_working_bone(doc):
+    mode = LassoMode(doc)
+    doc.settings.lasso_depth = "through"
+    doc.select_bones([0])
+    shown = doc.shown_indices()
+    xy = doc.skeleton.points[shown][:, [0, 2]].astype(float)  # a front view: x across, z up
+    outline = [(-1, 199.5), (300, 199.5), (300, 400), (-1, 400)]
+    zeros = np.zeros(len(xy))
+    n = mode.finish(outline, xy, zeros, zeros, shown)
+    assert n == int((doc.skeleton.points[shown][:, 2] >= 200).sum())
+    n2 = mode.finish(outline, xy, zeros, zeros, shown, remove=True)
+    assert n2 == n and (doc.attachments.bone == -1).all()
+
+
+def test_bone_edits_carry_attachments(doc):
+    a = doc.bones.index("L_THIGH")
+    doc.attachments.assign([0, 1, 2], a)
+    doc.bone_edits.set_root_order([a] + [i for i in range(len(doc.bones)) if i != a])
+    assert doc.attachments.bone[:3].tolist() == [0, 0, 0] and doc.bone_of_point(0) == "L_THIGH"
+    doc.bone_edits.remove_bones([0])
+    assert doc.attachments.bone[:3].tolist() == [-1, -1, -1]
+    doc.undo.undo()
+    assert doc.bone_of_point(0) == "L_THIGH"
+    doc.undo.undo()
+    assert doc.attachments.bone[0] == a
+
+
+def test_auto_connect_scopes_and_report(doc):
+    doc.attachments.assign([0], doc.bones.index("HEAD"))
+    report = doc.attachments.auto(scope="unconnected")
+    assert report.kept == 1 and report.attached == doc.visible_count - 1
+    assert doc.bone_of_point(0) == "HEAD"  # the manual attachment is kept
+    doc.undo.undo()
+    assert (doc.attachments.bone[1:] == -1).all()
+    report = doc.attachments.auto(scope="all", overwrite=True)
+    assert report.kept == 0
+    doc2 = Document()
+    doc2.set_skeleton(doc.skeleton)
+    doc2.bone_edits.set_bones(doc.bones)
+    with pytest.raises(ValueError, match="segmented volume"):
+        doc2.attachments.auto()
+
+
+def test_mirror_connectivity(doc):
+    doc.attachments.auto(scope="all")
+    left = doc.bones.index("L_FOREARM")
+    right = doc.bones.index("R_FOREARM")
+    on_left = np.flatnonzero(doc.attachments.bone == left)
+    doc.attachments.assign(np.flatnonzero(doc.attachments.bone == right), -1)
+    copied, lonely = doc.attachments.mirror([left])
+    assert copied > 0 and copied + lonely >= len(on_left) * 0.9
+    assert lonely == 0  # the mannequin is exactly symmetric
+    assert (doc.attachments.bone == right).sum() == len(on_left)
+
+
+def test_connect_save_reload_identical_and_missing_points(tmp_path, doc, mannequin):
+    doc.attachments.auto(scope="all")
+    doc.thinness = 0.6
+    name = doc.attachments.default_filename("man")
+    assert name == "man.0.60.connect"
+    n = doc.attachments.save(tmp_path / name)
+    shown = doc.visible_count
+    assert n == int((doc.attachments.bone[:shown] >= 0).sum())
+    other = Document()
+    other.set_skeleton(mannequin[1])
+    other.bone_edits.set_bones(doc.bones)
+    assert other.attachments.load(tmp_path / name) == []
+    assert np.array_equal(other.attachments.bone[:shown], doc.attachments.bone[:shown])
+    # a cloud lacking some points gets them back, with a warning
+    s = mannequin[1]
+    partial = Document()
+    partial.set_skeleton(type(s)(s.points[10:], s.dt[10:], s.thinness[10:]))
+    partial.bone_edits.set_bones(doc.bones)
+    warnings = partial.attachments.load(tmp_path / name)
+    assert "10 points are not in the loaded skeleton" in warnings[0]
+    assert len(partial.skeleton) == len(s) and partial.skeleton.is_sorted()
+    # alone: the file's points and bones become the session's
+    alone = Document()
+    alone.attachments.load(tmp_path / name)
+    assert len(alone.bones) == len(doc.bones) and (alone.attachments.bone >= 0).all()
+
+
+def test_reload_onto_a_different_bone_skeleton_names_the_bone(tmp_path, doc):
+    doc.attachments.auto(scope="all")
+    doc.attachments.save(tmp_path / "a.connect")
+    other = Document()
+    other.set_skeleton(doc.skeleton)
+    other.bone_edits.add_bone((1, 2, 3), (4, 5, 6))
+    with pytest.raises(ValueError, match=r"bone 0 \(SPINE\) is not in the loaded bone skeleton"):
+        other.attachments.load(tmp_path / "a.connect")
+    io.write_bones(tmp_path / "x.bones", doc.bones)
+
+
+def test_cube_keys_change_the_size_setting_that_the_panel_shows(doc):
+    """+/- used to change a document attribute the cube-size slider never heard of."""
+    mode = CubeMode(doc)
+    seen = []
+    doc.settings.events.cube_size.connect(lambda value, **_: seen.append(value))
+    doc.set_cube(doc.skeleton.points[0])
+    size = doc.settings.cube_size
+    mode.key("Plus")
+    mode.key("Plus")
+    mode.key("Minus")
+    assert doc.settings.cube_size == size + 2 and seen == [size + 2, size + 4, size + 2]

@@ -1,0 +1,88 @@
+"""Pose state and previews in the model (no Qt)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import io, samples
+from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.skeleton.skeletonize import skeletonize
+from volanim_studio.model import Document
+from volanim_studio.model.preview import make_preview
+
+
+@pytest.fixture
+def doc():
+    s = samples.mannequin()
+    d = Document()
+    d.set_volume(s.volume, s.mask)
+    d.set_skeleton(skeletonize(s.mask))
+    d.bone_edits.set_bones(s.bones)
+    d.attachments.load(ASSETS / "mannequin.0.50.connect")
+    return d
+
+
+def test_slider_drag_is_one_undo_step_and_children_follow(doc):
+    b = doc.bones.index("L_UPPERARM")
+    for a in range(0, -46, -5):
+        doc.pose.set_angles(b, (0, a, 0))
+    doc.undo.seal()
+    m = doc.pose.matrices()
+    assert np.allclose(m[doc.bones.index("L_FOREARM")], m[b]) and not np.allclose(m[b], np.eye(4))
+    doc.undo.undo()
+    assert doc.pose.is_rest
+    doc.undo.redo()
+    assert np.allclose(doc.pose.angles_of(b), (0, -45, 0))
+
+
+def test_pose_survives_reordering_and_reset(doc):
+    b = doc.bones.index("R_SHIN")
+    doc.pose.set_angles(b, (20, 0, 0), merge=False)
+    doc.bone_edits.set_root_order(list(range(len(doc.bones)))[::-1])
+    assert np.allclose(doc.pose.angles_of(doc.bones.index("R_SHIN")), (20, 0, 0))
+    doc.pose.reset(doc.bones.index("R_SHIN"))
+    assert doc.pose.is_rest
+
+
+def test_trans_and_tskel_round_trip(tmp_path, doc):
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -45, 10), merge=False)
+    doc.pose.save_trans(tmp_path / "p.trans")
+    m = doc.pose.matrices()
+    doc.pose.reset()
+    doc.pose.load_trans(tmp_path / "p.trans")
+    assert np.allclose(doc.pose.matrices(), m, atol=1e-9)
+    n = doc.pose.save_tskel(tmp_path / "p.tskel")
+    t = io.read_tskel(tmp_path / "p.tskel")
+    assert len(t) == n == int((doc.attachments.bone[: doc.visible_count] >= 0).sum())
+    assert np.allclose(t.matrices, m)
+    wrong = tmp_path / "w.trans"
+    wrong.write_text("Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n")
+    with pytest.raises(ValueError, match="18 bones but the .trans has 1"):
+        doc.pose.load_trans(wrong)
+
+
+def test_preview_equals_the_core_and_reduced_preview_is_coarser(doc):
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -45, 0), merge=False)
+    t = doc.pose.tskel()
+    p = make_preview(t, mode="sampled", source=doc.volume)
+    direct = reconstruct(t, mode="sampled", source=doc.volume)
+    assert np.array_equal(p.reconstruction.volume, direct.volume) and p.reconstruction.origin == direct.origin
+    half = make_preview(t, mode="bone", factor=2)
+    assert all(abs(a * 2 - b) <= 4 for a, b in zip(half.reconstruction.volume.shape, direct.volume.shape))
+    with pytest.raises(ValueError, match="connect points"):
+        make_preview(type(t)(t.bones, t.matrices, np.zeros((0, 3)), [], None, []))
+
+
+def test_neighbour_lists_are_cached_until_the_frame_changes(doc):
+    t = doc.pose.tskel()
+    first = doc.pose.neighbours(t)
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -30, 0), merge=False)
+    assert doc.pose.neighbours(doc.pose.tskel()) is first  # a pose change keeps them
+    doc.attachments.assign([0], doc.bones.index("HEAD"))
+    assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None  # an edit drops them
+    t = doc.pose.tskel()
+    assert doc.pose.neighbours(t) is not first
+    doc.thinness = 0.8
+    assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None

@@ -1,0 +1,216 @@
+"""Studio II with real widgets: cube, lasso (real mouse drags), mirror, autosave, crash recovery."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+from paths import ASSETS
+from volanim_core import io, samples
+from volanim_core.render.colours import label_table
+from volanim_core.skeleton.points import Skeleton
+from volanim_studio.model.modes import Mode
+
+from ..conftest import JOB_TIMEOUT_MS, click, clickable_point
+
+pytestmark = pytest.mark.gui
+
+J = samples.mannequin_bones().joints
+
+
+def qpos(window, xy) -> QPoint:
+    w = window.plotter
+    s = w.devicePixelRatioF()
+    return QPoint(int(round(xy[0] / s)), int(round(w.height() - 1 - xy[1] / s)))
+
+
+def drag_lasso(qtbot, window, polygon, modifier=Qt.NoModifier) -> None:
+    """Press, move through the outline and release, as a user's mouse would."""
+    w = window.plotter
+    pts = [qpos(window, p) for p in polygon]
+    qtbot.mousePress(w, Qt.LeftButton, modifier, pts[0])
+    for p in pts[1:]:
+        qtbot.mouseMove(w, p)
+    qtbot.mouseRelease(w, Qt.LeftButton, modifier, pts[0])
+
+
+def test_cube_connect_changes_colours_and_counts(qtbot, window):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    qtbot.keyClick(window, Qt.Key_K)
+    assert window.mode == Mode.CUBE
+    assert window.doc.settings.colour_by == "bone" == window.display_panel.colour_by.currentText()
+    p = clickable_point(window, J["L_ELBOW"])
+    click(qtbot, window, window.scene.display_of_point(p))
+    assert np.array_equal(window.doc.cube_centre, window.doc.skeleton.points[p])
+    forearm = window.doc.bones.index("L_FOREARM")
+    window.bone_panel.tree.topLevelItem(forearm).setSelected(True)
+    assert window.doc.working_bone == forearm and "L_FOREARM" in window.connect_panel.working.text()
+    qtbot.mouseClick(window.connect_panel.cube_connect, Qt.LeftButton)
+    inside = np.flatnonzero(window.doc.attachments.bone == forearm)
+    assert len(inside) > 0 and p in inside
+    want = label_table(forearm + 1)[forearm + 1]
+    assert (window.scene._colours[inside] == want).all()
+    assert window.bone_panel.tree.topLevelItem(forearm).text(4) == str(len(inside))
+    assert window.point_label.text().endswith("bone L_FOREARM")  # the status bar follows the attachment
+    unconnected = window.doc.visible_count - len(inside)
+    assert window.bone_panel.unconnected.text().startswith(f"{unconnected} of")
+    qtbot.keyClick(window, Qt.Key_Right)  # nudge, then remove with X
+    qtbot.keyClick(window, Qt.Key_X)
+    assert (window.doc.attachments.bone == forearm).sum() < len(inside)
+    qtbot.keyClick(window, Qt.Key_Z, Qt.ControlModifier)
+    assert (window.doc.attachments.bone == forearm).sum() == len(inside)
+
+
+@pytest.fixture
+def depth_scene(window):
+    """Front block F (y=10), back block B right behind it (y=60) and a side block S (y=40) not behind F."""
+    g = np.stack(np.meshgrid(np.arange(0, 10, 2), [0], np.arange(0, 10, 2), indexing="ij"), -1).reshape(-1, 3)
+    front, back = g + [40, 10, 140], g + [40, 60, 140]
+    side = g[:5] + [60, 40, 140]
+    pts = np.vstack([front, back, side]).astype(np.int32)
+    doc = window.doc
+    doc.set_skeleton(Skeleton(pts, np.ones(len(pts)), np.ones(len(pts))))
+    doc.set_hull(None, None)
+    doc.bone_edits.add_bone((45, 30, 120), (45, 30, 160))
+    doc.select_bones([0])
+    window.plotter.enable_parallel_projection()
+    window.scene.front_view()
+    window.set_mode(Mode.LASSO)
+    window.display_panel.point_size.setValue(10)
+    n = len(front)
+    return window, (set(range(n)), set(range(n, 2 * n)), set(range(2 * n, len(pts))))
+
+
+@pytest.mark.parametrize("mode", ["through", "visible", "slab"])
+def test_lasso_depth_modes(qtbot, depth_scene, mode):
+    window, (front, back, side) = depth_scene
+    window.connect_panel.depth_mode.setCurrentText(mode)
+    window.connect_panel.slab.setValue(15)
+    xy, _ = window.scene.project_world(window.scene._world)
+    lo, hi = xy.min(0) - 15, xy.max(0) + 15
+    drag_lasso(qtbot, window, [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])])
+    got = set(np.flatnonzero(window.doc.attachments.bone == 0).tolist())
+    want = {"through": front | back | side, "visible": front | side, "slab": front}[mode]
+    assert got == want
+    drag_lasso(qtbot, window, [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])],
+               Qt.ControlModifier)  # Ctrl removes
+    assert (window.doc.attachments.bone == -1).all()
+
+
+def test_auto_connect_and_mirror_in_the_gui(qtbot, window):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    window.connect_panel.scope.setCurrentText("all")
+    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    doc = window.doc
+    assert (doc.attachments.bone[: doc.visible_count] >= 0).all()
+    left, right = doc.bones.index("L_FOREARM"), doc.bones.index("R_FOREARM")
+    n_left = int((doc.attachments.bone == left).sum())
+    doc.attachments.assign(np.flatnonzero(doc.attachments.bone == right), -1)
+    window.bone_panel.tree.topLevelItem(left).setSelected(True)
+    qtbot.mouseClick(window.connect_panel.mirror_button, Qt.LeftButton)
+    assert int((doc.attachments.bone == right).sum()) == n_left
+    window.connect_panel.only_unconnected.setChecked(True)
+    assert window.scene.shown_points == int((doc.attachments.bone[: doc.visible_count] < 0).sum())
+
+
+def test_save_connect_quit_reopen_and_continue(qtbot, window, tmp_path):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    window.doc.attachments.auto(scope="all")
+    path = window.files.save_project(path=tmp_path / "man.volanim")
+    saved = window.files.save_connect(tmp_path / window.doc.attachments.default_filename("man"))
+    assert saved.name.startswith("man.") and saved.suffix == ".connect"
+    before = window.doc.attachments.bone.copy()
+    from volanim_studio.qt.main_window import MainWindow
+
+    other = MainWindow()
+    qtbot.addWidget(other)
+    other.files.open_project(path)
+    qtbot.waitUntil(lambda: not other.busy, timeout=JOB_TIMEOUT_MS)
+    assert np.array_equal(other.doc.attachments.bone, before)
+    other.close()
+
+
+def test_autosave_file_appears(qtbot, window, recovery_dir):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    for i in range(5):
+        window.doc.attachments.assign([i], 0)
+    files = list(recovery_dir.glob("*/recovery.volanim"))
+    assert len(files) == 1
+    assert io.read_bones(files[0].with_suffix(".bones")) == window.doc.bones
+    window.close()
+    assert not list(recovery_dir.glob("*/recovery.volanim"))  # a clean exit leaves nothing to recover
+
+
+CRASH = """
+import os, sys
+from PySide6.QtWidgets import QApplication
+app = QApplication([])
+from volanim_studio.qt.main_window import MainWindow
+w = MainWindow(autosave_every_edits=1)
+w.show()
+w.files.load_demo("mannequin")
+while w.busy:
+    app.processEvents()
+w.files.open_bones(sys.argv[1])
+w.doc.attachments.auto(scope="all")
+print("EDITED", int((w.doc.attachments.bone >= 0).sum()), flush=True)
+os._exit(3)  # a crash: no close, no cleanup
+"""
+
+
+def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
+    script = tmp_path / "crash.py"
+    script.write_text(textwrap.dedent(CRASH))
+    out = subprocess.run([sys.executable, str(script), str(ASSETS / "mannequin.bones")], capture_output=True,
+                         text=True, timeout=300, env=dict(os.environ))
+    assert out.returncode == 3 and "EDITED" in out.stdout, (out.returncode, out.stdout, out.stderr[-2000:])
+    attached = int(out.stdout.split("EDITED")[1].split()[0])
+    listing = sorted(str(p.relative_to(recovery_dir)) for p in recovery_dir.rglob("*"))
+    from volanim_studio.qt.main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    asked = []
+    w.offer_recovery(ask=lambda p: asked.append(p) or True)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert asked, listing
+    assert len(w.doc.bones) == 18, (listing, w.last_error)
+    assert int((w.doc.attachments.bone >= 0).sum()) == attached, (listing, w.last_error)
+    assert len(list(recovery_dir.glob("*/recovery.volanim"))) == 0  # the crashed session's copy is gone
+    w.close()
+
+
+def test_dead_sessions_without_autosave_are_pruned(tmp_path):
+    import json
+
+    from volanim_studio.model import autosave
+
+    dead = tmp_path / "999999999-1"
+    dead.mkdir()
+    (dead / "session.json").write_text(json.dumps({"pid": 999999999}))
+    kept = tmp_path / "999999999-2"
+    kept.mkdir()
+    (kept / "session.json").write_text(json.dumps({"pid": 999999999}))
+    (kept / autosave.RECOVERY_FILE).write_text("{}")
+    assert autosave.prune(tmp_path) == 1
+    assert not dead.exists() and kept.exists()  # a crashed session with work stays for restore
+
+
+def test_cube_size_slider_follows_the_plus_minus_keys(qtbot, window):
+    """The slider used to stay where it was while +/- resized the cube behind its back."""
+    window.doc.bone_edits.set_bones(samples.mannequin_bones())
+    qtbot.keyClick(window, Qt.Key_K)
+    window.doc.set_cube(window.doc.skeleton.points[0])
+    before = window.connect_panel.cube_size.value()
+    qtbot.keyClick(window, Qt.Key_Plus)
+    qtbot.keyClick(window, Qt.Key_Plus)
+    assert window.connect_panel.cube_size.value() == before + 4 == window.doc.settings.cube_size
+    assert window.connect_panel.cube_size_label.text() == f"{before + 4:g}"
+    window.connect_panel.cube_size.setValue(7)  # and the other way round
+    assert window.doc.settings.cube_size == 7

@@ -1,0 +1,116 @@
+"""Studio III with real widgets: pose with the sliders, preview, read the report, fix, preview again."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QPushButton
+
+from paths import ASSETS
+from volanim_core import samples
+from volanim_core.reconstruct.engine import reconstruct
+from volanim_studio.model.modes import Mode
+
+from ..conftest import JOB_TIMEOUT_MS, front_view
+
+pytestmark = pytest.mark.gui
+
+J = samples.mannequin_bones().joints
+
+
+@pytest.fixture
+def posed_window(qtbot, window):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    front_view(window)
+    qtbot.keyClick(window, Qt.Key_P)
+    assert window.mode == Mode.POSE
+    return window
+
+
+def drag(qtbot, window, axis: int, values) -> None:
+    """What a slider drag does: pressed, value changes, released."""
+    slider = window.pose_panel.sliders[axis]
+    slider.sliderPressed.emit()
+    for v in values:
+        slider.setValue(v)
+        qtbot.wait(1)
+    slider.sliderReleased.emit()
+
+
+def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
+    w = posed_window
+    w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
+    assert "L_UPPERARM" in w.pose_panel.bone_label.text()
+    drag(qtbot, w, 1, range(0, -46, -5))
+    assert w.previews.live_timings, "the live preview ran during the drag"
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.report is not None,
+                    timeout=JOB_TIMEOUT_MS)
+    p = w.doc.preview
+    assert p.mode == "bone" and p.factor == 1
+    direct = reconstruct(w.doc.pose.tskel(), mode="bone")  # the worker made what the core makes
+    assert np.array_equal(p.reconstruction.volume, direct.volume)
+    text = w.reconstruct_panel.report.text()
+    assert "healthy: one piece" in text and "cracks" in text and "hotspot" in text
+    assert w.reconstruct_panel.joints.count() == len(p.report.joints) + len(p.report.pieces)
+    assert w.scene._preview_actor is not None and w.scene._preview_actor.GetVisibility()
+    # one undo step for the whole drag
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
+    assert w.doc.pose.is_rest
+
+
+def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
+    w = posed_window
+    doc = w.doc
+    ua, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")
+    pts = doc.skeleton.points
+    near = np.flatnonzero((np.linalg.norm(pts - J["L_SHOULDER"], axis=1) < 20) & (doc.attachments.bone == ua))
+    doc.attachments.assign(near, spine)  # the mistake: the shoulder's points on the torso
+    doc.select_bones([ua])
+    drag(qtbot, w, 1, range(0, -91, -10))
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    assert "BROKEN" in w.reconstruct_panel.report.text()
+    first = w.reconstruct_panel.joints.item(0)
+    assert "detached piece" in first.text() and "L_SHOULDER" in first.text()
+    w.reconstruct_panel.joints.itemClicked.emit(first)  # the view jumps to the shoulder
+    focal = np.array(w.plotter.renderer.GetActiveCamera().GetFocalPoint())
+    assert np.allclose(focal, w.doc.pose.posed_joints()["L_SHOULDER"])
+    doc.attachments.assign(near, ua)  # the fix (the lasso does this in the GUI tests of Connect)
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert "healthy: one piece" in w.reconstruct_panel.report.text()
+
+
+def test_cancel_preview_leaves_the_gui_responsive(qtbot, posed_window):
+    w = posed_window
+    w.reconstruct_panel.mode.setCurrentText("sampled")
+    w.reconstruct_panel.kernel.setCurrentText("5")
+    worker = w.previews.preview()
+    assert worker is not None and w.busy
+    w.jobs.dialog.findChild(QPushButton).click()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert worker.isFinished()
+    w.reconstruct_panel.mode.setCurrentText("bone")
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert w.doc.preview is not None and w.doc.preview.mode == "bone"
+
+
+def test_compare_export_and_slices(qtbot, posed_window, tmp_path):
+    w = posed_window
+    w.doc.pose.set_angles(w.doc.bones.index("R_THIGH"), (30, 0, 0), merge=False)
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    posed_shape = w.scene._preview_key[1]
+    w.reconstruct_panel.show_rest.setChecked(True)
+    assert w.scene._preview_key[1] != posed_shape  # the rest reconstruction is shown
+    w.reconstruct_panel.show_rest.setChecked(False)
+    w.reconstruct_panel.slices.setChecked(True)
+    assert "slices" in w.plotter.renderer.actors
+    assert w.previews.export_preview(tmp_path / "posed.vti")
+    from volanim_core import io
+
+    data, origin, _ = io.read_volume_grid(tmp_path / "posed.vti")
+    assert np.array_equal(data, w.doc.preview.reconstruction.volume)
+    assert tuple(origin) == tuple(float(v) for v in w.doc.preview.origin_voxels)
