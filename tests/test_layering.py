@@ -36,3 +36,42 @@ def test_studio_help():
     out = subprocess.run([sys.executable, "-m", "volanim_studio.app", "--help"], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode == 0 and "--demo" in out.stdout and "examples:" in out.stdout
+
+
+# Where VTK/pyvista may be imported in the core: file formats, rendering, and the sample that
+# locates the frog file inside pyvista's wheel (it is then read like any other .vti).
+VTK_ALLOWED = ("volanim_core/io/", "volanim_core/render/", "volanim_core/samples.py")
+
+
+def _imports(path) -> set[str]:
+    import ast
+
+    tree = ast.parse(path.read_text())
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names |= {a.name.split(".")[0] for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_only_io_and_render_import_vtk_in_the_core():
+    from pathlib import Path
+
+    root = Path(volanim_core.__file__).parent
+    bad = [str(p.relative_to(root.parent)) for p in root.rglob("*.py")
+           if _imports(p) & {"vtk", "pyvista", "vtkmodules"}
+           and not str(p.relative_to(root.parent)).startswith(VTK_ALLOWED)]
+    assert not bad, f"VTK/pyvista imported outside io/ and render/: {bad}"
+
+
+def test_studio_model_imports_neither_qt_nor_vtk():
+    from pathlib import Path
+
+    import volanim_studio
+
+    model = Path(volanim_studio.__file__).parent / "model"
+    bad = [p.name for p in model.rglob("*.py")
+           if _imports(p) & {"PySide6", "pyvistaqt", "vtk", "pyvista", "vtkmodules", "matplotlib"}]
+    assert not bad, bad

@@ -26,6 +26,7 @@ from volanim_core.io import (
     write_tskel,
     write_volume,
 )
+from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.reconstruct.neighbours import sphere_neighbours
@@ -33,10 +34,11 @@ from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
 from volanim_core.rig.tskel import check_root_order, connect_to_tskel, identity_tskel
-from volanim_core.skeleton.hull import isosurface, write_mesh
+from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
 from . import samples, volume
+from .warmup import compile_kernels
 
 POSES = {"mannequin": ("L_UPPERARM", (0.0, -45.0, 0.0)), "frog": ("LEGS", (0.0, 0.0, 45.0))}
 
@@ -54,6 +56,8 @@ def bundled_connect(sample: str) -> Path | None:
 def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     """Run every stage on ``sample`` and write the files into ``folder``; returns their paths."""
     folder.mkdir(parents=True, exist_ok=True)
+    _say("compiling the numba kernels (about 25 s after a fresh install, under a second after that)...")
+    _say(f"  kernels ready in {compile_kernels():.1f} s")
     t0 = time.perf_counter()
     out: dict = {}
     s = samples.load(sample)

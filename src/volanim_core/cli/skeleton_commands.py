@@ -7,8 +7,9 @@ import time
 import numpy as np
 
 from volanim_core.io import write_mskel
+from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
-from volanim_core.skeleton.hull import isosurface, write_mesh
+from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
 from .. import volume

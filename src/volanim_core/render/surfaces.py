@@ -38,3 +38,14 @@ def label_surface(volume: np.ndarray, origin, spacing, table: np.ndarray | None 
         labels = np.asarray(volume)[tuple(idx.T)].astype(np.int64)
         surf.point_data["rgb"] = table[np.clip(labels, 0, len(table) - 1)].astype(np.uint8)
     return surf
+
+
+def flying_edges(box: np.ndarray, origin=(0, 0, 0), level: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """VTK flying edges on ``box`` (indexed ``[x, y, z]``): ``(V, 3)`` float32 vertices, ``(F, 3)`` int64 faces."""
+    import pyvista as pv
+
+    img = pv.ImageData(dimensions=box.shape, origin=tuple(float(v) for v in origin))
+    img.point_data["m"] = np.asarray(box).ravel(order="F")
+    surf = img.contour([level], scalars="m", method="flying_edges")
+    faces = surf.faces.reshape(-1, 4)[:, 1:] if surf.n_cells else np.zeros((0, 3), np.int64)
+    return np.asarray(surf.points, np.float32), faces.astype(np.int64)

@@ -61,26 +61,6 @@ def isosurface(mask, *, step: int = 1, engine: str = "vtk") -> tuple[np.ndarray,
 
         verts, faces, _, _ = marching_cubes(box, 0.5, step_size=step, allow_degenerate=False)
         return (verts + lo).astype(np.float32), faces.astype(np.int64)
-    import pyvista as pv
+    from volanim_core.render.surfaces import flying_edges
 
-    img = pv.ImageData(dimensions=box.shape, origin=tuple(float(v) for v in lo))
-    img.point_data["m"] = box.ravel(order="F")
-    surf = img.contour([0.5], scalars="m", method="flying_edges")
-    faces = surf.faces.reshape(-1, 4)[:, 1:] if surf.n_cells else np.zeros((0, 3), np.int64)
-    return np.asarray(surf.points, np.float32), faces.astype(np.int64)
-
-
-def write_mesh(path, vertices: np.ndarray, faces: np.ndarray) -> None:
-    """Write a mesh as ``.ply``, ``.vtp``, ``.obj`` or ``.stl`` (atomically)."""
-    from pathlib import Path
-
-    import pyvista as pv
-
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in (".ply", ".vtp", ".obj", ".stl"):
-        raise ValueError(f"cannot write a mesh as {suffix!r}: use .ply, .vtp, .obj or .stl")
-    from volanim_core.io._atomic import atomic_vtk_save
-
-    cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
-    atomic_vtk_save(path, pv.PolyData(np.asarray(vertices, np.float32), cells))
+    return flying_edges(box, origin=lo)

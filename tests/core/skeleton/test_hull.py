@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from volanim_core.skeleton.hull import isosurface, write_mesh
+from volanim_core.io.mesh_files import write_mesh
+from volanim_core.skeleton.hull import isosurface
 
 
 @pytest.fixture
