@@ -46,26 +46,28 @@ def compile_kernels(progress=None) -> float:
     source = np.where(mask, 200, 0).astype(np.uint8)
     bones = BoneSkeleton({"A": (3.0, 6.0, 6.0), "B": (12.0, 6.0, 6.0), "C": (21.0, 6.0, 6.0)},
                          [Bone("A", "B"), Bone("B", "C")])
-    steps = [("345", None), ("euclid", None)] + [(m, mode) for m in ("euclid", "345") for mode in MODES]
-    total = len(steps) + 1
-    done = 0
-    skel = None
-    for metric, mode in steps:
-        if mode is None:
-            skel = skeletonize(mask, metric=metric, min_thinness=-np.inf)
-        else:
-            roots = [RootBone(*bones.segment(i), bones.bones[i].label) for i in range(len(bones))]
-            bone_of, _ = auto_connect(skel.points, bones, mask, method="path")
-            conn = Connectivity(roots, skel.points, skel.dt, skel.thinness, np.maximum(bone_of, 0)).grouped()
-            matrices = pose_matrices(bones, {1: np.array([0.0, 0.0, 30.0])})
-            tskel = Tskel(conn.bones, matrices, conn.points, conn.dt, conn.thinness, conn.bone, metric)
+    roots = [RootBone(*bones.segment(i), bones.bones[i].label) for i in range(len(bones))]
+    matrices = pose_matrices(bones, {1: np.array([0.0, 0.0, 30.0])})
+    metrics = ("euclid", "345")
+    total, done = len(metrics) * (len(MODES) + 1) + 1, 0
+    tskel = None
+    for metric in metrics:
+        skel = skeletonize(mask, metric=metric, min_thinness=-np.inf)
+        bone_of, _ = auto_connect(skel.points, bones, mask, method="path")
+        conn = Connectivity(roots, skel.points, skel.dt, skel.thinness, np.maximum(bone_of, 0), metric).grouped()
+        tskel = Tskel(conn.bones, matrices, conn.points, conn.dt, conn.thinness, conn.bone, metric)
+        done += 1
+        _report(progress, done, total)
+        for mode in MODES:
             for kernel in ((1, 3) if mode == "sampled" else (1,)):
                 reconstruct(tskel, mode=mode, source=source if mode == "sampled" else None, kernel=kernel)
-        done += 1
-        if progress is not None:
-            progress(done, total)
+            done += 1
+            _report(progress, done, total)
     breakage_report(tskel, dict(bones.joints), dict(bones.joints))
-    done += 1
+    _report(progress, total, total)
+    return time.perf_counter() - t0
+
+
+def _report(progress, done: int, total: int) -> None:
     if progress is not None:
         progress(done, total)
-    return time.perf_counter() - t0

@@ -85,9 +85,9 @@ def read_project(path) -> dict:
         raise FormatError(path, "not a volanim project: nested too deeply") from None
     if not isinstance(data, dict) or data.get("format") != PROJECT_FORMAT:
         raise FormatError(path, f"not a volanim project: expected \"format\": \"{PROJECT_FORMAT}\"")
-    for key in ("volume", "mskel", "bones", "connect", "demo"):
-        _expect(path, data, key, str, "a file name")
-        if data.get(key) and key != "demo":
+    _expect(path, data, "demo", str, "a sample name")
+    for key in ("volume", "mskel", "bones", "connect"):
+        if _expect(path, data, key, str, "a file name"):
             data[key] = str((path.parent / data[key]).resolve())
     for key in ("thinness", "symmetry_x"):
         _expect(path, data, key, int | float, "a number")
@@ -96,10 +96,31 @@ def read_project(path) -> dict:
     _expect(path, data, "volume_dims", list, "a list of three sizes")
     seg = dict(DEFAULT_SEGMENTATION)
     seg.update({k: v for k, v in (data.get("segmentation") or {}).items() if k in seg})
-    if data.get("threshold") and not data.get("segmentation"):  # version 1
-        seg["lo"], seg["hi"] = data["threshold"]
-    data["segmentation"] = seg
+    threshold = _expect(path, data, "threshold", list, "a list [lo, hi]")
+    if threshold is not None and not data.get("segmentation"):  # version 1
+        if len(threshold) != 2:
+            raise FormatError(path, f"\"threshold\" must be a list [lo, hi], got {threshold!r}")
+        seg["lo"], seg["hi"] = threshold
+    data["segmentation"] = _checked_segmentation(path, seg)
     return data
+
+
+def _checked_segmentation(path, seg: dict) -> dict:
+    """The segmentation parameters, refused with the file's name when a value is not usable."""
+    def number(key, allow_none=False):
+        v = seg[key]
+        if (v is None and allow_none) or (isinstance(v, int | float) and not isinstance(v, bool)):
+            return
+        raise FormatError(path, f"\"segmentation\": \"{key}\" must be a number, got {v!r}")
+
+    number("lo")
+    number("hi", allow_none=True)
+    number("min_thinness")
+    if not isinstance(seg["fill"], bool):
+        raise FormatError(path, f"\"segmentation\": \"fill\" must be true or false, got {seg['fill']!r}")
+    if seg["metric"] not in ("euclid", "345"):
+        raise FormatError(path, f"\"segmentation\": \"metric\" must be \"euclid\" or \"345\", got {seg['metric']!r}")
+    return seg
 
 
 def apply_project(doc, data: dict, path) -> list[str]:

@@ -34,19 +34,20 @@ def one_of(*choices) -> Callable[[str, Any], Any]:
 
 
 def number(lo: float, hi: float, kind=float) -> Callable[[str, Any], Any]:
+    """A number in ``lo..hi``; with ``kind=int`` a whole one (2.5 is refused, not truncated)."""
     def check(name, value):
-        try:
-            v = kind(value)
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a number, got {value!r}") from None
-        if not lo <= v <= hi:  # also refuses NaN
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"{name} must be a number, got {value!r}")
+        if not lo <= value <= hi:  # also refuses NaN
             raise ValueError(f"{name} must be between {lo:g} and {hi:g}, got {value!r}")
-        return v
+        if kind is int and value != int(value):
+            raise ValueError(f"{name} must be a whole number, got {value!r}")
+        return kind(value)
     return check
 
 
 def flag(name, value) -> bool:
-    if not isinstance(value, bool | int):
+    if not isinstance(value, bool) and value not in (0, 1):
         raise ValueError(f"{name} must be true or false, got {value!r}")
     return bool(value)
 

@@ -17,12 +17,11 @@ from pathlib import Path
 from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
-from volanim_core.errors import FormatError
 
 from .. import tasks
 from ..model.project import apply_project, read_project
 from .threshold_dialog import ThresholdDialog
-from .worker import Worker
+from .worker import USER_ERRORS, Worker
 
 
 class FilesController:
@@ -53,7 +52,7 @@ class FilesController:
         """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
         try:
             loaded = tasks.load_volume_file(str(path), dims)
-        except FormatError as exc:
+        except USER_ERRORS as exc:
             self.show_error("Open volume", str(exc))
             return None
         if params is None:
@@ -75,7 +74,7 @@ class FilesController:
     def open_mskel(self, path) -> bool:
         try:
             skel = io.read_mskel(path)
-        except FormatError as exc:
+        except USER_ERRORS as exc:
             self.show_error("Open skeleton", str(exc))
             return False
         self.doc.set_skeleton(skel, path)
@@ -85,7 +84,7 @@ class FilesController:
     def open_bones(self, path) -> bool:
         try:
             self.doc.bone_edits.load_bones(path)
-        except FormatError as exc:
+        except USER_ERRORS as exc:
             self.show_error("Open bones", str(exc))
             return False
         self.doc.message(f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.")
@@ -94,7 +93,7 @@ class FilesController:
     def open_connections(self, path) -> bool:
         try:
             self.doc.bone_edits.load_connections(path)
-        except (FormatError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Open connections", str(exc))
             return False
         self.doc.message(f"{len(self.doc.bones)} bones in the root order of {Path(path).name}.")
@@ -104,14 +103,14 @@ class FilesController:
         """Open a ``.volanim``: its volume segmented as saved (its ``.mskel`` read, not recomputed), then its files."""
         try:
             data = read_project(path)
-        except FormatError as exc:
+        except USER_ERRORS as exc:
             self.show_error("Open project", str(exc))
             return None
 
         def rest(_=None):
             try:
                 warnings = apply_project(self.doc, data, path)
-            except (FormatError, ValueError) as exc:
+            except USER_ERRORS as exc:
                 self.show_error("Open project", str(exc))
                 return
             if warnings:
@@ -137,7 +136,7 @@ class FilesController:
     def open_connect(self, path) -> bool:
         try:
             warnings = self.doc.attachments.load(path)
-        except (FormatError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Open connectivity", str(exc))
             return False
         if warnings:
@@ -155,7 +154,7 @@ class FilesController:
                 return None
         try:
             n = self.doc.attachments.save(path)
-        except (OSError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Save connectivity", str(exc))
             return None
         self.doc.message(f"Saved {n} attached points (thinness ≥ {self.doc.thinness:.2f}) to {path}.")
@@ -180,7 +179,7 @@ class FilesController:
                     return None
         try:
             saved = self.doc.save_project(path, camera=self.scene.camera())
-        except (OSError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Save project", str(exc))
             return None
         self.doc.message(f"Saved {saved}.")
@@ -189,7 +188,7 @@ class FilesController:
     def save_bones(self, path) -> bool:
         try:
             self.doc.bone_edits.save_bones(path)
-        except (OSError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Save bones", str(exc))
             return False
         self.doc.message(f"Saved {len(self.doc.bones)} bones to {path}.")

@@ -17,10 +17,9 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
-from volanim_core.errors import FormatError
 
 from ..model.preview import make_preview
-from .worker import Worker
+from .worker import USER_ERRORS, Worker
 
 
 class PreviewController:
@@ -142,7 +141,7 @@ class PreviewController:
         vol, note = io.saturate_for_raw(path, p.reconstruction.volume)
         try:
             io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing)
-        except (OSError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Export", str(exc))
             return False
         self.doc.message(f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; "
@@ -152,7 +151,7 @@ class PreviewController:
     def load_trans(self, path) -> bool:
         try:
             self.doc.pose.load_trans(path)
-        except (FormatError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error("Load pose", str(exc))
             return False
         self.doc.message(f"Loaded the pose from {Path(path).name}.")
@@ -181,7 +180,7 @@ class PreviewController:
                 self.doc.pose.save_trans(path)
             else:
                 self.doc.pose.save_tskel(path)
-        except (OSError, ValueError) as exc:
+        except USER_ERRORS as exc:
             self.show_error(f"Save {kind}", str(exc))
             return
         self.doc.message(f"Saved {path}.")

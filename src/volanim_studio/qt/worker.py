@@ -23,7 +23,12 @@ from collections.abc import Callable
 from PySide6.QtCore import QCoreApplication, QEventLoop, QObject, Qt, QThread, Signal
 from PySide6.QtWidgets import QProgressDialog
 
-from volanim_core.errors import Cancelled, FormatError
+from volanim_core.errors import Cancelled
+
+#: What a user can cause and must be told about in words: a bad or unreadable file
+#: (FormatError is a ValueError; readers raise OSError subclasses for the rest) or a
+#: refused value. Every file action of the studio catches exactly these.
+USER_ERRORS = (OSError, ValueError)
 
 
 class Worker(QThread):
@@ -42,16 +47,12 @@ class Worker(QThread):
     def cancel(self) -> None:
         self._cancel = True
 
-    @property
-    def cancel_requested(self) -> bool:
-        return self._cancel
-
     def run(self) -> None:
         try:
             result = self._task(progress=self.progressed.emit, cancel=lambda: self._cancel)
         except Cancelled:
             self.was_cancelled.emit()
-        except (FormatError, ValueError, OSError, MemoryError) as exc:
+        except (*USER_ERRORS, MemoryError) as exc:
             self.failed.emit(str(exc))
         except Exception as exc:  # a bug: still tell the user rather than leave the dialog hanging
             self.failed.emit(f"unexpected {type(exc).__name__}: {exc}")
@@ -76,7 +77,6 @@ class JobRunner(QObject):
         self._on_idle = on_idle or (lambda: None)
         self.worker: Worker | None = None
         self.dialog: QProgressDialog | None = None
-        self.finishing = False
 
     @property
     def busy(self) -> bool:
@@ -107,16 +107,11 @@ class JobRunner(QObject):
         worker.start()
         return worker
 
-    def cancel(self) -> None:
-        if self.worker is not None:
-            self.worker.cancel()
-
     def shutdown(self) -> None:
         """Cancel the running job and wait until its thread has ended, however long that takes."""
         worker = self.worker
         if worker is None:
             return
-        self.finishing = True
         worker.cancel()
         self._message("Finishing the running job before closing…")
         if self.dialog is not None:
@@ -126,4 +121,3 @@ class JobRunner(QObject):
         while not worker.wait(50):
             QCoreApplication.processEvents(QEventLoop.ExcludeUserInputEvents)
         QCoreApplication.processEvents(QEventLoop.ExcludeUserInputEvents)  # its last signals
-        self.finishing = False

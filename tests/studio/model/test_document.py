@@ -168,6 +168,12 @@ def test_version_1_projects_read_with_their_defaults(tmp_path):
     ('{"format": "volanim project", "thinness": "x"}', '"thinness" must be a number'),
     ('{"format": "volanim project", "settings": []}', '"settings" must be an object'),
     ("[" * 100000 + "]" * 100000, "nested too deeply|not a volanim project"),
+    ('{"format": "volanim project", "demo": 3}', '"demo" must be a sample name'),
+    ('{"format": "volanim project", "threshold": [1, 2, 3]}', '"threshold" must be a list'),
+    ('{"format": "volanim project", "threshold": 5}', '"threshold" must be a list'),
+    ('{"format": "volanim project", "segmentation": {"lo": "x"}}', '"lo" must be a number'),
+    ('{"format": "volanim project", "segmentation": {"fill": "yes"}}', '"fill" must be true or false'),
+    ('{"format": "volanim project", "segmentation": {"metric": "manhattan"}}', '"metric" must be'),
 ])
 def test_bad_project_fields_are_format_errors_naming_the_file(tmp_path, content, message):
     path = tmp_path / "bad.volanim"

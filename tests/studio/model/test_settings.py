@@ -27,7 +27,8 @@ def test_a_change_emits_once_and_an_equal_value_not_at_all():
 
 @pytest.mark.parametrize("name, bad", [("colour_by", "purple"), ("point_size", 0), ("point_size", math.nan),
                                        ("hull_opacity", 2), ("preview_kernel", 2), ("lasso_depth", "deep"),
-                                       ("clip_axis", 3), ("spheres", "yes"), ("cube_size", "big")])
+                                       ("clip_axis", 3), ("spheres", "yes"), ("cube_size", "big"),
+                                       ("preview_padding", 2.5), ("current_frame", True), ("spheres", 5)])
 def test_bad_values_are_refused_with_the_name_and_value(name, bad):
     s = Settings()
     with pytest.raises(ValueError, match=name):
