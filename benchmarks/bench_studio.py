@@ -91,7 +91,7 @@ def bench_preview(app) -> None:
             bone = w.doc.bones.index("LEGS")
         w.set_mode(Mode.POSE)
         w.doc.select_bones([bone])
-        w._posing_drag = True
+        w.previews.drag_started()  # what pressing a pose slider does
         w.previews.live_timings.clear()
         t0 = time.perf_counter()
         steps = list(range(0, -46, -3))
@@ -99,11 +99,10 @@ def bench_preview(app) -> None:
             w.doc.pose.set_angles(bone, (0, a, 0))  # -> live preview (coalesced) -> drawn
             app.processEvents()
         elapsed = time.perf_counter() - t0
-        w._posing_drag = False
         live = statistics.median(w.previews.live_timings) if w.previews.live_timings else float("nan")
         rate = len(w.previews.live_timings) / elapsed
         t0 = time.perf_counter()
-        w.previews.preview()
+        w.previews.drag_finished()  # the release: a full preview with the report
         while w.busy:
             app.processEvents()
             time.sleep(0.002)
