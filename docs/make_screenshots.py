@@ -71,13 +71,13 @@ def main() -> None:
     w.set_mode(Mode.LASSO)
     w.display_panel.point_size.setValue(5)
     c = w.scene.project_world(w.scene.world(np.array([samples.mannequin_bones().joints["L_SHOULDER"]])))[0][0]
-    w.scene._lasso = [(c[0] + 40 * np.cos(t), c[1] + 30 * np.sin(t)) for t in np.linspace(0, 2 * np.pi, 40)]
-    w.scene._draw_lasso()
+    w.scene.lasso.points = [(c[0] + 40 * np.cos(t), c[1] + 30 * np.sin(t)) for t in np.linspace(0, 2 * np.pi, 40)]
+    w.scene.lasso.draw()
     for _ in range(5):
         app.processEvents()
     grab(w, HERE / "studio-connect.png")
-    w.scene._lasso = None
-    w.scene._draw_lasso()
+    w.scene.lasso.points = None
+    w.scene.lasso.draw()
 
     # Pose: a deliberate mistake (the shoulder's points on the torso), the break, the fix
     import time

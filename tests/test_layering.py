@@ -75,3 +75,34 @@ def test_studio_model_imports_neither_qt_nor_vtk():
     bad = [p.name for p in model.rglob("*.py")
            if _imports(p) & {"PySide6", "pyvistaqt", "vtk", "pyvista", "vtkmodules", "matplotlib"}]
     assert not bad, bad
+
+
+def _relative_imports(path) -> set[str]:
+    import ast
+
+    return {node.module or "" for node in ast.walk(ast.parse(path.read_text()))
+            if isinstance(node, ast.ImportFrom) and node.level}
+
+
+def test_qt_panels_talk_to_the_model_not_the_scene():
+    """Panels bind to the document and settings; only the window and controllers hold the scene."""
+    from pathlib import Path
+
+    import volanim_studio
+
+    qt = Path(volanim_studio.__file__).parent / "qt"
+    panels = [p for p in qt.glob("*.py") if p.stem.endswith(("_panel", "_dialog"))]
+    assert len(panels) >= 5
+    bad = [p.name for p in panels if any(m.startswith("scene") or m.startswith("..scene")
+                                          for m in _relative_imports(p))]
+    assert not bad, bad
+
+
+def test_no_module_over_450_lines():
+    from pathlib import Path
+
+    import volanim_studio
+
+    roots = [Path(volanim_core.__file__).parent, Path(volanim_studio.__file__).parent]
+    long = {p.name: n for r in roots for p in r.rglob("*.py") if (n := len(p.read_text().splitlines())) > 450}
+    assert not long, long

@@ -165,6 +165,11 @@ def release_workspace() -> None:
     _WORKSPACE.release()
 
 
+def workspace_nbytes() -> int:
+    """Bytes this thread's workspace holds between calls."""
+    return int(_WORKSPACE.stencil.nbytes)
+
+
 def mottled_values(n: int) -> np.ndarray:
     """One value 1..255 per sphere, neighbours in file order far apart (uint8)."""
     return (1 + (np.arange(n, dtype=np.int64) * 97) % 255).astype(np.uint8)

@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -19,7 +19,6 @@ from PySide6.QtWidgets import (
 
 from ..model.document import Document
 from ..model.settings import COLOUR_BY
-from ..scene.view import SceneView
 from .bindings import bind
 
 SLIDER_STEPS = 1000
@@ -29,9 +28,12 @@ CLIP_CHOICES = ("no clipping", "clip x", "clip y", "clip z")
 class DisplayPanel(QWidget):
     """Thinness slider, cloud style, hull opacity/visibility and clipping."""
 
-    def __init__(self, doc: Document, scene: SceneView, parent=None):  # scene: level of detail while dragging
+    #: the thinness slider is held (True) or released (False): the scene draws a level-of-detail subset
+    dragging = Signal(bool)
+
+    def __init__(self, doc: Document, parent=None):
         super().__init__(parent)
-        self.doc, self.scene = doc, scene
+        self.doc = doc
         self.thinness_slider = QSlider(Qt.Horizontal)
         self.thinness_slider.setRange(0, SLIDER_STEPS)
         self.thinness_spin = QDoubleSpinBox(decimals=3, singleStep=0.01)
@@ -79,8 +81,8 @@ class DisplayPanel(QWidget):
         layout.addStretch(1)
 
         self.thinness_slider.valueChanged.connect(self._slider_moved)
-        self.thinness_slider.sliderPressed.connect(lambda: scene.set_dragging(True))
-        self.thinness_slider.sliderReleased.connect(lambda: scene.set_dragging(False))
+        self.thinness_slider.sliderPressed.connect(lambda: self.dragging.emit(True))
+        self.thinness_slider.sliderReleased.connect(lambda: self.dragging.emit(False))
         self.thinness_spin.valueChanged.connect(self._spin_changed)
         doc.events.skeleton.connect(self._on_skeleton_changed)
         doc.events.thinness.connect(self._on_thinness_changed)

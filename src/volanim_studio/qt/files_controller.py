@@ -32,6 +32,20 @@ class FilesController:
         self.jobs = window.jobs
         self.show_error = window.show_error
 
+    def fill_menu(self, menu, action) -> None:
+        """The File menu's open and save entries; ``action(text, slot, shortcut=None, menu=None)``."""
+        action("Open &volume…", lambda: self.open_volume_dialog(), "Ctrl+O", menu=menu)
+        action("Open &skeleton (.mskel)…", lambda: self.open_dialog("mskel"), menu=menu)
+        action("Open &bones…", lambda: self.open_dialog("bones"), menu=menu)
+        action("Open connections…", lambda: self.open_dialog("connections"), menu=menu)
+        action("Open &project…", lambda: self.open_dialog("project"), menu=menu)
+        menu.addSeparator()
+        action("&Save project", lambda: self.save_project(), "Ctrl+S", menu=menu)
+        action("Save project &as…", lambda: self.save_project(ask=True), "Ctrl+Shift+S", menu=menu)
+        action("Save bones…", lambda: self.save_dialog("bones"), menu=menu)
+        action("Save connections…", lambda: self.save_dialog("connections"), menu=menu)
+        action("Screenshot…", lambda: self.save_dialog("png"), menu=menu)
+
     # -------------------------------------------------------------- loading
     def _apply_prepared(self, result: dict, path=None, spacing=None, dims=None) -> None:
         self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),

@@ -17,6 +17,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
+from volanim_core.reconstruct.engine import release_workspace
 
 from ..model.preview import make_preview
 from .worker import USER_ERRORS, Worker
@@ -44,6 +45,32 @@ class PreviewController:
         ev.bones.connect(self._forget_rest)
         st.show_rest.connect(lambda **_: self.draw())
         st.slices.connect(lambda **_: self.draw())
+
+    def fill_menu(self, menu, action) -> None:
+        """The Pose menu; ``action(text, slot, shortcut=None, menu=None)`` makes a window action."""
+        action("Preview reconstruction", lambda: self.preview(), "F5", menu=menu)
+        action("Reset pose", lambda: self.doc.pose.reset(), menu=menu)
+        action("Load pose (.trans)…", lambda: self.load_trans_dialog(), menu=menu)
+        action("Save pose (.trans)…", lambda: self.save_dialog("trans"), menu=menu)
+        action("Save frame (.tskel)…", lambda: self.save_dialog("tskel"), menu=menu)
+        action("Export reconstruction…", lambda: self.save_dialog("volume"), menu=menu)
+
+    def wire(self, pose_panel, reconstruct_panel) -> None:
+        """Connect the Pose and Reconstruct tabs' buttons and drags to this controller."""
+        pose_panel.drag_started.connect(self.drag_started)
+        pose_panel.drag_finished.connect(self.drag_finished)
+        pose_panel.load_trans.clicked.connect(lambda: self.load_trans_dialog())
+        pose_panel.save_trans.clicked.connect(lambda: self.save_dialog("trans"))
+        pose_panel.save_tskel.clicked.connect(lambda: self.save_dialog("tskel"))
+        reconstruct_panel.preview_button.clicked.connect(lambda: self.preview())
+        reconstruct_panel.export_button.clicked.connect(lambda: self.save_dialog("volume"))
+        reconstruct_panel.joint_clicked.connect(self.jump_to_joint)
+
+    def leave_pose(self) -> None:
+        """Leaving the pose stage frees the live preview's reconstruction workspace
+        (up to 4 bytes per output voxel, kept between drags for speed)."""
+        self._live_timer.stop()
+        release_workspace()
 
     def drag_started(self) -> None:
         self._posing_drag = True
@@ -120,12 +147,12 @@ class PreviewController:
                     return
             p = self._rest_preview
         if p is None:
-            self.scene.clear_volume()
+            self.scene.pose_layer.clear()
             return
         if p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
-            self.scene.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+            self.scene.pose_layer.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
         else:
-            self.scene.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+            self.scene.pose_layer.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
 
     def jump_to_joint(self, name: str) -> None:
         posed = self.doc.pose.posed_joints()

@@ -1,79 +1,108 @@
 """The selection overlays of the scene: the connect cube and the lasso outline.
 
-A mixin of :class:`~volanim_studio.scene.view.SceneView`: in lasso mode a left
-drag draws an outline in display pixels (VTK's camera style is swapped out)
-and hands the closed polygon to ``on_lasso``.
+Each overlay owns its actor and is handed the :class:`~volanim_studio.scene.view.SceneView`
+for coordinates, the plotter and coalesced rendering. In lasso mode a left drag
+draws an outline in display pixels (VTK's camera style is swapped out) and the
+closed polygon goes to ``on_lasso``.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 import pyvista as pv
 
 
-class SceneSelectionMixin:
-    # ---------------------------------------------------------------- cube
-    def _on_cube_changed(self, **_) -> None:
-        self.plotter.remove_actor("cube", render=False)
-        self._cube_actor = None
-        if self.doc.cube_centre is not None:
-            c = self.world(self.doc.cube_centre)
-            size = self.settings.cube_size * self.spacing
-            box = pv.Box(bounds=(c[0] - size[0] / 2, c[0] + size[0] / 2, c[1] - size[1] / 2, c[1] + size[1] / 2,
-                                 c[2] - size[2] / 2, c[2] + size[2] / 2))
-            self._cube_actor = self.plotter.add_mesh(box, style="wireframe", color="#00ffff", line_width=2,
-                                                     name="cube", render=False, reset_camera=False, pickable=False)
-        self._apply_stage()
-        self.render()
+class CubeOverlay:
+    """The wireframe connect cube, following ``doc.events.cube`` and ``settings.cube_size``."""
 
-    # ---------------------------------------------------------------- lasso
-    def set_lasso_enabled(self, on: bool) -> None:
+    def __init__(self, view):
+        self.view = view
+        self.actor = None
+        view.doc.events.cube.connect(self._on_cube_changed)
+        view.settings.events.cube_size.connect(self._on_cube_changed)
+
+    def _on_cube_changed(self, **_) -> None:
+        view = self.view
+        view.plotter.remove_actor("cube", render=False)
+        self.actor = None
+        if view.doc.cube_centre is not None:
+            c = view.world(view.doc.cube_centre)
+            half = view.settings.cube_size * view.spacing / 2
+            box = pv.Box(bounds=(c[0] - half[0], c[0] + half[0], c[1] - half[1], c[1] + half[1],
+                                 c[2] - half[2], c[2] + half[2]))
+            self.actor = view.plotter.add_mesh(box, style="wireframe", color="#00ffff", line_width=2,
+                                               name="cube", render=False, reset_camera=False, pickable=False)
+        view.apply_stage()
+        view.render()
+
+
+class LassoOverlay:
+    """A left drag draws a closed outline; on release ``on_lasso(polygon, ctrl)`` gets it."""
+
+    def __init__(self, view):
+        self.view = view
+        self.enabled = False
+        self.on_lasso: Callable[[np.ndarray, bool], None] | None = None
+        self.points: list | None = None  # display points of the outline being drawn
+        self._actor = None
+        self._trackball = None
+        raw = view.plotter.iren.interactor  # raw VTK observers: they run before the camera style
+        raw.AddObserver("LeftButtonPressEvent", self._press, 10.0)
+        raw.AddObserver("MouseMoveEvent", self._move, 10.0)
+        raw.AddObserver("LeftButtonReleaseEvent", self._release, 10.0)
+
+    def set_enabled(self, on: bool) -> None:
         """In lasso mode a left drag draws an outline; the camera keeps the wheel only."""
         import vtk
 
-        iren = self.plotter.iren.interactor
-        if on and not self.lasso_enabled:
+        iren = self.view.plotter.iren.interactor
+        if on and not self.enabled:
             self._trackball = iren.GetInteractorStyle()
             iren.SetInteractorStyle(vtk.vtkInteractorStyleUser())
-        elif not on and self.lasso_enabled and self._trackball is not None:
+        elif not on and self.enabled and self._trackball is not None:
             iren.SetInteractorStyle(self._trackball)
-        self.lasso_enabled = bool(on)
+        self.enabled = bool(on)
 
-    def _lasso_press(self, obj, event) -> None:
-        if self.lasso_enabled:
-            self._lasso = [self._event_position()]
+    def _press(self, obj, event) -> None:
+        if self.enabled:
+            self.points = [self.view.event_position()]
 
-    def _lasso_move(self, obj, event) -> None:
-        if self.lasso_enabled and self._lasso is not None:
-            self._lasso.append(self._event_position())
-            self._draw_lasso()
+    def _move(self, obj, event) -> None:
+        if self.enabled and self.points is not None:
+            self.points.append(self.view.event_position())
+            self.draw()
 
-    def _lasso_release(self, obj, event) -> None:
-        if not self.lasso_enabled or self._lasso is None:
+    def _release(self, obj, event) -> None:
+        if not self.enabled or self.points is None:
             return
-        polygon = np.asarray(self._lasso + [self._event_position()], np.float64)
-        self._lasso = None
-        self._draw_lasso()
-        ctrl = bool(self.plotter.iren.interactor.GetControlKey())
+        polygon = np.asarray(self.points + [self.view.event_position()], np.float64)
+        self.points = None
+        self.draw()
+        ctrl = bool(self.view.plotter.iren.interactor.GetControlKey())
         if self.on_lasso is not None and len(polygon) >= 3:
             self.on_lasso(polygon, ctrl)
 
-    def _draw_lasso(self) -> None:
+    def draw(self) -> None:
+        """Draw the outline so far (2-D, in display pixels), or remove it."""
         import vtk
 
-        ren = self.plotter.renderer
-        if self._lasso_actor is not None:
-            ren.RemoveViewProp(self._lasso_actor)
-            self._lasso_actor = None
-        if self._lasso and len(self._lasso) > 1:
+        ren = self.view.plotter.renderer
+        if self._actor is not None:
+            ren.RemoveViewProp(self._actor)
+            self._actor = None
+        pts_xy = self.points
+        if pts_xy and len(pts_xy) > 1:
             pts = vtk.vtkPoints()
-            for x, y in self._lasso:
+            for x, y in pts_xy:
                 pts.InsertNextPoint(x, y, 0)
             line = vtk.vtkPolyLine()
-            line.GetPointIds().SetNumberOfIds(len(self._lasso) + 1)
-            for i in range(len(self._lasso)):
-                line.GetPointIds().SetId(i, i)
-            line.GetPointIds().SetId(len(self._lasso), 0)
+            ids = line.GetPointIds()
+            ids.SetNumberOfIds(len(pts_xy) + 1)
+            for i in range(len(pts_xy)):
+                ids.SetId(i, i)
+            ids.SetId(len(pts_xy), 0)
             cells = vtk.vtkCellArray()
             cells.InsertNextCell(line)
             poly = vtk.vtkPolyData()
@@ -86,16 +115,5 @@ class SceneSelectionMixin:
             actor.GetProperty().SetColor(1.0, 0.85, 0.2)
             actor.GetProperty().SetLineWidth(2)
             ren.AddViewProp(actor)
-            self._lasso_actor = actor
-        self.render()
-
-    def shown_projection(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(shown indices, display xy, normalised depth, distance along the view)`` of the shown points."""
-        shown = self._shown
-        world = self._world[shown].astype(np.float64)
-        xy, depth = self.project_world(world)
-        cam = self.plotter.renderer.GetActiveCamera()
-        pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
-        direction = (focal - pos) / max(np.linalg.norm(focal - pos), 1e-12)
-        return shown, xy, depth, (world - pos) @ direction
-
+            self._actor = actor
+        self.view.render()

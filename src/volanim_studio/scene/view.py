@@ -20,8 +20,10 @@ from volanim_core.render.colours import label_table, scalar_colours
 
 from ..model.document import Document
 from ..model.modes import PickEvent
-from .overlays import SceneSelectionMixin
-from .pose_layer import ScenePoseMixin
+from . import camera
+from .hull_layer import HullLayer
+from .overlays import CubeOverlay, LassoOverlay
+from .pose_layer import PoseLayer, bone_lines
 from .projection import nearest_in_radius, project, segment_distance_2d
 
 LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
@@ -29,32 +31,27 @@ PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
 CLICK_SLOP = 4.0  # a press and release further apart than this is a drag (camera), not a click
 
 
-def _vtk_matrix(m) -> np.ndarray:
-    return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
+class SceneView:
+    """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor``.
 
+    Composed of parts that each own their actors: ``cube`` and ``lasso``
+    (selection overlays) and ``pose_layer`` (posed bones, previews).
+    """
 
-class SceneView(SceneSelectionMixin, ScenePoseMixin):
-    """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor``."""
+    EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube")
+    POSE_ACTORS = ("preview", "posed_bones", "slices")
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
         self.plotter = plotter
         self.doc = doc
         self.on_pick = on_pick
         self.settings = doc.settings
-        self._hull_actor = self._cloud_actor = self._bones_actor = self._joints_actor = None
+        self._cloud_actor = self._bones_actor = self._joints_actor = None
         self._selected_actor = self._picked_actor = None
         self._world = np.zeros((0, 3), np.float32)
         self._colours = np.zeros((0, 3), np.uint8)
         self._press = None
         self._shown = np.zeros(0, np.int64)
-        self._lasso: list | None = None  # display points of the outline being drawn
-        self.lasso_enabled = False
-        self.on_lasso = None  # callback(polygon, ctrl)
-        self._lasso_actor = None
-        self._cube_actor = None
-        self._trackball = None
-        self._preview_actor = None
-        self._preview_key = None
         self.posing = False
         self.dragging = False  # the thinness slider is held: draw a level-of-detail subset
         self._render_pending = False
@@ -66,8 +63,6 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
         iren.add_observer("RightButtonPressEvent", self._on_press)
         iren.add_observer("RightButtonReleaseEvent", self._on_release)
         ev = doc.events
-        ev.volume.connect(self._on_hull_changed)
-        ev.hull.connect(self._on_hull_changed)
         ev.skeleton.connect(self._on_skeleton_changed)
         ev.thinness.connect(self._on_thinness_changed)
         ev.bones.connect(self._on_bones_changed)
@@ -75,19 +70,14 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
         ev.picked.connect(self._on_picked_changed)
         ev.attachments.connect(self._on_attachments_changed)
         ev.filter.connect(self._on_thinness_changed)
-        ev.cube.connect(self._on_cube_changed)
-        ev.pose.connect(self._on_pose_changed)
         st = doc.settings.events
         st.colour_by.connect(self._on_colour_by_changed)
         st.point_size.connect(lambda **_: self._update_cloud())
         st.spheres.connect(lambda **_: self._update_cloud())
-        for name in ("hull_visible", "hull_opacity", "clip_axis", "clip_position"):
-            getattr(st, name).connect(self._on_hull_state_changed)
-        st.cube_size.connect(self._on_cube_changed)
-        raw = plotter.iren.interactor  # raw VTK observers: they run before the camera style
-        raw.AddObserver("LeftButtonPressEvent", self._lasso_press, 10.0)
-        raw.AddObserver("MouseMoveEvent", self._lasso_move, 10.0)
-        raw.AddObserver("LeftButtonReleaseEvent", self._lasso_release, 10.0)
+        self.hull = HullLayer(self)
+        self.cube = CubeOverlay(self)
+        self.lasso = LassoOverlay(self)
+        self.pose_layer = PoseLayer(self)
 
     def _fix_pixel_ratio(self) -> None:
         # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen
@@ -105,34 +95,37 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
     def world(self, voxel_xyz) -> np.ndarray:
         return np.asarray(voxel_xyz, np.float64) * self.spacing
 
-    def _camera(self):
-        ren = self.plotter.renderer
-        width, height = ren.GetSize()
-        x0, y0 = ren.GetOrigin()
-        m = ren.GetActiveCamera().GetCompositeProjectionTransformMatrix(width / max(height, 1), -1, 1)
-        return _vtk_matrix(m), (x0, y0, width, height)
-
     def project_world(self, world_points) -> tuple[np.ndarray, np.ndarray]:
         """Display pixels (device, bottom-left origin) and depth of world points."""
-        matrix, viewport = self._camera()
+        matrix, viewport = camera.composite_matrix(self.plotter.renderer)
         return project(world_points, matrix, viewport)
 
     def display_of_point(self, index: int) -> np.ndarray:
         """Where skeleton point ``index`` is drawn, in display pixels."""
         return self.project_world(self.world(self.doc.skeleton.points[index])[None])[0][0]
 
+    def shown_projection(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(shown indices, display xy, normalised depth, distance along the view)`` of the shown points."""
+        world = self._world[self._shown].astype(np.float64)
+        xy, depth = self.project_world(world)
+        return self._shown, xy, depth, camera.view_distances(self.plotter.renderer, world)
+
     def camera(self) -> dict:
         """The view's camera as plain lists (saved in projects)."""
-        cam = self.plotter.renderer.GetActiveCamera()
-        return {"position": list(cam.GetPosition()), "focal_point": list(cam.GetFocalPoint()),
-                "view_up": list(cam.GetViewUp())}
+        return camera.camera_state(self.plotter.renderer)
 
     def set_camera(self, data: dict) -> None:
-        cam = self.plotter.renderer.GetActiveCamera()
-        cam.SetPosition(*data["position"])
-        cam.SetFocalPoint(*data["focal_point"])
-        cam.SetViewUp(*data["view_up"])
-        self.plotter.renderer.ResetCameraClippingRange()
+        camera.set_camera_state(self.plotter.renderer, data)
+        self.render()
+
+    def front_view(self) -> None:
+        """Look along +y (from the front of a figure facing -y), z up, everything in view."""
+        if camera.front_view(self.plotter.renderer):
+            self.render()
+
+    def jump_to(self, voxel_xyz) -> None:
+        """Centre the view on a point and move closer."""
+        camera.move_closer_to(self.plotter.renderer, self.world(voxel_xyz))
         self.render()
 
     def pixel_ratio(self) -> float:
@@ -163,19 +156,19 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
                     bone = int(np.argmin(d))
         return PickEvent(point=point, joint=joint, bone=bone)
 
-    def _event_position(self) -> tuple[int, int]:
+    def event_position(self) -> tuple[int, int]:
         # pyvista hangs button observers on the interactor *style*; the position is the interactor's
         return self.plotter.iren.interactor.GetEventPosition()
 
     def _on_press(self, obj, event) -> None:
-        if self.lasso_enabled and event.startswith("Left"):
+        if self.lasso.enabled and event.startswith("Left"):
             return
-        self._press = self._event_position()
+        self._press = self.event_position()
 
     def _on_release(self, obj, event) -> None:
         if self._press is None:
             return
-        x, y = self._event_position()
+        x, y = self.event_position()
         px, py = self._press
         self._press = None
         if abs(x - px) > CLICK_SLOP or abs(y - py) > CLICK_SLOP:
@@ -185,72 +178,14 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
         if self.on_pick is not None:
             self.on_pick(PickEvent(ev.point, ev.joint, ev.bone, button))
 
-    # ---------------------------------------------------------------- hull
-    def _on_hull_changed(self, **_) -> None:
-        if self._hull_actor is not None:
-            self.plotter.remove_actor(self._hull_actor, render=False)
-            self._hull_actor = None
-        if self.doc.hull is None:
-            self.render()
-            return
-        verts, faces = self.doc.hull
-        cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
-        mesh = pv.PolyData(self.world(verts).astype(np.float32), cells)
-        self._hull_actor = self.plotter.add_mesh(
-            mesh, color="#d8c8b0", opacity=self.settings.hull_opacity, pickable=False, smooth_shading=True,
-            name="hull", render=False, reset_camera=False)
-        self._apply_hull_state()
-        self._apply_stage()
-        self.front_view()
-
-    def _apply_hull_state(self) -> None:
-        a = self._hull_actor
-        if a is None:
-            return
-        a.SetVisibility(self.settings.hull_visible)
-        a.GetProperty().SetOpacity(self.settings.hull_opacity)
-        mapper = a.GetMapper()
-        mapper.RemoveAllClippingPlanes()
-        if self.settings.clip_axis is not None and self.doc.shape is not None:
-            import vtk
-
-            plane = vtk.vtkPlane()
-            origin = [0.0, 0.0, 0.0]
-            extent = (self.doc.shape[self.settings.clip_axis] - 1) * self.spacing[self.settings.clip_axis]
-            origin[self.settings.clip_axis] = self.settings.clip_position * extent
-            normal = [0.0, 0.0, 0.0]
-            normal[self.settings.clip_axis] = -1.0
-            plane.SetOrigin(origin)
-            plane.SetNormal(normal)
-            mapper.AddClippingPlane(plane)
-
-    def _on_hull_state_changed(self, **_) -> None:
-        self._apply_hull_state()
-        self._apply_stage()
-        self.render()
-
     # ---------------------------------------------------------------- cloud
     def _on_skeleton_changed(self, **_) -> None:
         s = self.doc.skeleton
         self._world = np.zeros((0, 3), np.float32) if s is None else self.world(s.points).astype(np.float32)
         self._recolour()
         self._update_cloud()
-        if self._hull_actor is None and len(self._world):
+        if self.hull.actor is None and len(self._world):
             self.front_view()
-
-    def front_view(self) -> None:
-        """Look along +y (from the front of a figure facing -y), z up, everything in view."""
-        ren = self.plotter.renderer
-        b = ren.ComputeVisiblePropBounds()
-        if b[0] > b[1]:
-            return
-        c = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
-        cam = ren.GetActiveCamera()
-        cam.SetFocalPoint(*c)
-        cam.SetPosition(c[0], c[1] - 3 * max(b[1] - b[0], b[5] - b[4], 1.0), c[2])
-        cam.SetViewUp(0, 0, 1)
-        ren.ResetCamera()
-        self.render()
 
     def _recolour(self) -> None:
         s = self.doc.skeleton
@@ -318,7 +253,7 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
             prop = self._cloud_actor.GetProperty()
             prop.SetPointSize(self.settings.point_size)
             prop.SetRenderPointsAsSpheres(self.settings.spheres)
-        self._apply_stage()
+        self.apply_stage()
         self.render()
 
     def _on_thinness_changed(self, **_) -> None:
@@ -351,9 +286,7 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
                 pv.PolyData(jpos.astype(np.float32)), color="white", point_size=14,
                 render_points_as_spheres=True, name="joints", render=False, reset_camera=False)
         if len(bones):
-            segs = self.world(bones.segments().reshape(-1, 3))
-            lines = np.hstack([np.full((len(bones), 1), 2), np.arange(2 * len(bones)).reshape(-1, 2)]).ravel()
-            poly = pv.PolyData(segs.astype(np.float32), lines=lines)
+            poly = bone_lines(self.world(bones.segments()))
             poly.cell_data["rgb"] = label_table(len(bones))[1:]
             self._bones_actor = self.plotter.add_mesh(
                 poly, scalars="rgb", rgb=True, line_width=6, render_lines_as_tubes=True, name="bones",
@@ -367,12 +300,10 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
         self._selected_actor = None
         sel = [i for i in self.doc.selected_bones if i < len(self.doc.bones)]
         if sel:
-            segs = self.world(self.doc.bones.segments()[sel].reshape(-1, 3))
-            lines = np.hstack([np.full((len(sel), 1), 2), np.arange(2 * len(sel)).reshape(-1, 2)]).ravel()
             self._selected_actor = self.plotter.add_mesh(
-                pv.PolyData(segs.astype(np.float32), lines=lines), color="white", line_width=12,
+                bone_lines(self.world(self.doc.bones.segments()[sel])), color="white", line_width=12,
                 render_lines_as_tubes=True, opacity=0.5, name="selected", render=False, reset_camera=False)
-        self._apply_stage()
+        self.apply_stage()
         self.render()
 
     def _on_picked_changed(self, index=None, **_) -> None:
@@ -382,8 +313,29 @@ class SceneView(SceneSelectionMixin, ScenePoseMixin):
             self._picked_actor = self.plotter.add_mesh(
                 pv.PolyData(self._world[index : index + 1]), color="#00ffff", point_size=self.settings.point_size * 2.5,
                 render_points_as_spheres=True, name="picked", render=False, reset_camera=False)
-        self._apply_stage()
+        self.apply_stage()
         self.render()
+
+    # ---------------------------------------------------------------- stages
+    def set_posing(self, on: bool) -> None:
+        """Pose stage: the preview and the posed bones; edit stage: hull, cloud and rest bones."""
+        self.posing = bool(on)
+        self.apply_stage()
+        if self.posing:
+            self.pose_layer.on_pose_changed()
+        self.render()
+
+    def apply_stage(self) -> None:
+        """Show the edit stage's actors or the pose stage's, whichever is current."""
+        actors = self.plotter.renderer.actors
+        for name in self.EDIT_ACTORS:
+            if name in actors:
+                actors[name].SetVisibility(not self.posing)
+        if "hull" in actors:
+            actors["hull"].SetVisibility(not self.posing and self.settings.hull_visible)
+        for name in self.POSE_ACTORS:
+            if name in actors:
+                actors[name].SetVisibility(self.posing)
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once.

@@ -9,7 +9,7 @@ from PySide6.QtWidgets import QPushButton
 
 from paths import ASSETS
 from volanim_core import samples
-from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.reconstruct.engine import reconstruct, workspace_nbytes
 from volanim_studio.model.modes import Mode
 
 from ..conftest import JOB_TIMEOUT_MS, front_view
@@ -54,10 +54,14 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     text = w.reconstruct_panel.report.text()
     assert "healthy: one piece" in text and "cracks" in text and "hotspot" in text
     assert w.reconstruct_panel.joints.count() == len(p.report.joints) + len(p.report.pieces)
-    assert w.scene._preview_actor is not None and w.scene._preview_actor.GetVisibility()
+    assert w.scene.pose_layer.preview_actor is not None and w.scene.pose_layer.preview_actor.GetVisibility()
     # one undo step for the whole drag
     qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
     assert w.doc.pose.is_rest
+    # the live previews ran on this (GUI) thread and kept their stencil; leaving Pose frees it
+    assert workspace_nbytes() > 0
+    qtbot.keyClick(w, Qt.Key_V)
+    assert w.mode == Mode.VIEW and workspace_nbytes() == 0
 
 
 def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
@@ -102,9 +106,9 @@ def test_compare_export_and_slices(qtbot, posed_window, tmp_path):
     w.doc.pose.set_angles(w.doc.bones.index("R_THIGH"), (30, 0, 0), merge=False)
     w.previews.preview()
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
-    posed_shape = w.scene._preview_key[1]
+    posed_shape = w.scene.pose_layer.preview_key[1]
     w.reconstruct_panel.show_rest.setChecked(True)
-    assert w.scene._preview_key[1] != posed_shape  # the rest reconstruction is shown
+    assert w.scene.pose_layer.preview_key[1] != posed_shape  # the rest reconstruction is shown
     w.reconstruct_panel.show_rest.setChecked(False)
     w.reconstruct_panel.slices.setChecked(True)
     assert "slices" in w.plotter.renderer.actors

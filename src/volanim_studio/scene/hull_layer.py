@@ -1,0 +1,64 @@
+"""The translucent, never-pickable hull of the segmented volume, with its clipping plane."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+
+HULL_COLOUR = "#d8c8b0"
+
+
+class HullLayer:
+    """Follows ``doc.events.volume``/``hull`` and the hull settings (visible, opacity, clip)."""
+
+    def __init__(self, view):
+        self.view = view
+        self.actor = None
+        view.doc.events.volume.connect(self._on_hull_changed)
+        view.doc.events.hull.connect(self._on_hull_changed)
+        for name in ("hull_visible", "hull_opacity", "clip_axis", "clip_position"):
+            getattr(view.settings.events, name).connect(self._on_state_changed)
+
+    def _on_hull_changed(self, **_) -> None:
+        view = self.view
+        if self.actor is not None:
+            view.plotter.remove_actor(self.actor, render=False)
+            self.actor = None
+        if view.doc.hull is None:
+            view.render()
+            return
+        verts, faces = view.doc.hull
+        cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
+        mesh = pv.PolyData(view.world(verts).astype(np.float32), cells)
+        # not pickable: a click must reach the skeleton points inside it
+        self.actor = view.plotter.add_mesh(
+            mesh, color=HULL_COLOUR, opacity=view.settings.hull_opacity, pickable=False, smooth_shading=True,
+            name="hull", render=False, reset_camera=False)
+        self._apply_state()
+        view.apply_stage()
+        view.front_view()
+
+    def _apply_state(self) -> None:
+        if self.actor is None:
+            return
+        settings, doc = self.view.settings, self.view.doc
+        self.actor.SetVisibility(settings.hull_visible)
+        self.actor.GetProperty().SetOpacity(settings.hull_opacity)
+        mapper = self.actor.GetMapper()
+        mapper.RemoveAllClippingPlanes()
+        axis = settings.clip_axis
+        if axis is not None and doc.shape is not None:
+            import vtk
+
+            origin, normal = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+            origin[axis] = settings.clip_position * (doc.shape[axis] - 1) * self.view.spacing[axis]
+            normal[axis] = -1.0
+            plane = vtk.vtkPlane()
+            plane.SetOrigin(origin)
+            plane.SetNormal(normal)
+            mapper.AddClippingPlane(plane)
+
+    def _on_state_changed(self, **_) -> None:
+        self._apply_state()
+        self.view.apply_stage()
+        self.view.render()
