@@ -8,11 +8,14 @@ cancel (Ctrl+C) into exit 130, never a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
+from pathlib import Path
 
 from volanim_core.errors import Cancelled, FormatError
 
 from . import demo_command, reconstruct_commands, skeleton_commands, volume_commands
+from ._common import join_negative_infinity
 
 EPILOG = """examples:
   volanim samples mannequin -o data/          write the demo mannequin
@@ -39,16 +42,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+OUTPUT_ARGS = ("output", "out", "dst", "o")
+
+
+def _input_files(args) -> list[str]:
+    """The command's input files as given (positional paths that exist), for naming them in errors."""
+    found = []
+    for key, value in vars(args).items():
+        if key in OUTPUT_ARGS or not isinstance(value, str) or key == "command":
+            continue
+        with contextlib.suppress(OSError, ValueError):
+            if Path(value).exists():
+                found.append(value)
+    return found
+
+
+def describe(exc: BaseException, args) -> str:
+    """One line for the user: FormatErrors and OSErrors name their file; other refusals get the input's name."""
+    text = str(exc) or type(exc).__name__
+    if isinstance(exc, FormatError):
+        return text
+    if isinstance(exc, OSError) and exc.filename:
+        return f"{exc.filename}: {exc.strerror or text}"
+    inputs = _input_files(args)
+    if inputs and not any(Path(f).name in text for f in inputs):
+        return f"{', '.join(inputs)}: {text}"
+    return text
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(join_negative_infinity(list(sys.argv[1:] if argv is None else argv)))
     if not getattr(args, "func", None):
         parser.print_help()
         return 0
     try:
         result = args.func(args)
-    except (FormatError, ValueError, OSError) as exc:
-        print(f"volanim {args.command}: error: {exc}", file=sys.stderr)
+    except (FormatError, ValueError, OSError, MemoryError) as exc:
+        print(f"volanim {args.command}: error: {describe(exc, args)}", file=sys.stderr)
         return 2
     except (Cancelled, KeyboardInterrupt):
         print(f"\nvolanim {args.command}: cancelled", file=sys.stderr)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import math
+import re
 
 from volanim_core.io import read_volume, write_volume
 from volanim_core.volume import Bounds
@@ -24,7 +26,7 @@ def add_volume_in(p: argparse.ArgumentParser, name: str = "volume", help: str = 
 
 
 def add_dims(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--dims", nargs=3, type=int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
 
 
 def load(path: str, args) -> object:
@@ -36,12 +38,50 @@ def save(path: str, vol, **kw) -> None:
     print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype})")
 
 
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+_INFINITY = re.compile(r"[+-]?inf(?:inity)?", re.IGNORECASE)
+
+
+def ascii_float(text: str) -> float:
+    """A number as users type it in ASCII (``-inf`` allowed; NaN, ``1_2`` and full-width digits are not:
+    Python's ``float()`` accepts all three)."""
+    if _NUMBER.fullmatch(text) or _INFINITY.fullmatch(text):
+        return float(text)
+    raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
+
+
+def finite_float(text: str) -> float:
+    value = ascii_float(text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def ascii_int(text: str) -> int:
+    """A whole number in ASCII digits (Python's ``int()`` also takes ``１２`` and ``1_2``)."""
+    if re.fullmatch(r"[+-]?[0-9]+", text):
+        return int(text)
+    raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}")
+
+
+def join_negative_infinity(argv: list[str]) -> list[str]:
+    """``--opt -inf`` -> ``--opt=-inf``: argparse takes ``-inf`` for an option and refuses it."""
+    out: list[str] = []
+    for token in argv:
+        if out and _INFINITY.fullmatch(token) and token.startswith("-") and out[-1].startswith("--") \
+                and "=" not in out[-1]:
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
+
+
 def parse_range(text: str) -> tuple[float, float | None]:
     """``LO`` or ``LO:HI``."""
     lo, _, hi = text.partition(":")
     try:
-        return float(lo), (float(hi) if hi else None)
-    except ValueError:
+        return finite_float(lo), (finite_float(hi) if hi else None)
+    except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError(f"expected LO or LO:HI, got {text!r}") from None
 
 

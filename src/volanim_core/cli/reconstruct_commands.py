@@ -27,7 +27,7 @@ from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
 from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
 
-from ._common import add_command, bounds_arg
+from ._common import add_command, ascii_int, bounds_arg, finite_float
 
 
 def _connect(args):
@@ -45,8 +45,8 @@ def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
     """``BONE=RX,RY,RZ`` (degrees)."""
     name, sep, angles = text.partition("=")
     try:
-        values = tuple(float(v) for v in angles.split(","))
-    except ValueError:
+        values = tuple(finite_float(v) for v in angles.split(","))
+    except argparse.ArgumentTypeError:
         values = ()
     if not sep or len(values) != 3:
         raise argparse.ArgumentTypeError(f"expected BONE=RX,RY,RZ in degrees, got {text!r}")
@@ -135,7 +135,7 @@ def register(sub) -> None:
                     _connect)
     p.add_argument("mskel")
     p.add_argument("bones")
-    p.add_argument("--thinness", type=float, help="only points with thinness >= this")
+    p.add_argument("--thinness", type=finite_float, help="only points with thinness >= this")
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "pose", "Write a .trans frame: rotate bones about their proximal joints (FK).",
@@ -164,18 +164,18 @@ def register(sub) -> None:
     p = add_command(sub, "bounds", "Inclusive bounds of the posed spheres of one or more frames (tskelbounds).",
                     "volanim bounds walk-*.tskel --padding 2", _bounds)
     p.add_argument("tskel", nargs="+")
-    p.add_argument("--padding", type=int, default=2)
+    p.add_argument("--padding", type=ascii_int, default=2)
 
     p = add_command(sub, "reconstruct", "Re-grow a volume from a .tskel frame (numba, parallel).",
                     "volanim reconstruct arm.tskel --source mannequin.VOL --mode sampled -o arm.vti", _reconstruct)
     p.add_argument("tskel")
     p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
-    p.add_argument("--dims", nargs=3, type=int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
     p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
-    p.add_argument("--kernel", type=int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
+    p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     group = p.add_mutually_exclusive_group()
-    group.add_argument("--bounds", nargs=6, type=int, metavar="N", help="inclusive output bounds x0 y0 z0 x1 y1 z1")
-    group.add_argument("--padding", type=int, default=2, help="voxels around the posed spheres (default 2)")
-    p.add_argument("--threads", type=int, help="numba threads (default: all cores)")
+    group.add_argument("--bounds", nargs=6, type=ascii_int, metavar="N", help="inclusive bounds x0 y0 z0 x1 y1 z1")
+    group.add_argument("--padding", type=ascii_int, default=2, help="voxels around the posed spheres (default 2)")
+    p.add_argument("--threads", type=ascii_int, help="numba threads (default: all cores)")
     p.add_argument("--loss", action="store_true", help="also report voxel loss against the identity frame")
     p.add_argument("-o", "--output", required=True, help=".vti/.nrrd keep the origin; .vol/.VOL: it is printed")

@@ -13,7 +13,7 @@ from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
 from .. import volume
-from ._common import add_command, add_dims, add_volume_in, load, parse_range
+from ._common import add_command, add_dims, add_volume_in, ascii_float, ascii_int, load, parse_range
 
 
 def segment(vol: np.ndarray, threshold, fill: bool) -> np.ndarray:
@@ -58,13 +58,13 @@ def register(sub) -> None:
                     "volanim skeletonize frog.VOL --threshold 1:255 --fill-cavities -o frog.mskel", _skeletonize)
     _segment_args(p)
     p.add_argument("--metric", choices=("euclid", "345"), default="euclid", help="distance metric (default euclid)")
-    p.add_argument("--min-thinness", type=float, default=DEFAULT_MIN_THINNESS,
+    p.add_argument("--min-thinness", type=ascii_float, default=DEFAULT_MIN_THINNESS,
                    help=f"keep points with thinness >= this (default {DEFAULT_MIN_THINNESS}; -inf keeps all)")
     p.add_argument("-o", "--output", required=True, help="output .mskel")
 
     p = add_command(sub, "isosurface", "Isosurface hull of the object as a mesh (.ply, .vtp, .obj, .stl).",
                     "volanim isosurface frog.VOL --threshold 1:255 -o frog-hull.ply", _isosurface)
     _segment_args(p)
-    p.add_argument("--step", type=int, default=1, help="sampling step; > 1 gives a coarser mesh (skimage)")
+    p.add_argument("--step", type=ascii_int, default=1, help="sampling step; > 1 gives a coarser mesh (skimage)")
     p.add_argument("--engine", choices=("vtk", "skimage"), default="vtk", help="marching cubes engine (default vtk)")
     p.add_argument("-o", "--output", required=True, help="output mesh")

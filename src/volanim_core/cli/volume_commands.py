@@ -12,7 +12,17 @@ from volanim_core.io import add_header, float_to_uint8, histogram_file, remove_h
 from .. import samples, volume
 from ..io._text import parse_int, read_records
 from ..io.raw_volumes import raw_layout
-from ._common import add_command, add_dims, add_volume_in, bounds_arg, load, parse_range, save
+from ._common import (
+    add_command,
+    add_dims,
+    add_volume_in,
+    ascii_int,
+    bounds_arg,
+    finite_float,
+    load,
+    parse_range,
+    save,
+)
 
 
 def _info(args):
@@ -172,25 +182,26 @@ def register(sub) -> None:
                     "volanim threshold ct.VOL bone.VOL --range 180:255", _threshold)
     _io(p)
     p.add_argument("--range", type=parse_range, required=True, metavar="LO[:HI]", help="keep LO <= v <= HI")
-    p.add_argument("--value", type=int, default=255, help="value of kept voxels (default 255)")
+    p.add_argument("--value", type=ascii_int, default=255, help="value of kept voxels (default 255)")
 
     p = add_command(sub, "fill", "Fill enclosed cavities and/or a box (Fill).",
                     "volanim fill mask.VOL filled.VOL --cavities", _fill)
     _io(p)
     p.add_argument("--cavities", action="store_true", help="fill background regions enclosed by the object")
-    p.add_argument("--box", nargs=6, type=int, metavar="N", help="inclusive box x0 y0 z0 x1 y1 z1 to set")
-    p.add_argument("--value", type=int, default=255, help="value for --box (default 255)")
+    p.add_argument("--box", nargs=6, type=ascii_int, metavar="N", help="inclusive box x0 y0 z0 x1 y1 z1 to set")
+    p.add_argument("--value", type=ascii_int, default=255, help="value for --box (default 255)")
 
     p = add_command(sub, "crop", "Crop (or pad) to bounds, or to the tight bounds (CropVolume).",
                     "volanim crop frog.VOL small.VOL --pad 2", _crop)
     _io(p)
-    p.add_argument("--bounds", nargs=6, type=int, metavar="N", help="inclusive x0 y0 z0 x1 y1 z1 (default: tight)")
-    p.add_argument("--pad", type=int, default=0, help="grow the bounds by N voxels on every side")
+    p.add_argument("--bounds", nargs=6, type=ascii_int, metavar="N",
+                   help="inclusive x0 y0 z0 x1 y1 z1 (default: tight)")
+    p.add_argument("--pad", type=ascii_int, default=0, help="grow the bounds by N voxels on every side")
 
     p = add_command(sub, "tightbounds", "Print the inclusive bounds of the non-zero voxels (TightBounds).",
                     "volanim tightbounds frog.VOL", _tightbounds)
     _io(p, output=False)
-    p.add_argument("--level", type=float, default=0, help="count voxels above this value (default 0)")
+    p.add_argument("--level", type=finite_float, default=0, help="count voxels above this value (default 0)")
 
     p = add_command(sub, "flip", "Mirror a volume along an axis.", "volanim flip in.VOL out.VOL --axis x", _flip)
     _io(p)
@@ -236,7 +247,8 @@ def register(sub) -> None:
     p = add_command(sub, "float2uchar", "Map a range of float (or 16-bit) data onto 0..255 (float2uchar).",
                     "volanim float2uchar ct.nii.gz ct.VOL --range -1000 2000", _float2uchar)
     _io(p)
-    p.add_argument("--range", nargs=2, type=float, metavar=("LO", "HI"), help="input range (default: data min max)")
+    p.add_argument("--range", nargs=2, type=finite_float, metavar=("LO", "HI"),
+                   help="input range (default: data min max)")
 
     p = add_command(sub, "samples", "Write a demo dataset: mannequin, aliascube, frog or all.",
                     "volanim samples mannequin -o data/", _samples)

@@ -4,20 +4,93 @@ A crash (or an exception while formatting) leaves the previous file intact,
 never a half-written one. ``os.replace`` is atomic on POSIX and Windows when
 source and target are on the same file system, hence the temporary file lives
 in the target's folder.
+
+Temporary names carry the writer's process id (``.NAME.<pid>-<random>.tmp``).
+A kill -9 cannot clean up after itself, so every write first removes the
+temporaries in the same folder whose process is gone (``clean_stale``).
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
+import re
+import secrets
+import time
 from pathlib import Path
 
+LEGACY_STALE_SECONDS = 600  # temporaries without a pid (older versions) are stale after this
 
-def _umask() -> int:
+
+def pending_name(name: str, suffix: str = ".tmp") -> str:
+    """A hidden temporary name for ``name`` in the same folder, owned by this process."""
+    return f".{name}.{os.getpid()}-{secrets.token_hex(4)}{suffix}"  # matches _OURS
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+_OURS = re.compile(r"^\..+\.(\d+)-[0-9a-f]{8}\.tmp(?:\.[A-Za-z0-9]+)?$")  # pending_name's shape
+
+
+def clean_stale(folder: Path, name: str | None = None, suffix: str = ".tmp") -> int:
+    """Remove temporaries that writers which died left in ``folder``; returns how many.
+
+    Every temporary of ours names its process, so any of them whose process is
+    gone is stale, whatever it was for (a kill can leave nested ones). Older
+    versions' temporaries of ``name`` (no pid) are stale after ten minutes.
+    """
+    legacy = None
+    if name is not None:
+        legacy = re.compile(r"^\." + re.escape(name) + r"(?:\.[A-Za-z0-9_]{8})?" + re.escape(suffix) + "$")
+    removed = 0
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return 0
+    for entry in entries:
+        try:
+            ours = _OURS.match(entry.name)
+            if ours:
+                stale = not _pid_alive(int(ours.group(1)))
+            elif legacy is not None and legacy.match(entry.name):
+                stale = time.time() - entry.stat().st_mtime > LEGACY_STALE_SECONDS
+            else:
+                continue
+            if stale and entry.is_file(follow_symlinks=False):
+                os.unlink(entry.path)
+                removed += 1
+        except (OSError, ValueError):
+            continue
+    return removed
+
+
+def fsync_folder(folder: str | Path) -> None:
+    """Make renames inside ``folder`` durable (POSIX; a no-op where folders cannot be opened)."""
+    with contextlib.suppress(OSError):
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def _read_umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+_UMASK = _read_umask()  # read once: os.umask is process-wide, changing it per write races other threads
 
 
 @contextlib.contextmanager
@@ -25,11 +98,13 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs):
     """Open a temporary file for writing; on success rename it to ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    clean_stale(path.parent, path.name)
+    tmp = path.parent / pending_name(path.name)
+    # the mode a plain open() would give (or the mode of the file being replaced)
+    file_mode = path.stat().st_mode & 0o7777 if path.exists() else 0o666 & ~_UMASK
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
     try:
-        # mkstemp makes 0600 files; give the result the mode a plain open() would
-        # (or keep the mode of the file being replaced).
-        os.chmod(tmp, path.stat().st_mode & 0o7777 if path.exists() else 0o666 & ~_umask())
+        os.chmod(tmp, file_mode)
         with os.fdopen(fd, mode, **kwargs) as fh:
             yield fh
             fh.flush()
@@ -57,9 +132,13 @@ def atomic_vtk_save(path: str | Path, dataset) -> None:
     """Save a pyvista dataset atomically: VTK writes by file name, so write a
     temporary name beside the target (same suffix, so VTK picks the writer), then rename."""
     path = Path(path)
-    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    clean_stale(path.parent, path.stem, f".tmp{path.suffix}")
+    tmp = path.parent / pending_name(path.stem, f".tmp{path.suffix}")
     try:
         dataset.save(str(tmp))
+        with open(tmp, "rb") as fh:
+            os.fsync(fh.fileno())
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)

@@ -8,7 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from volanim_core.limits import MAX_COORD
+
 from ._text import TextRecords, parse_float, parse_int
+
+_NUMBER_CHARS = set("0123456789+-.eE")
 
 
 def parse_point_rows(
@@ -17,7 +21,8 @@ def parse_point_rows(
     """Parse ``x y z dt [thinness]`` rows into a float64 ``(N, max(ncols))`` array.
 
     Rows with fewer columns than the maximum get NaN in the missing ones.
-    ``x y z`` must be integers and ``dt`` finite and >= 0.
+    ``x y z`` must be integers within ``MAX_COORD``, every given value finite
+    ASCII, and ``dt`` >= 0.
     """
     width = max(ncols)
     for line, toks in rows:
@@ -28,15 +33,20 @@ def parse_point_rows(
     if not rows:
         return out
     try:
-        if all(len(t) == width for _, t in rows):
-            out[:] = np.array([t for _, t in rows], dtype=np.float64)
-        else:
-            for k, (_, t) in enumerate(rows):
-                out[k, : len(t)] = np.array(t, dtype=np.float64)
-        ok = np.isfinite(out[:, :4]).all() and (out[:, :3] == np.round(out[:, :3])).all()
-        ok = ok and (out[:, 3] >= 0).all() and not np.isinf(out[:, 4:]).any()
-        if ok:
-            return out
+        # float() would also take full-width digits, underscores, "nan": only ASCII digits, signs, '.', 'e'
+        chars = set("".join("".join(t) for _, t in rows))
+        if chars <= _NUMBER_CHARS:
+            lengths = np.fromiter((len(t) for _, t in rows), np.int64, len(rows))
+            if (lengths == width).all():
+                out[:] = np.array([t for _, t in rows], dtype=np.float64)
+            else:
+                for k, (_, t) in enumerate(rows):
+                    out[k, : len(t)] = np.array(t, dtype=np.float64)
+            given = np.arange(width)[None, :] < lengths[:, None]
+            ok = np.isfinite(out[given]).all() and (out[:, :3] == np.round(out[:, :3])).all()
+            ok = ok and (np.abs(out[:, :3]) <= MAX_COORD).all() and (out[:, 3] >= 0).all()
+            if ok:
+                return out
     except ValueError:
         pass
     # Slow path: locate the first bad token for the message.

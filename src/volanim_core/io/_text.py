@@ -1,11 +1,14 @@
 """Line reader shared by every text format.
 
-    file bytes -> decode (UTF-8, no NUL) -> lines (CRLF ok) -> strip '#' comments
-               -> (line number, tokens) records + header comments {key: value}
+    file bytes -> decode (UTF-8, no NUL, a leading byte-order mark dropped) -> lines (CRLF ok)
+               -> strip '#' comments -> (line number, tokens) records + header comments {key: value}
 
-Tolerant of blank lines, comments, tabs and CRLF (FORMATS.md); everything else
-is the caller's to validate, using :meth:`TextRecords.error` so messages carry
-the file and line.
+Tolerant of blank lines, comments, tabs, CRLF and the byte-order mark Windows
+editors write (FORMATS.md); everything else is the caller's to validate, using
+:meth:`TextRecords.error` so messages carry the file and line.
+
+Numbers are ASCII (``NUMBER``): Python's ``int()``/``float()`` also take
+full-width digits (``１２``) and underscores (``1_2``), which our formats do not.
 """
 
 from __future__ import annotations
@@ -15,8 +18,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from volanim_core.errors import FormatError
+from volanim_core.limits import MAX_COORD
 
 _HEADER = re.compile(r"^#\s*([A-Za-z_][\w ]*?)\s*:\s*(\S.*?)\s*$")
+NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+MAX_TEXT_BYTES = 2**31  # 2 GB of text is ~50 M points; anything larger is not one of our files
+
 
 
 @dataclass
@@ -40,6 +47,9 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
     """
     path = Path(path)
     try:
+        if path.stat().st_size > MAX_TEXT_BYTES:
+            raise FormatError(path, f"is {path.stat().st_size:,} bytes; text files over {MAX_TEXT_BYTES:,} "
+                                    "bytes are not read")
         raw = path.read_bytes()
     except OSError as exc:
         raise FormatError(path, f"cannot read file: {exc.strerror or exc}") from exc
@@ -50,6 +60,7 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise FormatError(path, "not UTF-8 text, expected a text file", line) from exc
+    text = text.removeprefix("\ufeff")
     records: list[tuple[int, list[str]]] = []
     header: dict[str, str] = {}
     first_comment = None
@@ -72,28 +83,29 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
     return result
 
 
-def parse_int(rec: TextRecords, line: int, token: str, what: str) -> int:
-    """An integer token (``12`` or ``12.0``), else a FormatError naming ``what``."""
-    try:
-        return int(token)
-    except ValueError:
-        pass
-    try:
-        value = float(token)
-    except ValueError:
-        raise rec.error(line, f"expected an integer {what}, got {token!r}") from None
+def is_number(token: str) -> bool:
+    """An ASCII decimal number (no NaN, no infinity, no underscores, no full-width digits)."""
+    return NUMBER.fullmatch(token) is not None
+
+
+def parse_int(rec: TextRecords, line: int, token: str, what: str, limit: int = MAX_COORD) -> int:
+    """An integer token (``12`` or ``12.0``) with ``|value| <= limit``, else a FormatError naming ``what``."""
+    if not is_number(token):
+        raise rec.error(line, f"expected an integer {what}, got {token!r}")
+    value = float(token)
     if not value.is_integer():
         raise rec.error(line, f"expected an integer {what}, got {token!r}")
-    return int(value)
+    if abs(value) > limit:
+        raise rec.error(line, f"{what} {token} is out of range (at most {limit:,} in size)")
+    return int(token) if token.lstrip("+-").isdigit() else int(value)
 
 
 def parse_float(rec: TextRecords, line: int, token: str, what: str) -> float:
     """A finite float token, else a FormatError naming ``what``."""
-    try:
-        value = float(token)
-    except ValueError:
-        raise rec.error(line, f"expected a number for {what}, got {token!r}") from None
-    if value != value or value in (float("inf"), float("-inf")):
+    if not is_number(token):
+        raise rec.error(line, f"expected a finite number for {what}, got {token!r}")
+    value = float(token)
+    if value in (float("inf"), float("-inf")):  # 1e999
         raise rec.error(line, f"expected a finite number for {what}, got {token!r}")
     return value
 

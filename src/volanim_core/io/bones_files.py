@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from volanim_core.rig.bones import Bone, BoneSkeleton
+from volanim_core.rig.bones import Bone, BoneSkeleton, bone_cycle
 
 from ._atomic import atomic_write_text
 from ._text import fmt_float, parse_float, read_records
@@ -47,6 +47,10 @@ def read_bones(path: str | Path) -> BoneSkeleton:
         if (b.proximal, b.distal) in seen:
             raise rec.error(line, f"bone {b.proximal} {b.distal} is listed twice")
         seen.add((b.proximal, b.distal))
+    cycle = bone_cycle(bones)
+    if cycle:
+        raise rec.error(bone_lines[max(cycle)], "the bones form a cycle ("
+                        + " -> ".join(bones[i].label for i in cycle) + "); a bone skeleton must be a tree")
     return BoneSkeleton(joints, bones)
 
 
@@ -63,11 +67,17 @@ def write_bones(path: str | Path, skeleton: BoneSkeleton) -> None:
 def read_connections(path: str | Path) -> list[tuple[str, str]]:
     """Read a ``.connections`` file: ``A B`` joint-name pairs in root order."""
     rec = read_records(path)
-    pairs = []
+    pairs, lines = [], {}
     for line, toks in rec.records:
         if len(toks) != 2:
             raise rec.error(line, f"expected 'A B' (two joint names), got {len(toks)} tokens")
-        pairs.append((toks[0], toks[1]))
+        a, b = toks
+        if a == b:
+            raise rec.error(line, f"'{a} {b}' joins joint {a!r} to itself")
+        if (a, b) in lines:
+            raise rec.error(line, f"'{a} {b}' is listed twice (also on line {lines[(a, b)]})")
+        lines[(a, b)] = line
+        pairs.append((a, b))
     return pairs
 
 

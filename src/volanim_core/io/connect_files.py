@@ -76,7 +76,12 @@ def _read_rooted(path, *, matrices: bool, points: bool):
     while i < len(records):
         line, toks = records[i]
         if _is_root(toks):
-            bones.append(_parse_root(rec, line, toks))
+            root = _parse_root(rec, line, toks)
+            for k, other in enumerate(bones):
+                if root.same_segment(other):
+                    raise rec.error(line, f"bone {root.label} is listed twice (bone {k} has the same joints); "
+                                          "each bone has one 'Root:' line")
+            bones.append(root)
             i += 1
             if matrices:
                 mats.append(_parse_matrix(rec, records, i, line))

@@ -8,7 +8,8 @@ exactly our ``order="F"`` layout.
 
 from __future__ import annotations
 
-import gzip
+import math
+import os
 import re
 import zlib
 from pathlib import Path
@@ -16,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
+from volanim_core.limits import checked_grid, expect_bytes
 
 from ._atomic import atomic_open
 
@@ -32,70 +34,146 @@ _WRITE_TYPES = {"u1": "uint8", "i1": "int8", "u2": "uint16", "i2": "int16",
                 "u4": "uint32", "i4": "int32", "f4": "float", "f8": "double"}
 
 
+MAX_HEADER_BYTES = 1 << 20
+_NUMBER = re.compile(r"^[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?$")  # ASCII only, finite
+
+
+def _number(text: str) -> float:
+    text = text.strip()
+    if not _NUMBER.match(text):
+        raise ValueError(text)
+    return float(text)
+
+
 def _vector(text: str) -> list[float]:
-    return [float(v) for v in text.strip("() ").split(",")]
+    text = text.strip()
+    if not (text.startswith("(") and text.endswith(")")):
+        raise ValueError(text)
+    return [_number(v) for v in text[1:-1].split(",")]
 
 
-def read_nrrd(path: str | Path):
-    """Read a 3-D NRRD: ``(data[x, y, z], origin, spacing)``."""
-    path = Path(path)
-    raw = path.read_bytes()
-    if not raw.startswith(b"NRRD000"):
+def _read_header(path: Path, fh) -> tuple[dict, dict]:
+    """``(fields, line numbers)`` of the header; ``fh`` is left at the first data byte.
+
+    Accepts a UTF-8 byte-order mark and CRLF line ends (files from Windows editors).
+    """
+    first = fh.readline(64)
+    if first.startswith(b"\xef\xbb\xbf"):
+        first = first[3:]
+    if not first.startswith(b"NRRD000"):
         raise FormatError(path, "expected a NRRD file starting with 'NRRD000'", 1)
-    end = raw.find(b"\n\n")
-    if end < 0:
-        raise FormatError(path, "the NRRD header has no blank line before the data")
-    fields = {}
-    for number, line in enumerate(raw[:end].decode("latin-1").splitlines()[1:], start=2):
-        if line.startswith("#") or not line.strip() or ":=" in line:
+    fields, lines, number, used = {}, {}, 1, len(first)
+    while True:
+        raw = fh.readline(MAX_HEADER_BYTES)
+        number += 1
+        used += len(raw)
+        if used > MAX_HEADER_BYTES:
+            raise FormatError(path, f"the NRRD header is longer than {MAX_HEADER_BYTES} bytes", number)
+        if not raw:
+            raise FormatError(path, "the NRRD header has no blank line before the data", number)
+        line = raw.decode("latin-1").rstrip("\r\n")
+        if not line.strip():
+            return fields, lines
+        if line.startswith("#") or ":=" in line:
             continue
         key, sep, value = line.partition(":")
         if not sep:
             raise FormatError(path, f"expected 'field: value', got {line!r}", number)
         fields[key.strip().lower()] = value.strip()
+        lines[key.strip().lower()] = number
+
+
+def _inflate(path: Path, fh, want: int) -> bytes:
+    """Inflate gzip data, refusing (without inflating further) as soon as it exceeds ``want`` bytes."""
+    inflater = zlib.decompressobj(wbits=47)  # gzip or zlib header, detected
+    out = bytearray()
     try:
-        dtype = np.dtype(_TYPES[fields["type"].lower()])
-        sizes = [int(s) for s in fields["sizes"].split()]
-    except KeyError as exc:
-        raise FormatError(path, f"NRRD header lacks or has an unknown {exc}") from None
-    except ValueError:
-        raise FormatError(path, f"bad NRRD sizes {fields.get('sizes')!r}") from None
-    if len(sizes) != 3:
-        raise FormatError(path, f"expected a 3-D NRRD, got sizes {sizes}")
-    if fields.get("endian", "little") == "big":
+        while not inflater.eof:
+            chunk = inflater.unconsumed_tail or fh.read(1 << 20)
+            if not chunk:
+                break
+            out += inflater.decompress(chunk, want + 1 - len(out))
+            if len(out) > want:
+                raise FormatError(path, f"the gzip-encoded NRRD data inflates to more than the {want:,} bytes "
+                                        "its header says")
+    except zlib.error as exc:
+        raise FormatError(path, f"the gzip-encoded NRRD data is corrupt: {exc}") from None
+    if not inflater.eof:
+        raise FormatError(path, f"the gzip-encoded NRRD data ends early ({len(out):,} of {want:,} bytes)")
+    return bytes(out)
+
+
+def read_nrrd(path: str | Path):
+    """Read a 3-D NRRD: ``(data[x, y, z], origin, spacing)``.
+
+    The header's sizes are checked against the input limits and the file size
+    before any voxel is read; gzip data are inflated with that size as a cap.
+    """
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            return _read_nrrd(path, fh)
+    except OSError as exc:
+        raise FormatError(path, f"cannot read file: {exc.strerror or exc}") from exc
+
+
+def _read_nrrd(path: Path, fh):
+    fields, lines = _read_header(path, fh)
+    if "type" not in fields or fields["type"].lower() not in _TYPES:
+        raise FormatError(path, f"NRRD type {fields.get('type')!r} is missing or not supported", lines.get("type"))
+    dtype = np.dtype(_TYPES[fields["type"].lower()])
+    if "sizes" not in fields:
+        raise FormatError(path, "the NRRD header lacks 'sizes'")
+    sizes = checked_grid(path, fields["sizes"].split(), dtype.itemsize, line=lines["sizes"], what="NRRD sizes")
+    if fields.get("dimension", "3").strip() != "3":
+        raise FormatError(path, f"expected a 3-D NRRD, got dimension {fields['dimension']!r}", lines["dimension"])
+    endian = fields.get("endian", "little").lower()
+    if endian not in ("little", "big"):
+        raise FormatError(path, f"NRRD endian must be little or big, got {endian!r}", lines.get("endian"))
+    if endian == "big":
         dtype = dtype.newbyteorder(">")
-    body = raw[end + 2 :]
     if "data file" in fields or "datafile" in fields:
         raise FormatError(path, "detached NRRD data files are not supported")
-    encoding = fields.get("encoding", "raw").lower()
-    if encoding in ("gzip", "gz"):
-        try:
-            body = gzip.decompress(body)
-        except (OSError, EOFError, zlib.error) as exc:
-            raise FormatError(path, f"the gzip-encoded NRRD data is corrupt: {exc}") from None
-    elif encoding != "raw":
-        raise FormatError(path, f"NRRD encoding {encoding!r} is not supported (raw, gzip)")
-    want = int(np.prod(sizes)) * dtype.itemsize
-    if len(body) != want:
-        raise FormatError(path, f"NRRD data has {len(body)} bytes, expected {want} for sizes {sizes}")
-    data = np.frombuffer(body, dtype).astype(dtype.newbyteorder("="), copy=True).reshape(sizes, order="F")
     try:
         origin, spacing = _geometry(fields)
-    except (ValueError, IndexError):
-        raise FormatError(path, "bad 'space directions', 'spacings' or 'space origin' in the NRRD header") from None
+    except (ValueError, IndexError, ZeroDivisionError):
+        raise FormatError(path, "bad 'space directions', 'spacings' or 'space origin' in the NRRD header: "
+                                "expected three finite vectors (x,y,z) with non-zero length") from None
+    want = math.prod(sizes) * dtype.itemsize
+    encoding = fields.get("encoding", "raw").lower()
+    if encoding in ("gzip", "gz"):
+        body = _inflate(path, fh, want)
+    elif encoding == "raw":
+        have = os.fstat(fh.fileno()).st_size - fh.tell()
+        expect_bytes(path, have, want, "the NRRD data")
+        body = fh.read(want)
+    else:
+        raise FormatError(path, f"NRRD encoding {encoding!r} is not supported (raw, gzip)", lines.get("encoding"))
+    expect_bytes(path, len(body), want, "the NRRD data")
+    data = np.frombuffer(body, dtype).astype(dtype.newbyteorder("="), copy=True).reshape(sizes, order="F")
     return data, origin, spacing
 
 
 def _geometry(fields: dict) -> tuple[tuple, tuple]:
     spacing = [1.0, 1.0, 1.0]
     if "space directions" in fields:
-        vecs = re.findall(r"\(([^)]*)\)", fields["space directions"])
-        spacing = [float(np.linalg.norm(_vector(v))) for v in vecs[:3]] or spacing
+        text = fields["space directions"]
+        vecs = re.findall(r"\([^()]*\)", text)
+        if len(vecs) != 3 or re.sub(r"\([^()]*\)", "", text).strip():
+            raise ValueError("need three vectors and nothing else")
+        spacing = []
+        for v in vecs:
+            vec = _vector(v)
+            if len(vec) != 3:
+                raise ValueError("need three components")
+            spacing.append(math.sqrt(sum(c * c for c in vec)))
     elif "spacings" in fields:
-        spacing = [float(s) for s in fields["spacings"].split()]
+        spacing = [_number(s) for s in fields["spacings"].split()]
     origin = _vector(fields["space origin"]) if "space origin" in fields else [0.0, 0.0, 0.0]
     if len(origin) != 3 or len(spacing) != 3:
         raise ValueError("need three values")
+    if not all(math.isfinite(v) for v in (*origin, *spacing)) or min(spacing) <= 0:
+        raise ValueError("need finite values and positive spacings")
     return tuple(origin), tuple(spacing)
 
 

@@ -7,12 +7,14 @@ they never hold a whole volume (the old AddHeader / rmhdr / Count).
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
 import numpy as np
 
 from volanim_core.errors import FormatError
+from volanim_core.limits import checked_grid
 
 from ._atomic import atomic_open
 
@@ -27,14 +29,8 @@ def dims_from_name(path: str | Path) -> tuple[int, int, int] | None:
     return tuple(int(g) for g in m.groups()) if m else None
 
 
-def _check_dims(path, dims) -> tuple[int, int, int]:
-    try:
-        dims = tuple(int(d) for d in dims)
-    except (TypeError, ValueError):
-        raise FormatError(path, f"dimensions must be three integers X Y Z, got {dims!r}") from None
-    if len(dims) != 3 or min(dims) < 1:
-        raise FormatError(path, f"dimensions must be three positive integers X Y Z, got {dims!r}")
-    return dims
+def _check_dims(path, dims, line: int | None = None, allocate: bool = True) -> tuple[int, int, int]:
+    return checked_grid(path, dims, line=line, allocate=allocate)
 
 
 def has_header(path: str | Path) -> bool:
@@ -55,30 +51,37 @@ def has_header(path: str | Path) -> bool:
         return False
 
 
-def _parse_header(path, head: bytes) -> tuple[int, int, int] | None:
+def _parse_header(path, head: bytes) -> tuple[int, int, int]:
+    """The three dimensions on the header's first line (signs kept, so ``-4`` is refused, not read as 4)."""
     if len(head) < HEADER_BYTES:
         raise FormatError(path, f"file has {len(head)} bytes, expected a {HEADER_BYTES}-byte .VOL header")
-    nums = re.findall(rb"\d+", head.split(b"\n", 1)[0])
-    if len(nums) < 3:
-        raise FormatError(path, "the .VOL header's first line does not hold three dimensions 'X Y Z'", 1)
-    return tuple(int(n) for n in nums[:3])
+    first = head.split(b"\n", 1)[0].replace(b"\0", b" ")
+    words = first.split()
+    if len(words) < 3 or not all(re.fullmatch(rb"[+-]?[0-9]+", w) for w in words[:3]):
+        raise FormatError(path, "the .VOL header's first line does not start with three dimensions 'X Y Z', "
+                                f"got {first[:40]!r}", 1)
+    return tuple(int(w) for w in words[:3])
 
 
-def read_header_dims(path: str | Path) -> tuple[int, int, int]:
-    """The dimensions recorded in a ``.VOL`` header."""
-    with Path(path).open("rb") as fh:
-        return _check_dims(path, _parse_header(path, fh.read(HEADER_BYTES)))
+def read_header_dims(path: str | Path, allocate: bool = True) -> tuple[int, int, int]:
+    """The dimensions recorded in a ``.VOL`` header (checked; see ``limits.checked_grid``)."""
+    try:
+        with Path(path).open("rb") as fh:
+            return _check_dims(path, _parse_header(path, fh.read(HEADER_BYTES)), 1, allocate)
+    except OSError as exc:
+        raise FormatError(path, f"cannot read file: {exc.strerror or exc}") from exc
 
 
-def raw_layout(path: str | Path, dims=None) -> tuple[tuple[int, int, int], int]:
-    """``(dims, byte offset of the voxels)`` of a raw volume, checked against the file size."""
+def raw_layout(path: str | Path, dims=None, *, allocate: bool = True) -> tuple[tuple[int, int, int], int]:
+    """``(dims, byte offset of the voxels)`` of a raw volume, checked against the file size
+    (and, with ``allocate``, against the input limits)."""
     path = Path(path)
     if not path.is_file():
         raise FormatError(path, "no such file")
     size = path.stat().st_size
     if has_header(path):
-        dims = _check_dims(path, dims) if dims is not None else read_header_dims(path)
-        want = int(np.prod(dims)) + HEADER_BYTES
+        dims = _check_dims(path, dims, None, allocate) if dims is not None else read_header_dims(path, allocate)
+        want = math.prod(dims) + HEADER_BYTES
         if size != want:
             raise FormatError(path, f"file has {size} bytes, expected {want} "
                               f"({HEADER_BYTES}-byte header + {dims[0]}x{dims[1]}x{dims[2]} voxels)")
@@ -86,8 +89,8 @@ def raw_layout(path: str | Path, dims=None) -> tuple[tuple[int, int, int], int]:
     dims = dims if dims is not None else dims_from_name(path)
     if dims is None:
         raise FormatError(path, "unknown dimensions: give them (e.g. --dims X Y Z) or name the file NAME.XxYxZ.vol")
-    dims = _check_dims(path, dims)
-    want = int(np.prod(dims))
+    dims = _check_dims(path, dims, None, allocate)
+    want = math.prod(dims)
     if size == want + HEADER_BYTES:
         raise FormatError(path, f"file has {size} bytes = {dims[0]}x{dims[1]}x{dims[2]} + {HEADER_BYTES}: "
                           "it looks like a .VOL with a 100-byte header; rename it to .VOL or strip "
@@ -107,7 +110,7 @@ def read_raw(path: str | Path, dims=None, *, mmap: bool = False) -> np.ndarray:
         return np.memmap(path, np.uint8, "r", offset=offset, shape=dims, order="F")
     with Path(path).open("rb") as fh:
         fh.seek(offset)
-        data = np.fromfile(fh, np.uint8, count=int(np.prod(dims)))
+        data = np.fromfile(fh, np.uint8, count=math.prod(dims))
     return data.reshape(dims, order="F")
 
 
@@ -155,33 +158,33 @@ def _copy_stream(src, dst, remaining: int) -> None:
 
 def add_header(src: str | Path, dst: str | Path, dims=None) -> tuple[int, int, int]:
     """Stream a ``.vol`` into a ``.VOL`` with a header (AddHeader)."""
-    dims, offset = raw_layout(src, dims)
+    dims, offset = raw_layout(src, dims, allocate=False)
     if offset:
         raise FormatError(src, "already has a .VOL header")
     with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
         fout.write(header_bytes(dims))
-        _copy_stream(fin, fout, int(np.prod(dims)))
+        _copy_stream(fin, fout, math.prod(dims))
     return dims
 
 
 def remove_header(src: str | Path, dst: str | Path) -> tuple[int, int, int]:
     """Stream a ``.VOL`` into a bare ``.vol`` (rmhdr)."""
-    dims = read_header_dims(src)
-    want = int(np.prod(dims)) + HEADER_BYTES
+    dims = read_header_dims(src, allocate=False)
+    want = math.prod(dims) + HEADER_BYTES
     size = Path(src).stat().st_size
     if size != want:
         raise FormatError(src, f"file has {size} bytes, expected {want} for header + {dims} voxels")
     with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
         fin.seek(HEADER_BYTES)
-        _copy_stream(fin, fout, int(np.prod(dims)))
+        _copy_stream(fin, fout, math.prod(dims))
     return dims
 
 
 def histogram_file(path: str | Path, dims=None) -> np.ndarray:
     """Counts of each value 0..255 in a raw volume, streamed in chunks (Count)."""
-    dims, offset = raw_layout(path, dims)
+    dims, offset = raw_layout(path, dims, allocate=False)
     counts = np.zeros(256, np.int64)
-    remaining = int(np.prod(dims))
+    remaining = math.prod(dims)
     with Path(path).open("rb") as fh:
         fh.seek(offset)
         while remaining:

@@ -21,6 +21,7 @@ from volanim_core.errors import FormatError
 from . import raw_volumes
 from ._atomic import atomic_vtk_save
 from .nrrd_files import read_nrrd, write_nrrd
+from .vtk_headers import check_claims
 
 VTK_SUFFIXES = (".vti", ".mha", ".mhd", ".nii", ".nii.gz", ".vtk")
 NRRD_SUFFIXES = (".nrrd",)
@@ -50,12 +51,16 @@ def float_to_uint8(vol: np.ndarray, lo: float | None = None, hi: float | None = 
 def _read_vtk(path: Path):
     import pyvista as pv  # lazy: VTK only when a VTK format is used
 
+    claimed = check_claims(path, _suffix(path))  # before VTK allocates what the header says
     try:
-        img = pv.read(str(path))
+        with pv.VtkErrorCatcher(raise_errors=True, send_to_logging=False):
+            img = pv.read(str(path))
     except Exception as exc:  # VTK raises many types; report them as one
         raise FormatError(path, f"VTK could not read it as {_suffix(path)}: {exc}") from exc
     if not isinstance(img, pv.ImageData) or img.n_points == 0 or img.point_data.active_scalars is None:
         raise FormatError(path, "expected a 3-D image with point scalars")
+    if tuple(img.dimensions) != tuple(claimed):
+        raise FormatError(path, f"VTK read a {img.dimensions} grid, the header says {claimed}")
     scalars = np.asarray(img.point_data.active_scalars)
     if scalars.ndim > 1:  # vector data: take the first component
         scalars = scalars[:, 0]

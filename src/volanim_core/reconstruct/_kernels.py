@@ -245,10 +245,47 @@ def sample_rows(owner, out, z0, z1, nthreads, row_ready, minv, source, weights, 
 
 
 @njit(cache=True)
-def count_outside(centres, r2s, radii, metric, shape):
-    """Sphere voxels that fall outside the grid ``shape = (nz, ny, nx)`` (clipped), summed."""
+def _row_run(metric, cx, dy, dz, r2, r, half):
+    """``(x0, x1)``, the inclusive run of integer x inside the sphere on one row (x1 < x0: none).
+
+    Distance grows monotonically away from the centre along a row (both metrics
+    are norms), so the voxel nearest the centre decides whether the run is empty
+    and binary searches find its ends: O(log r) per row, never O(r).
+    """
+    dy2, dz2 = dy * dy, dz * dz
+    xn = np.floor(cx + 0.5)
+    if not _inside(metric, xn - cx, dy, dz, dy2, dz2, r2, r):
+        return 0.0, -1.0
+    lo, hi = xn, np.ceil(cx + half) + 1.0  # lo inside, hi outside
+    while hi - lo > 1.0:
+        mid = np.floor((lo + hi) / 2.0)
+        if _inside(metric, mid - cx, dy, dz, dy2, dz2, r2, r):
+            lo = mid
+        else:
+            hi = mid
+    x1 = lo
+    lo, hi = np.floor(cx - half) - 1.0, xn  # lo outside, hi inside
+    while hi - lo > 1.0:
+        mid = np.floor((lo + hi) / 2.0)
+        if _inside(metric, mid - cx, dy, dz, dy2, dz2, r2, r):
+            hi = mid
+        else:
+            lo = mid
+    return hi, x1
+
+
+@njit(cache=True)
+def count_outside(centres, r2s, radii, metric, shape, row_budget):
+    """Sphere voxels that fall outside the grid ``shape = (nz, ny, nx)`` (clipped), summed.
+
+    Counted per row from run ends (O(log r) a row). A sphere with more than
+    ``row_budget`` rows in its box (radius ~ sqrt(budget) / 2) has its total
+    estimated from the continuous ball's volume instead; returns
+    ``(count, estimated)``.
+    """
     nz, ny, nx = shape
-    total = 0
+    total = 0.0
+    estimated = False
     for i in range(len(centres)):
         cx, cy, cz = centres[i, 0], centres[i, 1], centres[i, 2]
         r2, r = r2s[i], radii[i]
@@ -256,15 +293,30 @@ def count_outside(centres, r2s, radii, metric, shape):
         if cx - half >= 0 and cy - half >= 0 and cz - half >= 0 and \
                 cx + half <= nx - 1 and cy + half <= ny - 1 and cz + half <= nz - 1:
             continue
-        for z in range(int(np.floor(cz - half)) - 1, int(np.ceil(cz + half)) + 2):
-            dz = z - cz
-            for y in range(int(np.floor(cy - half)) - 1, int(np.ceil(cy + half)) + 2):
-                dy = y - cy
-                for x in range(int(np.floor(cx - half)) - 1, int(np.ceil(cx + half)) + 2):
-                    if _inside(metric, x - cx, dy, dz, dy * dy, dz * dz, r2, r):
-                        if z < 0 or z >= nz or y < 0 or y >= ny or x < 0 or x >= nx:
-                            total += 1
-    return total
+        z0, z1 = np.floor(cz - half) - 1.0, np.ceil(cz + half) + 1.0
+        y0, y1 = np.floor(cy - half) - 1.0, np.ceil(cy + half) + 1.0
+        inside_grid = 0.0
+        for z in range(int(max(z0, 0.0)), int(min(z1, nz - 1.0)) + 1):
+            for y in range(int(max(y0, 0.0)), int(min(y1, ny - 1.0)) + 1):
+                a, b = _row_run(metric, cx, y - cy, z - cz, r2, r, half)
+                a, b = max(a, 0.0), min(b, nx - 1.0)
+                if b >= a:
+                    inside_grid += b - a + 1.0
+        if (z1 - z0 + 1.0) * (y1 - y0 + 1.0) <= row_budget:
+            whole = 0.0
+            for zf in range(int(z1 - z0) + 1):
+                for yf in range(int(y1 - y0) + 1):
+                    a, b = _row_run(metric, cx, y0 + yf - cy, z0 + zf - cz, r2, r, half)
+                    if b >= a:
+                        whole += b - a + 1.0
+        else:
+            estimated = True
+            if metric == EUCLID:
+                whole = 4.0 / 3.0 * np.pi * r2 * np.sqrt(r2)
+            else:  # the chamfer ball 3a + b + c < r: 48 sorted-orthant simplices of r^3 / 360 each
+                whole = 48.0 / 360.0 * r * r * r
+        total += max(whole - inside_grid, 0.0)
+    return total, estimated
 
 
 @njit(cache=True)

@@ -21,6 +21,7 @@ as float32 (squared Euclidean, or integer 3-4-5 chamfer).
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from dataclasses import dataclass, field
@@ -28,9 +29,15 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from volanim_core.limits import MAX_COORD, available_bytes, human_bytes, max_voxels
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
-from volanim_core.reconstruct.neighbours import CUT_MIN_RADIUS, reorder_neighbours, sphere_neighbours
+from volanim_core.reconstruct.neighbours import (
+    CUT_MIN_RADIUS,
+    check_neighbours,
+    reorder_neighbours,
+    sphere_neighbours,
+)
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.pose import apply_matrices
@@ -39,6 +46,7 @@ from volanim_core.volume import Bounds
 MODES = ("binary", "mottled", "bone", "sampled", "hotspot")
 _MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT}
 SNAP = 2.0**20
+CLIP_ROW_BUDGET = 4_000_000  # rows counted exactly per clipped sphere (radius ~1000); beyond, estimated
 
 
 @dataclass
@@ -70,15 +78,62 @@ class Reconstruction:
 
 
 def check_matrices(tskel: Tskel) -> np.ndarray:
-    """Inverse of every bone matrix; a singular one is a ValueError naming the bone."""
-    inv = np.empty_like(tskel.matrices)
-    for b, m in enumerate(tskel.matrices):
+    """Inverse of every bone matrix; a matrix that is not a finite, invertible affine map
+    (row-vector convention: last column 0 0 0 1) is a ValueError naming the bone and what is wrong."""
+    mats = np.asarray(tskel.matrices)
+    if mats.shape != (len(tskel.bones), 4, 4):
+        raise ValueError(f"expected one 4x4 matrix per bone ({len(tskel.bones)}), got shape {mats.shape}")
+    inv = np.empty(mats.shape, np.float64)
+    for b, m in enumerate(mats):
+        name = f"bone {b} ({tskel.bones[b].label})"
+        if not np.isfinite(m).all():
+            raise ValueError(f"{name}: its matrix holds NaN or infinite values")
+        if not np.allclose(m[:, 3], (0, 0, 0, 1), atol=1e-6):
+            raise ValueError(f"{name}: its matrix is not affine (last column {m[:, 3].tolist()}, expected "
+                             "0 0 0 1: row-vector convention, translation in row 4)")
         det = np.linalg.det(m[:3, :3])
-        if not np.isfinite(m).all() or abs(det) < 1e-9:
-            raise ValueError(f"bone {b} ({tskel.bones[b].label}) has a singular matrix (det {det:.3g}); "
+        if abs(det) < 1e-9:
+            raise ValueError(f"{name}: its matrix is singular (determinant {det:.3g}); "
                              "it cannot be inverted to sample the source")
         inv[b] = np.linalg.inv(m)
     return inv
+
+
+def check_frame(tskel: Tskel) -> None:
+    """Refuse points a reconstruction cannot place: NaN/infinite values, negative radii,
+    and spheres that reach beyond ``MAX_COORD`` voxels."""
+    pts, dt = np.asarray(tskel.points, np.float64), np.asarray(tskel.dt, np.float64)
+    bad = ~np.isfinite(pts).all(axis=1) | ~np.isfinite(dt) | (dt < 0)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise ValueError(f"point {i} ({pts[i].tolist()}, dt {dt[i]}) has a NaN, infinite or negative value")
+    check_reach(pts, dt, "")
+
+
+def check_reach(centres: np.ndarray, extents: np.ndarray, where: str) -> None:
+    """Every sphere (centre +- extent) must lie within ``MAX_COORD`` voxels of the origin."""
+    if not len(centres):
+        return
+    reach = np.abs(centres).max(axis=1) + extents
+    if not np.isfinite(reach).all() or reach.max() > MAX_COORD:
+        i = int(np.argmax(np.where(np.isfinite(reach), reach, np.inf)))
+        raise ValueError(f"point {i}{where} at {np.round(centres[i], 3).tolist()} with radius {extents[i]:g} "
+                         f"reaches {reach[i]:.3g} voxels from the origin; coordinates and radii must stay "
+                         f"within {MAX_COORD:,}")
+
+
+def check_output_grid(shape, bytes_per_voxel: int) -> None:
+    """Refuse an output grid that cannot be allocated, stating its size."""
+    voxels = math.prod(int(n) for n in shape)
+    nbytes = voxels * bytes_per_voxel
+    shown = "x".join(str(int(n)) for n in shape)
+    if voxels > max_voxels():
+        raise ValueError(f"the output grid would be {shown} = {voxels:,} voxels ({human_bytes(nbytes)}); the limit "
+                         f"is {max_voxels():,} voxels: give smaller --bounds or check the radii")
+    free = available_bytes()
+    if free is not None and nbytes > free:
+        raise ValueError(f"the output grid would be {shown} voxels, {human_bytes(nbytes)}, but only "
+                         f"{human_bytes(free)} of memory is available")
 
 
 def posed_centres(tskel: Tskel) -> np.ndarray:
@@ -248,12 +303,16 @@ def reconstruct(
     t0 = time.perf_counter()
     report = Reporter(progress, cancel)
     minv_rest = check_matrices(tskel)
+    check_frame(tskel)
+    if neighbours is not None and neighbours is not False:
+        check_neighbours(neighbours, len(tskel))
     tskel, order = file_ordered(tskel)
     posed = posed_centres(tskel)
+    check_reach(posed, _extent(tskel), " once posed")
     if bounds is None:
         bounds = grid_bounds(tskel, padding, centres=[posed]) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
     if min(bounds.shape) < 1:
-        raise ValueError(f"empty output bounds {bounds}")
+        raise ValueError(f"empty output bounds {bounds.lo}..{bounds.hi}: each upper bound must be >= its lower bound")
     origin = np.asarray(bounds.lo, np.float64)
     nx, ny, nz = bounds.shape
     centres = np.ascontiguousarray(posed - origin)
@@ -262,8 +321,11 @@ def reconstruct(
     metric = K.CHAMFER if tskel.metric == "345" else K.EUCLID
     out_dtype, values = _labels(mode, tskel, value)
     final_dtype = source.dtype if mode == "sampled" else out_dtype
-    out = _output_array(out, (nz, ny, nx), out_dtype, final_dtype)
     relax = mode not in ("hotspot", "binary")  # binary is a union and hotspot a count: no stencil
+    per_voxel = np.dtype(out_dtype).itemsize + (4 if relax else 0) + \
+        (np.dtype(final_dtype).itemsize if final_dtype != out_dtype else 0)
+    check_output_grid(bounds.shape, per_voxel)
+    out = _output_array(out, (nz, ny, nx), out_dtype, final_dtype)
     stencil = _WORKSPACE.stencil_for((nz, ny, nx) if relax else (1, 1, 1))  # rows set on first use
     row_ready = np.zeros((nz, ny) if relax else (1, 1), np.bool_)
     if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
@@ -304,8 +366,10 @@ def reconstruct(
     finally:
         numba.set_num_threads(previous)
 
-    clipped = int(K.count_outside(centres, r2s, radii, metric, (nz, ny, nx))) if len(tskel) else 0
-    stats = _stats(len(tskel), filled, visits, clipped, out if mode == "hotspot" else None)
+    clipped, estimated = K.count_outside(centres, r2s, radii, metric, (nz, ny, nx), CLIP_ROW_BUDGET) \
+        if len(tskel) else (0.0, False)
+    stats = _stats(len(tskel), filled, visits, int(round(clipped)), out if mode == "hotspot" else None)
+    stats["clipped_estimated"] = bool(estimated)
     stats["seconds"] = time.perf_counter() - t0
     return Reconstruction(out.T, tuple(int(v) for v in bounds.lo), stats)  # [x, y, z] view: no copy
 
@@ -322,6 +386,9 @@ def _check_arguments(mode, kernel, source, value) -> None:
             raise ValueError("sampled mode needs the source volume (source=...)")
         if np.ndim(source) != 3:
             raise ValueError(f"source must be a 3-D volume, got shape {np.shape(source)}")
+        kind = np.asarray(source).dtype.kind
+        if kind not in "buif":
+            raise ValueError(f"source voxels must be numbers (bool, integer or float), got {np.asarray(source).dtype}")
 
 
 def _labels(mode: str, tskel: Tskel, value: int) -> tuple[type, np.ndarray]:

@@ -48,6 +48,17 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES) -> np.ndarray:
 
 
 
+def check_neighbours(neighbours, n: int) -> None:
+    """Neighbour lists must be ``(n, k)`` integers in ``-1..n-1`` (else the kernels would read out of bounds)."""
+    arr = np.asarray(neighbours)
+    if arr.ndim != 2 or arr.shape[0] != n or arr.dtype.kind not in "iu":
+        raise ValueError(f"neighbours must be an (N, k) integer array with N = {n} points, "
+                         f"got shape {arr.shape} of {arr.dtype}")
+    if arr.size and (arr.min() < -1 or arr.max() >= n):
+        raise ValueError(f"neighbours must be point indices 0..{n - 1} (or -1 for none), "
+                         f"got values {arr.min()}..{arr.max()}")
+
+
 def reorder_neighbours(neighbours: np.ndarray, order: np.ndarray | None) -> np.ndarray:
     """Neighbour lists given in the caller's point order, re-expressed after ``order`` was applied."""
     neighbours = np.asarray(neighbours, np.int32)

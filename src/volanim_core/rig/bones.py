@@ -50,6 +50,10 @@ class BoneSkeleton:
             if key in seen:
                 raise ValueError(f"bone {b.label} appears twice")
             seen.add(key)
+        cycle = bone_cycle(self.bones)
+        if cycle:
+            raise ValueError("the bones form a cycle (" + " -> ".join(self.bones[i].label for i in cycle)
+                             + "); a bone skeleton must be a tree, each bone hanging from one parent")
 
     def __eq__(self, other) -> bool:
         return (
@@ -89,3 +93,24 @@ class BoneSkeleton:
             if label in (b.name, b.label):
                 return i
         raise KeyError(f"no bone named {label!r}")
+
+
+def bone_cycle(bones: list[Bone]) -> list[int]:
+    """Bone indices of a parent cycle (A->B, B->A), or [] for a tree. Iterative: any depth.
+
+    A bone's parent is the bone whose distal joint is its proximal joint.
+    """
+    distal_of = {b.distal: j for j, b in enumerate(bones)}
+    parents = [distal_of.get(b.proximal) for b in bones]
+    state = [0] * len(parents)  # 0 unseen, 1 on the current walk, 2 known to reach a root
+    for start in range(len(parents)):
+        walk, i = [], start
+        while i is not None and state[i] == 0:
+            state[i] = 1
+            walk.append(i)
+            i = parents[i]
+        if i is not None and state[i] == 1:
+            return walk[walk.index(i):]
+        for j in walk:
+            state[j] = 2
+    return []

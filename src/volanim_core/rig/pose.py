@@ -49,21 +49,17 @@ def euler(degrees) -> np.ndarray:
 def _order(parents: list[int | None]) -> list[int]:
     """Bone indices with every parent before its children (the forest may list them in any order)."""
     done: list[int] = []
-    seen: set[int] = set()
-
-    def visit(i, stack=()):
-        if i in seen:
-            return
-        if i in stack:
-            raise ValueError(f"the bone hierarchy has a cycle through bone {i}")
-        p = parents[i]
-        if p is not None:
-            visit(p, (*stack, i))
-        seen.add(i)
-        done.append(i)
-
-    for i in range(len(parents)):
-        visit(i)
+    placed = [False] * len(parents)
+    for start in range(len(parents)):  # iterative: a 3000-bone chain listed leaf first must not recurse
+        chain, i = [], start
+        while i is not None and not placed[i]:
+            if len(chain) > len(parents):
+                raise ValueError(f"the bone hierarchy has a cycle through bone {i}")
+            chain.append(i)
+            i = parents[i]
+        for j in reversed(chain):
+            placed[j] = True
+            done.append(j)
     return done
 
 

@@ -169,9 +169,11 @@ class Attachments:
         order (matched by joint coordinates); with no bones loaded, the file's
         become the bone skeleton. One undo step for the attachments.
         """
+        return self.apply_connectivity(io.read_connect(path), Path(path).name)
+
+    def apply_connectivity(self, conn, name: str) -> list[str]:
+        """:meth:`load` for a connectivity already read (``name`` is its file's, for messages)."""
         doc = self.doc
-        conn = io.read_connect(path)
-        name = Path(path).name
         warnings: list[str] = []
         remap = self._match_bones(conn, name)
         if doc.skeleton is None or not len(doc.skeleton):

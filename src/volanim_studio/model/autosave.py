@@ -1,11 +1,14 @@
 """Autosave and crash recovery, Qt-free (the window drives it with a timer).
 
-    ROOT/<pid>-<start>/session.json      who owns this folder (pid)
-    ROOT/<pid>-<start>/recovery.volanim  the last autosave (+ .bones, .connect, .mskel)
+    ROOT/<pid>-<start>/session.json        who owns this folder (pid)
+    ROOT/<pid>-<start>/recovery.volanim    the last autosave, a project saved as one unit
+    ROOT/<pid>-<start>/recovery.volanim.d/ its data files (this save's and the one before)
 
 A save happens after every ``every_edits`` edits and every ``every_seconds``
 while there are unsaved edits. A clean exit removes the folder; a folder whose
 pid is dead on the next start is a crashed session, offered for restore.
+A restored session's folder is removed only once the new session has
+autosaved what it restored, and never when the restore failed.
 ROOT is ``$VOLANIM_RECOVERY_DIR`` or ``~/.cache/volanim/recovery``.
 """
 
@@ -17,9 +20,11 @@ import shutil
 import time
 from pathlib import Path
 
-from volanim_core import io
+from volanim_core.io._atomic import atomic_write_text
 
 RECOVERY_FILE = "recovery.volanim"
+DECLINED = "declined"
+KEEP_DECLINED_SECONDS = 7 * 24 * 3600
 
 
 def recovery_root() -> Path:
@@ -37,33 +42,49 @@ def _alive(pid: int) -> bool:
     return True
 
 
+def _session_pid(folder: Path) -> int | None:
+    """The pid that owns a session folder, or None when its ``session.json`` is unreadable."""
+    try:
+        info = json.loads((folder / "session.json").read_text())
+        return int(info["pid"])
+    except (OSError, ValueError, KeyError, TypeError, RecursionError):
+        return None
+
+
 def find_recoveries(root: Path | None = None) -> list[Path]:
-    """Recovery projects of sessions that did not exit cleanly, newest first."""
+    """Recovery projects of sessions that did not exit cleanly (and were not declined), newest first."""
     root = root or recovery_root()
     found = []
     for folder in root.glob("*") if root.is_dir() else []:
-        try:
-            info = json.loads((folder / "session.json").read_text())
-        except (OSError, ValueError):
-            continue
-        if (folder / RECOVERY_FILE).is_file() and not _alive(int(info.get("pid", -1))):
+        pid = _session_pid(folder)
+        if (pid is not None and (folder / RECOVERY_FILE).is_file() and not (folder / DECLINED).exists()
+                and not _alive(pid)):
             found.append(folder / RECOVERY_FILE)
     return sorted(found, key=lambda p: p.stat().st_mtime, reverse=True)
 
 
-def prune(root: Path | None = None) -> int:
-    """Remove folders of dead sessions that never autosaved (nothing to recover); returns how many."""
+def prune(root: Path | None = None, *, now: float | None = None) -> int:
+    """Remove folders of dead sessions with nothing to recover, and declined ones after a week.
+
+    Returns how many folders went."""
     root = root or recovery_root()
+    now = time.time() if now is None else now
     removed = 0
     for folder in root.glob("*") if root.is_dir() else []:
-        try:
-            info = json.loads((folder / "session.json").read_text())
-        except (OSError, ValueError):
+        pid = _session_pid(folder)
+        if pid is None or _alive(pid):
             continue
-        if not (folder / RECOVERY_FILE).exists() and not _alive(int(info.get("pid", -1))):
+        declined = folder / DECLINED
+        if not (folder / RECOVERY_FILE).exists() or (
+                declined.exists() and now - declined.stat().st_mtime > KEEP_DECLINED_SECONDS):
             shutil.rmtree(folder, ignore_errors=True)
             removed += 1
     return removed
+
+
+def decline(recovery: Path) -> None:
+    """The user said no: keep the folder a week (it can be opened as a project) but do not ask again."""
+    atomic_write_text(Path(recovery).parent / DECLINED, f"{time.time()}\n")
 
 
 def discard(recovery: Path) -> None:
@@ -81,10 +102,9 @@ class Autosaver:
         prune(root)
         self.folder = root / f"{os.getpid()}-{int(time.time() * 1000)}"
         self.folder.mkdir(parents=True, exist_ok=True)
-        (self.folder / "session.json").write_text(json.dumps({"pid": os.getpid(), "started": time.time()}))
+        atomic_write_text(self.folder / "session.json", json.dumps({"pid": os.getpid(), "started": time.time()}))
         self._saved_edits = doc.undo.edits
         self._saved_at = clock()
-        self._mskel_for = None
         self.saves = 0
 
     @property
@@ -108,16 +128,9 @@ class Autosaver:
         return False
 
     def save(self) -> bool:
-        doc = self.doc
-        mskel = doc.mskel_path
-        if doc.skeleton is not None and not mskel:
-            # a skeleton computed in this session: copy it once, not at every autosave
-            mskel = str(self.folder / "recovery.mskel")
-            if self._mskel_for is not doc.skeleton:
-                io.write_mskel(mskel, doc.skeleton)
-                self._mskel_for = doc.skeleton
-        doc.write_project(self.path, mskel=mskel)
-        self._saved_edits = doc.undo.edits
+        """Autosave now (the skeleton's file is written only when the skeleton changed)."""
+        self.doc.write_project(self.path)
+        self._saved_edits = self.doc.undo.edits
         self._saved_at = self.clock()
         self.saves += 1
         return True

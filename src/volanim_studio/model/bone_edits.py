@@ -211,8 +211,9 @@ class BoneEdits:
         return written
 
     # ----------------------------------------------------------------- files
-    def load_bones(self, path) -> None:
-        bones = io.read_bones(path)
+    def load_bones(self, path, bones=None) -> None:
+        """Load a ``.bones`` file (or ``bones`` already read from ``path``); one undo step."""
+        bones = io.read_bones(path) if bones is None else bones
         self.set_bones(bones, f"Load {Path(path).name}")
         self.doc.bones_path = str(path)
 

@@ -223,11 +223,11 @@ class Document:
         self.events.message.emit(text=text)
 
     def save_project(self, path, camera: dict | None = None) -> Path:
-        """Write ``NAME.volanim`` (JSON) plus the data it names that exists only in memory.
+        """Save the project as one unit: ``NAME.volanim`` and its data files in ``NAME.volanim.d/``.
 
-        The bone skeleton goes to ``NAME.bones``, the attachments (all of them,
-        whatever the slider) to ``NAME.connect``, and a skeleton computed in
-        this session (no ``.mskel`` on disk yet) to ``NAME.mskel``.
+        The bone skeleton, the attachments (all of them, whatever the slider)
+        and the skeleton are stored under content names; the manifest is
+        replaced last (see :mod:`volanim_studio.model.project`).
         """
         path = Path(path)
         if path.suffix != ".volanim":
@@ -239,9 +239,9 @@ class Document:
         self.events.project.emit(path=str(path))
         return path
 
-    def write_project(self, path, camera: dict | None = None, *, mskel: str | None = None) -> dict:
+    def write_project(self, path, camera: dict | None = None) -> dict:
         """Write the project files without adopting their paths (autosave uses this)."""
         from .project import write_project
 
-        return write_project(self, path, camera, mskel=mskel)
+        return write_project(self, path, camera)
 

@@ -1,65 +1,84 @@
 """What a project *is*: the ``.volanim`` file, and how it is written, read and applied (Qt-free).
 
-    NAME.volanim  {"format": "volanim project", "version": 2,
-                   "demo" | "volume" + "volume_dims",   what to load
-                   "segmentation": {lo, hi, fill, metric, min_thinness},   how it was segmented
-                   "mskel", "bones", "connect",           the data files (relative when below the project)
-                   "thinness", "symmetry_x", "settings", "camera"}
-    NAME.bones, NAME.connect (every attachment), NAME.mskel (when computed in the session)
+    NAME.volanim    {"format": "volanim project", "version": 3,
+                     "demo" | "volume" + "volume_dims",   what to load (the volume is referenced, never copied)
+                     "segmentation": {lo, hi, fill, metric, min_thinness},   how it was segmented
+                     "bones", "connect", "mskel": "NAME.volanim.d/<kind>-<hash>.<kind>",
+                     "sha256": {"bones": ..., ...},      what each data file must hash to
+                     "thinness", "symmetry_x", "settings", "camera"}
+    NAME.volanim.d/ the data files of the current and the previous save (``volanim_core.io.bundle``)
 
-Reopening loads the saved ``.mskel`` rather than skeletonizing again, and
-segments the volume (the mask: auto-connect and sampled previews need it)
-with the saved parameters, so the skeleton that comes back is the one the user
-connected. Version 1 files (no ``segmentation``) read with the defaults of
-their time: fill off, Euclidean, minimum thinness 0.5.
+A save is one unit: the data files are written under content names first and
+the manifest is renamed into place last, so a crash at any moment leaves the
+previous save or the new one, never a mix. Reopening loads the saved
+``.mskel`` rather than skeletonizing again, and segments the volume (the mask:
+auto-connect and sampled previews need it) with the saved parameters, so the
+skeleton that comes back is the one the user connected. Version 1 and 2 files
+(data files beside the project, no hashes) still read; version 1 has no
+``segmentation`` and gets the defaults of its time: fill off, Euclidean,
+minimum thinness 0.5.
 """
 
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 from volanim_core import io
 from volanim_core.errors import FormatError
-from volanim_core.io._atomic import atomic_write_text
+from volanim_core.io import bundle
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
 PROJECT_FORMAT = "volanim project"
+PROJECT_VERSION = 3
 DEFAULT_SEGMENTATION = {"lo": 1, "hi": None, "fill": False, "metric": "euclid", "min_thinness": DEFAULT_MIN_THINNESS}
+DATA_FILES = ("mskel", "bones", "connect")
+_stored_skeletons: dict = {}  # (store folder, id(skeleton)) -> (skeleton, relative path, sha256): written once
 
 
-def write_project(doc, path, camera: dict | None = None, *, mskel: str | None = None) -> dict:
-    """Write ``doc``'s project files; ``mskel`` names a skeleton file instead of writing one."""
+def _store_skeleton(path: Path, skeleton) -> tuple[str, str]:
+    """The skeleton's stored file; a skeleton already stored for this project is not written again."""
+    key = (str(bundle.store_folder(path).resolve()), id(skeleton))
+    hit = _stored_skeletons.get(key)
+    if hit is not None and hit[0] is skeleton and (path.parent / hit[1]).is_file():
+        return hit[1], hit[2]
+    rel, digest = bundle.store_file(path, "skeleton", ".mskel", lambda p: io.write_mskel(p, skeleton))
+    if len(_stored_skeletons) > 8:
+        _stored_skeletons.clear()
+    _stored_skeletons[key] = (skeleton, rel, digest)
+    return rel, digest
+
+
+def write_project(doc, path, camera: dict | None = None) -> dict:
+    """Write ``doc`` as one project save (see the module docstring); returns the absolute paths written."""
     path = Path(path)
-    stem = path.with_suffix("")
-    bones_path = f"{stem}.bones"
-    io.write_bones(bones_path, doc.bones)
-    mskel_path = mskel or doc.mskel_path
-    if doc.skeleton is not None and not mskel_path:
-        mskel_path = f"{stem}.mskel"
-        io.write_mskel(mskel_path, doc.skeleton)
-    connect = None
+    stored = {"bones": bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones))}
+    if doc.skeleton is not None:
+        stored["mskel"] = _store_skeleton(path, doc.skeleton)
     if len(doc.attachments.bone) and (doc.attachments.bone >= 0).any():
-        connect = f"{stem}.connect"
-        io.write_connect(connect, doc.attachments.to_connectivity())
+        conn = doc.attachments.to_connectivity()
+        stored["connect"] = bundle.store_file(path, "connect", ".connect", lambda p: io.write_connect(p, conn))
 
-    def rel(p):
-        if not p:
-            return None
+    volume = None
+    if doc.volume_path:
         try:
-            return str(Path(p).resolve().relative_to(path.parent.resolve()))
+            volume = str(Path(doc.volume_path).resolve().relative_to(path.parent.resolve()))
         except ValueError:
-            return str(Path(p).resolve())
-
+            volume = str(Path(doc.volume_path).resolve())
     data = {
-        "format": PROJECT_FORMAT, "version": 2, "demo": doc.demo_name,
-        "volume": rel(doc.volume_path), "volume_dims": list(doc.volume_dims) if doc.volume_dims else None,
-        "segmentation": doc.segmentation, "mskel": rel(mskel_path), "bones": rel(bones_path), "connect": rel(connect),
+        "format": PROJECT_FORMAT, "version": PROJECT_VERSION, "demo": doc.demo_name,
+        "volume": volume, "volume_dims": list(doc.volume_dims) if doc.volume_dims else None,
+        "segmentation": doc.segmentation,
+        **{key: rel for key, (rel, _) in stored.items()},
+        "sha256": {key: digest for key, (_, digest) in stored.items()},
         "thinness": doc.thinness, "symmetry_x": doc._symmetry_x, "settings": doc.settings.as_dict(),
         "camera": camera,
     }
-    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
-    return {"project": str(path), "bones": bones_path, "mskel": mskel_path, "connect": connect}
+    bundle.commit(path, data)
+    written = {"project": str(path), "bones": None, "mskel": None, "connect": None}
+    written.update({key: str((path.parent / rel).resolve()) for key, (rel, _) in stored.items()})
+    return written
 
 
 def _expect(path, data: dict, key: str, kinds, what: str):
@@ -72,28 +91,45 @@ def _expect(path, data: dict, key: str, kinds, what: str):
 def read_project(path) -> dict:
     """A ``.volanim`` file's content, checked, with paths made absolute and ``segmentation`` filled in.
 
-    Raises FormatError (naming the file, and the line for JSON errors) when it is not a project.
+    Its data files are checked against the saved hashes; when the last save is
+    damaged the previous one is read and ``data["warnings"]`` says so. Raises
+    FormatError (naming the file, and the line for JSON errors) when neither is usable.
     """
     path = Path(path)
+    data, warnings = bundle.load(path, _parse)
+    for key in ("volume", *DATA_FILES):
+        if data.get(key):
+            data[key] = str((path.parent / data[key]).resolve())
+    data["warnings"] = warnings
+    return data
+
+
+def _parse(path: Path, text: str) -> dict:
     try:
-        data = json.loads(path.read_text(encoding="utf-8-sig"))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FormatError(path, f"cannot read project: {exc}") from exc
+        data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise FormatError(path, f"not a volanim project (JSON error: {exc.msg})", exc.lineno) from exc
     except RecursionError:
         raise FormatError(path, "not a volanim project: nested too deeply") from None
     if not isinstance(data, dict) or data.get("format") != PROJECT_FORMAT:
         raise FormatError(path, f"not a volanim project: expected \"format\": \"{PROJECT_FORMAT}\"")
+    version = _expect(path, data, "version", int, "a whole number")
+    if version is not None and not isinstance(version, bool) and version > PROJECT_VERSION:
+        raise FormatError(path, f"was saved by a newer volanim (project version {version}; "
+                                f"this one reads up to {PROJECT_VERSION})")
     _expect(path, data, "demo", str, "a sample name")
-    for key in ("volume", "mskel", "bones", "connect"):
-        if _expect(path, data, key, str, "a file name"):
-            data[key] = str((path.parent / data[key]).resolve())
+    for key in ("volume", *DATA_FILES):
+        _expect(path, data, key, str, "a file name")
     for key in ("thinness", "symmetry_x"):
-        _expect(path, data, key, int | float, "a number")
-    for key in ("settings", "camera", "segmentation"):
+        value = _expect(path, data, key, int | float, "a number")
+        if value is not None and (isinstance(value, bool) or not math.isfinite(value)):
+            raise FormatError(path, f"\"{key}\" must be a finite number, got {value!r}")
+    for key in ("settings", "camera", "segmentation", "sha256"):
         _expect(path, data, key, dict, "an object")
-    _expect(path, data, "volume_dims", list, "a list of three sizes")
+    dims = _expect(path, data, "volume_dims", list, "a list of three sizes")
+    if dims is not None and (len(dims) != 3 or not all(isinstance(d, int) and not isinstance(d, bool) and d > 0
+                                                       for d in dims)):
+        raise FormatError(path, f"\"volume_dims\" must be three positive whole numbers, got {dims!r}")
     seg = dict(DEFAULT_SEGMENTATION)
     seg.update({k: v for k, v in (data.get("segmentation") or {}).items() if k in seg})
     threshold = _expect(path, data, "threshold", list, "a list [lo, hi]")
@@ -109,8 +145,9 @@ def _checked_segmentation(path, seg: dict) -> dict:
     """The segmentation parameters, refused with the file's name when a value is not usable."""
     def number(key, allow_none=False):
         v = seg[key]
-        if (v is None and allow_none) or (isinstance(v, int | float) and not isinstance(v, bool)):
-            return
+        if (v is None and allow_none) or (isinstance(v, int | float) and not isinstance(v, bool)
+                                          and (math.isfinite(v) or (key == "min_thinness" and v < 0))):
+            return  # -inf is a valid minimum thinness (keep every point); NaN never is
         raise FormatError(path, f"\"segmentation\": \"{key}\" must be a number, got {v!r}")
 
     number("lo")
@@ -126,19 +163,22 @@ def _checked_segmentation(path, seg: dict) -> dict:
 def apply_project(doc, data: dict, path) -> list[str]:
     """Load a read project's files and state into ``doc`` (after its volume, if any, is loaded).
 
-    Returns warnings for the user (settings that were refused, points added).
-    Raises FormatError for a data file that cannot be read; the document keeps
-    what was applied before it.
+    Every data file is read before the document is touched, so a bad file
+    (FormatError, naming it) leaves the document as it was. Returns warnings
+    for the user (the previous save was used, settings refused, points added).
     """
-    warnings = []
-    if data.get("mskel") and doc.skeleton is None:
-        doc.set_skeleton(io.read_mskel(data["mskel"]), data["mskel"])
+    warnings = list(data.get("warnings") or [])
+    skeleton = io.read_mskel(data["mskel"]) if data.get("mskel") and doc.skeleton is None else None
+    bones = io.read_bones(data["bones"]) if data.get("bones") else None
+    conn = io.read_connect(data["connect"]) if data.get("connect") else None
+    if skeleton is not None:
+        doc.set_skeleton(skeleton, data["mskel"])
     elif data.get("mskel"):
         doc.mskel_path = data["mskel"]
-    if data.get("bones"):
-        doc.bone_edits.load_bones(data["bones"])
-    if data.get("connect"):
-        warnings += doc.attachments.load(data["connect"])
+    if bones is not None:
+        doc.bone_edits.load_bones(data["bones"], bones)
+    if conn is not None:
+        warnings += doc.attachments.apply_connectivity(conn, Path(data["connect"]).name)
     if data.get("symmetry_x") is not None:
         doc.symmetry_x = data["symmetry_x"]
     if data.get("thinness") is not None:

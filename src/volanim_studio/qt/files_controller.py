@@ -12,6 +12,7 @@ and the window as the parent of its dialogs.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from PySide6.QtWidgets import QFileDialog
@@ -113,12 +114,18 @@ class FilesController:
         self.doc.message(f"{len(self.doc.bones)} bones in the root order of {Path(path).name}.")
         return True
 
-    def open_project(self, path) -> Worker | None:
-        """Open a ``.volanim``: its volume segmented as saved (its ``.mskel`` read, not recomputed), then its files."""
+    def open_project(self, path, on_opened: Callable[[bool], None] | None = None) -> Worker | None:
+        """Open a ``.volanim``: its volume segmented as saved (its ``.mskel`` read, not recomputed), then its files.
+
+        ``on_opened(ok)`` is called once it is all applied (True) or has failed
+        or been cancelled (False; the error was shown).
+        """
+        done = on_opened or (lambda ok: None)
         try:
             data = read_project(path)
         except USER_ERRORS as exc:
             self.show_error("Open project", str(exc))
+            done(False)
             return None
 
         def rest(_=None):
@@ -126,23 +133,28 @@ class FilesController:
                 warnings = apply_project(self.doc, data, path)
             except USER_ERRORS as exc:
                 self.show_error("Open project", str(exc))
+                done(False)
                 return
             if warnings:
                 self.show_error("Open project", "\n".join(warnings))
             if data.get("camera"):
                 self.scene.set_camera(data["camera"])
             self.doc.message(f"Opened {Path(path).name}.")
+            done(True)
 
         worker = None
         if data.get("volume"):
             worker = self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
                                       skeleton_path=data.get("mskel"))
             if worker is None:
+                done(False)
                 return None
         elif data.get("demo"):
             worker = self.load_demo(data["demo"], skeleton_path=data.get("mskel"))
         if worker is not None:
             worker.succeeded.connect(rest)
+            worker.failed.connect(lambda *_: done(False))
+            worker.was_cancelled.connect(lambda: done(False))
             return worker
         rest()
         return None

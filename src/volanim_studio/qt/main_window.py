@@ -137,22 +137,25 @@ class MainWindow(QMainWindow):
             restore = ask(latest)
         if not restore:
             for f in found:
-                autosave.discard(f)
+                autosave.decline(f)  # kept a week (the folder can still be opened as a project), not asked again
             return None
-        worker = self.files.open_project(latest)
 
-        def cleanup(_=None):
+        def opened(ok: bool) -> None:
+            if not ok:  # nothing is deleted: the next start offers it again
+                self.doc.message(f"The autosave in {latest.parent} was not restored; it is kept.")
+                return
             self.doc.project_path = None  # a restored session saves where the user says, not into the cache
             self.setWindowTitle("volanim studio — restored")
-            for f in found:
+            try:
+                self.autosaver.save()  # what was restored is safe in this session's folder ...
+            except (OSError, ValueError) as exc:
+                self.doc.message(f"Restored, but the autosave of it failed ({exc}); the old autosave is kept.")
+                return
+            for f in found:  # ... before the crashed sessions' folders go
                 autosave.discard(f)
             self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones).")
 
-        if worker is not None:
-            worker.succeeded.connect(cleanup)
-        else:
-            cleanup()
-        return worker
+        return self.files.open_project(latest, on_opened=opened)
 
     # ------------------------------------------------------------- actions
     def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:

@@ -239,3 +239,55 @@ def test_written_files_get_normal_permissions(tmp_path, small_bones):
     os.chmod(tmp_path / "a.bones", 0o640)
     io.write_bones(tmp_path / "a.bones", small_bones)  # replacing keeps the old mode
     assert (tmp_path / "a.bones").stat().st_mode & 0o777 == 0o640
+
+
+def _killed_writer(tmp_path, write) -> int:
+    """Fork a child that writes in a loop and SIGKILL it mid-write; returns its (dead) pid."""
+    import os
+    import signal
+    import time
+
+    pid = os.fork()
+    if pid == 0:
+        try:
+            while True:
+                write()
+        finally:
+            os._exit(0)
+    time.sleep(0.3)
+    os.kill(pid, signal.SIGKILL)
+    os.waitpid(pid, 0)
+    return pid
+
+
+def test_temporaries_of_killed_writers_are_cleaned_on_the_next_write(tmp_path, small_bones):
+    """A kill -9 mid-write leaves a hidden temporary; the next write to the same folder removes it."""
+    import os
+    import time
+
+    path = tmp_path / "b.bones"
+    dead = _killed_writer(tmp_path, lambda: io.write_bones(path, small_bones))
+    # what a kill leaves (made by hand too, in case the kill landed between writes)
+    (tmp_path / f".b.bones.{dead}-0123abcd.tmp").write_text("half")
+    legacy = tmp_path / ".b.bones.k3j_x9a2.tmp"  # an older version's mkstemp name
+    legacy.write_text("half")
+    old = time.time() - 3600
+    os.utime(legacy, (old, old))
+    alive = tmp_path / f".other.bones.{os.getpid()}-0123abcd.tmp"  # a write in progress (this process)
+    alive.write_text("being written")
+    user = tmp_path / ".notes.tmp"  # not ours: never touched
+    user.write_text("mine")
+    io.write_bones(path, small_bones)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([".notes.tmp", alive.name, "b.bones"])
+    assert io.read_bones(path) == small_bones
+
+
+def test_vtk_temporaries_of_killed_writers_are_cleaned(tmp_path):
+    import numpy as np
+
+    path = tmp_path / "v.vti"
+    vol = np.zeros((4, 5, 6), np.uint8)
+    dead = _killed_writer(tmp_path, lambda: io.write_volume(path, vol))
+    (tmp_path / f".v.{dead}-0123abcd.tmp.vti").write_bytes(b"half")
+    io.write_volume(path, vol)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["v.vti"]

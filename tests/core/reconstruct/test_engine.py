@@ -179,7 +179,7 @@ def test_empty_bone_zero_points_and_singular_matrix():
     r = reconstruct(none)
     assert r.stats["filled"] == 0 and r.volume.shape == (1, 1, 1)
     t.matrices[1, 1, 1] = 0  # EMPTY becomes singular
-    with pytest.raises(ValueError, match="bone 1 \\(EMPTY\\) has a singular matrix"):
+    with pytest.raises(ValueError, match="bone 1 \\(EMPTY\\): its matrix is singular"):
         reconstruct(t)
 
 

@@ -107,7 +107,8 @@ def test_cli_errors_are_clear(tmp_path, capsys):
     assert "no bone named 'L_WING'" in capsys.readouterr().err
     (tmp_path / "t.tskel").write_text("Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 0 0 0\n0 0 1 0\n0 0 0 1\n5 5 5 2\n")
     assert main(["reconstruct", str(tmp_path / "t.tskel"), "-o", str(tmp_path / "o.vti")]) == 2
-    assert "singular matrix" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "t.tskel: bone 0" in err and "its matrix is singular" in err  # names the file
     assert main(["reconstruct", str(tmp_path / "t.tskel"), "--mode", "sampled", "-o", str(tmp_path / "o.vti")]) == 2
     assert "needs --source" in capsys.readouterr().err
     assert main(["reconstruct", str(tmp_path / "t.tskel"), "-o", str(tmp_path / "o.png")]) == 2

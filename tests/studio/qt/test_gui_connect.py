@@ -16,6 +16,7 @@ from volanim_core import io, samples
 from volanim_core.render.colours import label_table
 from volanim_core.skeleton.points import Skeleton
 from volanim_studio.model.modes import Mode
+from volanim_studio.model.project import read_project
 
 from ..conftest import JOB_TIMEOUT_MS, click, clickable_point
 
@@ -142,7 +143,7 @@ def test_autosave_file_appears(qtbot, window, recovery_dir):
         window.doc.attachments.assign([i], 0)
     files = list(recovery_dir.glob("*/recovery.volanim"))
     assert len(files) == 1
-    assert io.read_bones(files[0].with_suffix(".bones")) == window.doc.bones
+    assert io.read_bones(read_project(files[0])["bones"]) == window.doc.bones
     window.close()
     assert not list(recovery_dir.glob("*/recovery.volanim"))  # a clean exit leaves nothing to recover
 
@@ -182,7 +183,11 @@ def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
     assert asked, listing
     assert len(w.doc.bones) == 18, (listing, w.last_error)
     assert int((w.doc.attachments.bone >= 0).sum()) == attached, (listing, w.last_error)
-    assert len(list(recovery_dir.glob("*/recovery.volanim"))) == 0  # the crashed session's copy is gone
+    # the restored state is autosaved in this session's folder; then the crashed session's copy goes
+    saved = list(recovery_dir.glob("*/recovery.volanim"))
+    assert len(saved) == 1 and saved[0].parent == w.autosaver.folder
+    again = read_project(saved[0])
+    assert io.read_connect(again["connect"]).bone.size == attached
     w.close()
 
 

@@ -1,0 +1,99 @@
+"""Input size limits, checked from a file's header *before* anything is allocated.
+
+Every volume reader asks :func:`checked_grid` about the dimensions a header
+claims. Sizes are multiplied as Python integers (they never wrap, unlike an
+int64 product of ``4294967296 4294967296 1``), each must be a positive whole
+number, and the volume must fit both the voxel limit and the memory this
+machine has free. ``VOLANIM_MAX_VOXELS`` raises or lowers the limit.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+from pathlib import Path
+
+from volanim_core.errors import FormatError
+
+DEFAULT_MAX_VOXELS = 2**33  # 8 G voxels: far above any scan we know of, far below exabytes
+MAX_AXIS = 2**31 - 1  # kernels index with 32-bit ints per axis
+MAX_COORD = 2**30  # voxel coordinates and radii (int32 with room to spare); text readers refuse larger
+
+
+def max_voxels() -> int:
+    env = os.environ.get("VOLANIM_MAX_VOXELS", "")
+    return int(env) if env.isascii() and env.isdigit() else DEFAULT_MAX_VOXELS
+
+
+def available_bytes() -> int | None:
+    """Memory available to a new allocation (Linux ``MemAvailable``), or None when unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def human_bytes(n: float) -> str:
+    for unit in ("bytes", "KB", "MB", "GB", "TB", "PB"):
+        if n < 1024 or unit == "PB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} PB"
+
+
+def whole_number(path, value, what: str, line: int | None = None) -> int:
+    """``value`` as an int: Python/NumPy integers or ASCII digit strings (with an optional sign) only."""
+    if isinstance(value, bool):
+        raise FormatError(path, f"{what} must be a whole number, got {value!r}", line)
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, str | bytes):
+        text = value.decode("latin-1") if isinstance(value, bytes) else value
+        digits = text.strip().lstrip("+-")
+        if digits.isascii() and digits.isdigit():
+            return int(text.strip())
+    raise FormatError(path, f"{what} must be a whole number, got {value!r}", line)
+
+
+def checked_grid(path: str | Path, dims, itemsize: int = 1, *, line: int | None = None,
+                 what: str = "dimensions", allocate: bool = True) -> tuple[int, ...]:
+    """Dimensions a file claims, refused (FormatError naming the file) unless allocatable.
+
+    Each size must be a whole number >= 1 and <= 2**31 - 1; with ``allocate``
+    (the volume will be held in memory) the voxel count must be at most
+    :func:`max_voxels` and the bytes at most the memory available now.
+    Streaming tools pass ``allocate=False`` and compare with the file size instead.
+    """
+    try:
+        dims = list(dims)
+    except TypeError:
+        raise FormatError(path, f"{what} must be three whole numbers X Y Z, got {dims!r}", line) from None
+    sizes = tuple(whole_number(path, d, what, line) for d in dims)
+    if len(sizes) != 3:
+        raise FormatError(path, f"{what} must be three whole numbers X Y Z, got {len(sizes)}: {sizes}", line)
+    if min(sizes) < 1 or max(sizes) > MAX_AXIS:
+        raise FormatError(path, f"{what} {' '.join(map(str, sizes))}: each must be between 1 and {MAX_AXIS}", line)
+    voxels = math.prod(sizes)
+    if not allocate:
+        return sizes
+    shown = "x".join(map(str, sizes))
+    if voxels > max_voxels():
+        raise FormatError(path, f"claims {shown} = {voxels:,} voxels ({human_bytes(voxels * itemsize)}); "
+                                f"the limit is {max_voxels():,} voxels (set VOLANIM_MAX_VOXELS to change it)", line)
+    free = available_bytes()
+    if free is not None and voxels * itemsize > free:
+        raise FormatError(path, f"claims {shown} voxels, {human_bytes(voxels * itemsize)}, but only "
+                                f"{human_bytes(free)} of memory is available", line)
+    return sizes
+
+
+def expect_bytes(path: str | Path, have: int, want: int, what: str) -> None:
+    """Refuse a file whose data is shorter (truncated) or longer than its header says."""
+    if have != want:
+        raise FormatError(path, f"{what} has {have:,} bytes, its header says {want:,}"
+                                + (" (the file is truncated)" if have < want else ""))

@@ -1,0 +1,177 @@
+"""A project save and an autosave are one unit: kill -9 at any moment leaves a consistent last state.
+
+The writer runs in a forked child that saves generation after generation; the
+parent kills it at a random moment (SIGKILL: no cleanup of any kind) and then
+reads what is on disk. Each generation moves the first joint to x = g and
+attaches g + 1 points, so a mix of two generations is detected by comparing
+the files with each other.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import signal
+import time
+
+import numpy as np
+import pytest
+
+from volanim_core import io, samples
+from volanim_core.errors import FormatError
+from volanim_core.io import bundle
+from volanim_core.rig.bones import BoneSkeleton
+from volanim_studio.model import Document, autosave
+from volanim_studio.model.project import apply_project, read_project
+
+FIRST_JOINT = next(iter(samples.mannequin_bones().joints))
+
+
+def make_generation(doc: Document, g: int) -> None:
+    base = samples.mannequin_bones()
+    joints = dict(base.joints)
+    joints[FIRST_JOINT] = np.array([float(g), *joints[FIRST_JOINT][1:]])
+    doc.bone_edits.set_bones(BoneSkeleton(joints, base.bones))
+    doc.attachments.bone[:] = -1
+    doc.attachments.assign(np.arange(g % 200 + 1), 0)
+
+
+def generation_on_disk(path) -> int:
+    """The generation the project at ``path`` holds, checking its files agree with each other."""
+    data = read_project(path)
+    assert not data["warnings"], data["warnings"]  # the current generation was complete
+    g = int(io.read_bones(data["bones"]).joints[FIRST_JOINT][0])
+    conn = io.read_connect(data["connect"])
+    assert len(conn) == g % 200 + 1, "the .connect is from another save than the .bones"
+    fresh = Document()
+    fresh.set_skeleton(io.read_mskel(data["mskel"]))
+    # applies cleanly: the .connect's bones are the .bones file's (else it raises), no point added
+    assert apply_project(fresh, data, path) == []
+    assert int((fresh.attachments.bone >= 0).sum()) == g % 200 + 1
+    return g
+
+
+def _kill_while_saving(save, trials: int) -> list[int]:
+    """Fork a child that calls ``save(g)`` for g = 1, 2, ...; SIGKILL it after a random delay."""
+    seen = []
+    rng = random.Random(7)
+    for _ in range(trials):
+        pid = os.fork()
+        if pid == 0:  # the child: save forever until killed
+            try:
+                g = 1 + seen[-1] if seen else 1
+                while True:
+                    save(g)
+                    g += 1
+            finally:
+                os._exit(0)
+        time.sleep(rng.uniform(0.0, 0.25))
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        on_disk = save.check()
+        assert on_disk >= (seen[-1] if seen else 0), "a kill took the project back further than one save"
+        seen.append(on_disk)
+    return seen
+
+
+class Saver:
+    def __init__(self, doc, path):
+        self.doc, self.path = doc, path
+
+    def __call__(self, g):
+        make_generation(self.doc, g)
+        self.doc.write_project(self.path)
+
+    def check(self) -> int:
+        return generation_on_disk(self.path)
+
+
+@pytest.mark.parametrize("trials", [40])
+def test_project_save_survives_kill_9_at_any_moment(tmp_path, doc, trials):
+    path = tmp_path / "session.volanim"
+    make_generation(doc, 0)
+    doc.save_project(path)
+    seen = _kill_while_saving(Saver(doc, path), trials)
+    assert seen[-1] > 0, "the child never completed a save: the kill moments missed the writes"
+    # the next save cleans what the kills left: no temporaries, only the files two manifests name
+    doc.save_project(path)
+    store = bundle.store_folder(path)
+    left = sorted(p.name for p in (*tmp_path.iterdir(), *store.iterdir()) if ".tmp" in p.name)
+    assert left == []
+    named = {json.loads(path.read_text())[k].split("/")[1] for k in ("bones", "connect", "mskel")}
+    named |= {json.loads((store / bundle.PREVIOUS).read_text())[k].split("/")[1]
+              for k in ("bones", "connect", "mskel")}
+    assert {p.name for p in store.iterdir() if p.name != bundle.PREVIOUS} == named
+
+
+def test_autosave_survives_kill_9_and_is_offered(tmp_path, doc):
+    saver = autosave.Autosaver(doc, tmp_path / "recovery")
+    make_generation(doc, 0)
+    saver.save()
+
+    class AutoSaver(Saver):
+        def __call__(self, g):
+            make_generation(self.doc, g)
+            saver.save()
+
+    seen = _kill_while_saving(AutoSaver(doc, saver.path), 25)
+    assert seen[-1] > 0
+    # a folder owned by a dead pid is what the next start finds
+    (saver.folder / "session.json").write_text(json.dumps({"pid": 2**22 + 12345}))
+    found = autosave.find_recoveries(tmp_path / "recovery")
+    assert found == [saver.path]
+    assert generation_on_disk(found[0]) == seen[-1]
+
+
+def test_a_damaged_save_opens_the_previous_one_and_deletes_nothing(tmp_path, doc):
+    path = tmp_path / "p.volanim"
+    make_generation(doc, 3)
+    doc.save_project(path)
+    make_generation(doc, 4)
+    doc.save_project(path)
+    data = read_project(path)
+    with open(data["connect"], "a") as fh:
+        fh.write("garbage\n")  # disk trouble, or an edit by hand
+    before = sorted(p.name for p in bundle.store_folder(path).iterdir())
+    again = read_project(path)
+    assert again["warnings"] and "was changed or damaged" in again["warnings"][0]
+    assert "opened the previous save" in again["warnings"][0]
+    assert int(io.read_bones(again["bones"]).joints[FIRST_JOINT][0]) == 3
+    assert sorted(p.name for p in bundle.store_folder(path).iterdir()) == before
+    # both generations damaged: a clear error naming the project and the file, still nothing deleted
+    with open(again["bones"], "a") as fh:
+        fh.write("x")
+    with pytest.raises(FormatError, match=r"p\.volanim: its connect file .* changed or damaged"):
+        read_project(path)
+    assert sorted(p.name for p in bundle.store_folder(path).iterdir()) == before
+
+
+def test_an_unchanged_skeleton_is_stored_once(tmp_path, doc):
+    path = tmp_path / "p.volanim"
+    make_generation(doc, 1)
+    doc.save_project(path)
+    mskel = read_project(path)["mskel"]
+    stamp = os.stat(mskel).st_mtime_ns
+    make_generation(doc, 2)
+    doc.save_project(path)
+    assert read_project(path)["mskel"] == mskel and os.stat(mskel).st_mtime_ns == stamp
+
+
+def test_project_from_a_newer_version_is_refused(tmp_path):
+    path = tmp_path / "new.volanim"
+    path.write_text('{"format": "volanim project", "version": 99}')
+    with pytest.raises(FormatError, match="newer volanim"):
+        read_project(path)
+
+
+def test_declined_recovery_is_kept_a_week_and_not_offered(tmp_path, doc):
+    root = tmp_path / "recovery"
+    saver = autosave.Autosaver(doc, root)
+    saver.save()
+    (saver.folder / "session.json").write_text(json.dumps({"pid": 2**22 + 12345}))
+    assert autosave.find_recoveries(root) == [saver.path]
+    autosave.decline(saver.path)
+    assert autosave.find_recoveries(root) == []
+    assert autosave.prune(root) == 0 and saver.path.exists()
+    assert autosave.prune(root, now=time.time() + 8 * 24 * 3600) == 1 and not saver.folder.exists()
