@@ -14,6 +14,8 @@ import numbers
 import os
 from pathlib import Path
 
+import numpy as np
+
 from volanim_core.errors import FormatError
 
 DEFAULT_MAX_VOXELS = 2**33  # 8 G voxels: far above any scan we know of, far below exabytes
@@ -39,11 +41,11 @@ def available_bytes() -> int | None:
 
 
 def human_bytes(n: float) -> str:
-    for unit in ("bytes", "KB", "MB", "GB", "TB", "PB"):
-        if n < 1024 or unit == "PB":
+    for unit in ("bytes", "KB", "MB", "GB", "TB", "PB", "EB"):
+        if n < 1024 or unit == "EB":
             return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
         n /= 1024
-    return f"{n:.1f} PB"
+    return f"{n:.1f} EB"
 
 
 def whole_number(path, value, what: str, line: int | None = None) -> int:
@@ -90,6 +92,24 @@ def checked_grid(path: str | Path, dims, itemsize: int = 1, *, line: int | None 
         raise FormatError(path, f"claims {shown} voxels, {human_bytes(voxels * itemsize)}, but only "
                                 f"{human_bytes(free)} of memory is available", line)
     return sizes
+
+
+def voxel_points(points) -> np.ndarray:
+    """``(N, 3)`` int32 voxel coordinates; NaN, fractions and magnitudes over ``MAX_COORD`` are a
+    ValueError naming the point (a plain int32 cast wraps 3e9 to -2147483648)."""
+    raw = np.asarray(points)
+    if raw.size and raw.dtype.kind not in "biuf":
+        raise ValueError(f"point coordinates must be numbers, got {raw.dtype}")
+    if raw.size and raw.dtype.kind == "f":
+        bad = ~np.isfinite(raw) | (np.abs(raw) > MAX_COORD) | (raw != np.round(raw))
+    else:
+        bad = np.abs(raw.astype(np.int64)) > MAX_COORD if raw.size else np.zeros(raw.shape, bool)
+    if bad.any():
+        i = int(np.argwhere(bad.reshape(-1, 3) if bad.size % 3 == 0 else bad)[0][0])
+        shown = raw.reshape(-1, 3)[i].tolist() if raw.size % 3 == 0 else raw.tolist()
+        raise ValueError(f"point {i} {shown} is not a voxel: coordinates must be finite whole numbers "
+                         f"within {MAX_COORD:,}")
+    return np.ascontiguousarray(raw, dtype=np.int32).reshape(-1, 3)
 
 
 def expect_bytes(path: str | Path, have: int, want: int, what: str) -> None:

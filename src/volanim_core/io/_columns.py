@@ -44,7 +44,7 @@ def parse_point_rows(
                     out[k, : len(t)] = np.array(t, dtype=np.float64)
             given = np.arange(width)[None, :] < lengths[:, None]
             ok = np.isfinite(out[given]).all() and (out[:, :3] == np.round(out[:, :3])).all()
-            ok = ok and (np.abs(out[:, :3]) <= MAX_COORD).all() and (out[:, 3] >= 0).all()
+            ok = ok and (np.abs(out[given]) <= MAX_COORD).all() and (out[:, 3] >= 0).all()
             if ok:
                 return out
     except ValueError:

@@ -100,13 +100,19 @@ def parse_int(rec: TextRecords, line: int, token: str, what: str, limit: int = M
     return int(token) if token.lstrip("+-").isdigit() else int(value)
 
 
-def parse_float(rec: TextRecords, line: int, token: str, what: str) -> float:
-    """A finite float token, else a FormatError naming ``what``."""
+def parse_float(rec: TextRecords, line: int, token: str, what: str, limit: float = MAX_COORD) -> float:
+    """A finite float token with ``|value| <= limit``, else a FormatError naming ``what``.
+
+    Every number in our files is a voxel coordinate, a radius, a thinness or a
+    matrix entry: none is meaningful beyond ``MAX_COORD``.
+    """
     if not is_number(token):
         raise rec.error(line, f"expected a finite number for {what}, got {token!r}")
     value = float(token)
     if value in (float("inf"), float("-inf")):  # 1e999
         raise rec.error(line, f"expected a finite number for {what}, got {token!r}")
+    if abs(value) > limit:
+        raise rec.error(line, f"{what} {token} is out of range (at most {limit:,} in size)")
     return value
 
 

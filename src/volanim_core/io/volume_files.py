@@ -116,6 +116,16 @@ def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False):
         their type unless the user asks.
     """
     path = Path(path)
+    try:
+        data, origin, spacing = _read_any(path, dims)
+    except OSError as exc:  # permissions, a file that vanished, disk errors: one error type, the file named
+        raise FormatError(getattr(exc, "filename", None) or path, f"cannot read: {exc.strerror or exc}") from exc
+    if rescale and data.dtype != np.uint8:
+        data = float_to_uint8(data)
+    return data, origin, spacing
+
+
+def _read_any(path: Path, dims):
     if path.is_dir():
         data, origin, spacing = read_image_folder(path), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
     elif not path.exists():
@@ -129,8 +139,6 @@ def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False):
     else:
         raise FormatError(path, f"unknown volume format {path.suffix!r}; expected .vol, .VOL, "
                           + ", ".join(VTK_SUFFIXES + NRRD_SUFFIXES) + " or a folder of slice images")
-    if rescale and data.dtype != np.uint8:
-        data = float_to_uint8(data)
     return data, origin, spacing
 
 

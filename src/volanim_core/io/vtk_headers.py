@@ -122,7 +122,7 @@ def _metaimage(path: Path) -> tuple[int, int, int]:
     if compressed:
         _inflated_size_at_least(path, data_path, 0, want)
     else:
-        expect_bytes(data_path, data_path.stat().st_size, want, "the MetaImage data file")
+        expect_bytes(path, data_path.stat().st_size, want, f"its data file {data_path.name}")
     return dims
 
 

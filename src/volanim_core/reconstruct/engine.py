@@ -179,6 +179,7 @@ def grid_bounds(tskels: Tskel | list[Tskel], padding: int = 2, *, centres: list 
     for k, t in enumerate(frames):
         if len(t):
             c, e = (posed_centres(t) if centres is None else centres[k]), _extent(t)
+            check_reach(c, e, " once posed")  # else the int conversion below wraps silently
             los.append((c - e[:, None]).min(0))
             his.append((c + e[:, None]).max(0))
     if not los:

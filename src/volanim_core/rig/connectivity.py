@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.limits import voxel_points
 from volanim_core.skeleton.points import check_metric
 
 
@@ -53,7 +54,7 @@ class RootBone:
 
 
 def _points_fields(points, dt, thinness, bone):
-    points = np.ascontiguousarray(points, dtype=np.int32).reshape(-1, 3)
+    points = voxel_points(points)
     n = len(points)
     dt = np.ascontiguousarray(dt, dtype=np.float64).reshape(n)
     thinness = np.full(n, np.nan) if thinness is None else thinness

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.limits import voxel_points
+
 METRICS = ("euclid", "345")
 
 
@@ -41,7 +43,7 @@ class Skeleton:
     metric: str = "euclid"
 
     def __post_init__(self):
-        self.points = np.ascontiguousarray(self.points, dtype=np.int32).reshape(-1, 3)
+        self.points = voxel_points(self.points)
         n = len(self.points)
         self.dt = np.ascontiguousarray(self.dt, dtype=np.float64).reshape(n)
         if self.thinness is None:

@@ -114,6 +114,8 @@ def skeletonize(
     ([4, 4, 4], 4.0)
     """
     check_metric(metric)
+    if min_thinness != min_thinness:  # NaN would silently keep nothing
+        raise ValueError("min_thinness is NaN; give a number (or -inf to keep every object voxel)")
     m = _as_mask(mask)
     report = Reporter(progress, cancel)
     report(0, 100)

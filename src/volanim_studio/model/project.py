@@ -28,6 +28,7 @@ from pathlib import Path
 from volanim_core import io
 from volanim_core.errors import FormatError
 from volanim_core.io import bundle
+from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
 PROJECT_FORMAT = "volanim project"
@@ -127,9 +128,8 @@ def _parse(path: Path, text: str) -> dict:
     for key in ("settings", "camera", "segmentation", "sha256"):
         _expect(path, data, key, dict, "an object")
     dims = _expect(path, data, "volume_dims", list, "a list of three sizes")
-    if dims is not None and (len(dims) != 3 or not all(isinstance(d, int) and not isinstance(d, bool) and d > 0
-                                                       for d in dims)):
-        raise FormatError(path, f"\"volume_dims\" must be three positive whole numbers, got {dims!r}")
+    if dims is not None:  # sizes of a headerless .vol: the same limits as any volume header
+        checked_grid(path, dims, what="\"volume_dims\"")
     seg = dict(DEFAULT_SEGMENTATION)
     seg.update({k: v for k, v in (data.get("segmentation") or {}).items() if k in seg})
     threshold = _expect(path, data, "threshold", list, "a list [lo, hi]")

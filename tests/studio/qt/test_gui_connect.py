@@ -191,6 +191,33 @@ def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
     w.close()
 
 
+def test_a_restore_that_fails_deletes_nothing(qtbot, tmp_path, recovery_dir):
+    """The old restore deleted the recovery folder even when it could not load it."""
+    import json
+
+    from volanim_studio.model import Document, autosave
+
+    doc = Document()
+    doc.bone_edits.set_bones(samples.mannequin_bones())
+    saver = autosave.Autosaver(doc, recovery_dir)
+    saver.save()
+    (saver.folder / "session.json").write_text(json.dumps({"pid": 2**22 + 12345}))  # a dead session
+    bones = read_project(saver.path)["bones"]
+    with open(bones, "a") as fh:
+        fh.write("joint X 1 2 3\n")  # the only save is damaged: there is no previous one to fall back to
+    before = sorted(p.name for p in saver.folder.rglob("*"))
+    from volanim_studio.qt.main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.offer_recovery(ask=lambda p: True)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert "changed or damaged" in (w.last_error or "")
+    assert sorted(p.name for p in saver.folder.rglob("*")) == before  # nothing deleted
+    assert autosave.find_recoveries(recovery_dir) == [saver.path]  # offered again next time
+    w.close()
+
+
 def test_dead_sessions_without_autosave_are_pruned(tmp_path):
     import json
 

@@ -1,0 +1,63 @@
+"""Runs reader cases one after another in a process with a memory cap; one JSON line per case.
+
+    python -m tests.faults.worker SPEC.json FIRST_INDEX
+
+The runner restarts it after the case that killed it (a crash) or that did not
+finish in time (a hang). The address-space cap turns a header-sized allocation
+into a MemoryError (or an abort) instead of eating the machine.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import sys
+from pathlib import Path
+
+MEMORY_CAP = 6 << 30  # address space; VTK and numpy need ~1-2 GB of it just to load
+
+
+def readers() -> dict:
+    from volanim_core import io
+    from volanim_studio.model.project import read_project
+
+    return {"read_volume": io.read_volume, "read_mskel": io.read_mskel, "read_bones": io.read_bones,
+            "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
+            "read_tskel": io.read_tskel, "read_project": read_project}
+
+
+CHECKS = {
+    "shape_3_4_5": lambda r: tuple(r.shape) == (3, 4, 5),
+    "shape_2_3_4": lambda r: tuple(r.shape) == (2, 3, 4) and r[1, 0, 0] == 1 and r[0, 1, 0] == 2,
+    "len_3": lambda r: len(r) == 3,
+    "first_pair_A_B": lambda r: r[0] == ("A", "B"),
+    "len_3000": lambda r: len(r) == 3000,
+}
+
+
+def main() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_CAP, MEMORY_CAP))
+    from volanim_core.errors import FormatError
+
+    spec = json.loads(Path(sys.argv[1]).read_text())
+    first = int(sys.argv[2])
+    table = readers()
+    for index in range(first, len(spec)):
+        case = spec[index]
+        print(json.dumps({"index": index, "started": True}), flush=True)
+        result = {"index": index}
+        try:
+            value = table[case["target"]](case["path"])
+            check = case.get("check")
+            result.update(outcome="returned", ok=bool(CHECKS[check](value)) if check else True)
+        except MemoryError:
+            result.update(outcome="memory", message="MemoryError")
+        except (FormatError, OSError) as exc:
+            result.update(outcome="refused", message=str(exc), type=type(exc).__name__)
+        except Exception as exc:  # noqa: BLE001 - the point: any other type is a bug to report
+            result.update(outcome="exception", message=f"{type(exc).__name__}: {exc}"[:300])
+        print(json.dumps(result), flush=True)
+
+
+if __name__ == "__main__":
+    main()
