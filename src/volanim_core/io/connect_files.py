@@ -103,7 +103,7 @@ def _read_rooted(path, *, matrices: bool, points: bool):
         if (counts > 1).any():
             dup = np.setdiff1d(np.arange(len(coords)), first)[0]
             twin = np.flatnonzero((coords == coords[dup]).all(axis=1))[0]
-            raise rec.error(rows[dup][0], f"point {tuple(coords[dup])} is listed twice (also on line "
+            raise rec.error(rows[dup][0], f"point {tuple(coords[dup].tolist())} is listed twice (also on line "
                             f"{rows[twin][0]}); a point belongs to at most one bone")
     return rec, bones, np.array(mats).reshape(-1, 4, 4), arr, np.array(owner, dtype=np.int32)
 
