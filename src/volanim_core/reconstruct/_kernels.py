@@ -245,33 +245,32 @@ def sample_rows(owner, out, z0, z1, nthreads, row_ready, minv, source, weights, 
 
 
 @njit(cache=True)
+def _last_inside(metric, cx, dy, dz, r2, r, inside, outside):
+    """Bisect between an x inside the sphere and an x outside it: the last inside x towards ``outside``."""
+    dy2, dz2 = dy * dy, dz * dz
+    while abs(outside - inside) > 1.0:
+        mid = np.floor((inside + outside) / 2.0)
+        if _inside(metric, mid - cx, dy, dz, dy2, dz2, r2, r):
+            inside = mid
+        else:
+            outside = mid
+    return inside
+
+
+@njit(cache=True)
 def _row_run(metric, cx, dy, dz, r2, r, half):
     """``(x0, x1)``, the inclusive run of integer x inside the sphere on one row (x1 < x0: none).
 
     Distance grows monotonically away from the centre along a row (both metrics
     are norms), so the voxel nearest the centre decides whether the run is empty
-    and binary searches find its ends: O(log r) per row, never O(r).
+    and bisection finds its ends: O(log r) per row, never O(r).
     """
-    dy2, dz2 = dy * dy, dz * dz
     xn = np.floor(cx + 0.5)
-    if not _inside(metric, xn - cx, dy, dz, dy2, dz2, r2, r):
+    if not _inside(metric, xn - cx, dy, dz, dy * dy, dz * dz, r2, r):
         return 0.0, -1.0
-    lo, hi = xn, np.ceil(cx + half) + 1.0  # lo inside, hi outside
-    while hi - lo > 1.0:
-        mid = np.floor((lo + hi) / 2.0)
-        if _inside(metric, mid - cx, dy, dz, dy2, dz2, r2, r):
-            lo = mid
-        else:
-            hi = mid
-    x1 = lo
-    lo, hi = np.floor(cx - half) - 1.0, xn  # lo outside, hi inside
-    while hi - lo > 1.0:
-        mid = np.floor((lo + hi) / 2.0)
-        if _inside(metric, mid - cx, dy, dz, dy2, dz2, r2, r):
-            hi = mid
-        else:
-            lo = mid
-    return hi, x1
+    x0 = _last_inside(metric, cx, dy, dz, r2, r, xn, np.floor(cx - half) - 1.0)
+    x1 = _last_inside(metric, cx, dy, dz, r2, r, xn, np.ceil(cx + half) + 1.0)
+    return x0, x1
 
 
 @njit(cache=True)
