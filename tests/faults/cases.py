@@ -86,6 +86,19 @@ IDENTITY = "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
 TSKEL = f"# metric: euclid\nRoot: 0 0 0 :: 0 0 10\n{IDENTITY}10 10 10 3 0.9\n11 10 10 2.5\n"
 
 
+BVH = ("HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+       "Yrotation\nJOINT Arm\n{\nOFFSET 0 10 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+       "End Site\n{\nOFFSET 0 5 0\n}\n}\n}\n"
+       "MOTION\nFrames: 1\nFrame Time: 0.04\n0 0 0 0 0 0 0 0 0\n")
+
+
+def deep_bvh(n: int) -> bytes:
+    """A chain ``n`` joints deep (more than a reader may hold; recursion would overflow long before)."""
+    head = "HIERARCHY\nROOT J0\n{\nOFFSET 0 0 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n"
+    body = "".join(f"JOINT J{i}\n{{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Xrotation Yrotation\n" for i in range(1, n))
+    return (head + body + "}\n" * n + "MOTION\nFrames: 1\nFrame Time: 0.1\n" + "0 " * 3 * n + "\n").encode()
+
+
 def chain_bones(n: int) -> bytes:
     """A chain of ``n`` bones listed leaf first (the recursion trap)."""
     joints = "".join(f"joint J{i} 0 0 {i}\n" for i in range(n + 1))
@@ -196,6 +209,13 @@ def hand_written() -> list[Case]:
              {"p.volanim": project(version=3, bones="p.volanim.d/bones-0.bones", sha256={"bones": "0" * 64}),
               "p.volanim.d/bones-0.bones": t(BONES)}, "p.volanim"),
         Case("project 20 MB", "read_project", {}, "p.volanim", sparse={"p.volanim": 20 << 20}),
+        Case("bvh Frames 10^12", "read_bvh", {"f.bvh": t(BVH.replace("Frames: 1", "Frames: 1000000000000"))}, "f.bvh"),
+        Case("bvh NaN channel", "read_bvh", {"f.bvh": t(BVH.replace("0 0 0 0 0 0 0 0 0\n", "0 0 0 nan 0 0 0 0 0\n"))},
+             "f.bvh"),
+        Case("bvh 20000 joints deep", "read_bvh", {"f.bvh": deep_bvh(20000)}, "f.bvh"),
+        Case("bvh empty", "read_bvh", {"f.bvh": b""}, "f.bvh"),
+        Case("bvh with BOM and CRLF", "read_bvh", {"f.bvh": b"\xef\xbb\xbf" + t(BVH.replace("\n", "\r\n"))}, "f.bvh",
+             "accept", "len_frames_1"),
         # --- the command line
         Case("count: VOL header overflow", "cli:count", {"f.VOL": vol_header(BIG, BIG, 1)}, "count {d}/f.VOL"),
         Case("rmheader: VOL header overflow", "cli:rmheader", {"f.VOL": vol_header(BIG, BIG, 1)},

@@ -19,11 +19,12 @@ MEMORY_CAP = 6 << 30  # address space; VTK and numpy need ~1-2 GB of it just to 
 
 def readers() -> dict:
     from volanim_core import io
+    from volanim_core.motion.bvh import read_bvh
     from volanim_studio.model.project import read_project
 
     return {"read_volume": io.read_volume, "read_mskel": io.read_mskel, "read_bones": io.read_bones,
             "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
-            "read_tskel": io.read_tskel, "read_project": read_project}
+            "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh}
 
 
 CHECKS = {
@@ -32,6 +33,7 @@ CHECKS = {
     "len_3": lambda r: len(r) == 3,
     "first_pair_A_B": lambda r: r[0] == ("A", "B"),
     "len_3000": lambda r: len(r) == 3000,
+    "len_frames_1": lambda r: r.frames == 1 and r.names == ["Hips", "Arm"],
 }
 
 

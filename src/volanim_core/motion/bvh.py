@@ -64,6 +64,34 @@ class Motion:
         except ValueError:
             raise KeyError(f"no joint named {name!r} in the clip") from None
 
+    def rest_positions(self) -> np.ndarray:
+        """``(J, 3)`` joint positions with every channel zero (the clip's rest pose, often a T-pose)."""
+        pos = np.zeros((len(self.names), 3))
+        for j, p in enumerate(self.parents):
+            pos[j] = self.offsets[j] + (pos[p] if p >= 0 else 0.0)
+        return pos
+
+    def rest_points(self) -> np.ndarray:
+        """Rest positions of the joints and of the End Sites (the clip's extent)."""
+        rest = self.rest_positions()
+        ends = [rest[j] + off for j, off in self.end_sites.items()]
+        return np.vstack([rest, *ends]) if ends else rest
+
+    def is_descendant(self, j: int, k: int) -> bool:
+        """Whether joint ``j`` hangs (at any depth) from joint ``k``."""
+        while j >= 0:
+            j = int(self.parents[j])
+            if j == k:
+                return True
+        return False
+
+    def child_directions(self, k: int) -> list[np.ndarray]:
+        """Rest offsets of joint ``k``'s children, or of its End Site: where its bone points."""
+        kids = [self.offsets[j] for j in np.flatnonzero(self.parents == k)]
+        if kids:
+            return [max(kids, key=np.linalg.norm)]  # the longest: the limb, not a side branch
+        return [self.end_sites[k]] if k in self.end_sites else []
+
     def local_transforms(self, frames=slice(None)) -> tuple[np.ndarray, np.ndarray]:
         """``(rotations (F, J, 3, 3), translations (F, J, 3))`` of every joint relative to its parent."""
         from scipy.spatial.transform import Rotation
