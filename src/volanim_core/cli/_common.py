@@ -7,6 +7,7 @@ import math
 import re
 
 from volanim_core.io import read_volume, write_volume
+from volanim_core.io._text import is_number
 from volanim_core.volume import Bounds
 
 
@@ -38,14 +39,13 @@ def save(path: str, vol, **kw) -> None:
     print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype})")
 
 
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _INFINITY = re.compile(r"[+-]?inf(?:inity)?", re.IGNORECASE)
 
 
 def ascii_float(text: str) -> float:
     """A number as users type it in ASCII (``-inf`` allowed; NaN, ``1_2`` and full-width digits are not:
     Python's ``float()`` accepts all three)."""
-    if _NUMBER.fullmatch(text) or _INFINITY.fullmatch(text):
+    if is_number(text) or _INFINITY.fullmatch(text):
         return float(text)
     raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
 

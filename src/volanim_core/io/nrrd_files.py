@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import zlib
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +19,8 @@ from volanim_core.errors import FormatError
 from volanim_core.limits import checked_grid, expect_bytes
 
 from ._atomic import atomic_open
+from ._inflate import inflate_capped
+from ._text import is_number
 
 _TYPES = {
     "uchar": "u1", "unsigned char": "u1", "uint8": "u1", "uint8_t": "u1",
@@ -35,12 +36,11 @@ _WRITE_TYPES = {"u1": "uint8", "i1": "int8", "u2": "uint16", "i2": "int16",
 
 
 MAX_HEADER_BYTES = 1 << 20
-_NUMBER = re.compile(r"^[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?$")  # ASCII only, finite
 
 
 def _number(text: str) -> float:
     text = text.strip()
-    if not _NUMBER.match(text):
+    if not is_number(text):
         raise ValueError(text)
     return float(text)
 
@@ -85,22 +85,12 @@ def _read_header(path: Path, fh) -> tuple[dict, dict]:
 
 def _inflate(path: Path, fh, want: int) -> bytes:
     """Inflate gzip data, refusing (without inflating further) as soon as it exceeds ``want`` bytes."""
-    inflater = zlib.decompressobj(wbits=47)  # gzip or zlib header, detected
-    out = bytearray()
-    try:
-        while not inflater.eof:
-            chunk = inflater.unconsumed_tail or fh.read(1 << 20)
-            if not chunk:
-                break
-            out += inflater.decompress(chunk, want + 1 - len(out))
-            if len(out) > want:
-                raise FormatError(path, f"the gzip-encoded NRRD data inflates to more than the {want:,} bytes "
-                                        "its header says")
-    except zlib.error as exc:
-        raise FormatError(path, f"the gzip-encoded NRRD data is corrupt: {exc}") from None
-    if not inflater.eof:
-        raise FormatError(path, f"the gzip-encoded NRRD data ends early ({len(out):,} of {want:,} bytes)")
-    return bytes(out)
+    body = b"".join(inflate_capped(path, fh, want + 1))
+    if len(body) > want:
+        raise FormatError(path, f"the gzip-encoded NRRD data inflates to more than the {want:,} bytes its header says")
+    if len(body) < want:
+        raise FormatError(path, f"the gzip-encoded NRRD data ends early ({len(body):,} of {want:,} bytes)")
+    return body
 
 
 def read_nrrd(path: str | Path):

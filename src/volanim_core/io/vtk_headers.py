@@ -21,6 +21,8 @@ from pathlib import Path
 from volanim_core.errors import FormatError
 from volanim_core.limits import checked_grid, expect_bytes, whole_number
 
+from ._inflate import inflate_capped
+
 HEAD_BYTES = 1 << 20
 _VTK_TYPES = {"int8": 1, "uint8": 1, "char": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4,
               "int64": 8, "uint64": 8, "float32": 4, "float64": 8, "idtype": 8}
@@ -128,18 +130,9 @@ def _metaimage(path: Path) -> tuple[int, int, int]:
 
 def _inflated_size_at_least(path: Path, data_path: Path, offset: int, want: int) -> None:
     """Inflate (and throw away) compressed data, refusing it when it holds fewer than ``want`` bytes."""
-    inflater = zlib.decompressobj(wbits=47)
-    got = 0
     with data_path.open("rb") as fh:
         fh.seek(offset)
-        try:
-            while got < want and not inflater.eof:
-                chunk = inflater.unconsumed_tail or fh.read(1 << 20)
-                if not chunk:
-                    break
-                got += len(inflater.decompress(chunk, 1 << 22))
-        except zlib.error as exc:
-            raise FormatError(path, f"its compressed data is corrupt: {exc}") from None
+        got = sum(len(chunk) for chunk in inflate_capped(path, fh, want))
     if got < want:
         raise FormatError(path, f"its compressed data holds {got:,} bytes, the header says {want:,} "
                                 "(the file is truncated)")

@@ -30,12 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
+from volanim_core.io._text import is_number
 from volanim_core.limits import available_bytes, human_bytes
 
 MAX_JOINTS = 10_000
 _AXES = {"xrotation": "X", "yrotation": "Y", "zrotation": "Z"}
 _POSITIONS = {"xposition": 0, "yposition": 1, "zposition": 2}
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 
 @dataclass
@@ -158,7 +158,7 @@ def read_bvh(path: str | Path) -> Motion:
 
 
 def _number(path, line: int, tok: str, what: str) -> float:
-    if not _NUMBER.fullmatch(tok):
+    if not is_number(tok):
         raise FormatError(path, f"expected a number for {what}, got {tok!r}", line)
     value = float(tok)
     if not np.isfinite(value):

@@ -26,7 +26,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.rig.bones import BoneSkeleton
-from volanim_core.rig.pose import _order
+from volanim_core.rig.pose import parents_first
 
 from .bvh import Motion
 
@@ -180,7 +180,7 @@ class Retarget:
         parents = bones.parents()
         rot = np.empty((n, len(bones), 3, 3))
         out = np.zeros((n, len(bones), 4, 4))
-        for b in _order(parents):
+        for b in parents_first(parents):
             p = parents[b]
             if b in self.mapping:
                 rot[:, b] = a @ world_rot[:, self.mapping[b]] @ a.T @ self.rest_align[b]

@@ -46,7 +46,7 @@ def euler(degrees) -> np.ndarray:
     return Rotation.from_euler("xyz", np.asarray(degrees, np.float64), degrees=True).as_matrix()
 
 
-def _order(parents: list[int | None]) -> list[int]:
+def parents_first(parents: list[int | None]) -> list[int]:
     """Bone indices with every parent before its children (the forest may list them in any order)."""
     done: list[int] = []
     placed = [False] * len(parents)
@@ -92,7 +92,7 @@ def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None, translatio
         shift[i] = np.asarray(t, np.float64).reshape(3)
     parents = bones.parents()
     out = np.zeros((n, 4, 4))
-    for i in _order(parents):
+    for i in parents_first(parents):
         m = rotation_about(bones.joints[bones.bones[i].proximal], local[i])
         m[3, :3] += shift[i]
         out[i] = m if parents[i] is None else m @ out[parents[i]]

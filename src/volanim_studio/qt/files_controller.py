@@ -21,18 +21,12 @@ from volanim_core import io
 
 from .. import tasks
 from ..model.project import apply_project, read_project
+from .controller import FAILED, Controller
 from .threshold_dialog import ThresholdDialog
-from .worker import USER_ERRORS, Worker
+from .worker import Worker
 
 
-class FilesController:
-    def __init__(self, window):
-        self.window = window  # the parent of file dialogs
-        self.doc = window.doc
-        self.scene = window.scene
-        self.jobs = window.jobs
-        self.show_error = window.show_error
-
+class FilesController(Controller):
     def fill_menu(self, menu, action) -> None:
         """The File menu's open and save entries; ``action(text, slot, shortcut=None, menu=None)``."""
         action("Open &volume…", lambda: self.open_volume_dialog(), "Ctrl+O", menu=menu)
@@ -65,10 +59,8 @@ class FilesController:
 
     def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None) -> Worker | None:
         """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
-        try:
-            loaded = tasks.load_volume_file(str(path), dims)
-        except USER_ERRORS as exc:
-            self.show_error("Open volume", str(exc))
+        loaded = self.attempt("Open volume", lambda: tasks.load_volume_file(str(path), dims))
+        if loaded is FAILED:
             return None
         if params is None:
             dialog = ThresholdDialog(loaded["volume"], Path(path).name, self.window)
@@ -87,32 +79,22 @@ class FilesController:
             self.open_volume(path)
 
     def open_mskel(self, path) -> bool:
-        try:
+        def load():
             skel = io.read_mskel(path)
-        except USER_ERRORS as exc:
-            self.show_error("Open skeleton", str(exc))
-            return False
-        self.doc.set_skeleton(skel, path)
-        self.doc.message(f"Loaded {len(skel)} points from {Path(path).name}.")
-        return True
+            self.doc.set_skeleton(skel, path)
+            return skel
+
+        return self.attempt("Open skeleton", load,
+                            lambda skel: f"Loaded {len(skel)} points from {Path(path).name}.") is not FAILED
 
     def open_bones(self, path) -> bool:
-        try:
-            self.doc.bone_edits.load_bones(path)
-        except USER_ERRORS as exc:
-            self.show_error("Open bones", str(exc))
-            return False
-        self.doc.message(f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.")
-        return True
+        return self.attempt("Open bones", lambda: self.doc.bone_edits.load_bones(path),
+                            lambda _: f"Loaded {len(self.doc.bones)} bones from {Path(path).name}.") is not FAILED
 
     def open_connections(self, path) -> bool:
-        try:
-            self.doc.bone_edits.load_connections(path)
-        except USER_ERRORS as exc:
-            self.show_error("Open connections", str(exc))
-            return False
-        self.doc.message(f"{len(self.doc.bones)} bones in the root order of {Path(path).name}.")
-        return True
+        return self.attempt("Open connections", lambda: self.doc.bone_edits.load_connections(path),
+                            lambda _: f"{len(self.doc.bones)} bones in the root order of {Path(path).name}."
+                            ) is not FAILED
 
     def open_project(self, path, on_opened: Callable[[bool], None] | None = None) -> Worker | None:
         """Open a ``.volanim``: its volume segmented as saved (its ``.mskel`` read, not recomputed), then its files.
@@ -121,18 +103,14 @@ class FilesController:
         or been cancelled (False; the error was shown).
         """
         done = on_opened or (lambda ok: None)
-        try:
-            data = read_project(path)
-        except USER_ERRORS as exc:
-            self.show_error("Open project", str(exc))
+        data = self.attempt("Open project", lambda: read_project(path))
+        if data is FAILED:
             done(False)
             return None
 
         def rest(_=None):
-            try:
-                warnings = apply_project(self.doc, data, path)
-            except USER_ERRORS as exc:
-                self.show_error("Open project", str(exc))
+            warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path))
+            if warnings is FAILED:
                 done(False)
                 return
             if warnings:
@@ -160,15 +138,13 @@ class FilesController:
         return None
 
     def open_connect(self, path) -> bool:
-        try:
-            warnings = self.doc.attachments.load(path)
-        except USER_ERRORS as exc:
-            self.show_error("Open connectivity", str(exc))
+        warnings = self.attempt("Open connectivity", lambda: self.doc.attachments.load(path),
+                                lambda _: f"Loaded {int(self.doc.attachments.counts()[0].sum())} attachments "
+                                          f"from {Path(path).name}.")
+        if warnings is FAILED:
             return False
         if warnings:
             self.show_error("Open connectivity", "\n".join(warnings))
-        per_bone, unconnected = self.doc.attachments.counts()
-        self.doc.message(f"Loaded {int(per_bone.sum())} attachments from {Path(path).name}.")
         return True
 
     def save_connect(self, path=None) -> Path | None:
@@ -178,13 +154,9 @@ class FilesController:
             path, _ = QFileDialog.getSaveFileName(self.window, "Save connectivity", default, "Connectivity (*.connect)")
             if not path:
                 return None
-        try:
-            n = self.doc.attachments.save(path)
-        except USER_ERRORS as exc:
-            self.show_error("Save connectivity", str(exc))
-            return None
-        self.doc.message(f"Saved {n} attached points (thinness ≥ {self.doc.thinness:.2f}) to {path}.")
-        return Path(path)
+        n = self.attempt("Save connectivity", lambda: self.doc.attachments.save(path),
+                         lambda n: f"Saved {n} attached points (thinness ≥ {self.doc.thinness:.2f}) to {path}.")
+        return None if n is FAILED else Path(path)
 
     def open_dialog(self, kind: str) -> None:
         filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
@@ -203,22 +175,13 @@ class FilesController:
                                                       "Projects (*.volanim)")
                 if not path:
                     return None
-        try:
-            saved = self.doc.save_project(path, camera=self.scene.camera())
-        except USER_ERRORS as exc:
-            self.show_error("Save project", str(exc))
-            return None
-        self.doc.message(f"Saved {saved}.")
-        return saved
+        saved = self.attempt("Save project", lambda: self.doc.save_project(path, camera=self.scene.camera()),
+                             lambda saved: f"Saved {saved}.")
+        return None if saved is FAILED else saved
 
     def save_bones(self, path) -> bool:
-        try:
-            self.doc.bone_edits.save_bones(path)
-        except USER_ERRORS as exc:
-            self.show_error("Save bones", str(exc))
-            return False
-        self.doc.message(f"Saved {len(self.doc.bones)} bones to {path}.")
-        return True
+        return self.attempt("Save bones", lambda: self.doc.bone_edits.save_bones(path),
+                            f"Saved {len(self.doc.bones)} bones to {path}.") is not FAILED
 
     def save_dialog(self, kind: str) -> None:
         """Ask where, then save: ``connect``, ``bones``, ``connections`` or a ``png`` screenshot."""

@@ -20,16 +20,13 @@ from volanim_core import io
 from volanim_core.reconstruct.engine import release_workspace
 
 from ..model.preview import make_preview
-from .worker import USER_ERRORS, Worker
+from .controller import FAILED, Controller
+from .worker import Worker
 
 
-class PreviewController:
+class PreviewController(Controller):
     def __init__(self, window):
-        self.window = window  # the parent of dialogs
-        self.doc = window.doc
-        self.scene = window.scene
-        self.jobs = window.jobs
-        self.show_error = window.show_error
+        super().__init__(window)
         self.in_pose_mode = lambda: False  # the window sets it: full previews follow drags only in Pose mode
         self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
         self._posing_drag = False
@@ -166,23 +163,14 @@ class PreviewController:
             self.show_error("Export", "nothing to export: preview first (F5)")
             return False
         vol, note = io.saturate_for_raw(path, p.reconstruction.volume)
-        try:
-            io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing)
-        except USER_ERRORS as exc:
-            self.show_error("Export", str(exc))
-            return False
-        self.doc.message(f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; "
-                         f"origin {tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {note}." if note else ""))
-        return True
+        return self.attempt(
+            "Export", lambda: io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing),
+            f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; origin "
+            f"{tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {note}." if note else "")) is not FAILED
 
     def load_trans(self, path) -> bool:
-        try:
-            self.doc.pose.load_trans(path)
-        except USER_ERRORS as exc:
-            self.show_error("Load pose", str(exc))
-            return False
-        self.doc.message(f"Loaded the pose from {Path(path).name}.")
-        return True
+        return self.attempt("Load pose", lambda: self.doc.pose.load_trans(path),
+                            f"Loaded the pose from {Path(path).name}.") is not FAILED
 
 
     # -------------------------------------------------------------- dialogs
@@ -202,12 +190,5 @@ class PreviewController:
         if kind == "volume":
             self.export_preview(path)
             return
-        try:
-            if kind == "trans":
-                self.doc.pose.save_trans(path)
-            else:
-                self.doc.pose.save_tskel(path)
-        except USER_ERRORS as exc:
-            self.show_error(f"Save {kind}", str(exc))
-            return
-        self.doc.message(f"Saved {path}.")
+        save = self.doc.pose.save_trans if kind == "trans" else self.doc.pose.save_tskel
+        self.attempt(f"Save {kind}", lambda: save(path), f"Saved {path}.")

@@ -1,0 +1,34 @@
+"""What the main window hands each controller, and the one way a user action reports a user error."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from .worker import USER_ERRORS
+
+FAILED = object()  # what :meth:`Controller.attempt` returns when the action was refused
+
+
+class Controller:
+    """Base of the window's controllers (composed by the window, never inheriting from it)."""
+
+    def __init__(self, window):
+        self.window = window  # the parent of dialogs
+        self.doc = window.doc
+        self.scene = window.scene
+        self.jobs = window.jobs
+        self.show_error = window.show_error
+
+    def attempt(self, title: str, action: Callable[[], Any], done: str | Callable[[Any], str] | None = None):
+        """Run ``action()``: a bad file, a full disk or a refused value is shown under ``title`` (the
+        document stays as it was) and :data:`FAILED` returned; otherwise ``done`` (a message, or a
+        function of the result making one) goes to the status bar and the result is returned."""
+        try:
+            result = action()
+        except USER_ERRORS as exc:
+            self.show_error(title, str(exc))
+            return FAILED
+        if done is not None:
+            self.doc.message(done(result) if callable(done) else done)
+        return result
