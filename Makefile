@@ -59,6 +59,7 @@ bench: install-test system-deps
 	$(PY) benchmarks/bench_reconstruct.py
 	$(PY) benchmarks/thesis_tables.py
 	xvfb-run -a $(PY) benchmarks/bench_studio.py
+	xvfb-run -a $(PY) benchmarks/bench_motion.py
 
 screenshots: install-test system-deps
 	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py

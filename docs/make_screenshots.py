@@ -118,6 +118,15 @@ def main() -> None:
     preview_and_wait()
     w.panel_tabs.setCurrentWidget(w.reconstruct_panel)
     grab(w, HERE / "studio-pose-fixed.png")
+
+    # Timeline: the real walk clip on the mannequin, mid-stride, previewed in full
+    w.timeline.load_bvh(ROOT.parent / "shared" / "data" / "walk.bvh")
+    w.doc.settings.current_frame = 330
+    doc.settings.preview_mode = "sampled"
+    w.scene.front_view()
+    preview_and_wait()
+    w.panel_tabs.setCurrentWidget(w.pose_panel)
+    grab(w, HERE / "studio-timeline.png")
     w.close()
 
 

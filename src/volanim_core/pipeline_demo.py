@@ -5,6 +5,8 @@
       connectivity (assets/, else nearest bone) --> NAME.0.50.connect
       --identity--> rest.tskel --reconstruct--> rest-sampled.vti
       --pose (left upper arm 45 deg)--> arm.trans --> arm.tskel --> arm-sampled.vti, arm-bone.vti
+      walk.bvh (assets/, real motion capture) --retarget--> walk/walk.NNNN.trans + .tskel
+        --> walk/walk.NNNN-sampled.vti for a few frames across the clip     (mannequin only)
 """
 
 from __future__ import annotations
@@ -45,6 +47,12 @@ POSES = {"mannequin": ("L_UPPERARM", (0.0, -45.0, 0.0)), "frog": ("LEGS", (0.0, 
 
 def _say(msg: str) -> None:
     print(msg, flush=True)
+
+
+def bundled_clip() -> Path | None:
+    """The walk clip shipped in ``assets/`` (MIT, licence beside it), when running from the repository."""
+    path = Path(__file__).resolve().parents[2] / "assets" / "walk.bvh"
+    return path if path.is_file() else None
 
 
 def bundled_connect(sample: str) -> Path | None:
@@ -122,6 +130,36 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     _say(f"[5] {bone} turned {angles} deg: sampled reconstruction {r.stats['filled']} voxels in "
          f"{r.stats['seconds']:.3f} s (overdraw {r.stats['overdraw']:.1f}), hotspot max {hot.stats['hotspot_max']}, "
          f"origin {r.origin} -> {out['posed'].name}, arm-bone.vti")
+    clip = bundled_clip()
+    if sample == "mannequin" and clip is not None:
+        out["walk"] = _walk(folder / "walk", clip, s, conn)
     out["skeleton"], out["sample"], out["connectivity"] = skel, s, conn
     _say(f"done in {time.perf_counter() - t0:.1f} s; files in {folder}/")
     return out
+
+
+def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)) -> list[Path]:
+    """Motion capture onto the mannequin: a few frames across the clip written and reconstructed."""
+    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.motion.frames import frame_path, write_frames
+    from volanim_core.motion.retarget import Retarget
+
+    t = time.perf_counter()
+    motion = read_bvh(clip)
+    r = Retarget.build(s.bones, motion)
+    numbers = list(range(motion.frames))[frames]
+    mats = r.matrices(frames)
+    written = write_frames(folder, "walk", s.bones, mats, numbers, connect=conn)
+    _say(f"[6] {clip.name}: {motion.frames} frames at {motion.fps:.4g} fps retargeted onto {len(r.mapping)} bones "
+         f"(up {r.up}, facing {r.forward}) in {time.perf_counter() - t:.2f} s; {len(numbers)} frames -> "
+         f"{folder.name}/walk.NNNN.trans, .tskel")
+    nbrs = None
+    for n, m in zip(numbers, mats):
+        tskel = connect_to_tskel(conn, Trans(root_bones(s.bones), m))
+        nbrs = sphere_neighbours(tskel) if nbrs is None else nbrs  # pose-independent: once
+        r = reconstruct(tskel, mode="sampled", source=s.volume, neighbours=nbrs)
+        path = frame_path(folder, "walk", n, "-sampled.vti")
+        write_volume(path, r.volume, origin=r.origin)
+        _say(f"    frame {n:4d}: {r.stats['filled']} voxels, origin {r.origin}, {r.stats['seconds']:.3f} s "
+             f"-> {folder.name}/{path.name}")
+    return written

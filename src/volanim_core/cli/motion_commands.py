@@ -5,11 +5,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from volanim_core.io import read_bones, read_connect, read_trans, write_trans, write_tskel
+from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
 from volanim_core.motion.bvh import read_bvh
+from volanim_core.motion.frames import write_frames
 from volanim_core.motion.retarget import Retarget, check_mapping_file, format_mapping, read_mapping
-from volanim_core.rig.connectivity import Trans
-from volanim_core.rig.pose import root_bones
+from volanim_core.progress import TextProgress
 from volanim_core.rig.tskel import connect_to_tskel
 
 from ._common import add_command
@@ -42,21 +42,12 @@ def _bvh2trans(args):
     print(format_mapping(used, bones), end="")
     for label, angle in retarget.absorbed_degrees().items():
         print(f"# {label}: rest poses differ by {angle:.1f} degrees (absorbed)")
-    out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    stem = Path(args.clip).stem
-    roots = root_bones(bones)
-    mats = retarget.matrices(args.frames)
     conn = read_connect(args.connect) if args.connect else None
-    for n, (frame, m) in enumerate(zip(frames, mats)):
-        trans = Trans(roots, m)
-        write_trans(out / f"{stem}.{frame:04d}.trans", trans)
-        if conn is not None:
-            write_tskel(out / f"{stem}.{frame:04d}.tskel", connect_to_tskel(conn, trans))
-        if n % 100 == 0 or n == len(frames) - 1:
-            print(f"\rframe {frame} ({n + 1}/{len(frames)})", end="", flush=True)
-    print(f"\nwrote {len(frames)} frames ({motion.fps:.1f} fps in the clip, scale {retarget.scale:.3g} voxels per "
-          f"BVH unit) -> {out}")
+    mats = retarget.matrices(args.frames)
+    write_frames(args.output, Path(args.clip).stem, bones, mats, frames, connect=conn,
+                 progress=TextProgress(f"writing {len(frames)} frames"))
+    print(f"wrote {len(frames)} frames ({motion.fps:.1f} fps in the clip; up {retarget.up}, forward "
+          f"{retarget.forward}; scale {retarget.scale:.3g} voxels per BVH unit) -> {args.output}")
 
 
 def _trans2tskel(args):
@@ -76,8 +67,9 @@ def register(sub) -> None:
     p.add_argument("--bones", required=True, help="our .bones file")
     p.add_argument("--map", help="BONE BVH_JOINT per line (default: suggested from the names; printed)")
     p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
-    p.add_argument("--up", default="y", help="the clip's up axis (default y; e.g. z, -y)")
-    p.add_argument("--forward", default="z", help="the way the clip's figure faces at rest (default z)")
+    p.add_argument("--up", default="auto", help="the clip's up axis: x, y, z, -x, ... (default: detected "
+                                                "from the mapped bones' rest directions; BVH is usually y)")
+    p.add_argument("--forward", default="auto", help="the way the clip's figure faces at rest (default: detected)")
     p.add_argument("--connect", help="also write each frame's .tskel for this .connect")
     p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
 

@@ -43,10 +43,16 @@ SUGGESTIONS = {
     "CALF": ["{S}Leg", "{S}Shin"], "FOOT": ["{S}Foot", "{S}Ankle"], "TOE": ["{S}ToeBase", "{S}Toe"],
 }
 SIDES = {"L": "Left", "R": "Right"}
+ARM_PARTS = {"CLAVICLE", "SHOULDER", "UPPERARM", "ARM", "FOREARM", "ELBOW", "HAND", "WRIST"}
 
 
 def _plain(name: str) -> str:
     return re.sub(r"^.*[:|]", "", name).lower()  # mixamorig:LeftArm -> leftarm
+
+
+def _part(label: str) -> str:
+    """``L_UPPERARM`` -> ``UPPERARM``: the body part of one of our bone labels."""
+    return re.sub(r"^[LR]_", "", label.upper())
 
 
 def suggest_mapping(bones: BoneSkeleton, motion: Motion) -> dict[str, str]:
@@ -129,6 +135,58 @@ def _align(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(axis / s * np.arctan2(s, c)).as_matrix()
 
 
+def rest_directions(bones: BoneSkeleton, motion: Motion, index: dict[int, int]) -> dict[int, tuple]:
+    """Per mapped bone: (our rest direction, the clip's rest direction in BVH axes), both unit vectors.
+
+    The clip's direction points from the bone's joint towards the joints that
+    drive its child bones (or its own children when none is mapped).
+    """
+    rest = motion.rest_positions()
+    out = {}
+    for b, k in index.items():
+        ours = bones.joints[bones.bones[b].distal] - bones.joints[bones.bones[b].proximal]
+        targets = [index[c] for c in range(len(bones)) if c in index and
+                   bones.bones[c].proximal == bones.bones[b].distal and motion.is_descendant(index[c], k)]
+        clip_dirs = [rest[t] - rest[k] for t in targets] or motion.child_directions(k)
+        clip_dirs = [d / np.linalg.norm(d) for d in clip_dirs if np.linalg.norm(d) > 1e-9]
+        if clip_dirs and np.linalg.norm(ours) > 1e-9:
+            clip = np.mean(clip_dirs, axis=0)
+            if np.linalg.norm(clip) > 1e-9:
+                out[b] = (ours / np.linalg.norm(ours), clip / np.linalg.norm(clip))
+    return out
+
+
+def detect_axes(bones: BoneSkeleton, motion: Motion, index: dict[int, int], up: str = "auto",
+                forward: str = "auto") -> tuple[str, str]:
+    """The clip's up and forward axes: of the 24 axis-aligned frames, the one under which the
+    mapped bones' rest directions agree best with ours.
+
+    Arm bones do not vote (a T-pose clip and our arms-down rest disagree
+    there); the spine, neck, legs, hips and feet do. With no such bone mapped,
+    or when they leave forward undetermined, BVH's usual y up, z forward wins.
+    A given ``up`` or ``forward`` (not ``"auto"``) is kept.
+    """
+    pairs = {b: d for b, d in rest_directions(bones, motion, index).items()
+             if _part(bones.bones[b].label) not in ARM_PARTS}  # a T-pose and arms-down disagree there
+    default = ("y" if up == "auto" else up), ("z" if forward == "auto" else forward)
+    if not pairs:
+        return default
+    ours = np.array([o for o, _ in pairs.values()])
+    clip = np.array([c for _, c in pairs.values()])
+    names = [s + a for a in "xyz" for s in ("", "-")]
+    candidates = [(u, f) for u in ([up] if up != "auto" else names) for f in ([forward] if forward != "auto" else names)
+                  if u.lstrip("+-") != f.lstrip("+-")]
+    # ties (only vertical bones mapped: forward is undetermined) go to the usual conventions
+    usual = [default, ("y", "z"), ("z", "-y"), ("y", "-z"), ("z", "y")]
+    candidates.sort(key=lambda c: usual.index(c) if c in usual else len(usual))
+    best, best_score = default, -np.inf
+    for u, f in candidates:
+        score = float(np.einsum("ij,ij->", ours, clip @ axes_matrix(u, f).T))
+        if score > best_score + 1e-6:
+            best, best_score = (u, f), score
+    return best
+
+
 @dataclass
 class Retarget:
     """A clip bound to our bones; :meth:`matrices` gives each frame's ``.trans`` matrices."""
@@ -139,10 +197,12 @@ class Retarget:
     axes: np.ndarray
     scale: float  # BVH units -> voxels, for the root's displacement
     rest_align: np.ndarray  # (B, 3, 3) Q_b
+    up: str = "y"  # the clip's axes, as given or detected
+    forward: str = "z"
 
     @classmethod
     def build(cls, bones: BoneSkeleton, motion: Motion, mapping: dict[str, str] | None = None,
-              up: str = "y", forward: str = "z") -> Retarget:
+              up: str = "auto", forward: str = "auto") -> Retarget:
         mapping = suggest_mapping(bones, motion) if mapping is None else mapping
         index = {}
         for label, joint in mapping.items():
@@ -151,25 +211,20 @@ class Retarget:
             except KeyError:
                 raise ValueError(f"the mapping names bone {label!r}, which the bone skeleton lacks") from None
             index[b] = motion.index(joint)
+        if up == "auto" or forward == "auto":
+            up, forward = detect_axes(bones, motion, index, up, forward)
         axes = axes_matrix(up, forward)
         rest = motion.rest_positions()
-        # per bone: the clip's rest direction towards the joints that drive its child bones
         align = np.tile(np.eye(3), (len(bones), 1, 1))
-        for b, k in index.items():
-            ours = bones.joints[bones.bones[b].distal] - bones.joints[bones.bones[b].proximal]
-            targets = [index[c] for c in range(len(bones)) if c in index and
-                       bones.bones[c].proximal == bones.bones[b].distal and motion.is_descendant(index[c], k)]
-            clip_dirs = [rest[t] - rest[k] for t in targets] or motion.child_directions(k)
-            clip_dirs = [d / np.linalg.norm(d) for d in clip_dirs if np.linalg.norm(d) > 1e-9]
-            if clip_dirs and np.linalg.norm(ours) > 1e-9:
-                align[b] = _align(ours, axes @ np.mean(clip_dirs, axis=0))
+        for b, (ours, clip) in rest_directions(bones, motion, index).items():
+            align[b] = _align(ours, axes @ clip)
         up_axis = axes.T @ OUR_UP  # the clip's up, in its own axes
         clip_height = rest[0] @ up_axis - min(p @ up_axis for p in motion.rest_points())
         roots = [b for b, p in enumerate(bones.parents()) if p is None]
         our_root = bones.joints[bones.bones[roots[0]].proximal] if roots else np.zeros(3)
         our_height = our_root @ OUR_UP - min(j @ OUR_UP for j in bones.joints.values())
         scale = our_height / clip_height if clip_height > 1e-9 and our_height > 0 else 1.0
-        return cls(bones, motion, index, axes, float(scale), align)
+        return cls(bones, motion, index, axes, float(scale), align, up, forward)
 
     def matrices(self, frames=slice(None)) -> np.ndarray:
         """``(F, B, 4, 4)`` row-vector matrices, rest voxel coordinates -> posed, one set per frame."""

@@ -117,17 +117,15 @@ def lost_voxels(rest_bone: Reconstruction, posed: Reconstruction, matrices: np.n
     return rest[~filled]
 
 
-def cracks(tskel: Tskel, min_gap: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
-    """Sphere pairs of different bones that overlap at rest and are ``min_gap`` apart in the pose.
+def touching_pairs(tskel: Tskel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sphere pairs ``(i, j, touch)`` of different bones that overlap at rest (pose-independent).
 
-    Returns the pairs' rest midpoints ``(K, 3)`` and their gaps ``(K,)`` in voxels.
+    ``touch`` is the sum of the radii: a posed pair further apart than that has cracked.
     """
     from scipy.spatial import cKDTree
 
-    from volanim_core.reconstruct.engine import posed_centres
-
     if len(tskel) < 2:
-        return np.zeros((0, 3)), np.zeros(0)
+        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
     p = tskel.points.astype(np.float64)
     # cracks are local: each sphere against its nearest neighbours (all pairs would be
     # ~10^8 on the frog's 137 k spheres)
@@ -140,9 +138,22 @@ def cracks(tskel: Tskel, min_gap: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
     keep = tskel.bone[i] != tskel.bone[j]
     i, j = i[keep], j[keep]
     touch = tskel.dt[i] + tskel.dt[j]
-    rest_d = np.linalg.norm(p[i] - p[j], axis=1)
-    overlap = rest_d < touch
-    i, j, touch = i[overlap], j[overlap], touch[overlap]
+    overlap = np.linalg.norm(p[i] - p[j], axis=1) < touch
+    return i[overlap], j[overlap], touch[overlap]
+
+
+def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, np.ndarray]:
+    """Sphere pairs of different bones that overlap at rest and are ``min_gap`` apart in the pose.
+
+    Returns the pairs' rest midpoints ``(K, 3)`` and their gaps ``(K,)`` in voxels.
+    ``pairs``: :func:`touching_pairs` of the same points, when the caller scans many frames.
+    """
+    from volanim_core.reconstruct.engine import posed_centres
+
+    i, j, touch = touching_pairs(tskel) if pairs is None else pairs
+    if not len(i):
+        return np.zeros((0, 3)), np.zeros(0)
+    p = tskel.points.astype(np.float64)
     c = posed_centres(tskel)
     gap = np.linalg.norm(c[i] - c[j], axis=1) - touch
     open_ = gap > min_gap

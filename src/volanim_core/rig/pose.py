@@ -11,6 +11,8 @@ then applies every ancestor's motion. Rigid motions keep bone lengths.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -90,12 +92,28 @@ def pose_matrices(bones: BoneSkeleton, rotations: dict | None = None, translatio
     for key, t in (translations or {}).items():
         i = key if isinstance(key, int | np.integer) else bones.index(key)
         shift[i] = np.asarray(t, np.float64).reshape(3)
+    return pose_frames(bones, np.reshape(local, (1, n, 3, 3)), np.reshape(shift, (1, n, 3)))[0]
+
+
+def pose_frames(bones: BoneSkeleton, rotations: np.ndarray, shifts: np.ndarray | None = None) -> np.ndarray:
+    """Forward kinematics for many frames at once: ``(F, B, 4, 4)`` from local rotations.
+
+    ``rotations`` is ``(F, B, 3, 3)`` (column convention, about each bone's
+    proximal joint) and ``shifts`` ``(F, B, 3)``; one batched product per bone,
+    so a 1000-frame keyframed clip costs what 18 single poses do.
+    """
+    rot = np.asarray(rotations, np.float64)
+    n_frames, n = rot.shape[:2]
+    shift = np.zeros((n_frames, n, 3)) if shifts is None else np.asarray(shifts, np.float64)
     parents = bones.parents()
-    out = np.zeros((n, 4, 4))
+    out = np.zeros((n_frames, n, 4, 4))
     for i in parents_first(parents):
-        m = rotation_about(bones.joints[bones.bones[i].proximal], local[i])
-        m[3, :3] += shift[i]
-        out[i] = m if parents[i] is None else m @ out[parents[i]]
+        j = bones.joints[bones.bones[i].proximal]
+        m = np.zeros((n_frames, 4, 4))
+        m[:, :3, :3] = np.swapaxes(rot[:, i], 1, 2)
+        m[:, 3, :3] = j - np.einsum("k,fkl->fl", j, m[:, :3, :3]) + shift[:, i]
+        m[:, 3, 3] = 1.0
+        out[:, i] = m if parents[i] is None else m @ out[:, parents[i]]
     return out
 
 
@@ -113,7 +131,9 @@ def local_motion(bones: BoneSkeleton, matrices: np.ndarray) -> tuple[dict, dict]
         r = local[:3, :3].T  # row-vector matrix -> column-convention rotation
         u, _, vt = np.linalg.svd(r)  # nearest rotation, in case of float drift
         r = u @ vt
-        angles[i] = Rotation.from_matrix(r).as_euler("xyz", degrees=True)
+        with warnings.catch_warnings():  # at +-90 degrees about y any split of x and z is right: take one
+            warnings.filterwarnings("ignore", "Gimbal lock", UserWarning)
+            angles[i] = Rotation.from_matrix(r).as_euler("xyz", degrees=True)
         j = bones.joints[b.proximal]
         shifts[i] = local[3, :3] - (j - j @ r.T)
     return angles, shifts

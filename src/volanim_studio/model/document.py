@@ -7,6 +7,7 @@
     bones (BoneSkeleton) .......... named joints, bones in root order  [undoable: bone_edits]
     attachments ................... the bone of every skeleton point  [undoable]
     pose .......................... rotations per bone, the posed frame  [undoable]
+    timeline ...................... a clip (BVH, .trans frames) or pose keys  [keys undoable]
     selected_bones, picked_point .. view state (not undoable)
     symmetry_x .................... mirror plane for Symmetrize
     settings ...................... view and tool settings (colours, preview, lasso, cube, ...)
@@ -31,6 +32,7 @@ from .bone_edits import BoneEdits
 from .events import EventEmitter
 from .posing import PoseState
 from .settings import Settings
+from .timeline import Timeline
 from .undo import UndoStack
 
 
@@ -40,7 +42,7 @@ class Document:
     def __init__(self):
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
-                                   "point_selection", "pose", "preview")
+                                   "point_selection", "pose", "preview", "timeline")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -63,6 +65,7 @@ class Document:
         self.bone_edits = BoneEdits(self)
         self.attachments = Attachments(self)
         self.pose = PoseState(self)
+        self.timeline = Timeline(self)
         self.preview = None  # the last preview.Preview shown
         self.only_unconnected = False
         self.only_working = False

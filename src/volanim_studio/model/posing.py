@@ -95,6 +95,14 @@ class PoseState:
         self._push(f"Reset {self.doc.bones.bones[bone].label}", {a: v for a, v in self.angles.items() if a != k},
                    {a: v for a, v in self.shifts.items() if a != k})
 
+    def show(self, matrices: np.ndarray) -> None:
+        """Take a frame's matrices as the pose without an undo step (the timeline's current frame:
+        scrubbing is looking, not editing); the sliders show the frame's angles."""
+        angles, shifts = local_motion(self.doc.bones, matrices)
+        keys = [self._key(i) for i in range(len(self.doc.bones))]
+        self._write({keys[i]: a for i, a in angles.items() if np.any(np.abs(a) > 1e-9)},
+                    {keys[i]: t for i, t in shifts.items() if np.any(np.abs(t) > 1e-9)})
+
     # ----------------------------------------------------------------- files
     def load_trans(self, path) -> None:
         """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order)."""

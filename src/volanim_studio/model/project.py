@@ -5,7 +5,10 @@
                      "segmentation": {lo, hi, fill, metric, min_thinness},   how it was segmented
                      "bones", "connect", "mskel": "NAME.volanim.d/<kind>-<hash>.<kind>",
                      "sha256": {"bones": ..., ...},      what each data file must hash to
-                     "thinness", "symmetry_x", "settings", "camera"}
+                     "thinness", "symmetry_x", "settings", "camera",
+                     "timeline": {"keys": {FRAME: [[PROXIMAL, DISTAL, rx, ry, rz, tx, ty, tz], ...]},
+                                  "ease", "length", "fps", "clip": {"kind": "bvh"|"trans", "path", "mapping",
+                                  "up", "forward"}}     the animation (a clip is referenced, never copied)
     NAME.volanim.d/ the data files of the current and the previous save (``volanim_core.io.bundle``)
 
 A save is one unit: the data files are written under content names first and
@@ -30,6 +33,8 @@ from volanim_core.errors import FormatError
 from volanim_core.io import bundle
 from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
+
+from .timeline import DEFAULT_LENGTH, Timeline
 
 PROJECT_FORMAT = "volanim project"
 PROJECT_VERSION = 3
@@ -61,12 +66,7 @@ def write_project(doc, path, camera: dict | None = None) -> dict:
         conn = doc.attachments.to_connectivity()
         stored["connect"] = bundle.store_file(path, "connect", ".connect", lambda p: io.write_connect(p, conn))
 
-    volume = None
-    if doc.volume_path:
-        try:
-            volume = str(Path(doc.volume_path).resolve().relative_to(path.parent.resolve()))
-        except ValueError:
-            volume = str(Path(doc.volume_path).resolve())
+    volume = _relative(path, doc.volume_path) if doc.volume_path else None
     data = {
         "format": PROJECT_FORMAT, "version": PROJECT_VERSION, "demo": doc.demo_name,
         "volume": volume, "volume_dims": list(doc.volume_dims) if doc.volume_dims else None,
@@ -74,12 +74,30 @@ def write_project(doc, path, camera: dict | None = None) -> dict:
         **{key: rel for key, (rel, _) in stored.items()},
         "sha256": {key: digest for key, (_, digest) in stored.items()},
         "thinness": doc.thinness, "symmetry_x": doc._symmetry_x, "settings": doc.settings.as_dict(),
-        "camera": camera,
+        "camera": camera, "timeline": _timeline_json(doc, path),
     }
     bundle.commit(path, data)
     written = {"project": str(path), "bones": None, "mskel": None, "connect": None}
     written.update({key: str((path.parent / rel).resolve()) for key, (rel, _) in stored.items()})
     return written
+
+
+def _relative(path: Path, target: str) -> str:
+    """``target`` relative to the project's folder when it is inside it (the pair can move together)."""
+    try:
+        return str(Path(target).resolve().relative_to(path.parent.resolve()))
+    except ValueError:
+        return str(Path(target).resolve())
+
+
+def _timeline_json(doc, path: Path) -> dict | None:
+    t = doc.timeline
+    if not t.active and t.length == DEFAULT_LENGTH:
+        return None
+    data = t.to_json()
+    if data["clip"]:
+        data["clip"]["path"] = _relative(path, data["clip"]["path"])
+    return data
 
 
 def _expect(path, data: dict, key: str, kinds, what: str):
@@ -125,8 +143,16 @@ def _parse(path: Path, text: str) -> dict:
         value = _expect(path, data, key, int | float, "a number")
         if value is not None and (isinstance(value, bool) or not math.isfinite(value)):
             raise FormatError(path, f"\"{key}\" must be a finite number, got {value!r}")
-    for key in ("settings", "camera", "segmentation", "sha256"):
+    for key in ("settings", "camera", "segmentation", "sha256", "timeline"):
         _expect(path, data, key, dict, "an object")
+    if data.get("timeline") is not None:
+        try:
+            data["timeline"] = Timeline.parse(data["timeline"], path.name)
+        except ValueError as exc:
+            raise FormatError(path, str(exc).removeprefix(f"{path.name}: ")) from None
+        clip = data["timeline"]["clip"]
+        if clip:
+            clip["path"] = str((path.parent / clip["path"]).resolve())
     dims = _expect(path, data, "volume_dims", list, "a list of three sizes")
     if dims is not None:  # sizes of a headerless .vol: the same limits as any volume header
         checked_grid(path, dims, what="\"volume_dims\"")
@@ -183,6 +209,8 @@ def apply_project(doc, data: dict, path) -> list[str]:
         doc.symmetry_x = data["symmetry_x"]
     if data.get("thinness") is not None:
         doc.thinness = data["thinness"]
+    if data.get("timeline") is not None:
+        warnings += doc.timeline.restore(data["timeline"], Path(path).name)
     warnings += [f"{Path(path).name}: {w}" for w in doc.settings.update(data.get("settings") or {})]
     doc.project_path = str(path)
     doc.events.project.emit(path=str(path))

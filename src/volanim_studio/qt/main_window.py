@@ -29,6 +29,8 @@ from .files_controller import FilesController
 from .pose_panel import PosePanel
 from .preview_controller import PreviewController
 from .reconstruct_panel import ReconstructPanel
+from .timeline_controller import TimelineController
+from .timeline_panel import TimelinePanel
 from .worker import JobRunner, Worker
 
 SHORTCUTS = [
@@ -44,6 +46,9 @@ SHORTCUTS = [
     ("Right click", "End the bone chain"),
     ("Delete", "Remove the selected bones"),
     ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
+    ("Space", "Play / pause the timeline (a BVH clip, .trans frames or keys)"),
+    ("Left / Right, Home / End", "Previous / next frame, first / last frame (outside Cube mode)"),
+    ("S / Shift+S", "Set / delete the pose key at the current frame"),
     ("Ctrl+Z / Ctrl+Shift+Z", "Undo / redo"),
     ("Ctrl+O", "Open a volume"),
     ("Ctrl+S", "Save the project"),
@@ -89,6 +94,13 @@ class MainWindow(QMainWindow):
         dock.setWidget(tabs)
         dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
+        self.timeline_panel = TimelinePanel(self.doc)
+        self.timeline = TimelineController(self, self.previews)
+        self.timeline.enter_pose = lambda: self.set_mode(Mode.POSE) if self.mode != Mode.POSE else None
+        timeline_dock = QDockWidget("Timeline", self)
+        timeline_dock.setWidget(self.timeline_panel)
+        timeline_dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
+        self.addDockWidget(Qt.BottomDockWidgetArea, timeline_dock)
         self.point_label = QLabel("")
         self.statusBar().addPermanentWidget(self.point_label)
         self._build_actions()
@@ -211,6 +223,8 @@ class MainWindow(QMainWindow):
         self._action("Open .connect…", lambda: self.files.open_dialog("connect"), menu=connect_menu)
         self.previews.fill_menu(bar.addMenu("&Pose"), self._action)
         self.previews.wire(self.pose_panel, self.reconstruct_panel)
+        self.timeline.fill_menu(bar.addMenu("&Timeline"), self._action)
+        self.timeline.wire(self.timeline_panel)
         self.connect_panel.auto_button.clicked.connect(self.auto_connect)
         self.connect_panel.mirror_button.clicked.connect(self.mirror_connectivity)
         help_menu = bar.addMenu("&Help")
@@ -229,6 +243,8 @@ class MainWindow(QMainWindow):
             self.panel_tabs.setCurrentWidget(self.pose_panel)
         for a in getattr(self, "cube_actions", []):
             a.setEnabled(self.mode == Mode.CUBE)
+        for a in self.timeline.step_actions:  # the arrows nudge the cube in Cube mode, step frames elsewhere
+            a.setEnabled(self.mode != Mode.CUBE)
         if self.mode in (Mode.CUBE, Mode.LASSO):
             self.panel_tabs.setCurrentWidget(self.connect_panel)
             self.doc.settings.colour_by = "bone"
@@ -336,6 +352,7 @@ class MainWindow(QMainWindow):
         self.plotter.screenshot(str(path))
 
     def closeEvent(self, event):  # noqa: N802 (Qt name)
+        self.timeline.stop()
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
         self.autosave_timer.stop()
         self.autosaver.close()

@@ -84,6 +84,13 @@ class PreviewController(Controller):
         if self._posing_drag and self.doc.settings.live_preview:
             self._live_timer.start()  # coalesced: one live preview per event-loop pass
 
+    def live_preview_soon(self) -> None:
+        """A live preview at the next event-loop pass (the timeline's frame changed), if there is anything
+        attached to preview and live previews are on."""
+        bone = self.doc.attachments.bone
+        if self.doc.settings.live_preview and len(bone) and (bone >= 0).any():
+            self._live_timer.start()
+
     def live_preview(self) -> None:
         """Half-resolution binary or bone preview on the GUI thread (tens of ms on the mannequin)."""
         t0 = time.perf_counter()

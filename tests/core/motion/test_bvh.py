@@ -7,10 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from paths import ASSETS
 from volanim_core.errors import FormatError
 from volanim_core.motion.bvh import read_bvh
 
-WALK = Path(__file__).resolve().parents[4] / "shared" / "data" / "walk.bvh"
+WALK = ASSETS / "walk.bvh"  # the real clip of ../shared/data, bundled with its MIT licence
 
 
 def clip(order: str, frames: list[str], root_channels: str = "Xposition Yposition Zposition",

@@ -13,6 +13,7 @@ from volanim_core.errors import FormatError
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.retarget import Retarget, axes_matrix, read_mapping, suggest_mapping
 from volanim_core.rig.bones import Bone, BoneSkeleton
+from volanim_core.samples import mannequin_bones
 
 from .test_bvh import WALK
 
@@ -161,3 +162,51 @@ def test_bvh2trans_and_trans2tskel_command_line(tmp_path, capsys):
     assert main(["bvh2trans", str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "--map",
                  str(tmp_path / "m.txt"), "-o", str(out)]) == 2
     assert "m.txt: BVH joint 'NoSuchJoint' is not in the clip" in capsys.readouterr().err
+
+
+def figure_clip(tmp_path, up: str, forward: str) -> Path:
+    """A small figure (spine, pelvis, left leg and foot, a T-pose left arm) written in the axes ``up``/``forward``."""
+    to_clip = axes_matrix(up, forward).T  # ours -> the clip's axes
+
+    def off(x, y, z):
+        return " ".join(f"{v:g}" for v in to_clip @ np.array([x, y, z], float))
+
+    joint = "CHANNELS 3 Zrotation Xrotation Yrotation"
+    text = (f"HIERARCHY\nROOT Hips\n{{\nOFFSET {off(0, 0, 10)}\nCHANNELS 6 Xposition Yposition Zposition "
+            f"Zrotation Xrotation Yrotation\n"
+            f"JOINT Spine\n{{\nOFFSET {off(0, 0, 1)}\n{joint}\nEnd Site\n{{\nOFFSET {off(0, 0, 5)}\n}}\n}}\n"
+            f"JOINT LeftUpLeg\n{{\nOFFSET {off(2, 0, 0)}\n{joint}\nJOINT LeftLeg\n{{\nOFFSET {off(0, 0, -5)}\n{joint}\n"
+            f"JOINT LeftFoot\n{{\nOFFSET {off(0, 0, -5)}\n{joint}\n"
+            f"End Site\n{{\nOFFSET {off(0, -2, 0)}\n}}\n}}\n}}\n}}\n"
+            f"JOINT LeftArm\n{{\nOFFSET {off(2, 0, 5)}\n{joint}\nEnd Site\n{{\nOFFSET {off(6, 0, 0)}\n}}\n}}\n}}\n"
+            "MOTION\nFrames: 1\nFrame Time: 0.04\n" + " ".join(["0"] * 21) + "\n")
+    p = tmp_path / f"figure_{up}_{forward}.bvh"
+    p.write_text(text)
+    return p
+
+
+def figure_bones() -> BoneSkeleton:
+    joints = {"ROOT": (0, 0, 10), "CHEST": (0, 0, 16), "L_HIP": (2, 0, 10), "L_KNEE": (2, 0, 5), "L_ANKLE": (2, 0, 0),
+              "L_TOE": (2, -2, 0), "L_SHOULDER": (2, 0, 15), "L_ELBOW": (2, 0, 10)}
+    return BoneSkeleton(joints, [Bone("ROOT", "CHEST", "SPINE"), Bone("ROOT", "L_HIP", "L_PELVIS"),
+                                 Bone("L_HIP", "L_KNEE", "L_THIGH"), Bone("L_KNEE", "L_ANKLE", "L_SHIN"),
+                                 Bone("L_ANKLE", "L_TOE", "L_FOOT"), Bone("L_SHOULDER", "L_ELBOW", "L_UPPERARM")])
+
+
+@pytest.mark.parametrize("up, forward", [("y", "z"), ("z", "-y"), ("z", "x"), ("-x", "y"), ("y", "-x")])
+def test_up_and_forward_axes_are_detected_despite_a_t_pose_arm(tmp_path, up, forward):
+    bones = figure_bones()
+    r = Retarget.build(bones, read_bvh(figure_clip(tmp_path, up, forward)))
+    assert (r.up, r.forward) == (up, forward)
+    assert np.allclose(r.axes, axes_matrix(up, forward))
+    # the legs and spine agree with ours at rest; only the T-pose arm needed aligning
+    absorbed = r.absorbed_degrees()
+    assert absorbed["L_UPPERARM"] == pytest.approx(90) and absorbed["L_THIGH"] == pytest.approx(0, abs=1e-6)
+
+
+def test_given_axes_are_kept_and_the_walk_is_detected_y_up(tmp_path):
+    bones = figure_bones()
+    r = Retarget.build(bones, read_bvh(figure_clip(tmp_path, "z", "-y")), up="z")
+    assert (r.up, r.forward) == ("z", "-y")
+    walk = Retarget.build(mannequin_bones(), read_bvh(WALK))
+    assert (walk.up, walk.forward) == ("y", "z")

@@ -1,0 +1,96 @@
+"""Keyframed animation without motion capture: pose keys, slerp between them, optional ease.
+
+    key at frame k:  per bone a local rotation (x, y, z degrees, as the pose
+                     sliders give it) and a shift, keyed by the bone's joints
+                     (PROXIMAL, DISTAL) so renaming or reordering bones keeps it
+    frame f between keys a < f < b:
+        t = (f - a) / (b - a)            (eased: t^2 (3 - 2t), slow in and out)
+        R_bone(f) = slerp(R_a, R_b, t)   shortest arc, per bone, in the bone's parent frame
+        shift(f)  = lerp(shift_a, shift_b, t)
+    before the first key / after the last: held
+
+Interpolating *local* rotations and then running forward kinematics keeps
+every bone length (a child turns with its parent), which interpolating the
+final matrices would not. A bone missing from a key is at rest in that key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.pose import pose_frames
+
+BoneKey = tuple[str, str]  # (proximal joint, distal joint)
+
+
+@dataclass
+class KeyPose:
+    """One key: per bone, Euler angles (degrees, extrinsic x-y-z as the sliders) and a shift (voxels)."""
+
+    angles: dict[BoneKey, np.ndarray] = field(default_factory=dict)
+    shifts: dict[BoneKey, np.ndarray] = field(default_factory=dict)
+
+    def to_json(self) -> list:
+        """``[[PROXIMAL, DISTAL, rx, ry, rz, tx, ty, tz], ...]`` for the bones this key moves."""
+        out = []
+        for k in sorted(set(self.angles) | set(self.shifts)):
+            a = self.angles.get(k, np.zeros(3))
+            t = self.shifts.get(k, np.zeros(3))
+            out.append([k[0], k[1], *(float(v) for v in a), *(float(v) for v in t)])
+        return out
+
+    @classmethod
+    def from_json(cls, rows, where: str) -> KeyPose:
+        """Inverse of :meth:`to_json`; ``where`` names the key in errors (ValueError)."""
+        if not isinstance(rows, list):
+            raise ValueError(f"{where}: expected a list of [PROXIMAL, DISTAL, rx, ry, rz, tx, ty, tz]")
+        key = cls()
+        for row in rows:
+            ok = (isinstance(row, list) and len(row) == 8 and all(isinstance(v, str) for v in row[:2])
+                  and all(isinstance(v, int | float) and not isinstance(v, bool) for v in row[2:]))
+            values = np.asarray(row[2:], np.float64) if ok else None
+            if not ok or not np.isfinite(values).all() or np.abs(values).max() > 1e9:
+                raise ValueError(f"{where}: expected [PROXIMAL, DISTAL, rx, ry, rz, tx, ty, tz] "
+                                 f"with finite numbers, got {str(row)[:80]}")
+            k = (row[0], row[1])
+            if k in key.angles:
+                raise ValueError(f"{where}: bone {k[0]}-{k[1]} is keyed twice")
+            key.angles[k], key.shifts[k] = values[:3], values[3:]
+        return key
+
+
+def bone_keys(bones: BoneSkeleton) -> list[BoneKey]:
+    return [(b.proximal, b.distal) for b in bones.bones]
+
+
+def interpolate(bones: BoneSkeleton, keys: dict[int, KeyPose], frames, *, ease: bool = False) -> np.ndarray:
+    """``(F, B, 4, 4)`` pose matrices (``.trans``) at ``frames`` from the keys (frame -> KeyPose)."""
+    frames = np.asarray(frames, np.float64).reshape(-1)
+    n = len(bones)
+    if not keys:
+        return pose_frames(bones, np.tile(np.eye(3), (len(frames), n, 1, 1)))
+    at = np.array(sorted(keys), np.float64)
+    poses = [keys[int(k)] for k in at]
+    names = bone_keys(bones)
+    # eased times: each frame's position between its two keys, reshaped, put back on the key axis
+    t = np.clip(frames, at[0], at[-1])
+    if len(at) > 1:
+        seg = np.clip(np.searchsorted(at, t, side="right") - 1, 0, len(at) - 2)
+        a, b = at[seg], at[seg + 1]
+        u = (t - a) / (b - a)
+        if ease:
+            u = u * u * (3.0 - 2.0 * u)
+        t = a + u * (b - a)
+    rot = np.empty((len(frames), n, 3, 3))
+    shift = np.empty((len(frames), n, 3))
+    for i, name in enumerate(names):
+        angles = np.array([p.angles.get(name, np.zeros(3)) for p in poses])
+        shifts = np.array([p.shifts.get(name, np.zeros(3)) for p in poses])
+        r = Rotation.from_euler("xyz", angles, degrees=True)
+        rot[:, i] = (Slerp(at, r)(t) if len(at) > 1 else r[np.zeros(len(t), int)]).as_matrix()
+        shift[:, i] = np.column_stack([np.interp(t, at, shifts[:, c]) for c in range(3)])
+    return pose_frames(bones, rot, shift)

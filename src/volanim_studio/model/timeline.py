@@ -1,0 +1,257 @@
+"""The animation on the timeline: a loaded clip or pose keys; the current frame drives the pose. Qt-free.
+
+    settings.current_frame --> Timeline.show_frame --> pose.show(matrices) (not an edit: no undo)
+    clip:  a BVH retargeted onto the bones, or a folder of .trans frames (takes precedence)
+    keys:  frame -> KeyPose, slerped (volanim_core.motion.keyframes); set / delete are undoable
+    doc.events.timeline  whenever the clip, the keys, ease or the length change
+
+A clip made from a BVH is retargeted again when the bones change (it keeps
+the parsed clip, the mapping and the axes); a clip of ``.trans`` frames
+cannot follow an edited skeleton and is unloaded with a message.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from volanim_core.motion.bvh import Motion, read_bvh
+from volanim_core.motion.frames import read_frames
+from volanim_core.motion.keyframes import KeyPose, interpolate
+from volanim_core.motion.retarget import Retarget, check_mapping_file
+
+from .undo import Command
+
+DEFAULT_LENGTH, DEFAULT_FPS = 48, 24.0
+
+
+@dataclass
+class Clip:
+    name: str
+    matrices: np.ndarray  # (F, B, 4, 4)
+    fps: float
+    path: str  # the .bvh, or the folder of .trans
+    frames: list[int] = field(default_factory=list)  # frame numbers (of the files; BVH: 0..F-1)
+    motion: Motion | None = None  # BVH only: kept to retarget again when the bones change
+    mapping: dict[str, str] | None = None
+    up: str = "auto"
+    forward: str = "auto"
+
+    @property
+    def kind(self) -> str:
+        return "bvh" if self.motion is not None else "trans"
+
+
+class Timeline:
+    def __init__(self, doc):
+        self.doc = doc
+        self.clip: Clip | None = None
+        self.keys: dict[int, KeyPose] = {}
+        self.ease = True
+        self.length = DEFAULT_LENGTH  # frames of a keyed animation
+        self.fps = DEFAULT_FPS  # of a keyed animation
+        doc.settings.events.current_frame.connect(lambda value: self.show_frame(value))
+        doc.events.bones.connect(self._on_bones)
+
+    # ------------------------------------------------------------ queries
+    @property
+    def active(self) -> bool:
+        """Is anything animated (a clip or at least one key)?"""
+        return self.clip is not None or bool(self.keys)
+
+    @property
+    def frame_count(self) -> int:
+        if self.clip is not None:
+            return len(self.clip.matrices)
+        return max(self.length, max(self.keys, default=-1) + 1)
+
+    @property
+    def frame_rate(self) -> float:
+        return self.clip.fps if self.clip is not None else self.fps
+
+    def matrices(self, frames=None) -> np.ndarray:
+        """``(F, B, 4, 4)`` pose matrices of ``frames`` (default: all) from the clip or the keys."""
+        frames = np.arange(self.frame_count) if frames is None else np.asarray(frames, np.int64).reshape(-1)
+        if self.clip is not None:
+            return self.clip.matrices[np.clip(frames, 0, len(self.clip.matrices) - 1)]
+        return interpolate(self.doc.bones, self.keys, frames, ease=self.ease)
+
+    def frame_label(self, frame: int) -> str:
+        """The number a frame's file gets: the clip's own numbering for a .trans folder."""
+        if self.clip is not None and self.clip.frames:
+            return str(self.clip.frames[min(frame, len(self.clip.frames) - 1)])
+        return str(frame)
+
+    # -------------------------------------------------------------- frames
+    def show_frame(self, frame: int | None = None) -> None:
+        """Put the frame's pose on the bones (view state, like scrubbing: no undo step)."""
+        if not self.active or not len(self.doc.bones):
+            return
+        frame = self.doc.settings.current_frame if frame is None else frame
+        self.doc.pose.show(self.matrices([min(frame, self.frame_count - 1)])[0])
+
+    def step(self, delta: int) -> int:
+        """Move the current frame by ``delta``, wrapping around the animation; returns the new frame."""
+        n = max(self.frame_count, 1)
+        self.doc.settings.current_frame = (self.doc.settings.current_frame + delta) % n
+        return self.doc.settings.current_frame
+
+    # ---------------------------------------------------------------- keys
+    def _set_keys(self, keys: dict[int, KeyPose]) -> None:
+        self.keys = dict(keys)
+        self.doc.events.timeline.emit()
+        self.show_frame()
+
+    def _push_keys(self, label: str, keys: dict[int, KeyPose]) -> None:
+        old, new = dict(self.keys), dict(keys)
+        self.doc.undo.push(Command(label, lambda: self._set_keys(new), lambda: self._set_keys(old)))
+
+    def _refuse_with_clip(self) -> None:
+        if self.clip is not None:
+            raise ValueError(f"the clip {self.clip.name} drives the bones: unload it (Timeline → Unload clip) "
+                             "to animate with keys")
+
+    def set_key(self, frame: int | None = None) -> int:
+        """Key the current pose at ``frame`` (default: the current frame); undoable."""
+        self._refuse_with_clip()
+        frame = self.doc.settings.current_frame if frame is None else int(frame)
+        pose = self.doc.pose
+        key = KeyPose({k: v.copy() for k, v in pose.angles.items()}, {k: v.copy() for k, v in pose.shifts.items()})
+        self._push_keys(f"Set key at frame {frame}", {**self.keys, frame: key})
+        return frame
+
+    def delete_key(self, frame: int | None = None) -> None:
+        frame = self.doc.settings.current_frame if frame is None else int(frame)
+        if frame not in self.keys:
+            raise ValueError(f"there is no key at frame {frame}")
+        self._push_keys(f"Delete key at frame {frame}", {f: k for f, k in self.keys.items() if f != frame})
+
+    def set_options(self, *, ease: bool | None = None, length: int | None = None, fps: float | None = None) -> None:
+        """Ease in/out, the keyed animation's length in frames and its frame rate (view options: no undo)."""
+        if length is not None and not (isinstance(length, int) and 1 <= length <= 100_000):
+            raise ValueError(f"length must be 1 to 100000 frames, got {length!r}")
+        if fps is not None and not (isinstance(fps, int | float) and 1 <= fps <= 1000):
+            raise ValueError(f"frame rate must be 1 to 1000 per second, got {fps!r}")
+        self.ease = self.ease if ease is None else bool(ease)
+        self.length = self.length if length is None else length
+        self.fps = self.fps if fps is None else float(fps)
+        self.doc.events.timeline.emit()
+        self.show_frame()
+
+    # ---------------------------------------------------------------- clips
+    def load_bvh(self, path, mapping: dict[str, str] | None = None, up: str = "auto", forward: str = "auto",
+                 motion: Motion | None = None) -> Retarget:
+        """Retarget a BVH clip onto the bones and put it on the timeline (FormatError names the file)."""
+        if not len(self.doc.bones):
+            raise ValueError("build or open the bone skeleton first: the clip drives its bones")
+        motion = read_bvh(path) if motion is None else motion
+        if mapping is not None:
+            check_mapping_file(path, mapping, self.doc.bones, motion)
+        r = Retarget.build(self.doc.bones, motion, mapping, up=up, forward=forward)
+        if not r.mapping:
+            raise ValueError(f"{Path(path).name}: no bone is mapped to a joint of the clip; map them by hand")
+        used = {self.doc.bones.bones[b].label: motion.names[k] for b, k in r.mapping.items()}
+        self._put_clip(Clip(Path(path).stem, r.matrices(), motion.fps, str(path), list(range(motion.frames)),
+                            motion, used, r.up, r.forward))
+        return r
+
+    def load_trans(self, paths) -> Clip:
+        """A folder (or list) of ``.trans`` frames of these bones as the clip."""
+        if not len(self.doc.bones):
+            raise ValueError("build or open the bone skeleton first: the frames move its bones")
+        mats, files = read_frames(paths, self.doc.bones)
+        from volanim_core.motion.frames import frame_number
+
+        numbers = [frame_number(p) for p in files]
+        name = files[0].parent.name if len(files) > 1 else files[0].stem
+        clip = Clip(name, mats, self.fps, str(files[0].parent if len(files) > 1 else files[0]),
+                    [n if n is not None else i for i, n in enumerate(numbers)])
+        self._put_clip(clip)
+        return clip
+
+    def _put_clip(self, clip: Clip | None) -> None:
+        self.clip = clip
+        st = self.doc.settings
+        if st.current_frame >= self.frame_count:
+            st.current_frame = 0  # (shows that frame)
+        self.doc.events.timeline.emit()
+        if clip is not None:
+            self.show_frame()
+
+    def unload(self) -> None:
+        self._put_clip(None)
+        self.show_frame()
+
+    def _on_bones(self, **_) -> None:
+        c = self.clip
+        if c is None:
+            return
+        if c.motion is not None and len(self.doc.bones):
+            try:
+                self.load_bvh(c.path, {k: v for k, v in c.mapping.items()
+                                       if k in {b.label for b in self.doc.bones.bones}}, c.up, c.forward, c.motion)
+                return
+            except ValueError as exc:
+                self.doc.message(f"The clip {c.name} was unloaded: {exc}")
+        else:
+            self.doc.message(f"The clip {c.name} was unloaded: its .trans frames were made for the old bones.")
+        self._put_clip(None)
+
+    # ------------------------------------------------------------- project
+    def to_json(self) -> dict:
+        data = {"keys": {str(f): k.to_json() for f, k in sorted(self.keys.items())}, "ease": self.ease,
+                "length": self.length, "fps": self.fps, "clip": None}
+        c = self.clip
+        if c is not None:
+            data["clip"] = {"kind": c.kind, "path": c.path, "mapping": c.mapping, "up": c.up, "forward": c.forward}
+        return data
+
+    @staticmethod
+    def parse(data, where: str) -> dict:
+        """A project's ``"timeline"`` checked (ValueError naming ``where``), before anything is applied."""
+        if not isinstance(data, dict):
+            raise ValueError(f"{where}: \"timeline\" must be an object")
+        keys = data.get("keys") or {}
+        if not isinstance(keys, dict):
+            raise ValueError(f"{where}: \"timeline\": \"keys\" must be an object of frame -> bones")
+        parsed = {}
+        for f, rows in keys.items():
+            if not (isinstance(f, str) and f.isascii() and f.isdigit() and int(f) <= 10**7):
+                raise ValueError(f"{where}: a key's frame must be a whole number 0..10000000, got {f!r}")
+            parsed[int(f)] = KeyPose.from_json(rows, f"{where}: key at frame {f}")
+        ease, length, fps = data.get("ease", True), data.get("length", DEFAULT_LENGTH), data.get("fps", DEFAULT_FPS)
+        if not isinstance(ease, bool):
+            raise ValueError(f"{where}: \"timeline\": \"ease\" must be true or false, got {ease!r}")
+        if isinstance(length, bool) or not isinstance(length, int) or not 1 <= length <= 100_000:
+            raise ValueError(f"{where}: \"timeline\": \"length\" must be 1 to 100000 frames, got {length!r}")
+        if isinstance(fps, bool) or not isinstance(fps, int | float) or not 1 <= fps <= 1000:
+            raise ValueError(f"{where}: \"timeline\": \"fps\" must be 1 to 1000, got {fps!r}")
+        clip = data.get("clip")
+        if clip is not None:
+            mapping = clip.get("mapping") if isinstance(clip, dict) else None
+            if (not isinstance(clip, dict) or clip.get("kind") not in ("bvh", "trans")
+                    or not isinstance(clip.get("path"), str)
+                    or not all(isinstance(clip.get(k, "auto"), str) for k in ("up", "forward"))
+                    or (mapping is not None and not (isinstance(mapping, dict) and all(
+                        isinstance(k, str) and isinstance(v, str) for k, v in mapping.items())))):
+                raise ValueError(f"{where}: \"timeline\": \"clip\" must be {{\"kind\": \"bvh\" or \"trans\", "
+                                 "\"path\": FILE, \"mapping\": {BONE: JOINT}, \"up\": AXIS, \"forward\": AXIS}")
+        return {"keys": parsed, "ease": ease, "length": length, "fps": float(fps), "clip": clip}
+
+    def restore(self, parsed: dict, where: str) -> list[str]:
+        """Apply :meth:`parse`'s result; a clip that cannot be loaded again is a warning, not a failure."""
+        self.ease, self.length, self.fps = parsed["ease"], parsed["length"], parsed["fps"]
+        self._set_keys(parsed["keys"])
+        clip = parsed["clip"]
+        if not clip:
+            return []
+        try:
+            if clip["kind"] == "bvh":
+                self.load_bvh(clip["path"], clip.get("mapping"), clip.get("up", "auto"), clip.get("forward", "auto"))
+            else:
+                self.load_trans(clip["path"])
+        except (OSError, ValueError) as exc:
+            return [f"{where}: the timeline's clip was not loaded ({exc})"]
+        return []

@@ -1,0 +1,235 @@
+"""The timeline's actions: load clips, play, step, key, scan for breakage, export frames.
+
+    Play --> QTimer --> frame = start + elapsed * fps  (a slow preview drops frames, never lags)
+         --> settings.current_frame --> Timeline.show_frame --> pose --> live preview (coalesced)
+    Pause / scrub released --> the full preview with its report (in Pose mode)
+    Scan --> JobRunner(scan_frames) --> ScanDialog (worst first; double-click jumps to the frame)
+    Export --> JobRunner(write_frames) --> NAME.0000.trans (+ .tskel)
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QDialog, QFileDialog
+
+from volanim_core.motion.bvh import read_bvh
+from volanim_core.motion.frames import write_frames
+from volanim_core.reconstruct.scan import scan_frames, worst_first
+
+from .controller import FAILED, Controller
+from .mapping_dialog import MappingDialog
+from .scan_dialog import ScanDialog
+
+
+class TimelineController(Controller):
+    def __init__(self, window, previews):
+        super().__init__(window)
+        self.previews = previews
+        self.enter_pose = lambda: None  # the window sets it: playing shows the posed preview
+        self.step_actions = []  # arrows: the window disables them in Cube mode (the cube's nudges)
+        self.shown_frames: list[int] = []  # frames drawn while playing (tests, benchmarks)
+        self.scan_dialog: ScanDialog | None = None
+        self.last_scan = None
+        self._play = QTimer(window)
+        self._play.timeout.connect(self._tick)
+        self._start = (0.0, 0)
+        self.doc.settings.events.current_frame.connect(lambda **_: self._frame_changed())
+
+    # ------------------------------------------------------------ wiring
+    def fill_menu(self, menu, action) -> None:
+        action("Load BVH clip…", lambda: self.load_bvh_dialog(), menu=menu)
+        action("Load .trans frames…", lambda: self.load_trans_dialog(), menu=menu)
+        action("Unload clip", lambda: self.doc.timeline.unload(), menu=menu)
+        menu.addSeparator()
+        action("Play / pause", lambda: self.toggle_play(), "Space", menu=menu)
+        self.step_actions = [action("Previous frame", lambda: self.step(-1), "Left", menu=menu),
+                             action("Next frame", lambda: self.step(1), "Right", menu=menu),
+                             action("First frame", lambda: self.go(0), "Home", menu=menu),
+                             action("Last frame", lambda: self.go(-1), "End", menu=menu)]
+        menu.addSeparator()
+        action("Set key", lambda: self.set_key(), "S", menu=menu)
+        action("Delete key", lambda: self.delete_key(), "Shift+S", menu=menu)
+        menu.addSeparator()
+        action("Scan clip for breakage…", lambda: self.scan(), menu=menu)
+        action("Export frames (.trans)…", lambda: self.export_dialog(tskel=False), menu=menu)
+        action("Export frames (.trans + .tskel)…", lambda: self.export_dialog(tskel=True), menu=menu)
+
+    def wire(self, panel) -> None:
+        self.panel = panel
+        panel.load_bvh.clicked.connect(lambda: self.load_bvh_dialog())
+        panel.load_trans.clicked.connect(lambda: self.load_trans_dialog())
+        panel.play.clicked.connect(lambda: self.toggle_play())
+        panel.first.clicked.connect(lambda: self.go(0))
+        panel.back.clicked.connect(lambda: self.step(-1))
+        panel.forward.clicked.connect(lambda: self.step(1))
+        panel.last.clicked.connect(lambda: self.go(-1))
+        panel.set_key.clicked.connect(lambda: self.set_key())
+        panel.delete_key.clicked.connect(lambda: self.delete_key())
+        panel.scan.clicked.connect(lambda: self.scan())
+        panel.export.clicked.connect(lambda: self.export_dialog(tskel=False))
+        panel.scrub_started.connect(self.previews.drag_started)
+        panel.scrub_finished.connect(self.previews.drag_finished)
+
+    # ------------------------------------------------------------ frames
+    def _frame_changed(self) -> None:
+        if self.doc.timeline.active:
+            self.previews.live_preview_soon()
+
+    def step(self, delta: int) -> None:
+        self.doc.timeline.step(delta)
+
+    def go(self, frame: int) -> None:
+        n = self.doc.timeline.frame_count
+        self.doc.settings.current_frame = frame % n if n else 0
+
+    @property
+    def playing(self) -> bool:
+        return self._play.isActive()
+
+    def toggle_play(self) -> None:
+        self.stop() if self.playing else self.play()
+
+    def play(self) -> None:
+        tl = self.doc.timeline
+        if not tl.active:
+            self.doc.message("Nothing to play: load a BVH clip or .trans frames, or set keys.")
+            self._sync_button()
+            return
+        self.enter_pose()
+        self.previews.drag_started()  # live previews follow; a running full preview is cancelled
+        self.shown_frames = []
+        self._start = (time.perf_counter(), self.doc.settings.current_frame)
+        self._play.start(max(5, int(1000 / tl.frame_rate)))
+        self._sync_button()
+
+    def stop(self) -> None:
+        if not self.playing:
+            return
+        self._play.stop()
+        self._sync_button()
+        self.previews.drag_finished()  # the full preview with its report, of the frame stopped on
+
+    def _tick(self) -> None:
+        tl = self.doc.timeline
+        t0, f0 = self._start
+        frame = (f0 + int((time.perf_counter() - t0) * tl.frame_rate)) % max(tl.frame_count, 1)
+        if frame != self.doc.settings.current_frame:
+            self.doc.settings.current_frame = frame
+            self.shown_frames.append(frame)
+
+    def _sync_button(self) -> None:
+        panel = getattr(self, "panel", None)
+        if panel is not None:
+            panel.play.setChecked(self.playing)
+            panel.play.setText("❚❚ Pause" if self.playing else "▶ Play")
+
+    # -------------------------------------------------------------- keys
+    def set_key(self) -> None:
+        self.attempt("Set key", lambda: self.doc.timeline.set_key(), lambda f: f"Keyed the pose at frame {f}.")
+
+    def delete_key(self) -> None:
+        self.attempt("Delete key", lambda: self.doc.timeline.delete_key(), "Deleted the key.")
+
+    # ------------------------------------------------------------- clips
+    def load_bvh(self, path, *, ask=None) -> bool:
+        """Read a clip, let the user confirm the mapping (``ask(dialog) -> bool``; None: the suggestions)
+        and retarget it onto the bones."""
+        self.stop()
+        motion = self.attempt("Load BVH", lambda: read_bvh(path))
+        if motion is FAILED:
+            return False
+        mapping, up, forward = None, "auto", "auto"
+        if ask is not None:
+            dialog = MappingDialog(self.doc.bones, motion, Path(path).name, self.window)
+            if not ask(dialog):
+                return False
+            mapping, (up, forward) = dialog.mapping(), dialog.axes()
+        r = self.attempt("Load BVH", lambda: self.doc.timeline.load_bvh(path, mapping, up, forward, motion))
+        if r is FAILED:
+            return False
+        absorbed = r.absorbed_degrees()
+        worst = max(absorbed, key=absorbed.get) if absorbed else None
+        self.doc.message(f"{Path(path).name}: {motion.frames} frames at {motion.fps:.4g} fps on {len(r.mapping)} of "
+                         f"{len(self.doc.bones)} bones (up {r.up}, facing {r.forward})"
+                         + (f"; largest rest difference {absorbed[worst]:.0f}° at {worst}" if worst else "")
+                         + ". Space plays, arrows step.")
+        return True
+
+    def load_bvh_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Load a motion-capture clip", "",
+                                              "BVH clips (*.bvh *.BVH);;All files (*)")
+        if path:
+            self.load_bvh(path, ask=lambda d: d.exec() == QDialog.Accepted)
+
+    def load_trans(self, folder) -> bool:
+        self.stop()
+        clip = self.attempt("Load frames", lambda: self.doc.timeline.load_trans(folder))
+        if clip is FAILED:
+            return False
+        self.doc.message(f"Loaded {len(clip.matrices)} frames from {clip.path}. Space plays, arrows step.")
+        return True
+
+    def load_trans_dialog(self) -> None:
+        folder = QFileDialog.getExistingDirectory(self.window, "Folder of .trans frames")
+        if folder:
+            self.load_trans(folder)
+
+    # ---------------------------------------------------------- jobs
+    def scan(self):
+        """Scan every frame for breakage in the background; the report lists the worst first."""
+        tl = self.doc.timeline
+        if not tl.active or self.jobs.busy:
+            self.doc.message("Nothing to scan: load a clip or set keys." if not tl.active else
+                             "A job is running; scan when it ends.")
+            return None
+        self.stop()
+        try:
+            conn = self.doc.pose.tskel().connectivity
+            if not len(conn):
+                raise ValueError("no attached points: connect points to bones first (Connect tab)")
+        except ValueError as exc:
+            self.show_error("Scan for breakage", str(exc))
+            return None
+        mats, joints, n = tl.matrices(), dict(self.doc.bones.joints), tl.frame_count
+        return self.jobs.run(f"Scanning {n} frames for breakage", lambda progress, cancel: scan_frames(
+            conn, mats, range(n), joints=joints, progress=progress, cancel=cancel), self._scanned)
+
+    def _scanned(self, verdicts) -> None:
+        self.last_scan = worst_first(verdicts)
+        if self.scan_dialog is None:
+            self.scan_dialog = ScanDialog(self.window)
+            self.scan_dialog.jump.connect(lambda f: self.go(f))
+        self.scan_dialog.show_verdicts(self.last_scan, self.doc.timeline.frame_label)
+        self.scan_dialog.show()
+        bad = [v for v in verdicts if not v.healthy]
+        w = self.last_scan[0]
+        self.doc.message(f"Scanned {len(verdicts)} frames: {len(bad)} with cracks or pieces; worst frame "
+                         f"{self.doc.timeline.frame_label(w.frame)} ({w.pieces} piece(s), {w.cracks} cracks"
+                         + (f" near {w.worst_joint}" if w.worst_joint else "") + ").")
+
+    def export(self, folder, *, tskel: bool = False):
+        tl = self.doc.timeline
+        if not tl.active:
+            self.show_error("Export frames", "nothing to export: load a clip or set keys first")
+            return None
+        try:
+            conn = self.doc.attachments.to_connectivity() if tskel else None
+            if conn is not None and not len(conn):
+                raise ValueError("no attached points for .tskel frames: connect points to bones first")
+        except ValueError as exc:
+            self.show_error("Export frames", str(exc))
+            return None
+        stem = tl.clip.name if tl.clip is not None else "keys"
+        numbers = [int(tl.frame_label(f)) for f in range(tl.frame_count)]
+        mats, bones = tl.matrices(), self.doc.bones
+        return self.jobs.run(f"Writing {len(numbers)} frames", lambda progress, cancel: write_frames(
+            folder, stem, bones, mats, numbers, connect=conn, progress=progress, cancel=cancel),
+            lambda paths: self.doc.message(f"Wrote {len(paths)} frames to {folder} ({paths[0].name} …)."))
+
+    def export_dialog(self, *, tskel: bool) -> None:
+        folder = QFileDialog.getExistingDirectory(self.window, "Folder for the frames")
+        if folder:
+            self.export(folder, tskel=tskel)

@@ -1,0 +1,131 @@
+"""The timeline model (no Qt): keys with undo, frames driving the pose, clips, and projects keeping it all."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import samples
+from volanim_core.errors import FormatError
+from volanim_core.motion.frames import write_frames
+from volanim_core.motion.keyframes import KeyPose
+from volanim_studio.model import Document
+from volanim_studio.model.project import apply_project, read_project, write_project
+
+WALK = ASSETS / "walk.bvh"  # the real clip of ../shared/data, bundled with its MIT licence
+
+
+@pytest.fixture
+def doc():
+    d = Document()
+    d.bone_edits.set_bones(samples.mannequin_bones())
+    d.undo.clear()
+    return d
+
+
+def arm(doc):
+    return doc.bones.index("L_UPPERARM")
+
+
+def test_keys_are_undoable_and_frames_between_them_interpolate(doc):
+    tl, st = doc.timeline, doc.settings
+    tl.set_key(0)
+    st.current_frame = 20
+    doc.pose.set_angles(arm(doc), (0, -80, 0))
+    tl.set_key()
+    assert sorted(tl.keys) == [0, 20] and doc.undo.undo_label == "Set key at frame 20"
+    tl.set_options(ease=False)
+    st.current_frame = 10
+    assert np.allclose(doc.pose.angles_of(arm(doc)), (0, -40, 0))  # halfway, shown on the sliders
+    edits = doc.undo.edits
+    st.current_frame = 5
+    assert doc.undo.edits == edits  # scrubbing is not an edit
+    doc.undo.undo()  # the key at 20 goes: frame 5 shows the only key left (rest)
+    assert sorted(tl.keys) == [0] and doc.pose.is_rest
+    doc.undo.redo()
+    assert np.allclose(doc.pose.angles_of(arm(doc)), (0, -20, 0))
+    tl.delete_key(0)
+    assert sorted(tl.keys) == [20] and np.allclose(doc.pose.angles_of(arm(doc)), (0, -80, 0))
+    with pytest.raises(ValueError, match="no key at frame 3"):
+        tl.delete_key(3)
+
+
+def test_stepping_wraps_and_the_length_covers_every_key(doc):
+    tl = doc.timeline
+    tl.set_key(60)
+    assert tl.frame_count == 61
+    tl.set_options(length=100)
+    assert tl.frame_count == 100 and tl.step(-1) == 99 and tl.step(2) == 1
+    with pytest.raises(ValueError, match="length"):
+        tl.set_options(length=0)
+
+
+def test_a_bvh_clip_drives_the_pose_and_keys_wait_for_it_to_unload(doc):
+    tl = doc.timeline
+    r = tl.load_bvh(WALK)
+    assert tl.frame_count == 1064 and tl.frame_rate == pytest.approx(r.motion.fps) and (r.up, r.forward) == ("y", "z")
+    doc.settings.current_frame = 500
+    assert np.allclose(doc.pose.matrices(), tl.matrices([500])[0], atol=1e-6)
+    with pytest.raises(ValueError, match="unload it"):
+        tl.set_key()
+    # editing the bones retargets the clip onto the new skeleton (FK keeps our new bone length)
+    wrist = doc.bones.joints["L_WRIST"].copy()
+    doc.bone_edits.move_joint("L_WRIST", wrist + [0, 0, -5])
+    assert tl.clip is not None and tl.matrices([500]).shape == (1, 18, 4, 4)
+    tl.unload()
+    assert tl.clip is None and tl.frame_count == 48
+    tl.set_key()
+
+
+def test_a_trans_folder_becomes_the_clip_in_frame_order(doc, tmp_path):
+    mats = np.stack([doc.pose.matrices()] * 3)
+    mats[:, :, 3, 0] += np.array([0.0, 5.0, 10.0])[:, None]
+    write_frames(tmp_path / "f", "walk", doc.bones, mats, [8, 10, 12])
+    clip = doc.timeline.load_trans(tmp_path / "f")
+    assert clip.frames == [8, 10, 12] and doc.timeline.frame_label(2) == "12"
+    doc.settings.current_frame = 2
+    assert np.allclose(doc.pose.matrices(), mats[2], atol=1e-5)
+    doc.bone_edits.move_joint("L_WRIST", doc.bones.joints["L_WRIST"] + [0, 0, -5])
+    assert doc.timeline.clip is None  # its frames were made for the old bones
+
+
+def test_a_project_keeps_keys_options_and_the_clip(doc, tmp_path):
+    tl = doc.timeline
+    doc.pose.set_angles(arm(doc), (0, -30, 0))
+    tl.set_key(12)
+    tl.set_options(ease=False, length=90, fps=30)
+    write_project(doc, tmp_path / "anim.volanim")
+    other = Document()
+    apply_project(other, read_project(tmp_path / "anim.volanim"), tmp_path / "anim.volanim")
+    t2 = other.timeline
+    assert sorted(t2.keys) == [12] and (t2.ease, t2.length, t2.fps) == (False, 90, 30.0)
+    assert np.allclose(t2.keys[12].angles[("L_SHOULDER", "L_ELBOW")], (0, -30, 0))
+
+    tl.load_bvh(WALK)
+    write_project(doc, tmp_path / "walk.volanim")
+    other = Document()
+    apply_project(other, read_project(tmp_path / "walk.volanim"), tmp_path / "walk.volanim")
+    assert other.timeline.clip is not None and other.timeline.frame_count == 1064
+
+
+def test_a_missing_clip_is_a_warning_and_a_bad_timeline_names_the_project(doc, tmp_path):
+    clip = tmp_path / "gone.bvh"
+    clip.write_bytes(WALK.read_bytes())
+    doc.timeline.load_bvh(clip)
+    write_project(doc, tmp_path / "p.volanim")
+    clip.unlink()
+    other = Document()
+    warnings = apply_project(other, read_project(tmp_path / "p.volanim"), tmp_path / "p.volanim")
+    assert any("clip was not loaded" in w and "gone.bvh" in w for w in warnings)
+
+    data = json.loads((tmp_path / "p.volanim").read_text())
+    for bad in ({"keys": {"x": []}}, {"keys": {"3": [["A", "B", 1, 2, 3]]}}, {"fps": 0}, {"ease": "yes"},
+                {"clip": {"kind": "avi", "path": "x"}}):
+        data["timeline"] = bad
+        (tmp_path / "bad.volanim").write_text(json.dumps(data))
+        with pytest.raises(FormatError, match="bad.volanim"):
+            read_project(tmp_path / "bad.volanim")
+    assert KeyPose.from_json([], "k").angles == {}

@@ -1,0 +1,121 @@
+"""The timeline with real widgets: load the walk, step with the keys, play with live previews, key a wave,
+scan it for breakage, export its frames, and keep it in the project."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+
+from paths import ASSETS
+from volanim_core import io
+from volanim_studio.model.modes import Mode
+from volanim_studio.qt.mapping_dialog import UNMAPPED
+
+from ..conftest import JOB_TIMEOUT_MS
+
+pytestmark = pytest.mark.gui
+
+WALK = ASSETS / "walk.bvh"  # the real clip of ../shared/data, bundled with its MIT licence
+
+
+@pytest.fixture
+def rigged(qtbot, window):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    return window
+
+
+def test_load_the_walk_through_the_mapping_dialog_and_step_with_the_keys(qtbot, rigged):
+    w = rigged
+    seen = {}
+
+    def ask(dialog):  # what the user sees: suggestions filled in, unmapped bones say so
+        seen["mapping"] = dialog.mapping()
+        seen["unmapped"] = [k for k, c in dialog.combos.items() if c.currentText() == UNMAPPED]
+        dialog.combos["HEAD"].setCurrentText(UNMAPPED)  # the user's edit: the head follows the neck
+        return True
+
+    assert w.timeline.load_bvh(WALK, ask=ask)
+    assert seen["mapping"]["L_UPPERARM"] == "LeftArm" and seen["mapping"]["R_THIGH"] == "RightUpLeg"
+    tl = w.doc.timeline
+    assert tl.frame_count == 1064 and "HEAD" not in tl.clip.mapping
+    assert w.timeline_panel.slider.maximum() == 1063 and "walk: frame 0" in w.timeline_panel.info.text()
+    qtbot.keyClick(w, Qt.Key_Right)
+    qtbot.keyClick(w, Qt.Key_Right)
+    assert w.doc.settings.current_frame == 2 and w.timeline_panel.frame.value() == 2
+    assert np.allclose(w.doc.pose.matrices(), tl.matrices([2])[0], atol=1e-6)
+    qtbot.keyClick(w, Qt.Key_End)
+    assert w.doc.settings.current_frame == 1063
+    qtbot.keyClick(w, Qt.Key_Right)  # wraps
+    assert w.doc.settings.current_frame == 0
+    qtbot.keyClick(w, Qt.Key_K)  # Cube mode: the arrows nudge the cube, not the frame
+    assert w.mode == Mode.CUBE
+    qtbot.keyClick(w, Qt.Key_Right)
+    assert w.doc.settings.current_frame == 0
+    # a cancelled mapping dialog leaves the clip as it was
+    before = dict(tl.clip.mapping)
+    assert not w.timeline.load_bvh(WALK, ask=lambda d: False)
+    assert tl.clip.mapping == before
+
+
+def test_play_draws_live_previews_dropping_frames_then_previews_in_full(qtbot, rigged):
+    w = rigged
+    assert w.timeline.load_bvh(WALK)
+    qtbot.keyClick(w, Qt.Key_Space)
+    assert w.timeline.playing and w.mode == Mode.POSE and w.timeline_panel.play.isChecked()
+    qtbot.waitUntil(lambda: len(w.timeline.shown_frames) >= 8, timeout=60_000)
+    qtbot.keyClick(w, Qt.Key_Space)
+    assert not w.timeline.playing
+    shown = w.timeline.shown_frames
+    assert all(b > a for a, b in zip(shown, shown[1:]))  # forward in clip time, frames skipped when slow
+    assert w.previews.live_timings and w.doc.preview is not None
+    # pausing previews the frame stopped on at full resolution, with its report
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    assert w.doc.preview.factor == 1
+    assert np.allclose(w.doc.pose.matrices(), w.doc.timeline.matrices([w.doc.settings.current_frame])[0], atol=1e-6)
+
+
+def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
+    w = rigged
+    doc, tl = w.doc, w.doc.timeline
+    arm = doc.bones.index("L_UPPERARM")
+    w.timeline_panel.length.setValue(12)
+    w.timeline_panel.length.editingFinished.emit()
+    assert tl.length == 12
+    qtbot.keyClick(w, Qt.Key_S)  # key the rest pose at frame 0
+    doc.settings.current_frame = 11
+    doc.pose.set_angles(arm, (0, -90, 0))
+    w.timeline_panel.set_key.click()
+    assert sorted(tl.keys) == [0, 11] and w.timeline_panel.slider.keys == [0, 11]
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
+    assert sorted(tl.keys) == [0]
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)
+    assert sorted(tl.keys) == [0, 11]
+    doc.settings.current_frame = 0
+    qtbot.keyClick(w, Qt.Key_S, Qt.ShiftModifier)
+    assert sorted(tl.keys) == [11]
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
+
+    w.timeline.scan()
+    qtbot.waitUntil(lambda: not w.busy and w.timeline.last_scan is not None, timeout=JOB_TIMEOUT_MS)
+    assert sorted(v.frame for v in w.timeline.last_scan) == list(range(12))
+    assert w.timeline.scan_dialog.table.rowCount() == 12 and "Scanned 12 frames" in w.statusBar().currentMessage()
+    worst = w.timeline.scan_dialog.frames[0]
+    w.timeline.scan_dialog.table.cellDoubleClicked.emit(0, 0)
+    assert doc.settings.current_frame == worst
+
+    w.timeline.export(tmp_path / "wave", tskel=True)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    files = sorted((tmp_path / "wave").glob("keys.*.trans"))
+    assert len(files) == 12 and len(list((tmp_path / "wave").glob("*.tskel"))) == 12
+    assert np.allclose(io.read_trans(files[-1]).matrices, tl.matrices([11])[0], atol=1e-5)
+
+    # the keys live in the project: save, reopen in a fresh window's model
+    assert w.files.save_project(path=tmp_path / "wave.volanim")
+    from volanim_studio.model import Document
+    from volanim_studio.model.project import apply_project, read_project
+
+    other = Document()
+    apply_project(other, read_project(tmp_path / "wave.volanim"), tmp_path / "wave.volanim")
+    assert sorted(other.timeline.keys) == [0, 11] and other.timeline.length == 12
