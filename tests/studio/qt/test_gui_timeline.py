@@ -68,7 +68,9 @@ def test_play_draws_live_previews_dropping_frames_then_previews_in_full(qtbot, r
     qtbot.keyClick(w, Qt.Key_Space)
     assert not w.timeline.playing
     shown = w.timeline.shown_frames
-    assert all(b > a for a, b in zip(shown, shown[1:]))  # forward in clip time, frames skipped when slow
+    # forward in clip time (frames skipped when the preview is slower than the clip; the clip loops once
+    # every 8.9 s, which a very busy machine may reach)
+    assert sum(b <= a for a, b in zip(shown, shown[1:])) <= 1
     assert w.previews.live_timings and w.doc.preview is not None
     # pausing previews the frame stopped on at full resolution, with its report
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
