@@ -14,7 +14,14 @@ from pathlib import Path
 
 from volanim_core.errors import Cancelled, FormatError
 
-from . import demo_command, motion_commands, reconstruct_commands, skeleton_commands, volume_commands
+from . import (
+    demo_command,
+    motion_commands,
+    reconstruct_commands,
+    sequence_commands,
+    skeleton_commands,
+    volume_commands,
+)
 from ._common import join_negative_infinity
 
 EPILOG = """examples:
@@ -37,7 +44,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (volume_commands, skeleton_commands, reconstruct_commands, motion_commands, demo_command):
+    for module in (volume_commands, skeleton_commands, reconstruct_commands, motion_commands, sequence_commands,
+                   demo_command):
         module.register(sub)
     return parser
 

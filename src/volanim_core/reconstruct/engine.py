@@ -392,20 +392,31 @@ def _check_arguments(mode, kernel, source, value) -> None:
             raise ValueError(f"source voxels must be numbers (bool, integer or float), got {np.asarray(source).dtype}")
 
 
+def output_dtype(mode: str, n_bones: int, source_dtype=None) -> np.dtype:
+    """The dtype :func:`reconstruct` returns for ``mode`` (a sequence's store is made before any frame)."""
+    if mode == "sampled":
+        return np.dtype(source_dtype)
+    if mode == "hotspot":
+        return np.dtype(np.uint16)
+    if mode == "bone":
+        return np.dtype(np.uint8 if n_bones < 256 else np.uint16)
+    return np.dtype(np.uint8)
+
+
 def _labels(mode: str, tskel: Tskel, value: int) -> tuple[type, np.ndarray]:
     """The kernel's output dtype and the value each sphere writes.
 
     Sampled relaxes like bone mode (owner = bone + 1) and then samples
     (``K.sample_rows``); hotspot counts, so its values are unused.
     """
-    bone_dtype = np.uint8 if len(tskel.bones) < 256 else np.uint16
+    dtype = output_dtype("bone" if mode == "sampled" else mode, len(tskel.bones)).type
     if mode == "hotspot":
-        return np.uint16, np.zeros(len(tskel), np.uint16)
+        return dtype, np.zeros(len(tskel), dtype)
     if mode in ("bone", "sampled"):
-        return bone_dtype, (tskel.bone + 1).astype(bone_dtype)
+        return dtype, (tskel.bone + 1).astype(dtype)
     if mode == "mottled":
-        return np.uint8, mottled_values(len(tskel))
-    return np.uint8, np.full(len(tskel), value, np.uint8)
+        return dtype, mottled_values(len(tskel))
+    return dtype, np.full(len(tskel), value, dtype)
 
 
 def _output_array(out, shape_zyx, out_dtype, final_dtype) -> np.ndarray:

@@ -1,0 +1,104 @@
+"""``volanim sequence``: many frames into one OME-Zarr time series, resumable, on all cores or a Dask cluster."""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+from ._common import add_command, ascii_float, ascii_int
+
+EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr
+  volanim sequence mannequin.0.50.connect assets/walk.bvh --bones mannequin.bones --frames 0:240:4 \\
+          --mode bone --melt 24 --workers 2 -o walk.zarr
+  volanim sequence ... --scheduler tcp://10.0.0.5:8786 -o /shared/walk.zarr     (a Dask cluster)
+  volanim sequence ... -o walk.zarr      (again: finished frames are skipped; --force starts over)"""
+
+
+class _Progress:
+    """frames done / total, frames per second and ETA on one stderr line."""
+
+    def __init__(self, skipped: int):
+        self.t0 = time.perf_counter()
+        self.skipped = skipped
+
+    def __call__(self, rec: dict, done: int, total: int) -> None:
+        made = done - self.skipped
+        elapsed = time.perf_counter() - self.t0
+        rate = made / elapsed if elapsed > 0 else 0.0
+        eta = (total - done) / rate if rate > 0 else 0.0
+        print(f"\rframe {done}/{total}  {rate:.2f} frames/s  ETA {int(eta) // 60}:{int(eta) % 60:02d}   ",
+              end="", file=sys.stderr, flush=True)
+
+
+def _sequence(args):
+    from volanim_core.io import read_bones, read_connect, read_volume_grid
+    from volanim_core.motion.retarget import read_mapping
+    from volanim_core.sequence import store
+    from volanim_core.sequence.frames import frames_from_files, melt
+    from volanim_core.sequence.run import default_workers, run_sequence
+
+    conn = read_connect(args.connect)
+    bones = read_bones(args.bones) if args.bones else None
+    frames = frames_from_files(conn, args.frames, bones=bones, mapping=read_mapping(args.map) if args.map else None,
+                               frames=args.range, up=args.up, forward=args.forward)
+    if args.melt:
+        frames += melt(frames, args.melt)
+    source, source_origin = None, (0, 0, 0)
+    if args.source:
+        source, origin, _ = read_volume_grid(args.source, dims=args.dims)
+        source_origin = tuple(int(round(v)) for v in origin)
+    workers = None if args.scheduler else (args.workers or default_workers())
+    done_before = len(store.finished(args.output)) if Path(args.output).exists() and not args.force else 0
+    rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_origin=source_origin,
+                       kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
+                       workers=workers, scheduler=args.scheduler, force=args.force,
+                       threads_per_worker=args.threads_per_worker, on_frame=_Progress(done_before))
+    print(file=sys.stderr)
+    print(format_report(rep))
+    print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "
+          f"origin {rep.bounds.lo}; {rep.computed} made, {rep.skipped} already complete; {rep.workers}; "
+          f"{rep.seconds:.1f} s")
+
+
+def format_report(rep) -> str:
+    """The per-frame table: filled voxels, loss against the rest pose, hotspot max, clipped, time, memory."""
+    lines = ["frame   filled voxels   loss %   hotspot max   clipped   seconds   worker peak MB"]
+    for r in rep.records:
+        loss = 100.0 * (rep.rest_filled - r["filled"]) / max(rep.rest_filled, 1)
+        hot = "-" if r.get("hotspot_max") is None else str(r["hotspot_max"])
+        lines.append(f"{r['number']:5d}   {r['filled']:13,d}   {loss:6.2f}   {hot:>11}   {r['clipped']:7d}   "
+                     f"{r['seconds']:7.3f}   {r['peak_rss'] / 2**20:14.0f}")
+    return "\n".join(lines)
+
+
+def register(sub) -> None:
+    from volanim_core.reconstruct.engine import MODES
+
+    from .motion_commands import parse_frames
+
+    p = add_command(sub, "sequence", "Reconstruct many frames into one OME-Zarr time series (t, z, y, x): one grid "
+                    "for all frames, resumable, on all local cores or a Dask cluster.", EXAMPLE, _sequence)
+    p.add_argument("connect", help="the .connect every frame uses")
+    p.add_argument("frames", nargs="+", help=".trans or .tskel files (numbered NAME.0000.trans ...), or one .bvh")
+    p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
+    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
+    p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
+    p.add_argument("--padding", type=ascii_int, default=2, help="voxels around every frame's spheres (default 2)")
+    p.add_argument("-o", "--output", required=True, help="the .zarr store (a folder)")
+    p.add_argument("--every-frame-as", metavar="DIR/NAME.%%04d.vti",
+                   help="also write each frame as a file (.vti, .nrrd, .vol, .VOL; %%04d = frame number)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=ascii_int, help="local worker processes (default: every core)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on this Dask cluster instead")
+    p.add_argument("--threads-per-worker", type=ascii_int, default=1, help="numba threads per worker (default 1)")
+    p.add_argument("--force", action="store_true", help="recompute every frame (and replace another sequence)")
+    p.add_argument("--fps", type=ascii_float, default=24.0, help="frame rate recorded in the store (default 24)")
+    p.add_argument("--melt", type=ascii_int, metavar="N", help="after the frames, N more: every DT shrinks to 0")
+    p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
+    p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
+    p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",
+                   help="BVH: which frames")
+    p.add_argument("--up", default="auto", help="BVH: the clip's up axis (default detected)")
+    p.add_argument("--forward", default="auto", help="BVH: the way the clip faces (default detected)")

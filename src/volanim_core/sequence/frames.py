@@ -1,0 +1,97 @@
+"""What a sequence is made of: one pose per frame for one connectivity, from any source.
+
+    .trans files          the matrices, checked against the .connect's bones
+    .tskel files          the matrices; its points must be the .connect's (else refused)
+    a .bvh clip           retargeted onto --bones (optionally --map), --frames START:STOP:STEP
+    melt(N) after them    the last pose held while every DT shrinks linearly to 0 (the old meltMan)
+
+Each frame is a :class:`FrameSpec`: a number (for file names and the manifest),
+the bone matrices and a DT scale (1 except in melts).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from volanim_core.errors import FormatError
+from volanim_core.motion.frames import frame_number
+from volanim_core.rig.connectivity import Connectivity, Tskel
+from volanim_core.rig.tskel import check_root_order
+
+
+@dataclass(frozen=True)
+class FrameSpec:
+    number: int
+    matrices: np.ndarray  # (B, 4, 4) row-vector, rest voxel coordinates -> posed
+    dt_scale: float = 1.0
+
+    def tskel(self, conn: Connectivity) -> Tskel:
+        dt = conn.dt if self.dt_scale == 1.0 else conn.dt * self.dt_scale
+        return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric)
+
+
+def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, frames=slice(None),
+                      up: str = "auto", forward: str = "auto") -> list[FrameSpec]:
+    """FrameSpecs from ``.trans``/``.tskel`` files or one ``.bvh`` (needs ``bones``: a BoneSkeleton)."""
+    from volanim_core import io
+
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise ValueError("no frames given: name .trans or .tskel files, or a .bvh clip")
+    if any(p.suffix.lower() == ".bvh" for p in paths):
+        if len(paths) != 1:
+            raise ValueError("give one .bvh clip, or .trans/.tskel files, not both")
+        return _from_bvh(conn, paths[0], bones, mapping, frames, up, forward)
+    numbers = [frame_number(p) for p in paths]
+    if None in numbers or len(set(numbers)) != len(numbers):
+        numbers = list(range(len(paths)))  # names without (distinct) numbers: their order on the command line
+    out = []
+    for p, n in sorted(zip(paths, numbers), key=lambda pn: pn[1]):
+        suffix = p.suffix.lower()
+        if suffix == ".trans":
+            trans = io.read_trans(p)
+            mats, bones_of = trans.matrices, trans.bones
+        elif suffix == ".tskel":
+            t = io.read_tskel(p)
+            same = len(t) == len(conn) and np.array_equal(t.points, conn.points) and np.array_equal(t.bone, conn.bone)
+            if not same:
+                raise FormatError(p, f"its {len(t)} points are not the .connect's {len(conn)}: a sequence runs "
+                                     "one connectivity; pass the .trans frames (or the matching .connect)")
+            mats, bones_of = t.matrices, t.bones
+        else:
+            raise ValueError(f"{p}: a frame must be a .trans, .tskel or .bvh file")
+        try:
+            check_root_order(conn.bones, bones_of, p.name)
+        except ValueError as exc:
+            raise FormatError(p, str(exc)) from None
+        out.append(FrameSpec(int(n), np.asarray(mats, np.float64)))
+    return out
+
+
+def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward) -> list[FrameSpec]:
+    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.motion.retarget import Retarget, check_mapping_file
+    from volanim_core.rig.pose import root_bones
+
+    if bones is None:
+        raise ValueError(f"{path.name}: a BVH clip needs the bone skeleton it drives (--bones MODEL.bones)")
+    check_root_order(conn.bones, root_bones(bones), ".bones")
+    motion = read_bvh(path)
+    if mapping is not None:
+        check_mapping_file(path, mapping, bones, motion)
+    mats = Retarget.build(bones, motion, mapping, up=up, forward=forward).matrices(frames)
+    numbers = list(range(motion.frames))[frames]
+    if not numbers:
+        raise ValueError(f"{path.name}: the frame range selects none of its {motion.frames} frames")
+    return [FrameSpec(n, m) for n, m in zip(numbers, mats)]
+
+
+def melt(after: list[FrameSpec], n: int) -> list[FrameSpec]:
+    """``n`` frames after the last one: its pose held while every sphere's DT shrinks linearly to 0."""
+    if n < 1:
+        raise ValueError(f"a melt needs at least one frame, got {n}")
+    last = after[-1]
+    return [FrameSpec(last.number + k, last.matrices, float(1.0 - k / n)) for k in range(1, n + 1)]

@@ -1,0 +1,202 @@
+"""Run a sequence: plan one grid for every frame, skip what is done, reconstruct the rest anywhere.
+
+    frames --shared bounds (tskelbounds over all frames + padding)--> one grid, one origin
+    plan key (connectivity, frames, mode, kernel, padding, source) --> new store, or resume the old one
+    frames not in the manifest --executor.submit(reconstruct_frame)--> stats --> manifest (driver only)
+
+The executor is anything with ``submit`` (``concurrent.futures``): this
+process (1 worker), a local process pool (N workers, one numba thread each),
+or a Dask cluster's ``client.get_executor()`` -- the same task function runs
+in all three, so a frame is bit-identical wherever it was made.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import time
+from concurrent.futures import FIRST_COMPLETED, Future, wait
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from volanim_core.limits import available_bytes, human_bytes
+from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
+from volanim_core.rig.connectivity import Connectivity
+from volanim_core.volume import Bounds
+
+from . import store
+from .frames import FrameSpec
+from .task import Payload, install, reconstruct_frame
+
+
+@dataclass
+class SequenceReport:
+    bounds: Bounds
+    dtype: str
+    records: list[dict]  # per frame (index order): the manifest record
+    skipped: int  # frames already complete, not redone
+    computed: int
+    seconds: float
+    rest_filled: int  # the rest pose's filled voxels in the same mode (for loss)
+    workers: str = ""
+    extra: dict = field(default_factory=dict)
+
+
+def shared_bounds(conn: Connectivity, frames: list[FrameSpec], padding: int = 2) -> Bounds:
+    """One output grid holding every frame (the old ``tskelbounds`` over all of them)."""
+    return grid_bounds([f.tskel(conn) for f in frames], padding)
+
+
+def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int, padding: int, source) -> str:
+    """What the store's content depends on; a rerun with another key must not resume."""
+    h = hashlib.blake2b(digest_size=16)
+    for a in (conn.points, conn.dt, conn.bone, *[np.asarray(b.proximal + b.distal) for b in conn.bones]):
+        h.update(np.ascontiguousarray(a).tobytes())
+    for f in frames:
+        h.update(np.ascontiguousarray(f.matrices).tobytes())
+        h.update(np.array([f.number, f.dt_scale]).tobytes())
+    h.update(f"{mode}|{kernel}|{padding}|{conn.metric}".encode())
+    if source is not None:
+        h.update(str((source.shape, source.dtype.str)).encode())
+        h.update(np.ascontiguousarray(source).data)
+    return h.hexdigest()
+
+
+def check_memory(bounds: Bounds, dtype: np.dtype, workers: int, source) -> int:
+    """Bytes one frame needs; refuse (ValueError) when ``workers`` of them cannot fit, saying how large."""
+    voxels = int(np.prod(bounds.shape, dtype=np.int64))
+    per_frame = voxels * (2 * dtype.itemsize + 4)  # output + stencil (float32) + the copy written out
+    check_output_grid(bounds.shape, 2 * dtype.itemsize + 4)  # the voxel limit, and one frame at all
+    source_bytes = 0 if source is None else int(source.nbytes)
+    need = workers * (per_frame + source_bytes)
+    free = available_bytes()
+    if free is not None and need > free:
+        grid = "x".join(map(str, bounds.shape))
+        raise ValueError(f"each frame needs {human_bytes(per_frame)} (grid {grid} = {voxels:,} voxels of "
+                         f"{dtype}) plus the source ({human_bytes(source_bytes)}) per worker: {workers} workers "
+                         f"need {human_bytes(need)} but {human_bytes(free)} is available; use fewer --workers "
+                         f"or a smaller --padding")
+    return per_frame
+
+
+def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str = "binary", source=None,
+                 source_origin=(0, 0, 0), kernel: int = 1, padding: int = 2, fps: float = 24.0,
+                 every_frame_as: str | None = None, workers: int | None = None, scheduler=None,
+                 force: bool = False, threads_per_worker: int = 1, on_frame=None) -> SequenceReport:
+    """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
+
+    ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
+    ``on_frame(record, done, total)`` after each finished frame (progress).
+    """
+    if not frames:
+        raise ValueError("no frames to reconstruct")
+    if mode == "sampled" and source is None:
+        raise ValueError("sampled mode needs the source volume (--source)")
+    t0 = time.perf_counter()
+    out = Path(out)
+    bounds = shared_bounds(conn, frames, padding)
+    dtype = output_dtype(mode, len(conn.bones), None if source is None else source.dtype)
+    n_workers = 1 if workers is None and scheduler is None else (workers or 1)
+    if scheduler is None:
+        check_memory(bounds, dtype, n_workers, source)
+    key = plan_key(conn, frames, mode, kernel, padding, source)
+    plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
+            "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
+    old = store.read_plan(out) if out.exists() else None
+    if old is not None and old.get("key") == key and not force:
+        done = store.finished(out)
+    else:
+        if out.exists() and old is None and any(out.iterdir()) and not force:
+            raise ValueError(f"{out} exists and is not a volanim sequence; choose another -o or pass --force")
+        if old is not None and old.get("key") != key and not force:
+            raise ValueError(f"{out} holds another sequence (different frames, connectivity, mode or source); "
+                             "pass --force to replace it, or choose another -o")
+        store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps)
+        done = {}
+    if every_frame_as:
+        Path(every_frame_as).parent.mkdir(parents=True, exist_ok=True)
+    todo = [i for i in range(len(frames)) if i not in done]
+    payload = Payload(conn, mode, kernel, bounds, str(out.resolve()), source, tuple(source_origin), every_frame_as,
+                      threads_per_worker)
+    records = dict(done)
+    total = len(frames)
+    with _executor(payload, n_workers, scheduler) as (submit, label):
+        pending: set[Future] = set()
+        queue = list(todo)
+        limit = 2 * max(n_workers, 1) if scheduler is None else 4 * 64  # bounded: frames are big in flight
+        while queue or pending:
+            while queue and len(pending) < limit:
+                i = queue.pop(0)
+                pending.add(submit(i, frames[i]))
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                rec = fut.result()
+                store.record(out, rec)
+                records[rec["index"]] = rec
+                if on_frame is not None:
+                    on_frame(rec, len(records), total)
+    rest = _rest_filled(conn)
+    return SequenceReport(bounds, dtype.name, [records[i] for i in range(total)], len(done), len(todo),
+                          time.perf_counter() - t0, rest, label)
+
+
+def _rest_filled(conn) -> int:
+    """Filled voxels of the rest pose (every mode covers the same voxels): each frame's loss is against it."""
+    from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.rig.tskel import identity_tskel
+
+    r = reconstruct(identity_tskel(conn), mode="bone")
+    return int(r.stats["filled"])
+
+
+class _executor:
+    """``with _executor(payload, workers, scheduler) as (submit, label)``: submit(index, spec) -> Future."""
+
+    def __init__(self, payload: Payload, workers: int, scheduler):
+        self.payload, self.workers, self.scheduler = payload, workers, scheduler
+        self._close = []
+
+    def __enter__(self):
+        p = self.payload
+        if self.scheduler is not None:
+            from distributed import Client
+
+            client = self.scheduler if isinstance(self.scheduler, Client) else Client(self.scheduler)
+            if client is not self.scheduler:
+                self._close.append(client.close)
+            shared = client.scatter(p, broadcast=True, hash=False)  # shipped to each worker once
+            ex = client.get_executor(pure=False)
+            n = len(client.scheduler_info().get("workers", {}))
+            return (lambda i, spec: ex.submit(reconstruct_frame, shared, i, spec)), f"Dask, {n} workers"
+        if self.workers <= 1:
+            install(p)
+            return _inline, "1 worker (this process)"
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=install, initargs=(p,))
+        self._close.append(lambda: pool.shutdown(wait=True, cancel_futures=True))
+        return (lambda i, spec: pool.submit(reconstruct_frame, None, i, spec)), f"{self.workers} local workers"
+
+    def __exit__(self, *exc):
+        for close in reversed(self._close):
+            close()
+        return False
+
+
+def _inline(index: int, spec: FrameSpec) -> Future:
+    fut: Future = Future()
+    try:
+        fut.set_result(reconstruct_frame(None, index, spec))
+    except BaseException as exc:  # noqa: BLE001 - handed to the caller through the future, like a pool would
+        fut.set_exception(exc)
+        if isinstance(exc, KeyboardInterrupt):
+            raise
+    return fut
+
+
+def default_workers() -> int:
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)

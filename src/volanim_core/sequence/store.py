@@ -1,0 +1,122 @@
+"""A sequence on disk: an OME-Zarr time series plus an append-only manifest of finished frames.
+
+    OUT.zarr/zarr.json            group; attributes "ome" (NGFF 0.5 multiscales: t, z, y, x) and "volanim"
+    OUT.zarr/0/                   the array (T, Z, Y, X); chunks (1, cz, Y, X) inside shards (1, Z, Y, X):
+                                  one shard per frame, so no two tasks ever write the same shard
+                                  (concurrent writes into one shard silently lose data)
+    OUT.zarr/volanim-plan.json    what was asked (the plan's key), written once, atomically
+    OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes, stats
+
+A frame is appended to the manifest only after its shard is written, by the
+one process that runs the sequence, in one ``write`` + ``fsync``; a killed run
+leaves at most a torn last line, which reading ignores. So a rerun skips
+exactly the frames that were complete and redoes the rest.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+PLAN_FILE, FRAMES_FILE = "volanim-plan.json", "volanim-frames.jsonl"
+
+
+def frame_checksum(frame_zyx: np.ndarray) -> str:
+    return hashlib.sha256(np.ascontiguousarray(frame_zyx).data).hexdigest()
+
+
+def chunk_depth(shape_zyx, itemsize: int, target: int = 4 << 20) -> int:
+    """Slices per chunk: about ``target`` bytes, so a viewer reading one slice reads little."""
+    z, y, x = shape_zyx
+    return int(max(1, min(z, target // max(1, y * x * itemsize))))
+
+
+def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: dict, *, fps: float = 24.0,
+           spacing=(1.0, 1.0, 1.0)):
+    """A new, empty sequence store (an existing one at ``path`` is replaced)."""
+    import zarr
+
+    from volanim_core.io._atomic import atomic_write_text
+
+    path = Path(path)
+    dtype = np.dtype(dtype)
+    z, y, x = (int(v) for v in shape_zyx)
+    ox, oy, oz = (float(v) for v in origin_xyz)
+    sx, sy, sz = (float(v) for v in spacing)
+    ome = {"version": "0.5", "multiscales": [{
+        "name": path.stem,
+        "axes": [{"name": "t", "type": "time", "unit": "second"}, {"name": "z", "type": "space"},
+                 {"name": "y", "type": "space"}, {"name": "x", "type": "space"}],
+        "datasets": [{"path": "0", "coordinateTransformations": [
+            {"type": "scale", "scale": [1.0 / fps, sz, sy, sx]},
+            {"type": "translation", "translation": [0.0, oz * sz, oy * sy, ox * sx]}]}],
+    }]}
+    root = zarr.open_group(str(path), mode="w", zarr_format=3)
+    root.attrs.update({"ome": ome, "volanim": {"origin_xyz": [ox, oy, oz], "mode": plan.get("mode"),
+                                               "frames": plan.get("numbers")}})
+    cz = chunk_depth((z, y, x), dtype.itemsize)
+    # the shard must hold whole chunks: round its depth up (past the array's edge), still one per frame
+    root.create_array("0", shape=(n_frames, z, y, x), dtype=dtype,
+                      chunks=(1, cz, y, x), shards=(1, -(-z // cz) * cz, y, x),
+                      fill_value=0, dimension_names=("t", "z", "y", "x"))
+    atomic_write_text(path / PLAN_FILE, json.dumps(plan, indent=1))
+    (path / FRAMES_FILE).write_bytes(b"")
+
+
+def read_plan(path: str | Path) -> dict | None:
+    p = Path(path) / PLAN_FILE
+    if not p.is_file():
+        return None
+    try:
+        return json.loads(p.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        return None
+
+
+def finished(path: str | Path) -> dict[int, dict]:
+    """Frame index -> its manifest record, for every frame recorded complete (a torn last line is ignored)."""
+    p = Path(path) / FRAMES_FILE
+    out: dict[int, dict] = {}
+    if not p.is_file():
+        return out
+    for line in p.read_bytes().split(b"\n"):
+        try:
+            rec = json.loads(line)
+            out[int(rec["index"])] = rec
+        except (ValueError, KeyError, TypeError):
+            continue  # the line a kill cut short
+    return out
+
+
+def record(path: str | Path, rec: dict) -> None:
+    """Append one finished frame: one write, then fsync (called by the driver only)."""
+    line = (json.dumps(rec, separators=(",", ":")) + "\n").encode()
+    fd = os.open(Path(path) / FRAMES_FILE, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    try:
+        os.write(fd, line)
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def open_frames(path: str | Path, mode: str = "r"):
+    """The ``(T, Z, Y, X)`` zarr array of a sequence."""
+    import zarr
+
+    return zarr.open_array(str(Path(path) / "0"), mode=mode)
+
+
+def read_frame(path: str | Path, index: int) -> np.ndarray:
+    """Frame ``index`` as a ``[x, y, z]`` volume (like every volanim volume)."""
+    return np.asarray(open_frames(path)[index]).T
+
+
+def origin(path: str | Path) -> tuple[int, int, int]:
+    import zarr
+
+    o = zarr.open_group(str(path), mode="r").attrs["volanim"]["origin_xyz"]
+    return tuple(int(v) for v in o)

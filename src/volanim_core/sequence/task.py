@@ -1,0 +1,91 @@
+"""The one function that reconstructs a frame of a sequence, wherever it runs.
+
+    Payload (connectivity, source, mode, shared bounds, store path)
+        --local pool: handed to each worker process once (initializer)
+        --Dask: scattered to every worker once, passed to each task as a future
+    reconstruct_frame(payload, index, spec) --> writes shard ``index`` of the zarr store
+        (+ the optional per-frame file) --> returns statistics, never the voxels
+
+Neighbour lists depend on the connectivity and the radii, not on the pose,
+so each worker computes them once per DT scale and keeps them.
+"""
+
+from __future__ import annotations
+
+import resource
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from volanim_core.rig.connectivity import Connectivity
+from volanim_core.volume import Bounds
+
+from .frames import FrameSpec
+from .store import frame_checksum, open_frames
+
+
+@dataclass
+class Payload:
+    conn: Connectivity
+    mode: str
+    kernel: int
+    bounds: Bounds
+    store: str
+    source: np.ndarray | None = None
+    source_origin: tuple = (0, 0, 0)
+    every_frame_as: str | None = None  # "DIR/NAME.%04d.vti" (or .nrrd, .vol, .VOL)
+    threads: int = 1  # numba threads per task: N workers x 1 thread use N cores without oversubscription
+
+
+_INSTALLED: Payload | None = None
+_NEIGHBOURS: dict = {}  # (id(payload), dt_scale) -> sphere_neighbours
+
+
+def install(payload: Payload) -> None:
+    """A local pool worker's initializer: keep the payload for every task it runs."""
+    global _INSTALLED
+    _INSTALLED = payload
+    _NEIGHBOURS.clear()
+
+
+def _neighbours(p: Payload, spec: FrameSpec, tskel):
+    from volanim_core.reconstruct.neighbours import sphere_neighbours
+
+    key = (id(p), spec.dt_scale)
+    if key not in _NEIGHBOURS:
+        if len(_NEIGHBOURS) > 4:  # a melt has a new scale every frame: keep only the recent ones
+            _NEIGHBOURS.clear()
+        _NEIGHBOURS[key] = sphere_neighbours(tskel)
+    return _NEIGHBOURS[key]
+
+
+def frame_file(pattern: str, number: int) -> str:
+    """``DIR/NAME.%04d.vti`` with the frame number filled in."""
+    return pattern % number if "%" in pattern else pattern.replace("{}", str(number))
+
+
+def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> dict:
+    """Reconstruct ``spec`` into frame ``index`` of the store; returns its statistics."""
+    from volanim_core.reconstruct.engine import reconstruct
+
+    p = payload if payload is not None else _INSTALLED
+    if p is None:
+        raise RuntimeError("reconstruct_frame: no payload (the pool's initializer did not run)")
+    t0 = time.perf_counter()
+    tskel = spec.tskel(p.conn)
+    r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
+                    bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads)
+    zyx = np.ascontiguousarray(r.volume.T)
+    open_frames(p.store, "r+")[index] = zyx  # shard ``index``: this task's alone
+    if p.every_frame_as:
+        from volanim_core import io
+
+        vol, _ = io.saturate_for_raw(frame_file(p.every_frame_as, spec.number), r.volume)
+        io.write_volume(frame_file(p.every_frame_as, spec.number), vol, origin=r.origin)
+    s = r.stats
+    return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(zyx),
+            "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),
+            "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
+            "dt_scale": spec.dt_scale, "seconds": round(time.perf_counter() - t0, 4),
+            "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}

@@ -1,0 +1,136 @@
+"""Sequences: one grid for every frame, bit-identical on 1 worker, 2 workers and a Dask cluster, resumable
+after a kill -9, and each frame equal to the single-frame reconstruction placed in the shared grid."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import io
+from volanim_core.cli import main
+from volanim_core.errors import FormatError
+from volanim_core.motion.frames import write_frames
+from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.samples import mannequin_bones
+from volanim_core.sequence import store
+from volanim_core.sequence.frames import frames_from_files, melt
+from volanim_core.sequence.run import run_sequence, shared_bounds
+
+CONNECT = ASSETS / "mannequin.0.50.connect"
+WALK = ASSETS / "walk.bvh"
+
+
+@pytest.fixture(scope="module")
+def conn():
+    return io.read_connect(CONNECT)
+
+
+@pytest.fixture(scope="module")
+def walk(conn):
+    """Six frames across the first stride of the real walk."""
+    return frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 120, 20))
+
+
+def frames_of(path) -> list[np.ndarray]:
+    return [np.asarray(f) for f in store.open_frames(path)[:]]
+
+
+def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_path, conn, walk):
+    from distributed import Client, LocalCluster
+
+    one = run_sequence(conn, walk, tmp_path / "one.zarr", mode="bone", workers=1)
+    two = run_sequence(conn, walk, tmp_path / "two.zarr", mode="bone", workers=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client)
+        ran_on = {w["host"] for w in client.scheduler_info()["workers"].values()}
+    assert ran_on == {"127.0.0.1"} and dask.workers == "Dask, 2 workers"
+    a, b, c = (frames_of(tmp_path / f"{n}.zarr") for n in ("one", "two", "dask"))
+    assert len(a) == 6 and all(np.array_equal(x, y) and np.array_equal(x, z) for x, y, z in zip(a, b, c))
+    assert [r["sha256"] for r in one.records] == [r["sha256"] for r in dask.records]
+    assert len({r["sha256"] for r in two.records}) == 6  # the frames differ from each other
+    assert all(r["filled"] > 0 and "peak_rss" in r for r in dask.records)
+
+
+def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_grid(tmp_path, conn, walk):
+    frames = walk + melt(walk, 2)
+    rep = run_sequence(conn, frames, tmp_path / "s.zarr", mode="mottled", padding=3)
+    bounds = shared_bounds(conn, frames, 3)
+    assert rep.bounds == bounds and store.origin(tmp_path / "s.zarr") == bounds.lo
+    assert store.open_frames(tmp_path / "s.zarr").shape == (8, *bounds.shape[::-1])
+    for i, spec in enumerate(frames):
+        alone = reconstruct(spec.tskel(conn), mode="mottled")  # its own tight grid
+        placed = np.zeros(bounds.shape, alone.volume.dtype)
+        at = np.subtract(alone.origin, bounds.lo)
+        placed[at[0]:at[0] + alone.volume.shape[0], at[1]:at[1] + alone.volume.shape[1],
+               at[2]:at[2] + alone.volume.shape[2]] = alone.volume
+        assert np.array_equal(store.read_frame(tmp_path / "s.zarr", i), placed), f"frame {i}"
+    assert rep.records[-1]["filled"] < rep.records[0]["filled"] / 2  # melting
+
+
+def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
+    frames = tmp_path / "frames"
+    conn = io.read_connect(CONNECT)
+    clip = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))
+    write_frames(frames, "walk", mannequin_bones(), np.array([f.matrices for f in clip]), [f.number for f in clip])
+    out = tmp_path / "walk.zarr"
+    trans = [str(p) for p in sorted(frames.glob("*.trans"))]
+    cmd = [sys.executable, "-m", "volanim_core.cli", "sequence", str(CONNECT), *trans, "--mode", "bone", "--workers",
+           "1", "-o", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.monotonic() + 300
+    while len(store.finished(out)) < 5 and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    complete = store.finished(out)
+    assert 5 <= len(complete) < 24, "the kill came half-way"
+    made = []
+    rep = run_sequence(conn, frames_from_files(conn, sorted(frames.glob("*.trans"))), out, mode="bone",
+                       on_frame=lambda rec, done, total: made.append(rec["index"]))
+    assert rep.skipped == len(complete) and sorted(made) == sorted(set(range(24)) - set(complete))
+    clean = run_sequence(conn, frames_from_files(conn, sorted(frames.glob("*.trans"))), tmp_path / "clean.zarr",
+                         mode="bone")
+    assert [r["sha256"] for r in rep.records] == [r["sha256"] for r in clean.records]
+    assert all(np.array_equal(x, y) for x, y in zip(frames_of(out), frames_of(tmp_path / "clean.zarr")))
+
+
+def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tmp_path, capsys):
+    out = tmp_path / "w.zarr"
+    args = ["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "--frames", "0:40:20",
+            "--mode", "bone", "--workers", "1", "-o", str(out), "--every-frame-as", str(tmp_path / "f" / "w.%04d.nrrd")]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "loss %" in text and "wrote" in text and "2 made, 0 already complete" in text
+    vol, origin, _ = io.read_volume_grid(tmp_path / "f" / "w.0020.nrrd")
+    assert np.array_equal(vol, store.read_frame(out, 1)) and tuple(int(v) for v in origin) == store.origin(out)
+    assert main(args) == 0 and "0 made, 2 already complete" in capsys.readouterr().out
+    assert main(args[:-4] + ["-o", str(out), "--padding", "5"]) == 2
+    assert "holds another sequence" in capsys.readouterr().err
+    assert main(args[:-4] + ["-o", str(out), "--padding", "5", "--force"]) == 0
+
+
+def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
+    with pytest.raises(ValueError, match="100000 workers need .* available"):
+        run_sequence(conn, walk, tmp_path / "m.zarr", mode="bone", workers=100_000)
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "a.txt").write_text("mine")
+    with pytest.raises(ValueError, match="not a volanim sequence"):
+        run_sequence(conn, walk, tmp_path / "notes", mode="bone")
+    assert (tmp_path / "notes" / "a.txt").read_text() == "mine"
+    with pytest.raises(ValueError, match="needs the source"):
+        run_sequence(conn, walk, tmp_path / "s.zarr", mode="sampled")
+    from volanim_core.rig.tskel import identity_tskel
+
+    io.write_tskel(tmp_path / "x.0001.tskel", identity_tskel(conn.take(np.arange(100))))
+    with pytest.raises(FormatError, match=r"x\.0001\.tskel.*not the \.connect"):
+        frames_from_files(conn, [tmp_path / "x.0001.tskel"])
+    with pytest.raises(ValueError, match="needs the bone skeleton"):
+        frames_from_files(conn, [WALK])
