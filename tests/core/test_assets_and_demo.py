@@ -38,3 +38,7 @@ def test_headless_demo_writes_every_stage(tmp_path, capsys):
     later, o1, _ = io.read_volume_grid(tmp_path / "walk" / "walk.0532-sampled.vti")
     assert abs(int((first > 0).sum()) - int((rest > 0).sum())) < 0.1 * (rest > 0).sum()  # same body, posed
     assert o1[1] < o0[1] - 100  # the mannequin walked forward (-y) across the clip
+    from volanim_core.sequence import store
+
+    assert "[7] sequence: 24 frames" in text and store.open_frames(out["sequence"]).shape[0] == 24
+    assert len(store.finished(out["sequence"])) == 24

@@ -1,9 +1,9 @@
 """A sequence on disk: an OME-Zarr time series plus an append-only manifest of finished frames.
 
     OUT.zarr/zarr.json            group; attributes "ome" (NGFF 0.5 multiscales: t, z, y, x) and "volanim"
-    OUT.zarr/0/                   the array (T, Z, Y, X); chunks (1, cz, Y, X) inside shards (1, Z, Y, X):
-                                  one shard per frame, so no two tasks ever write the same shard
-                                  (concurrent writes into one shard silently lose data)
+    OUT.zarr/0/                   the array (T, Z, Y, X); 64^3 chunks inside shards (1, Z, Y, X): one shard
+                                  per frame, so no two tasks ever write the same shard (concurrent writes
+                                  into one shard silently lose data); all-zero chunks are not stored
     OUT.zarr/volanim-plan.json    what was asked (the plan's key), written once, atomically
     OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes, stats
 
@@ -25,14 +25,17 @@ import numpy as np
 PLAN_FILE, FRAMES_FILE = "volanim-plan.json", "volanim-frames.jsonl"
 
 
-def frame_checksum(frame_zyx: np.ndarray) -> str:
-    return hashlib.sha256(np.ascontiguousarray(frame_zyx).data).hexdigest()
+def frame_checksum(part_zyx: np.ndarray, region=None) -> str:
+    """sha256 of a frame: the part its body reaches (and where that is); the rest is zero by construction."""
+    h = hashlib.sha256(repr([(s.start, s.stop) for s in region or ()]).encode())
+    h.update(np.ascontiguousarray(part_zyx).data)
+    return h.hexdigest()
 
 
-def chunk_depth(shape_zyx, itemsize: int, target: int = 4 << 20) -> int:
-    """Slices per chunk: about ``target`` bytes, so a viewer reading one slice reads little."""
-    z, y, x = shape_zyx
-    return int(max(1, min(z, target // max(1, y * x * itemsize))))
+def chunk_shape(shape_zyx, edge: int = 64) -> tuple[int, int, int]:
+    """Bricks of ``edge`` voxels (fewer along a shorter axis): a posed body fills a small part of a
+    sequence's shared grid, and bricks it does not touch are all zero, so they are never written."""
+    return tuple(int(max(1, min(n, edge))) for n in shape_zyx)
 
 
 def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: dict, *, fps: float = 24.0,
@@ -58,11 +61,11 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     root = zarr.open_group(str(path), mode="w", zarr_format=3)
     root.attrs.update({"ome": ome, "volanim": {"origin_xyz": [ox, oy, oz], "mode": plan.get("mode"),
                                                "frames": plan.get("numbers")}})
-    cz = chunk_depth((z, y, x), dtype.itemsize)
-    # the shard must hold whole chunks: round its depth up (past the array's edge), still one per frame
-    root.create_array("0", shape=(n_frames, z, y, x), dtype=dtype,
-                      chunks=(1, cz, y, x), shards=(1, -(-z // cz) * cz, y, x),
-                      fill_value=0, dimension_names=("t", "z", "y", "x"))
+    chunks = chunk_shape((z, y, x))
+    # a shard holds whole chunks: round it up (past the array's edge), still exactly one per frame
+    shard = tuple(-(-n // c) * c for n, c in zip((z, y, x), chunks))
+    root.create_array("0", shape=(n_frames, z, y, x), dtype=dtype, chunks=(1, *chunks), shards=(1, *shard),
+                      fill_value=0, dimension_names=("t", "z", "y", "x"), config={"write_empty_chunks": False})
     atomic_write_text(path / PLAN_FILE, json.dumps(plan, indent=1))
     (path / FRAMES_FILE).write_bytes(b"")
 

@@ -40,6 +40,7 @@ class Payload:
 
 _INSTALLED: Payload | None = None
 _NEIGHBOURS: dict = {}  # (id(payload), dt_scale) -> sphere_neighbours
+_LAST: dict = {}  # id(payload) -> the previous frame's volume: every frame has the same grid, so it is reused
 
 
 def install(payload: Payload) -> None:
@@ -47,6 +48,7 @@ def install(payload: Payload) -> None:
     global _INSTALLED
     _INSTALLED = payload
     _NEIGHBOURS.clear()
+    _LAST.clear()
 
 
 def _neighbours(p: Payload, spec: FrameSpec, tskel):
@@ -58,6 +60,22 @@ def _neighbours(p: Payload, spec: FrameSpec, tskel):
             _NEIGHBOURS.clear()
         _NEIGHBOURS[key] = sphere_neighbours(tskel)
     return _NEIGHBOURS[key]
+
+
+def occupied(tskel, bounds: Bounds, edge: int = 64) -> tuple[slice, slice, slice]:
+    """The ``[z, y, x]`` slices of the shared grid that this frame's spheres can reach, widened to
+    whole ``edge``-voxel chunks (outside them the frame is zero by construction)."""
+    from volanim_core.reconstruct.engine import grid_bounds
+
+    if not len(tskel):
+        return (slice(0, 0),) * 3
+    own = grid_bounds(tskel, padding=1)
+    out = []
+    for axis in (2, 1, 0):  # z, y, x
+        lo = max(own.lo[axis] - bounds.lo[axis], 0) // edge * edge
+        hi = min(own.hi[axis] - bounds.lo[axis] + 1, bounds.shape[axis])
+        out.append(slice(int(lo), int(max(lo, hi))))
+    return tuple(out)
 
 
 def frame_file(pattern: str, number: int) -> str:
@@ -74,17 +92,25 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
         raise RuntimeError("reconstruct_frame: no payload (the pool's initializer did not run)")
     t0 = time.perf_counter()
     tskel = spec.tskel(p.conn)
+    # reusing the last frame's output skips allocating and first-touching a whole grid per frame
+    # (page faults do not parallelise well between processes on a VM; engine.reconstruct ``out=``)
     r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
-                    bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads)
+                    bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads, out=_LAST.get(id(p)))
+    _LAST.clear()
+    _LAST[id(p)] = r.volume
     zyx = np.ascontiguousarray(r.volume.T)
-    open_frames(p.store, "r+")[index] = zyx  # shard ``index``: this task's alone
+    region = occupied(tskel, p.bounds)
+    part = zyx[region]
+    # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
+    # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)
+    open_frames(p.store, "r+")[(index, *region)] = part
     if p.every_frame_as:
         from volanim_core import io
 
         vol, _ = io.saturate_for_raw(frame_file(p.every_frame_as, spec.number), r.volume)
         io.write_volume(frame_file(p.every_frame_as, spec.number), vol, origin=r.origin)
     s = r.stats
-    return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(zyx),
+    return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
             "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),
             "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
             "dt_scale": spec.dt_scale, "seconds": round(time.perf_counter() - t0, 4),
