@@ -73,6 +73,13 @@ def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_gri
                at[2]:at[2] + alone.volume.shape[2]] = alone.volume
         assert np.array_equal(store.read_frame(tmp_path / "s.zarr", i), placed), f"frame {i}"
     assert rep.records[-1]["filled"] < rep.records[0]["filled"] / 2  # melting
+    # OME-Zarr (NGFF 0.5) metadata a viewer reads: axes t, z, y, x and the origin as a translation
+    import zarr
+
+    ms = zarr.open_group(str(tmp_path / "s.zarr"), mode="r").attrs["ome"]["multiscales"][0]
+    assert [a["name"] for a in ms["axes"]] == ["t", "z", "y", "x"] and ms["datasets"][0]["path"] == "0"
+    translation = ms["datasets"][0]["coordinateTransformations"][1]["translation"]
+    assert translation == [0.0, *map(float, bounds.lo[::-1])]
 
 
 def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
