@@ -40,7 +40,7 @@ def best_of(fn, repeats: int = 5) -> float:
     return min(times)
 
 
-def per_frame_baseline(motion, bones):
+def per_frame_baseline(motion):
     """The loop a direct port would write: per frame, per joint, one Euler conversion and matrix product."""
     values = motion.values
     out = []
@@ -74,7 +74,7 @@ def bench_clip() -> None:
 
     parse = best_of(lambda: read_bvh(WALK))
     whole = best_of(ours)
-    baseline = best_of(lambda: per_frame_baseline(motion, bones), repeats=2)
+    baseline = best_of(lambda: per_frame_baseline(motion), repeats=2)
     duration = motion.frames / motion.fps
     rows = [["parse only", f"{1000 * parse:.0f}", "", ""],
             ["parse + FK + retarget, all frames", f"{1000 * whole:.0f}", f"{baseline / whole:.1f}",

@@ -133,14 +133,14 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
          f"origin {r.origin} -> {out['posed'].name}, arm-bone.vti")
     clip = bundled_clip()
     if sample == "mannequin" and clip is not None:
-        out["walk"] = _walk(folder / "walk", clip, s, conn)
-        out["sequence"] = _sequence(folder / "walk.zarr", clip, s, conn)
+        out["walk"], retarget = _walk(folder / "walk", clip, s, conn)
+        out["sequence"] = _sequence(folder / "walk.zarr", retarget, conn, s.volume)
     out["skeleton"], out["sample"], out["connectivity"] = skel, s, conn
     _say(f"done in {time.perf_counter() - t0:.1f} s; files in {folder}/")
     return out
 
 
-def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)) -> list[Path]:
+def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
     """Motion capture onto the mannequin: a few frames across the clip written and reconstructed."""
     from volanim_core.motion.bvh import read_bvh
     from volanim_core.motion.frames import frame_path, write_frames
@@ -159,21 +159,22 @@ def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)) -> list
     for n, m in zip(numbers, mats):
         tskel = connect_to_tskel(conn, Trans(root_bones(s.bones), m))
         nbrs = sphere_neighbours(tskel) if nbrs is None else nbrs  # pose-independent: once
-        r = reconstruct(tskel, mode="sampled", source=s.volume, neighbours=nbrs)
+        rec = reconstruct(tskel, mode="sampled", source=s.volume, neighbours=nbrs)
         path = frame_path(folder, "walk", n, "-sampled.vti")
-        write_volume(path, r.volume, origin=r.origin)
-        _say(f"    frame {n:4d}: {r.stats['filled']} voxels, origin {r.origin}, {r.stats['seconds']:.3f} s "
+        write_volume(path, rec.volume, origin=rec.origin)
+        _say(f"    frame {n:4d}: {rec.stats['filled']} voxels, origin {rec.origin}, {rec.stats['seconds']:.3f} s "
              f"-> {folder.name}/{path.name}")
-    return written
+    return written, r
 
 
-def _sequence(out: Path, clip: Path, s, conn, frames=slice(0, 144, 6)) -> Path:
+def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Path:
     """One walk cycle (about 1.2 s of the clip) as a sequence: every frame in one grid, all cores."""
-    from volanim_core.sequence.frames import frames_from_files
+    from volanim_core.sequence.frames import FrameSpec
     from volanim_core.sequence.run import default_workers, run_sequence
 
-    specs = frames_from_files(conn, [clip], bones=s.bones, frames=frames)
-    rep = run_sequence(conn, specs, out, mode="sampled", source=s.volume, workers=min(default_workers(), 4),
+    numbers = range(retarget.motion.frames)[frames]
+    specs = [FrameSpec(n, m) for n, m in zip(numbers, retarget.matrices(frames))]
+    rep = run_sequence(conn, specs, out, mode="sampled", source=source, workers=min(default_workers(), 4),
                        fps=20.0)
     _say(f"[7] sequence: {len(specs)} frames of one walk cycle, one {'x'.join(map(str, rep.bounds.shape))} grid "
          f"at origin {rep.bounds.lo}, {rep.workers}, {rep.seconds:.1f} s ({rep.computed} made, {rep.skipped} "

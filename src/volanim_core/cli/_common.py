@@ -64,6 +64,22 @@ def ascii_int(text: str) -> int:
     raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}")
 
 
+def positive_float(text: str) -> float:
+    """A finite number above 0 (frame rates)."""
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a number above 0, got {text!r}")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """A whole number of 1 or more (workers, threads, frames)."""
+    value = ascii_int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected 1 or more, got {text!r}")
+    return value
+
+
 def join_negative_infinity(argv: list[str]) -> list[str]:
     """``--opt -inf`` -> ``--opt=-inf``: argparse takes ``-inf`` for an option and refuses it."""
     out: list[str] = []

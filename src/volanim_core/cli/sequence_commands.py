@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
-from pathlib import Path
 
-from ._common import add_command, ascii_float, ascii_int
+from ._common import add_command, ascii_int, positive_float, positive_int
 
 EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr
   volanim sequence mannequin.0.50.connect assets/walk.bvh --bones mannequin.bones --frames 0:240:4 \\
@@ -18,12 +18,14 @@ EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source manne
 class _Progress:
     """frames done / total, frames per second and ETA on one stderr line."""
 
-    def __init__(self, skipped: int):
+    def __init__(self):
         self.t0 = time.perf_counter()
-        self.skipped = skipped
+        self.before = None  # frames complete before this run (known at the first report)
 
     def __call__(self, rec: dict, done: int, total: int) -> None:
-        made = done - self.skipped
+        if self.before is None:
+            self.before = done - 1
+        made = done - self.before
         elapsed = time.perf_counter() - self.t0
         rate = made / elapsed if elapsed > 0 else 0.0
         eta = (total - done) / rate if rate > 0 else 0.0
@@ -31,10 +33,19 @@ class _Progress:
               end="", file=sys.stderr, flush=True)
 
 
+def _frame_pattern(text: str) -> str:
+    from volanim_core.sequence.task import check_frame_pattern
+
+    try:
+        check_frame_pattern(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix(f"--every-frame-as {text!r} ")) from None
+    return text
+
+
 def _sequence(args):
     from volanim_core.io import read_bones, read_connect, read_volume_grid
     from volanim_core.motion.retarget import read_mapping
-    from volanim_core.sequence import store
     from volanim_core.sequence.frames import frames_from_files, melt
     from volanim_core.sequence.run import default_workers, run_sequence
 
@@ -48,12 +59,11 @@ def _sequence(args):
     if args.source:
         source, origin, _ = read_volume_grid(args.source, dims=args.dims)
         source_origin = tuple(int(round(v)) for v in origin)
-    workers = None if args.scheduler else (args.workers or default_workers())
-    done_before = len(store.finished(args.output)) if Path(args.output).exists() and not args.force else 0
+    workers = None if args.scheduler else (default_workers() if args.workers is None else args.workers)
     rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_origin=source_origin,
                        kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
                        workers=workers, scheduler=args.scheduler, force=args.force,
-                       threads_per_worker=args.threads_per_worker, on_frame=_Progress(done_before))
+                       threads_per_worker=args.threads_per_worker, on_frame=_Progress())
     print(file=sys.stderr)
     print(format_report(rep))
     print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "
@@ -87,15 +97,15 @@ def register(sub) -> None:
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     p.add_argument("--padding", type=ascii_int, default=2, help="voxels around every frame's spheres (default 2)")
     p.add_argument("-o", "--output", required=True, help="the .zarr store (a folder)")
-    p.add_argument("--every-frame-as", metavar="DIR/NAME.%%04d.vti",
+    p.add_argument("--every-frame-as", type=_frame_pattern, metavar="DIR/NAME.%%04d.vti",
                    help="also write each frame as a file (.vti, .nrrd, .vol, .VOL; %%04d = frame number)")
     where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=ascii_int, help="local worker processes (default: every core)")
+    where.add_argument("--workers", type=positive_int, help="local worker processes (default: every core)")
     where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on this Dask cluster instead")
-    p.add_argument("--threads-per-worker", type=ascii_int, default=1, help="numba threads per worker (default 1)")
+    p.add_argument("--threads-per-worker", type=positive_int, default=1, help="numba threads per worker (default 1)")
     p.add_argument("--force", action="store_true", help="recompute every frame (and replace another sequence)")
-    p.add_argument("--fps", type=ascii_float, default=24.0, help="frame rate recorded in the store (default 24)")
-    p.add_argument("--melt", type=ascii_int, metavar="N", help="after the frames, N more: every DT shrinks to 0")
+    p.add_argument("--fps", type=positive_float, default=24.0, help="frame rate recorded in the store (default 24)")
+    p.add_argument("--melt", type=positive_int, metavar="N", help="after the frames, N more: every DT shrinks to 0")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",

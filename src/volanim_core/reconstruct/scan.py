@@ -21,7 +21,7 @@ from volanim_core.progress import Reporter
 from volanim_core.reconstruct.breakage import components, cracks, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.connectivity import Connectivity, Tskel
-from volanim_core.rig.pose import scaled
+from volanim_core.rig.tskel import coarse_tskel, identity_tskel
 
 
 @dataclass(frozen=True)
@@ -51,13 +51,11 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
 
     frames = list(range(len(matrices))) if frames is None else [int(f) for f in frames]
     report = Reporter(progress, cancel)
-    rest = Tskel(conn.bones, np.tile(np.eye(4), (len(conn.bones), 1, 1)), conn.points, conn.dt, conn.thinness,
-                 conn.bone, conn.metric)
+    rest = identity_tskel(conn)
     pairs = touching_pairs(rest)
     names = list(joints or {})
     near = cKDTree(np.array([joints[n] for n in names], np.float64)) if names else None
-    coarse = Tskel(conn.bones, rest.matrices, conn.points, conn.dt / factor, conn.thinness, conn.bone, conn.metric)
-    nbrs = sphere_neighbours(coarse)
+    nbrs = sphere_neighbours(coarse_tskel(rest, factor))  # pose-independent: once for the clip
     out = []
     for n, (frame, mats) in enumerate(zip(frames, matrices)):
         report(n, len(frames))
@@ -67,9 +65,7 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
         if len(gaps) and near is not None:
             _, k = near.query(where)
             worst = names[int(np.bincount(k, weights=gaps, minlength=len(names)).argmax())]
-        small = Tskel(conn.bones, scaled(posed.matrices, factor), conn.points, coarse.dt, conn.thinness, conn.bone,
-                      conn.metric)
-        sizes = components(reconstruct(small, mode="bone", neighbours=nbrs, padding=1).volume)
+        sizes = components(reconstruct(coarse_tskel(posed, factor), mode="bone", neighbours=nbrs, padding=1).volume)
         out.append(FrameVerdict(frame, len(sizes), int(sum(sizes[1:])) * factor ** 3, len(gaps),
                                 float(gaps.sum()), worst))
     report(len(frames), len(frames))

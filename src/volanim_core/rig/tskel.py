@@ -2,6 +2,7 @@
 
     connect_to_tskel(conn, trans)   connect2tskel: attach a frame's matrices
     identity_tskel(conn)            connect2identitytskel: every matrix the identity
+    coarse_tskel(tskel, factor)     the frame on a coarser grid (previews, scans)
     sort_tskel(tskel)               sorttskel: points of each bone by decreasing DT
     reconstruct.grid_bounds         tskelbounds
 """
@@ -37,6 +38,17 @@ def identity_tskel(conn: Connectivity) -> Tskel:
     """The rest frame: every matrix the identity (reconstructs the original shape)."""
     mats = np.tile(np.eye(4), (len(conn.bones), 1, 1))
     return Tskel(conn.bones, mats, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric)
+
+
+def coarse_tskel(tskel: Tskel, factor: int) -> Tskel:
+    """The frame on a ``factor``-times coarser grid: matrices followed by a 1/factor scale, radii alike
+    (live previews and the clip scan: factor^3 fewer voxels, the same shape)."""
+    if factor == 1:
+        return tskel
+    from volanim_core.rig.pose import scaled
+
+    return Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
+                 tskel.bone, tskel.metric)
 
 
 def sort_tskel(tskel: Tskel) -> Tskel:

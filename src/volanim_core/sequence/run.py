@@ -16,7 +16,8 @@ import hashlib
 import os
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, wait
-from dataclasses import dataclass, field
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +29,7 @@ from volanim_core.volume import Bounds
 
 from . import store
 from .frames import FrameSpec
-from .task import Payload, install, reconstruct_frame
+from .task import Payload, check_frame_pattern, install, reconstruct_frame
 
 
 @dataclass
@@ -41,7 +42,6 @@ class SequenceReport:
     seconds: float
     rest_filled: int  # the rest pose's filled voxels in the same mode (for loss)
     workers: str = ""
-    extra: dict = field(default_factory=dict)
 
 
 def shared_bounds(conn: Connectivity, frames: list[FrameSpec], padding: int = 2) -> Bounds:
@@ -92,27 +92,37 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
     """
     if not frames:
         raise ValueError("no frames to reconstruct")
+    for name, value in (("workers", workers), ("threads per worker", threads_per_worker)):
+        if value is not None and value < 1:
+            raise ValueError(f"{name} must be 1 or more, got {value}")
+    if not 0 < fps <= 1000:
+        raise ValueError(f"fps must be above 0 and at most 1000, got {fps:g}")
+    if every_frame_as:
+        check_frame_pattern(every_frame_as)
     if mode == "sampled" and source is None:
         raise ValueError("sampled mode needs the source volume (--source)")
     t0 = time.perf_counter()
     out = Path(out)
     bounds = shared_bounds(conn, frames, padding)
     dtype = output_dtype(mode, len(conn.bones), None if source is None else source.dtype)
-    n_workers = 1 if workers is None and scheduler is None else (workers or 1)
+    n_workers = workers or 1
     if scheduler is None:
         check_memory(bounds, dtype, n_workers, source)
     key = plan_key(conn, frames, mode, kernel, padding, source)
     plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
             "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
     old = store.read_plan(out) if out.exists() else None
+    if out.exists() and old is None and (out.is_file() or any(out.iterdir())):
+        # never replaced, even with --force: it may be anything the user keeps there
+        raise ValueError(f"{out} exists and is not a volanim sequence; choose another -o")
     if old is not None and old.get("key") == key and not force:
         done = store.finished(out)
+        rest = int(old["rest_filled"]) if isinstance(old.get("rest_filled"), int) else _rest_filled(conn)
     else:
-        if out.exists() and old is None and any(out.iterdir()) and not force:
-            raise ValueError(f"{out} exists and is not a volanim sequence; choose another -o or pass --force")
         if old is not None and old.get("key") != key and not force:
             raise ValueError(f"{out} holds another sequence (different frames, connectivity, mode or source); "
                              "pass --force to replace it, or choose another -o")
+        rest = plan["rest_filled"] = _rest_filled(conn)  # once per store: a resumed run does not redo it
         store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps)
         done = {}
     if every_frame_as:
@@ -122,12 +132,11 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                       threads_per_worker)
     records = dict(done)
     total = len(frames)
-    with _executor(payload, n_workers, scheduler) as (submit, label):
+    with _executor(payload, n_workers, scheduler) as (submit, label, running):
         pending: set[Future] = set()
         queue = list(todo)
-        limit = 2 * max(n_workers, 1) if scheduler is None else 4 * 64  # bounded: frames are big in flight
-        while queue or pending:
-            while queue and len(pending) < limit:
+        while queue or pending:  # two frames per worker in flight: frames finish about in order
+            while queue and len(pending) < 2 * max(running, 1):
                 i = queue.pop(0)
                 pending.add(submit(i, frames[i]))
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
@@ -137,7 +146,6 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                 records[rec["index"]] = rec
                 if on_frame is not None:
                     on_frame(rec, len(records), total)
-    rest = _rest_filled(conn)
     return SequenceReport(bounds, dtype.name, [records[i] for i in range(total)], len(done), len(todo),
                           time.perf_counter() - t0, rest, label)
 
@@ -151,50 +159,45 @@ def _rest_filled(conn) -> int:
     return int(r.stats["filled"])
 
 
-class _executor:
-    """``with _executor(payload, workers, scheduler) as (submit, label)``: submit(index, spec) -> Future."""
+@contextmanager
+def _executor(payload: Payload, workers: int, scheduler):
+    """``(submit(index, spec) -> Future, description, workers)`` for this process, a local pool or Dask."""
+    if scheduler is not None:
+        from distributed import Client
 
-    def __init__(self, payload: Payload, workers: int, scheduler):
-        self.payload, self.workers, self.scheduler = payload, workers, scheduler
-        self._close = []
-
-    def __enter__(self):
-        p = self.payload
-        if self.scheduler is not None:
-            from distributed import Client
-
-            client = self.scheduler if isinstance(self.scheduler, Client) else Client(self.scheduler)
-            if client is not self.scheduler:
-                self._close.append(client.close)
-            shared = client.scatter(p, broadcast=True, hash=False)  # shipped to each worker once
+        client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+        try:
+            shared = client.scatter(payload, broadcast=True, hash=False)  # shipped to each worker once
             ex = client.get_executor(pure=False)
             n = len(client.scheduler_info().get("workers", {}))
-            return (lambda i, spec: ex.submit(reconstruct_frame, shared, i, spec)), f"Dask, {n} workers"
-        if self.workers <= 1:
-            install(p)
-            return _inline, "1 worker (this process)"
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
+            yield (lambda i, spec: ex.submit(reconstruct_frame, shared, i, spec)), f"Dask, {n} workers", n
+        finally:
+            if client is not scheduler:
+                client.close()
+        return
+    if workers <= 1:
+        install(payload)
+        yield _inline, "1 worker (this process)", 1
+        return
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
 
-        pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                   initializer=install, initargs=(p,))
-        self._close.append(lambda: pool.shutdown(wait=True, cancel_futures=True))
-        return (lambda i, spec: pool.submit(reconstruct_frame, None, i, spec)), f"{self.workers} local workers"
-
-    def __exit__(self, *exc):
-        for close in reversed(self._close):
-            close()
-        return False
+    # spawn, not fork: zarr's I/O thread and numba's threads do not survive a fork
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=install,
+                             initargs=(payload,)) as pool:
+        try:
+            yield (lambda i, spec: pool.submit(reconstruct_frame, None, i, spec)), f"{workers} local workers", workers
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _inline(index: int, spec: FrameSpec) -> Future:
+    """A finished Future, so this process runs frames through the same loop as a pool."""
     fut: Future = Future()
     try:
         fut.set_result(reconstruct_frame(None, index, spec))
-    except BaseException as exc:  # noqa: BLE001 - handed to the caller through the future, like a pool would
+    except Exception as exc:  # handed to the caller through the future, like a pool would
         fut.set_exception(exc)
-        if isinstance(exc, KeyboardInterrupt):
-            raise
     return fut
 
 

@@ -40,7 +40,6 @@ class Payload:
 
 _INSTALLED: Payload | None = None
 _NEIGHBOURS: dict = {}  # (id(payload), dt_scale) -> sphere_neighbours
-_LAST: dict = {}  # id(payload) -> the previous frame's volume: every frame has the same grid, so it is reused
 
 
 def install(payload: Payload) -> None:
@@ -48,7 +47,6 @@ def install(payload: Payload) -> None:
     global _INSTALLED
     _INSTALLED = payload
     _NEIGHBOURS.clear()
-    _LAST.clear()
 
 
 def _neighbours(p: Payload, spec: FrameSpec, tskel):
@@ -80,7 +78,20 @@ def occupied(tskel, bounds: Bounds, edge: int = 64) -> tuple[slice, slice, slice
 
 def frame_file(pattern: str, number: int) -> str:
     """``DIR/NAME.%04d.vti`` with the frame number filled in."""
-    return pattern % number if "%" in pattern else pattern.replace("{}", str(number))
+    return pattern % number
+
+
+def check_frame_pattern(pattern: str) -> None:
+    """Refuse (before any frame runs) a per-frame name that is not one %d field or names no volume format."""
+    try:
+        names = {pattern % 0, pattern % 1}
+    except (TypeError, ValueError):
+        names = set()
+    if len(names) != 2:
+        raise ValueError(f"--every-frame-as {pattern!r} needs one number field for the frame, e.g. "
+                         "frames/walk.%04d.vti")
+    if not pattern.lower().endswith((".vti", ".nrrd", ".vol")):
+        raise ValueError(f"--every-frame-as {pattern!r} must end in .vti, .nrrd or .vol/.VOL")
 
 
 def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> dict:
@@ -92,12 +103,8 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
         raise RuntimeError("reconstruct_frame: no payload (the pool's initializer did not run)")
     t0 = time.perf_counter()
     tskel = spec.tskel(p.conn)
-    # reusing the last frame's output skips allocating and first-touching a whole grid per frame
-    # (page faults do not parallelise well between processes on a VM; engine.reconstruct ``out=``)
     r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
-                    bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads, out=_LAST.get(id(p)))
-    _LAST.clear()
-    _LAST[id(p)] = r.volume
+                    bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads)
     zyx = np.ascontiguousarray(r.volume.T)
     region = occupied(tskel, p.bounds)
     part = zyx[region]

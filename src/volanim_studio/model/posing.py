@@ -98,20 +98,21 @@ class PoseState:
     def show(self, matrices: np.ndarray) -> None:
         """Take a frame's matrices as the pose without an undo step (the timeline's current frame:
         scrubbing is looking, not editing); the sliders show the frame's angles."""
+        self._write(*self._from_matrices(matrices))
+
+    def _from_matrices(self, matrices) -> tuple[dict, dict]:
+        """Slider angles and shifts (by bone key, rest entries left out) that make ``matrices``."""
         angles, shifts = local_motion(self.doc.bones, matrices)
         keys = [self._key(i) for i in range(len(self.doc.bones))]
-        self._write({keys[i]: a for i, a in angles.items() if np.any(np.abs(a) > 1e-9)},
-                    {keys[i]: t for i, t in shifts.items() if np.any(np.abs(t) > 1e-9)})
+        return ({keys[i]: a for i, a in angles.items() if np.any(np.abs(a) > 1e-9)},
+                {keys[i]: t for i, t in shifts.items() if np.any(np.abs(t) > 1e-9)})
 
     # ----------------------------------------------------------------- files
     def load_trans(self, path) -> None:
         """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order)."""
         trans = io.read_trans(path)
         check_root_order(root_bones(self.doc.bones), trans.bones, ".trans")
-        angles, shifts = local_motion(self.doc.bones, trans.matrices)
-        keys = [self._key(i) for i in range(len(self.doc.bones))]
-        self._push(f"Load pose {path}", {keys[i]: a for i, a in angles.items() if np.any(np.abs(a) > 1e-9)},
-                   {keys[i]: t for i, t in shifts.items() if np.any(np.abs(t) > 1e-9)})
+        self._push(f"Load pose {path}", *self._from_matrices(trans.matrices))
 
     def save_trans(self, path) -> None:
         io.write_trans(path, Trans(root_bones(self.doc.bones), self.matrices()))

@@ -14,8 +14,7 @@ import numpy as np
 from volanim_core.reconstruct.breakage import BreakageReport, breakage_report
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
 from volanim_core.rig.connectivity import Tskel
-from volanim_core.rig.pose import scaled
-from volanim_core.rig.tskel import identity_tskel
+from volanim_core.rig.tskel import coarse_tskel, identity_tskel
 
 
 @dataclass
@@ -35,13 +34,6 @@ class Preview:
         return np.asarray(self.reconstruction.origin, np.float64) * self.factor
 
 
-def coarse(tskel: Tskel, factor: int) -> Tskel:
-    if factor == 1:
-        return tskel
-    return Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
-                 tskel.bone, tskel.metric)
-
-
 def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,
                  factor: int = 1, joints=None, posed_joints=None, report: bool = False, neighbours=None,
                  progress=None, cancel=None) -> Preview:
@@ -54,7 +46,7 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     from volanim_core.reconstruct.neighbours import sphere_neighbours
 
     nbrs = sphere_neighbours(tskel) if neighbours is None else neighbours  # pose-independent: shared below
-    r = reconstruct(coarse(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,
+    r = reconstruct(coarse_tskel(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,
                     padding=max(1, padding // factor), progress=progress, cancel=cancel)
     out = Preview(r, factor, mode)
     if report:  # three more reconstructions: each checks ``cancel`` between its chunks

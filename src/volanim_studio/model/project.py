@@ -34,7 +34,7 @@ from volanim_core.io import bundle
 from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
-from .timeline import DEFAULT_LENGTH, Timeline
+from .timeline import Timeline
 
 PROJECT_FORMAT = "volanim project"
 PROJECT_VERSION = 3
@@ -90,11 +90,8 @@ def _relative(path: Path, target: str) -> str:
         return str(Path(target).resolve())
 
 
-def _timeline_json(doc, path: Path) -> dict | None:
-    t = doc.timeline
-    if not t.active and t.length == DEFAULT_LENGTH:
-        return None
-    data = t.to_json()
+def _timeline_json(doc, path: Path) -> dict:
+    data = doc.timeline.to_json()
     if data["clip"]:
         data["clip"]["path"] = _relative(path, data["clip"]["path"])
     return data

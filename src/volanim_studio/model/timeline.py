@@ -18,13 +18,23 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.motion.bvh import Motion, read_bvh
-from volanim_core.motion.frames import read_frames
+from volanim_core.motion.frames import frame_number, read_frames
 from volanim_core.motion.keyframes import KeyPose, interpolate
 from volanim_core.motion.retarget import Retarget, check_mapping_file
 
 from .undo import Command
 
 DEFAULT_LENGTH, DEFAULT_FPS = 48, 24.0
+
+
+def check_options(ease, length, fps) -> None:
+    """The one rule for the keyed animation's options (the panel and a saved project); ValueError."""
+    if not isinstance(ease, bool):
+        raise ValueError(f"\"ease\" must be true or false, got {ease!r}")
+    if isinstance(length, bool) or not isinstance(length, int) or not 1 <= length <= 100_000:
+        raise ValueError(f"\"length\" must be 1 to 100000 frames, got {length!r}")
+    if isinstance(fps, bool) or not isinstance(fps, int | float) or not 1 <= fps <= 1000:
+        raise ValueError(f"\"fps\" must be 1 to 1000 frames per second, got {fps!r}")
 
 
 @dataclass
@@ -78,11 +88,11 @@ class Timeline:
             return self.clip.matrices[np.clip(frames, 0, len(self.clip.matrices) - 1)]
         return interpolate(self.doc.bones, self.keys, frames, ease=self.ease)
 
-    def frame_label(self, frame: int) -> str:
+    def frame_number(self, frame: int) -> int:
         """The number a frame's file gets: the clip's own numbering for a .trans folder."""
         if self.clip is not None and self.clip.frames:
-            return str(self.clip.frames[min(frame, len(self.clip.frames) - 1)])
-        return str(frame)
+            return self.clip.frames[min(frame, len(self.clip.frames) - 1)]
+        return frame
 
     # -------------------------------------------------------------- frames
     def show_frame(self, frame: int | None = None) -> None:
@@ -130,13 +140,11 @@ class Timeline:
 
     def set_options(self, *, ease: bool | None = None, length: int | None = None, fps: float | None = None) -> None:
         """Ease in/out, the keyed animation's length in frames and its frame rate (view options: no undo)."""
-        if length is not None and not (isinstance(length, int) and 1 <= length <= 100_000):
-            raise ValueError(f"length must be 1 to 100000 frames, got {length!r}")
-        if fps is not None and not (isinstance(fps, int | float) and 1 <= fps <= 1000):
-            raise ValueError(f"frame rate must be 1 to 1000 per second, got {fps!r}")
-        self.ease = self.ease if ease is None else bool(ease)
-        self.length = self.length if length is None else length
-        self.fps = self.fps if fps is None else float(fps)
+        ease = self.ease if ease is None else ease
+        length = self.length if length is None else length
+        fps = self.fps if fps is None else fps
+        check_options(ease, length, fps)
+        self.ease, self.length, self.fps = ease, length, float(fps)
         self.doc.events.timeline.emit()
         self.show_frame()
 
@@ -162,8 +170,6 @@ class Timeline:
         if not len(self.doc.bones):
             raise ValueError("build or open the bone skeleton first: the frames move its bones")
         mats, files = read_frames(paths, self.doc.bones)
-        from volanim_core.motion.frames import frame_number
-
         numbers = [frame_number(p) for p in files]
         name = files[0].parent.name if len(files) > 1 else files[0].stem
         clip = Clip(name, mats, self.fps, str(files[0].parent if len(files) > 1 else files[0]),
@@ -173,16 +179,15 @@ class Timeline:
 
     def _put_clip(self, clip: Clip | None) -> None:
         self.clip = clip
+        self.doc.events.timeline.emit()
         st = self.doc.settings
         if st.current_frame >= self.frame_count:
-            st.current_frame = 0  # (shows that frame)
-        self.doc.events.timeline.emit()
-        if clip is not None:
+            st.current_frame = 0  # shows that frame
+        else:
             self.show_frame()
 
     def unload(self) -> None:
         self._put_clip(None)
-        self.show_frame()
 
     def _on_bones(self, **_) -> None:
         c = self.clip
@@ -222,12 +227,10 @@ class Timeline:
                 raise ValueError(f"{where}: a key's frame must be a whole number 0..10000000, got {f!r}")
             parsed[int(f)] = KeyPose.from_json(rows, f"{where}: key at frame {f}")
         ease, length, fps = data.get("ease", True), data.get("length", DEFAULT_LENGTH), data.get("fps", DEFAULT_FPS)
-        if not isinstance(ease, bool):
-            raise ValueError(f"{where}: \"timeline\": \"ease\" must be true or false, got {ease!r}")
-        if isinstance(length, bool) or not isinstance(length, int) or not 1 <= length <= 100_000:
-            raise ValueError(f"{where}: \"timeline\": \"length\" must be 1 to 100000 frames, got {length!r}")
-        if isinstance(fps, bool) or not isinstance(fps, int | float) or not 1 <= fps <= 1000:
-            raise ValueError(f"{where}: \"timeline\": \"fps\" must be 1 to 1000, got {fps!r}")
+        try:
+            check_options(ease, length, fps)
+        except ValueError as exc:
+            raise ValueError(f"{where}: \"timeline\": {exc}") from None
         clip = data.get("clip")
         if clip is not None:
             mapping = clip.get("mapping") if isinstance(clip, dict) else None

@@ -202,12 +202,12 @@ class TimelineController(Controller):
         if self.scan_dialog is None:
             self.scan_dialog = ScanDialog(self.window)
             self.scan_dialog.jump.connect(lambda f: self.go(f))
-        self.scan_dialog.show_verdicts(self.last_scan, self.doc.timeline.frame_label)
+        self.scan_dialog.show_verdicts(self.last_scan, self.doc.timeline.frame_number)
         self.scan_dialog.show()
         bad = [v for v in verdicts if not v.healthy]
         w = self.last_scan[0]
         self.doc.message(f"Scanned {len(verdicts)} frames: {len(bad)} with cracks or pieces; worst frame "
-                         f"{self.doc.timeline.frame_label(w.frame)} ({w.pieces} piece(s), {w.cracks} cracks"
+                         f"{self.doc.timeline.frame_number(w.frame)} ({w.pieces} piece(s), {w.cracks} cracks"
                          + (f" near {w.worst_joint}" if w.worst_joint else "") + ").")
 
     def export(self, folder, *, tskel: bool = False):
@@ -223,7 +223,7 @@ class TimelineController(Controller):
             self.show_error("Export frames", str(exc))
             return None
         stem = tl.clip.name if tl.clip is not None else "keys"
-        numbers = [int(tl.frame_label(f)) for f in range(tl.frame_count)]
+        numbers = [tl.frame_number(f) for f in range(tl.frame_count)]
         mats, bones = tl.matrices(), self.doc.bones
         return self.jobs.run(f"Writing {len(numbers)} frames", lambda progress, cancel: write_frames(
             folder, stem, bones, mats, numbers, connect=conn, progress=progress, cancel=cancel),

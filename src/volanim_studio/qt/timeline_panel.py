@@ -155,7 +155,7 @@ class TimelinePanel(QWidget):
         tl = self.doc.timeline
         f = self.doc.settings.current_frame
         if tl.clip is not None:
-            text = f"{tl.clip.name}: frame {tl.frame_label(f)} · {tl.frame_count} frames · {tl.frame_rate:.4g} fps"
+            text = f"{tl.clip.name}: frame {tl.frame_number(f)} · {tl.frame_count} frames · {tl.frame_rate:.4g} fps"
         elif tl.keys:
             text = f"keyed: {tl.frame_count} frames · {tl.frame_rate:.4g} fps" + (" · key" if f in tl.keys else "")
         else:

@@ -131,7 +131,15 @@ def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
     (tmp_path / "notes" / "a.txt").write_text("mine")
     with pytest.raises(ValueError, match="not a volanim sequence"):
         run_sequence(conn, walk, tmp_path / "notes", mode="bone")
+    with pytest.raises(ValueError, match="not a volanim sequence"):
+        run_sequence(conn, walk, tmp_path / "notes", mode="bone", force=True)  # --force never deletes it
     assert (tmp_path / "notes" / "a.txt").read_text() == "mine"
+    for bad, match in (({"every_frame_as": str(tmp_path / "f.vti")}, "one number field"),
+                       ({"every_frame_as": str(tmp_path / "f.%d.png")}, r"must end in \.vti"),
+                       ({"fps": 0.0}, "fps must be above 0"), ({"workers": 0}, "workers must be 1 or more")):
+        with pytest.raises(ValueError, match=match):
+            run_sequence(conn, walk, tmp_path / "bad.zarr", mode="bone", **bad)
+    assert not (tmp_path / "bad.zarr").exists()  # refused before anything was written
     with pytest.raises(ValueError, match="needs the source"):
         run_sequence(conn, walk, tmp_path / "s.zarr", mode="sampled")
     from volanim_core.rig.tskel import identity_tskel
@@ -141,3 +149,13 @@ def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
         frames_from_files(conn, [tmp_path / "x.0001.tskel"])
     with pytest.raises(ValueError, match="needs the bone skeleton"):
         frames_from_files(conn, [WALK])
+
+
+@pytest.mark.parametrize("option", [["--workers", "0"], ["--fps", "0"], ["--melt", "-2"],
+                                    ["--every-frame-as", "frames/walk.vti"]])
+def test_bad_options_are_argument_errors_naming_the_option(tmp_path, capsys, option):
+    with pytest.raises(SystemExit) as exc:
+        main(["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "-o",
+              str(tmp_path / "x.zarr"), *option])
+    assert exc.value.code == 2 and f"argument {option[0]}" in capsys.readouterr().err
+    assert not (tmp_path / "x.zarr").exists()

@@ -85,7 +85,7 @@ def test_a_trans_folder_becomes_the_clip_in_frame_order(doc, tmp_path):
     mats[:, :, 3, 0] += np.array([0.0, 5.0, 10.0])[:, None]
     write_frames(tmp_path / "f", "walk", doc.bones, mats, [8, 10, 12])
     clip = doc.timeline.load_trans(tmp_path / "f")
-    assert clip.frames == [8, 10, 12] and doc.timeline.frame_label(2) == "12"
+    assert clip.frames == [8, 10, 12] and doc.timeline.frame_number(2) == 12
     doc.settings.current_frame = 2
     assert np.allclose(doc.pose.matrices(), mats[2], atol=1e-5)
     doc.bone_edits.move_joint("L_WRIST", doc.bones.joints["L_WRIST"] + [0, 0, -5])
