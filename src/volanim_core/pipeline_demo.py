@@ -7,7 +7,7 @@
       --pose (left upper arm 45 deg)--> arm.trans --> arm.tskel --> arm-sampled.vti, arm-bone.vti
       walk.bvh (assets/, real motion capture) --retarget--> walk/walk.NNNN.trans + .tskel
         --> walk/walk.NNNN-sampled.vti for a few frames across the clip     (mannequin only)
-      --sequence--> walk.zarr: one walk cycle, one grid, on every core           (mannequin only)
+      --sequence--> walk.zarr: one walk cycle, then a crumble; one grid, every core (mannequin only)
 """
 
 from __future__ import annotations
@@ -168,15 +168,19 @@ def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
 
 
 def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Path:
-    """One walk cycle (about 1.2 s of the clip) as a sequence: every frame in one grid, all cores."""
+    """One walk cycle (about 1.2 s of the clip), then the body crumbles into a heap: a sequence,
+    every frame in one grid, all cores."""
+    from volanim_core.sequence.effects import crumble
     from volanim_core.sequence.frames import FrameSpec
     from volanim_core.sequence.run import default_workers, run_sequence
 
     numbers = range(retarget.motion.frames)[frames]
     specs = [FrameSpec(n, m) for n, m in zip(numbers, retarget.matrices(frames))]
+    specs += crumble(specs, 10)
     rep = run_sequence(conn, specs, out, mode="sampled", source=source, workers=min(default_workers(), 4),
                        fps=20.0)
-    _say(f"[7] sequence: {len(specs)} frames of one walk cycle, one {'x'.join(map(str, rep.bounds.shape))} grid "
+    grid = "x".join(map(str, rep.bounds.shape))
+    _say(f"[7] sequence: {len(specs) - 10} frames of one walk cycle and 10 of crumbling, one {grid} grid "
          f"at origin {rep.bounds.lo}, {rep.workers}, {rep.seconds:.1f} s ({rep.computed} made, {rep.skipped} "
          f"already there) -> {out.name} (OME-Zarr: t, z, y, x)")
     return out

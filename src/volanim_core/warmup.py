@@ -2,7 +2,7 @@
 
     compile_kernels()
         skeletonize (euclid, 345) --> auto_connect (path) --> reconstruct
-        (every mode x metric, sampled with kernel 1 and 3) --> breakage report
+        (every mode x metric, sampled with kernel 1 and 3) --> breakage report --> a crumble's heap
 
 The kernels are ``@njit(cache=True)``: the machine code lands in the package's
 ``__pycache__`` and later processes load it in well under a second. A fresh
@@ -39,6 +39,7 @@ def compile_kernels(progress=None) -> float:
     from volanim_core.rig.bones import Bone, BoneSkeleton
     from volanim_core.rig.connectivity import Connectivity, RootBone, Tskel
     from volanim_core.rig.pose import pose_matrices
+    from volanim_core.sequence.effects import fall
     from volanim_core.skeleton.skeletonize import skeletonize
 
     t0 = time.perf_counter()
@@ -64,6 +65,7 @@ def compile_kernels(progress=None) -> float:
             done += 1
             _report(progress, done, total)
     breakage_report(tskel, dict(bones.joints), dict(bones.joints))
+    fall(np.pad(source, ((8, 8), (8, 8), (0, 8))), 1.0)  # a crumble's heap (room for it around the bar)
     _report(progress, total, total)
     return time.perf_counter() - t0
 

@@ -11,6 +11,7 @@ from ._common import add_command, ascii_int, positive_float, positive_int
 EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr
   volanim sequence mannequin.0.50.connect assets/walk.bvh --bones mannequin.bones --frames 0:240:4 \\
           --mode bone --melt 24 --workers 2 -o walk.zarr
+  volanim sequence ... --crumble 36 -o walk.zarr      (after the walk, the body falls into a heap)
   volanim sequence ... --scheduler tcp://10.0.0.5:8786 -o /shared/walk.zarr     (a Dask cluster)
   volanim sequence ... -o walk.zarr      (again: finished frames are skipped; --force starts over)"""
 
@@ -43,10 +44,21 @@ def _frame_pattern(text: str) -> str:
     return text
 
 
+def _axis(text: str) -> str:
+    from volanim_core.sequence.effects import parse_axis
+
+    try:
+        parse_axis(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def _sequence(args):
     from volanim_core.io import read_bones, read_connect, read_volume_grid
     from volanim_core.motion.retarget import read_mapping
-    from volanim_core.sequence.frames import frames_from_files, melt
+    from volanim_core.sequence.effects import crumble, melt, teleport
+    from volanim_core.sequence.frames import frames_from_files
     from volanim_core.sequence.run import default_workers, run_sequence
 
     conn = read_connect(args.connect)
@@ -55,6 +67,10 @@ def _sequence(args):
                                frames=args.range, up=args.up, forward=args.forward)
     if args.melt:
         frames += melt(frames, args.melt)
+    elif args.teleport:
+        frames += teleport(conn, frames, args.teleport, down=args.down)
+    elif args.crumble:
+        frames += crumble(frames, args.crumble, down=args.down)
     source, source_origin = None, (0, 0, 0)
     if args.source:
         source, origin, _ = read_volume_grid(args.source, dims=args.dims)
@@ -105,7 +121,14 @@ def register(sub) -> None:
     p.add_argument("--threads-per-worker", type=positive_int, default=1, help="numba threads per worker (default 1)")
     p.add_argument("--force", action="store_true", help="recompute every frame (and replace another sequence)")
     p.add_argument("--fps", type=positive_float, default=24.0, help="frame rate recorded in the store (default 24)")
-    p.add_argument("--melt", type=positive_int, metavar="N", help="after the frames, N more: every DT shrinks to 0")
+    effect = p.add_mutually_exclusive_group()
+    effect.add_argument("--melt", type=positive_int, metavar="N",
+                        help="after the frames, N more: every DT shrinks to 0")
+    effect.add_argument("--teleport", type=positive_int, metavar="N",
+                        help="after the frames, N more: the body vanishes from the head down")
+    effect.add_argument("--crumble", type=positive_int, metavar="N",
+                        help="after the frames, N more: the voxels fall and pile into a heap")
+    p.add_argument("--down", type=_axis, default="-z", help="teleport/crumble: the way down (default -z)")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",

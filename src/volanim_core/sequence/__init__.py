@@ -1,6 +1,6 @@
 """Many frames at once: one output grid, resumable runs, local or Dask executors (issue: Sequences).
 
-Planned modules: ``plan.py`` (shared bounds over all frames), ``run.py`` (a
-manifest of finished frames, OME-Zarr output), ``executors.py`` (process pool,
-``distributed``), ``effects.py`` (melt, crumble).
+``frames.py`` (a FrameSpec per frame, from .trans/.tskel/BVH), ``effects.py``
+(melt, teleport, crumble), ``store.py`` (OME-Zarr + manifest), ``task.py`` (the
+one frame function), ``run.py`` (shared bounds, resume, local pool or Dask).
 """

@@ -3,10 +3,11 @@
     .trans files          the matrices, checked against the .connect's bones
     .tskel files          the matrices; its points must be the .connect's (else refused)
     a .bvh clip           retargeted onto --bones (optionally --map), --frames START:STOP:STEP
-    melt(N) after them    the last pose held while every DT shrinks linearly to 0 (the old meltMan)
+    effects after them    melt, teleport, crumble (``effects.py``)
 
 Each frame is a :class:`FrameSpec`: a number (for file names and the manifest),
-the bone matrices and a DT scale (1 except in melts).
+the bone matrices, a DT scale (1 except in melts: one number, or one per point)
+and how far the crumble has fallen (0 except in crumbles).
 """
 
 from __future__ import annotations
@@ -26,11 +27,19 @@ from volanim_core.rig.tskel import check_root_order
 class FrameSpec:
     number: int
     matrices: np.ndarray  # (B, 4, 4) row-vector, rest voxel coordinates -> posed
-    dt_scale: float = 1.0
+    dt_scale: float | np.ndarray = 1.0  # every DT times this (a number, or one per point)
+    crumble: float = 0.0  # 0: standing; 1: every voxel has fallen onto the heap
+    down: str = "-z"  # the way voxels fall in a crumble
 
     def tskel(self, conn: Connectivity) -> Tskel:
-        dt = conn.dt if self.dt_scale == 1.0 else conn.dt * self.dt_scale
+        plain = np.isscalar(self.dt_scale) and self.dt_scale == 1.0
+        dt = conn.dt if plain else conn.dt * np.asarray(self.dt_scale, np.float64)
         return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric)
+
+    def key(self) -> bytes:
+        """Everything that decides this frame's voxels besides the connectivity (for plan keys)."""
+        return b"|".join([np.ascontiguousarray(self.matrices).tobytes(), str(self.number).encode(),
+                          np.asarray(self.dt_scale, np.float64).tobytes(), repr((self.crumble, self.down)).encode()])
 
 
 def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, frames=slice(None),
@@ -88,10 +97,3 @@ def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward) -> list[Fra
         raise ValueError(f"{path.name}: the frame range selects none of its {motion.frames} frames")
     return [FrameSpec(n, m) for n, m in zip(numbers, mats)]
 
-
-def melt(after: list[FrameSpec], n: int) -> list[FrameSpec]:
-    """``n`` frames after the last one: its pose held while every sphere's DT shrinks linearly to 0."""
-    if n < 1:
-        raise ValueError(f"a melt needs at least one frame, got {n}")
-    last = after[-1]
-    return [FrameSpec(last.number + k, last.matrices, float(1.0 - k / n)) for k in range(1, n + 1)]

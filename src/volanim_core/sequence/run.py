@@ -45,8 +45,32 @@ class SequenceReport:
 
 
 def shared_bounds(conn: Connectivity, frames: list[FrameSpec], padding: int = 2) -> Bounds:
-    """One output grid holding every frame (the old ``tskelbounds`` over all of them)."""
-    return grid_bounds([f.tskel(conn) for f in frames], padding)
+    """One output grid holding every frame (the old ``tskelbounds`` over all of them), and room
+    on the floor for a crumble's heap."""
+    bounds = grid_bounds([f.tskel(conn) for f in frames], padding)
+    crumbles = [f for f in frames if f.crumble]
+    if crumbles:
+        room = heap_room(conn, crumbles[0], padding)
+        bounds = Bounds(tuple(map(min, bounds.lo, room.lo)), tuple(map(max, bounds.hi, room.hi)))
+    return bounds
+
+
+def heap_room(conn: Connectivity, spec: FrameSpec, padding: int) -> Bounds:
+    """The pose's box widened sideways to hold the heap its voxels make: a 45-degree pile of
+    ``V`` voxels on 4-neighbour columns is a square pyramid of height ``(1.5 V)**(1/3)`` and
+    as wide each side of its centre (``V`` from the rest pose; the grid's sides are walls,
+    so a heap that is a little larger leans on them, nothing is lost)."""
+    from .effects import parse_axis
+
+    box = grid_bounds(spec.tskel(conn), padding)
+    reach = int(np.ceil((1.5 * _rest_filled(conn)) ** (1 / 3))) + padding
+    axis, _ = parse_axis(spec.down)
+    lo, hi = list(box.lo), list(box.hi)
+    for a in range(3):
+        if a != axis:
+            mid = (box.lo[a] + box.hi[a]) // 2
+            lo[a], hi[a] = min(lo[a], mid - reach), max(hi[a], mid + reach)
+    return Bounds(tuple(lo), tuple(hi))
 
 
 def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int, padding: int, source) -> str:
@@ -55,8 +79,7 @@ def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int
     for a in (conn.points, conn.dt, conn.bone, *[np.asarray(b.proximal + b.distal) for b in conn.bones]):
         h.update(np.ascontiguousarray(a).tobytes())
     for f in frames:
-        h.update(np.ascontiguousarray(f.matrices).tobytes())
-        h.update(np.array([f.number, f.dt_scale]).tobytes())
+        h.update(f.key())
     h.update(f"{mode}|{kernel}|{padding}|{conn.metric}".encode())
     if source is not None:
         h.update(str((source.shape, source.dtype.str)).encode())

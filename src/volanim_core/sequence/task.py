@@ -52,27 +52,24 @@ def install(payload: Payload) -> None:
 def _neighbours(p: Payload, spec: FrameSpec, tskel):
     from volanim_core.reconstruct.neighbours import sphere_neighbours
 
-    key = (id(p), spec.dt_scale)
+    key = (id(p), np.asarray(spec.dt_scale, np.float64).tobytes())
     if key not in _NEIGHBOURS:
-        if len(_NEIGHBOURS) > 4:  # a melt has a new scale every frame: keep only the recent ones
+        if len(_NEIGHBOURS) > 4:  # a melt has new radii every frame: keep only the recent ones
             _NEIGHBOURS.clear()
         _NEIGHBOURS[key] = sphere_neighbours(tskel)
     return _NEIGHBOURS[key]
 
 
-def occupied(tskel, bounds: Bounds, edge: int = 64) -> tuple[slice, slice, slice]:
-    """The ``[z, y, x]`` slices of the shared grid that this frame's spheres can reach, widened to
-    whole ``edge``-voxel chunks (outside them the frame is zero by construction)."""
-    from volanim_core.reconstruct.engine import grid_bounds
-
-    if not len(tskel):
-        return (slice(0, 0),) * 3
-    own = grid_bounds(tskel, padding=1)
+def occupied(zyx: np.ndarray, edge: int = 64) -> tuple[slice, slice, slice]:
+    """The ``[z, y, x]`` slices holding every filled voxel of a frame, widened to whole
+    ``edge``-voxel chunks (outside them the frame is zero)."""
     out = []
-    for axis in (2, 1, 0):  # z, y, x
-        lo = max(own.lo[axis] - bounds.lo[axis], 0) // edge * edge
-        hi = min(own.hi[axis] - bounds.lo[axis] + 1, bounds.shape[axis])
-        out.append(slice(int(lo), int(max(lo, hi))))
+    for axis in range(3):
+        filled = np.flatnonzero(np.any(zyx, axis=tuple(a for a in range(3) if a != axis)))
+        if not len(filled):
+            return (slice(0, 0),) * 3
+        lo, hi = int(filled[0]) // edge * edge, int(filled[-1]) + 1
+        out.append(slice(lo, hi))
     return tuple(out)
 
 
@@ -105,8 +102,13 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
     tskel = spec.tskel(p.conn)
     r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
                     bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads)
-    zyx = np.ascontiguousarray(r.volume.T)
-    region = occupied(tskel, p.bounds)
+    volume = r.volume
+    if spec.crumble:
+        from .effects import fall
+
+        volume = fall(volume, spec.crumble, spec.down)
+    zyx = np.ascontiguousarray(volume.T)
+    region = occupied(zyx)
     part = zyx[region]
     # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
     # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)
@@ -114,11 +116,12 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
     if p.every_frame_as:
         from volanim_core import io
 
-        vol, _ = io.saturate_for_raw(frame_file(p.every_frame_as, spec.number), r.volume)
+        vol, _ = io.saturate_for_raw(frame_file(p.every_frame_as, spec.number), volume)
         io.write_volume(frame_file(p.every_frame_as, spec.number), vol, origin=r.origin)
     s = r.stats
     return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
             "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),
             "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
-            "dt_scale": spec.dt_scale, "seconds": round(time.perf_counter() - t0, 4),
+            "dt_scale": round(float(np.mean(spec.dt_scale)), 6), "crumble": spec.crumble,
+            "seconds": round(time.perf_counter() - t0, 4),
             "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}

@@ -20,7 +20,8 @@ from volanim_core.motion.frames import write_frames
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
-from volanim_core.sequence.frames import frames_from_files, melt
+from volanim_core.sequence.effects import melt
+from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import run_sequence, shared_bounds
 
 CONNECT = ASSETS / "mannequin.0.50.connect"
@@ -152,10 +153,11 @@ def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
 
 
 @pytest.mark.parametrize("option", [["--workers", "0"], ["--fps", "0"], ["--melt", "-2"],
-                                    ["--every-frame-as", "frames/walk.vti"]])
+                                    ["--every-frame-as", "frames/walk.vti"], ["--down=up"],
+                                    ["--melt", "2", "--crumble", "3"]])
 def test_bad_options_are_argument_errors_naming_the_option(tmp_path, capsys, option):
     with pytest.raises(SystemExit) as exc:
         main(["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "-o",
               str(tmp_path / "x.zarr"), *option])
-    assert exc.value.code == 2 and f"argument {option[0]}" in capsys.readouterr().err
+    assert exc.value.code == 2 and f"argument {option[0].split('=')[0]}" in capsys.readouterr().err
     assert not (tmp_path / "x.zarr").exists()

@@ -1,0 +1,130 @@
+"""Effects after a clip: melt and teleport shrink the spheres, crumble drops the voxels into a heap.
+
+``fall`` is checked against what falling means (every voxel and value kept, a shift
+before anything lands, a settled 45-degree heap on the floor at the end); the
+effects run through the real sequence machinery on 2 workers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import io
+from volanim_core.cli import main
+from volanim_core.reconstruct.engine import posed_centres, reconstruct
+from volanim_core.samples import mannequin_bones
+from volanim_core.sequence import store
+from volanim_core.sequence.effects import crumble, fall, melt, parse_axis, teleport
+from volanim_core.sequence.frames import frames_from_files
+from volanim_core.sequence.run import run_sequence, shared_bounds
+
+CONNECT = ASSETS / "mannequin.0.50.connect"
+WALK = ASSETS / "walk.bvh"
+
+
+@pytest.fixture(scope="module")
+def conn():
+    return io.read_connect(CONNECT)
+
+
+def random_body(seed=1, shape=(9, 8, 30), density=0.3) -> np.ndarray:
+    """Random voxels in the lower two thirds of the grid (room above for the heap), the lowest at z=3."""
+    rng = np.random.default_rng(seed)
+    vol = np.where(rng.random(shape) < density, rng.integers(1, 250, shape), 0).astype(np.uint8)
+    vol[:, :, :3] = 0
+    vol[:, :, shape[2] * 2 // 3:] = 0
+    vol[2, 3, 3] = 7  # the lowest voxel: the floor
+    return vol
+
+
+def test_fall_keeps_every_voxel_and_value_and_ends_in_a_settled_heap_on_the_floor():
+    for seed in range(12):
+        vol = random_body(seed, density=0.2 + 0.05 * seed)
+        assert np.array_equal(fall(vol, 0.0), vol)
+        for fraction in np.linspace(0.1, 1.0, 10):
+            out = fall(vol, fraction)
+            assert out.dtype == vol.dtype and out.shape == vol.shape
+            assert np.array_equal(np.sort(out[out != 0]), np.sort(vol[vol != 0])), (seed, fraction)
+        heap = fall(vol, 1.0)
+        height = np.count_nonzero(heap, axis=2)
+        for x, y in np.ndindex(*height.shape):  # every column a solid stack standing on the floor
+            assert np.all(heap[x, y, 3:3 + height[x, y]] != 0) and not heap[x, y, 3 + height[x, y]:].any()
+        # settled: no slope steeper than 45 degrees between neighbouring columns
+        assert np.abs(np.diff(height, axis=0)).max() <= 1 and np.abs(np.diff(height, axis=1)).max() <= 1
+        assert height.max() <= np.count_nonzero(vol, axis=2).max()
+
+
+def test_a_heap_that_cannot_fit_is_refused_not_cut():
+    vol = np.zeros((3, 3, 12), np.uint8)
+    vol[:, :, 1:11] = 5  # a 3x3 grid filled to its top: sand slumping into one hole lifts the rest
+    vol[1, 1, 11] = 5
+    vol[0, 0, 5] = 0
+    with pytest.raises(ValueError, match="heap does not fit.*--padding"):
+        fall(vol, 0.05)
+
+
+def test_fall_before_anything_lands_is_a_shift_and_any_axis_can_be_down():
+    vol = np.zeros((4, 5, 40), np.uint16)
+    vol[1:3, 1:4, 20:30] = np.arange(1, 61, dtype=np.uint16).reshape(2, 3, 10)
+    vol[0, 0, 2] = 9  # the floor, far below
+    out = fall(vol, 0.5)  # 27 * 0.25 -> 6 voxels down
+    assert np.array_equal(out[1:3, 1:4, 14:24], vol[1:3, 1:4, 20:30]) and out[0, 0, 2] == 9
+    up_is_y = np.ascontiguousarray(np.flip(vol.transpose(0, 2, 1), axis=1))  # z -> -y
+    assert np.array_equal(fall(up_is_y, 0.7, "+y"), np.flip(fall(vol, 0.7).transpose(0, 2, 1), axis=1))
+    assert not fall(np.zeros((3, 3, 3), np.uint8), 1.0).any()
+    with pytest.raises(ValueError, match="between 0 and 1"):
+        fall(vol, 1.5)
+    for bad in ("w", "--z", "", "zz"):
+        with pytest.raises(ValueError, match="x, y or z"):
+            parse_axis(bad)
+
+
+def test_teleport_vanishes_from_the_head_down_and_ends_empty(conn):
+    walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 1))
+    frames = teleport(conn, walk, 8)
+    assert [f.number for f in frames] == list(range(1, 9))
+    height = posed_centres(walk[0].tskel(conn))[:, 2]
+    high, low = height > np.percentile(height, 80), height < np.percentile(height, 20)
+    mid = frames[3].dt_scale
+    assert mid[high].mean() < 0.2 and mid[low].mean() > 0.8  # the beam is half-way down
+    assert frames[0].dt_scale.min() < 1 and frames[-1].dt_scale.max() == 0
+    scales = np.array([f.dt_scale for f in frames])
+    assert np.all(np.diff(scales, axis=0) <= 0)  # nothing grows back
+    assert np.array_equal(teleport(conn, walk, 8)[3].dt_scale, mid)  # reproducible
+
+
+def test_a_walk_then_a_crumble_runs_on_two_workers_and_keeps_every_voxel(tmp_path, conn):
+    walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 60, 30))
+    frames = walk + crumble(walk, 3)
+    rep = run_sequence(conn, frames, tmp_path / "c.zarr", mode="mottled", workers=2)
+    last = rep.records[1]["filled"]
+    assert [r["filled"] for r in rep.records[2:]] == [last] * 3  # falling loses nothing
+    standing = store.read_frame(tmp_path / "c.zarr", 1)
+    for i in (2, 3, 4):
+        assert np.array_equal(store.read_frame(tmp_path / "c.zarr", i), fall(standing, (i - 1) / 3)), i
+    alone = reconstruct(walk[-1].tskel(conn), mode="mottled")
+    assert np.count_nonzero(alone.volume) == last
+    heap = store.read_frame(tmp_path / "c.zarr", 4)
+    z = np.nonzero(standing)[2]
+    assert np.ptp(np.nonzero(heap)[2]) < np.ptp(z) / 3  # a heap, not a body
+    assert np.nonzero(heap)[2].min() == z.min()  # on the floor the body stood on
+    assert rep.bounds.shape[1] > shared_bounds(conn, walk).shape[1]  # the grid made room for the heap ...
+    for axis in (0, 1):  # ... so it never leans on the grid's sides
+        at = np.nonzero(heap)[axis]
+        assert at.min() > 0 and at.max() < heap.shape[axis] - 1
+
+
+def test_cli_effects_and_the_down_option(tmp_path, capsys):
+    base = ["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "--frames", "0:1",
+            "--mode", "bone", "--workers", "1"]
+    assert main([*base, "--teleport", "2", "-o", str(tmp_path / "t.zarr")]) == 0
+    assert "3 made" in capsys.readouterr().out
+    assert not store.read_frame(tmp_path / "t.zarr", 2).any()  # gone
+    assert main([*base, "--crumble", "2", "--down=-z", "-o", str(tmp_path / "c.zarr")]) == 0
+    assert len(store.finished(tmp_path / "c.zarr")) == 3
+    assert [f.number for f in melt(frames_from_files(io.read_connect(CONNECT), [WALK], bones=mannequin_bones(),
+                                                     frames=slice(0, 1)), 2)] == [1, 2]
+    with pytest.raises(ValueError, match="follows a pose"):
+        crumble([], 3)
