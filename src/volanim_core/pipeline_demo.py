@@ -170,9 +170,10 @@ def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
 def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Path:
     """One walk cycle (about 1.2 s of the clip), then the body crumbles into a heap: a sequence,
     every frame in one grid, all cores."""
+    from volanim_core.parallel import default_workers
     from volanim_core.sequence.effects import crumble
     from volanim_core.sequence.frames import FrameSpec
-    from volanim_core.sequence.run import default_workers, run_sequence
+    from volanim_core.sequence.run import run_sequence
 
     numbers = range(retarget.motion.frames)[frames]
     specs = [FrameSpec(n, m) for n, m in zip(numbers, retarget.matrices(frames))]

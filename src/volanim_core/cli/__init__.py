@@ -18,6 +18,7 @@ from . import (
     demo_command,
     motion_commands,
     reconstruct_commands,
+    render_commands,
     sequence_commands,
     skeleton_commands,
     volume_commands,
@@ -45,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for module in (volume_commands, skeleton_commands, reconstruct_commands, motion_commands, sequence_commands,
-                   demo_command):
+                   render_commands, demo_command):
         module.register(sub)
     return parser
 

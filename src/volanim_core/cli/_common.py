@@ -103,3 +103,30 @@ def parse_range(text: str) -> tuple[float, float | None]:
 
 def bounds_arg(values) -> Bounds:
     return Bounds(tuple(values[:3]), tuple(values[3:]))
+
+
+class FrameProgress:
+    """``frame done/total  N frames/s  ETA m:ss`` on one stderr line (sequence, render).
+
+    Called as ``progress(anything, done, total)`` after each frame; frames complete
+    before this run (a resume) count toward done, not toward the rate.
+    """
+
+    def __init__(self):
+        import time
+
+        self._clock = time.perf_counter
+        self.t0 = self._clock()
+        self.before = None
+
+    def __call__(self, _item, done: int, total: int) -> None:
+        import sys
+
+        if self.before is None:
+            self.before = done - 1
+        made = done - self.before
+        elapsed = self._clock() - self.t0
+        rate = made / elapsed if elapsed > 0 else 0.0
+        eta = (total - done) / rate if rate > 0 else 0.0
+        print(f"\rframe {done}/{total}  {rate:.2f} frames/s  ETA {int(eta) // 60}:{int(eta) % 60:02d}   ",
+              end="", file=sys.stderr, flush=True)

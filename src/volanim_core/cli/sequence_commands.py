@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 
-from ._common import add_command, ascii_int, positive_float, positive_int
+from ._common import FrameProgress, add_command, ascii_int, positive_float, positive_int
 
 EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr
   volanim sequence mannequin.0.50.connect assets/walk.bvh --bones mannequin.bones --frames 0:240:4 \\
@@ -14,24 +13,6 @@ EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source manne
   volanim sequence ... --crumble 36 -o walk.zarr      (after the walk, the body falls into a heap)
   volanim sequence ... --scheduler tcp://10.0.0.5:8786 -o /shared/walk.zarr     (a Dask cluster)
   volanim sequence ... -o walk.zarr      (again: finished frames are skipped; --force starts over)"""
-
-
-class _Progress:
-    """frames done / total, frames per second and ETA on one stderr line."""
-
-    def __init__(self):
-        self.t0 = time.perf_counter()
-        self.before = None  # frames complete before this run (known at the first report)
-
-    def __call__(self, rec: dict, done: int, total: int) -> None:
-        if self.before is None:
-            self.before = done - 1
-        made = done - self.before
-        elapsed = time.perf_counter() - self.t0
-        rate = made / elapsed if elapsed > 0 else 0.0
-        eta = (total - done) / rate if rate > 0 else 0.0
-        print(f"\rframe {done}/{total}  {rate:.2f} frames/s  ETA {int(eta) // 60}:{int(eta) % 60:02d}   ",
-              end="", file=sys.stderr, flush=True)
 
 
 def _frame_pattern(text: str) -> str:
@@ -57,9 +38,10 @@ def _axis(text: str) -> str:
 def _sequence(args):
     from volanim_core.io import read_bones, read_connect, read_volume_grid
     from volanim_core.motion.retarget import read_mapping
+    from volanim_core.parallel import default_workers
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
-    from volanim_core.sequence.run import default_workers, run_sequence
+    from volanim_core.sequence.run import run_sequence
 
     conn = read_connect(args.connect)
     bones = read_bones(args.bones) if args.bones else None
@@ -79,7 +61,7 @@ def _sequence(args):
     rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_origin=source_origin,
                        kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
                        workers=workers, scheduler=args.scheduler, force=args.force,
-                       threads_per_worker=args.threads_per_worker, on_frame=_Progress())
+                       threads_per_worker=args.threads_per_worker, on_frame=FrameProgress())
     print(file=sys.stderr)
     print(format_report(rep))
     print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "

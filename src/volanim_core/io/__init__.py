@@ -24,6 +24,7 @@ from .raw_volumes import (
     remove_header,
     write_raw,
 )
+from .render_files import read_camera, read_transfer_function, write_camera, write_transfer_function
 from .skeleton_files import read_mskel, read_skel, write_mskel, write_skel
 from .volume_files import (
     float_to_uint8,
@@ -35,6 +36,10 @@ from .volume_files import (
 )
 
 __all__ = [
+    "read_camera",
+    "read_transfer_function",
+    "write_camera",
+    "write_transfer_function",
     "FormatError",
     "add_header",
     "connect_filename",

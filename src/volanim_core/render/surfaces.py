@@ -33,9 +33,14 @@ def label_surface(volume: np.ndarray, origin, spacing, table: np.ndarray | None 
     img.point_data["values"] = (np.asarray(volume) > 0).astype(np.uint8).ravel(order="F")
     surf = img.contour([0.5], scalars="values", method="flying_edges")
     if surf.n_points and table is not None:
-        idx = np.rint((np.asarray(surf.points) - origin) / spacing).astype(np.int64)
-        idx = np.clip(idx, 0, np.array(volume.shape) - 1)
-        labels = np.asarray(volume)[tuple(idx.T)].astype(np.int64)
+        # a surface point lies on a grid edge between a filled and an empty voxel: colour it by the
+        # filled one (rounding picked the empty one half the time, speckling the surface with row 0)
+        at = (np.asarray(surf.points) - origin) / spacing
+        top = np.array(volume.shape) - 1
+        lo = np.clip(np.floor(at).astype(np.int64), 0, top)
+        hi = np.clip(np.ceil(at).astype(np.int64), 0, top)
+        vol = np.asarray(volume)
+        labels = np.maximum(vol[tuple(lo.T)], vol[tuple(hi.T)]).astype(np.int64)
         surf.point_data["rgb"] = table[np.clip(labels, 0, len(table) - 1)].astype(np.uint8)
     return surf
 

@@ -4,25 +4,24 @@
     plan key (connectivity, frames, mode, kernel, padding, source) --> new store, or resume the old one
     frames not in the manifest --executor.submit(reconstruct_frame)--> stats --> manifest (driver only)
 
-The executor is anything with ``submit`` (``concurrent.futures``): this
-process (1 worker), a local process pool (N workers, one numba thread each),
-or a Dask cluster's ``client.get_executor()`` -- the same task function runs
-in all three, so a frame is bit-identical wherever it was made.
+The executor (``volanim_core.parallel``) is this process (1 worker), a local
+process pool (N workers, one numba thread each) or a Dask cluster's
+``client.get_executor()`` -- the same task function runs in all three, so a
+frame is bit-identical wherever it was made.
 """
 
 from __future__ import annotations
 
 import hashlib
-import os
 import time
 from concurrent.futures import FIRST_COMPLETED, Future, wait
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from volanim_core.limits import available_bytes, human_bytes
+from volanim_core.parallel import executor
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.volume import Bounds
@@ -155,7 +154,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                       threads_per_worker)
     records = dict(done)
     total = len(frames)
-    with _executor(payload, n_workers, scheduler) as (submit, label, running):
+    with executor(reconstruct_frame, payload, install, workers=n_workers, scheduler=scheduler) as (submit, label,
+                                                                                                running):
         pending: set[Future] = set()
         queue = list(todo)
         while queue or pending:  # two frames per worker in flight: frames finish about in order
@@ -180,49 +180,3 @@ def _rest_filled(conn) -> int:
 
     r = reconstruct(identity_tskel(conn), mode="bone")
     return int(r.stats["filled"])
-
-
-@contextmanager
-def _executor(payload: Payload, workers: int, scheduler):
-    """``(submit(index, spec) -> Future, description, workers)`` for this process, a local pool or Dask."""
-    if scheduler is not None:
-        from distributed import Client
-
-        client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
-        try:
-            shared = client.scatter(payload, broadcast=True, hash=False)  # shipped to each worker once
-            ex = client.get_executor(pure=False)
-            n = len(client.scheduler_info().get("workers", {}))
-            yield (lambda i, spec: ex.submit(reconstruct_frame, shared, i, spec)), f"Dask, {n} workers", n
-        finally:
-            if client is not scheduler:
-                client.close()
-        return
-    if workers <= 1:
-        install(payload)
-        yield _inline, "1 worker (this process)", 1
-        return
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    # spawn, not fork: zarr's I/O thread and numba's threads do not survive a fork
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=install,
-                             initargs=(payload,)) as pool:
-        try:
-            yield (lambda i, spec: pool.submit(reconstruct_frame, None, i, spec)), f"{workers} local workers", workers
-        finally:
-            pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _inline(index: int, spec: FrameSpec) -> Future:
-    """A finished Future, so this process runs frames through the same loop as a pool."""
-    fut: Future = Future()
-    try:
-        fut.set_result(reconstruct_frame(None, index, spec))
-    except Exception as exc:  # handed to the caller through the future, like a pool would
-        fut.set_exception(exc)
-    return fut
-
-
-def default_workers() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)

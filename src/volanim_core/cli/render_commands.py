@@ -1,0 +1,107 @@
+"""``volanim render``: volumes and sequences to pictures and movies (the old ``vtkRender``)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ._common import FrameProgress, add_command, ascii_int, finite_float, positive_float, positive_int
+
+EXAMPLE = """volanim render walk.zarr -o walk.mp4                          (the sequence's mode picks the colours)
+  volanim render walk.zarr -o walk.gif --size 320x240 --view front --frame-numbers
+  volanim render arm-sampled.vti -o arm.png --style volume --tf bone-and-skin.tf
+  volanim render walk.zarr -o frames/ --camera studio.camera --cut 64 60 150 0 -1 0   (cut away the front half)
+  volanim render walk.zarr -o walk.mp4 --workers 2        (again after a kill: only missing frames are drawn)"""
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    parts = text.lower().split("x")
+    if len(parts) != 2 or not all(p.isascii() and p.isdigit() for p in parts):
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, e.g. 640x480, got {text!r}")
+    w, h = (int(p) for p in parts)
+    if not (16 <= w <= 8192 and 16 <= h <= 8192):
+        raise argparse.ArgumentTypeError(f"a picture is 16..8192 pixels each way, got {text}")
+    return w, h
+
+
+def parse_colour(text: str) -> str:
+    from pyvista import Color
+
+    try:
+        Color(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a colour: {text!r} (a name like black, or #rrggbb)") from None
+    return text
+
+
+def _render(args):
+    from volanim_core import io
+    from volanim_core.parallel import default_workers
+    from volanim_core.render.camera import named_view
+    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.scene import RenderSettings
+
+    inputs = open_inputs(args.inputs, args.range, dims=args.dims)
+    preset = args.preset or inputs.mode or "sampled"
+    w, h = args.size
+    if args.camera:
+        camera = io.read_camera(args.camera)
+    else:
+        camera = named_view(args.view, inputs.lo, inputs.hi, aspect=w / h)
+    if args.save_camera:
+        io.write_camera(args.save_camera, camera)
+    cut = None
+    if args.cut:
+        cut = (tuple(args.cut[:3]), tuple(args.cut[3:]))
+    settings = RenderSettings(camera, style=args.style, preset=preset, vmax=inputs.vmax,
+                              transfer=io.read_transfer_function(args.tf) if args.tf else None, size=(w, h),
+                              background=args.background, cut=cut, title=args.title,
+                              frame_numbers=args.frame_numbers, mapper=args.mapper)
+    workers = None if args.scheduler else (default_workers() if args.workers is None else args.workers)
+    rep = render(inputs, settings, args.output, fps=args.fps, workers=workers or 1, scheduler=args.scheduler,
+                 force=args.force, keep_frames=args.keep_frames, dims=args.dims, on_frame=FrameProgress())
+    print(file=sys.stderr)
+    print(f"wrote {rep.out}: {rep.frames} frame{'s' if rep.frames != 1 else ''} of {w}x{h} ({args.style}, {preset} "
+          f"colours), {rep.drawn} drawn, {rep.skipped} already there; {rep.workers}; {rep.seconds:.1f} s"
+          + (f"; {rep.fps:g} fps" if rep.frames > 1 else ""))
+
+
+def register(sub) -> None:
+    from volanim_core.reconstruct.engine import MODES
+    from volanim_core.render.camera import VIEWS
+    from volanim_core.render.scene import MAPPERS, STYLES
+
+    from .motion_commands import parse_frames
+
+    p = add_command(sub, "render", "Render a volume, several volumes or a zarr sequence to a PNG, a folder of "
+                    "PNGs, an .mp4 or a .gif, with one fixed camera, off-screen.", EXAMPLE, _render)
+    p.add_argument("inputs", nargs="+", help="a .zarr sequence, or volume files (.vti .nrrd .vol .VOL ...)")
+    p.add_argument("-o", "--output", required=True, help="NAME.png (one frame), a folder, NAME.mp4 or NAME.gif")
+    p.add_argument("--style", choices=STYLES, default="surface",
+                   help="surface: the filled voxels' boundary (fast); volume: ray-cast (default surface)")
+    p.add_argument("--preset", choices=MODES, help="colours for this reconstruction mode (default: the "
+                   "sequence's mode, else sampled)")
+    p.add_argument("--tf", metavar="FILE.tf", help="a transfer function: VALUE RED GREEN BLUE ALPHA per line (0..1)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--view", choices=VIEWS, default="three-quarter", help="a named view (default three-quarter)")
+    where.add_argument("--camera", metavar="FILE.camera", help="a camera file (the studio: View > Save view as "
+                       "camera file)")
+    p.add_argument("--save-camera", metavar="FILE.camera", help="also write the camera used, to edit or reuse")
+    p.add_argument("--size", type=parse_size, default=(640, 480), metavar="WxH",
+                   help="pixels (default 640x480; .mp4 needs multiples of 16)")
+    p.add_argument("--background", type=parse_colour, default="black", help="a colour name or #rrggbb")
+    p.add_argument("--cut", nargs=6, type=finite_float, metavar=("X", "Y", "Z", "NX", "NY", "NZ"),
+                   help="cut away everything on the side the normal (NX NY NZ) points to from voxel (X Y Z)")
+    p.add_argument("--title", help="text in the top left corner")
+    p.add_argument("--frame-numbers", action="store_true", help="the frame number in the top right corner")
+    p.add_argument("--fps", type=positive_float, help="movie frame rate (default: the sequence's, else 24)")
+    p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",
+                   help="which frames (counted from 0)")
+    pool = p.add_mutually_exclusive_group()
+    pool.add_argument("--workers", type=positive_int, help="local worker processes (default: every core)")
+    pool.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="draw on this Dask cluster instead")
+    p.add_argument("--mapper", choices=MAPPERS, default="auto",
+                   help="volume style: auto (VTK picks) or cpu (the fixed-point ray caster)")
+    p.add_argument("--force", action="store_true", help="draw every frame again")
+    p.add_argument("--keep-frames", action="store_true", help="keep a movie's PNG frames (.NAME.frames/)")
+    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")

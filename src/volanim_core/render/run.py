@@ -1,0 +1,331 @@
+"""Render many frames to pictures and a movie: one camera, all local cores or a Dask cluster, resumable.
+
+    inputs (a zarr sequence, or volume files) --open_inputs--> FrameRefs + the box every frame fits
+    FrameRefs not yet drawn --executor.submit(render_task)--> (number, RGB image) --> NAME.0000.png (atomic)
+    every PNG --encode--> .mp4 (imageio-ffmpeg's own ffmpeg) or .gif
+
+Each worker keeps one off-screen plotter for all its frames. Pictures are
+written by the driver only, each atomically, so a run killed at any moment
+leaves whole PNGs; rerunning with the same settings draws only the missing
+ones (``volanim-render.json`` holds the settings' key; other settings start over).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from concurrent.futures import FIRST_COMPLETED, wait
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from volanim_core.errors import FormatError
+from volanim_core.parallel import executor
+
+from .scene import Renderer, RenderSettings
+
+KEY_FILE = "volanim-render.json"
+MOVIES = (".mp4", ".gif")
+
+
+@dataclass(frozen=True)
+class FrameRef:
+    path: str
+    index: int  # the frame inside a zarr sequence (-1: a volume file)
+    number: int  # the frame's number (file names, the overlay)
+
+
+@dataclass
+class RenderInputs:
+    frames: list[FrameRef]
+    lo: tuple  # the voxel box every frame fits in (the camera frames it)
+    hi: tuple
+    mode: str | None  # the reconstruction mode, when the input says
+    vmax: float  # the top of the colour range over every frame
+    fps: float | None
+    fingerprint: list  # what the pictures depend on besides the settings (for resuming)
+
+
+def open_inputs(paths, frames: slice = slice(None), dims=None) -> RenderInputs:
+    """Frames to render from one zarr sequence or from volume files (in frame-number order)."""
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise ValueError("nothing to render: give a volume file, several, or a .zarr sequence")
+    zarrs = [p for p in paths if (p / "volanim-plan.json").is_file() or p.suffix.lower() == ".zarr"]
+    if zarrs:
+        if len(paths) != 1:
+            raise ValueError("render one .zarr sequence, or volume files, not both")
+        return _zarr_inputs(paths[0], frames)
+    return _file_inputs(paths, frames, dims)
+
+
+def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
+    import zarr
+
+    from volanim_core.sequence import store
+
+    plan = store.read_plan(path)
+    if plan is None:
+        raise FormatError(path, "is not a volanim sequence (no volanim-plan.json): make one with `volanim sequence`")
+    done = store.finished(path)
+    indices = list(range(int(plan["frames"])))[frames]
+    if not indices:
+        raise ValueError(f"{path}: the frame range selects none of its {plan['frames']} frames")
+    missing = [i for i in indices if i not in done]
+    if missing:
+        raise ValueError(f"{path}: {len(missing)} of the frames to render are not reconstructed yet (first: frame "
+                         f"{plan['numbers'][missing[0]]}); finish them with `volanim sequence` (rerun it: it resumes)")
+    arr = store.open_frames(path)
+    lo = store.origin(path)
+    hi = tuple(o + n - 1 for o, n in zip(lo, arr.shape[1:][::-1]))
+    mode = plan.get("mode")
+    if mode == "hotspot":
+        vmax = max(float(done[i].get("hotspot_max") or 1) for i in indices)
+    else:
+        vmax = float(np.iinfo(arr.dtype).max) if np.dtype(arr.dtype).kind in "ui" else 1.0
+        if np.dtype(arr.dtype).itemsize > 1 or np.dtype(arr.dtype).kind == "f":
+            vmax = float(np.max(arr[indices[len(indices) // 2]]))  # a middle frame's brightest voxel
+    scale = zarr.open_group(str(path), mode="r").attrs["ome"]["multiscales"][0]["datasets"][0][
+        "coordinateTransformations"][0]["scale"][0]
+    refs = [FrameRef(str(path.resolve()), i, int(plan["numbers"][i])) for i in indices]
+    return RenderInputs(refs, tuple(lo), hi, mode, vmax, 1.0 / float(scale),
+                        [plan["key"], *[done[i]["sha256"] for i in indices]])
+
+
+def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
+    from volanim_core.motion.frames import frame_number
+
+    numbers = [frame_number(p) for p in paths]
+    if None in numbers or len(set(numbers)) != len(numbers):
+        numbers = list(range(len(paths)))  # their order on the command line
+    pairs = sorted(zip(numbers, paths))[frames]
+    if not pairs:
+        raise ValueError("the frame range selects none of the files")
+    los, his, vmax, fingerprint = [], [], 1.0, []
+    for _, p in pairs:  # every file once: the box and the colour range must hold for all of them
+        vol, origin, _ = _read(p, dims)
+        o = np.rint(np.asarray(origin, np.float64)).astype(int)
+        los.append(o)
+        his.append(o + np.array(vol.shape) - 1)
+        if vol.size:
+            vmax = max(vmax, float(vol.max()))
+        st = p.stat()
+        fingerprint.append([str(p.resolve()), st.st_size, st.st_mtime_ns])
+    refs = [FrameRef(str(p.resolve()), -1, int(n)) for n, p in pairs]
+    return RenderInputs(refs, tuple(np.min(los, 0).tolist()), tuple(np.max(his, 0).tolist()), None, vmax, None,
+                        fingerprint)
+
+
+def _read(path, dims=None):
+    from volanim_core.io import read_volume_grid
+
+    return read_volume_grid(path, dims=dims)
+
+
+@dataclass
+class RenderJob:
+    settings: RenderSettings
+    dims: tuple | None = None
+
+
+_JOB: RenderJob | None = None
+_RENDERER: Renderer | None = None
+
+
+def install(job: RenderJob) -> None:
+    """A worker's initializer: keep the job; its plotter is made at the first frame."""
+    global _JOB
+    release()
+    _JOB = job
+
+
+def release() -> None:
+    """Close this process's plotter (a pool worker's goes with the process; this one must not outlive
+    the display it was opened on)."""
+    global _RENDERER
+    if _RENDERER is not None:
+        _RENDERER.close()
+        _RENDERER = None
+
+
+def render_task(job: RenderJob | None, ref: FrameRef) -> tuple[int, np.ndarray]:
+    """Draw one frame; returns its number and the picture (the driver writes it)."""
+    global _RENDERER, _JOB
+    job = job if job is not None else _JOB
+    if job is None:
+        raise RuntimeError("render_task: no job (the pool's initializer did not run)")
+    if _RENDERER is None or _RENDERER.settings != job.settings:
+        if _RENDERER is not None:
+            _RENDERER.close()
+        _RENDERER, _JOB = Renderer(job.settings), job  # one plotter per worker, reused for every frame
+    if ref.index >= 0:
+        from volanim_core.sequence import store
+
+        volume, origin = store.read_frame(ref.path, ref.index), store.origin(ref.path)
+    else:
+        volume, origin, _ = _read(ref.path, job.dims)
+    return ref.number, _RENDERER.render(volume, origin, ref.number)
+
+
+def output_kind(out: Path) -> str:
+    """``png`` (one picture), ``mp4``/``gif`` (a movie) or ``folder`` (numbered PNGs)."""
+    suffix = out.suffix.lower()
+    if suffix == ".png":
+        return "png"
+    if suffix in MOVIES:
+        return suffix[1:]
+    if suffix and not out.is_dir():
+        raise ValueError(f"{out}: render to a .png, .mp4, .gif or a folder (no extension)")
+    return "folder"
+
+
+def check_size(size, kind: str) -> None:
+    w, h = size
+    if kind == "mp4" and (w % 16 or h % 16):
+        raise ValueError(f"a video is encoded in 16x16 blocks: --size {w}x{h} must be multiples of 16 "
+                         f"(e.g. {max(16, w // 16 * 16)}x{max(16, h // 16 * 16)})")
+
+
+@dataclass
+class RenderReport:
+    out: Path
+    frames: int
+    drawn: int
+    skipped: int
+    seconds: float
+    workers: str
+    fps: float
+
+
+def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | None = None, workers: int = 1,
+           scheduler=None, force: bool = False, keep_frames: bool = False, dims=None, on_frame=None) -> RenderReport:
+    """Render every frame of ``inputs`` to ``out``; see the module docstring.
+
+    ``on_frame(number, done, total)`` after each picture (progress).
+    """
+    t0 = time.perf_counter()
+    out = Path(out)
+    kind = output_kind(out)
+    settings.check()
+    check_size(settings.size, kind)
+    fps = float(fps or inputs.fps or 24.0)
+    if not 0 < fps <= 1000:
+        raise ValueError(f"fps must be above 0 and at most 1000, got {fps:g}")
+    total = len(inputs.frames)
+    if kind == "png" and total != 1:
+        raise ValueError(f"{total} frames do not fit in one .png: render to a folder, an .mp4 or a .gif")
+    job = RenderJob(settings, dims)
+    if kind == "png":
+        try:
+            with executor(render_task, job, install, workers=1) as (submit, label, _):
+                number, image = submit(inputs.frames[0]).result()
+        finally:
+            release()
+        write_png(out, image)
+        if on_frame is not None:
+            on_frame(number, 1, 1)
+        return RenderReport(out, 1, 1, 0, time.perf_counter() - t0, label, fps)
+    folder = out if kind == "folder" else out.parent / f".{out.name}.frames"
+    key = _key(inputs, settings)
+    todo, skipped = _plan_folder(folder, key, inputs.frames, force)
+    done = total - len(todo)
+    label = "nothing to draw"
+    if todo:
+        try:
+            label = _draw(todo, job, folder, workers, scheduler, on_frame, done, total)
+        finally:
+            release()
+    if kind in ("mp4", "gif"):
+        encode([frame_path(folder, f.number) for f in inputs.frames], out, fps)
+        if not keep_frames:
+            shutil.rmtree(folder, ignore_errors=True)
+    return RenderReport(out, total, len(todo), skipped, time.perf_counter() - t0, label, fps)
+
+
+def _draw(todo, job, folder, workers, scheduler, on_frame, done, total) -> str:
+    """Draw ``todo`` anywhere; the driver writes each picture as it arrives. Returns where it ran."""
+    with executor(render_task, job, install, workers=min(workers, len(todo)), scheduler=scheduler) as (
+            submit, label, running):
+        pending, queue = set(), list(todo)
+        while queue or pending:  # two frames per worker in flight: pictures arrive about in order
+            while queue and len(pending) < 2 * max(running, 1):
+                pending.add(submit(queue.pop(0)))
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                number, image = fut.result()
+                write_png(frame_path(folder, number), image)
+                done += 1
+                if on_frame is not None:
+                    on_frame(number, done, total)
+    return label
+
+
+def frame_path(folder: Path, number: int) -> Path:
+    return Path(folder) / f"frame.{number:04d}.png"
+
+
+def write_png(path, image: np.ndarray) -> None:
+    import imageio.v3 as iio
+
+    from volanim_core.io._atomic import atomic_write_bytes
+
+    atomic_write_bytes(path, iio.imwrite("<bytes>", image, extension=".png"))
+
+
+def _key(inputs: RenderInputs, settings: RenderSettings) -> str:
+    def plain(v):
+        if isinstance(v, np.ndarray):
+            return v.tolist()
+        return str(v)
+
+    text = json.dumps([asdict(settings), inputs.fingerprint, [asdict(f) for f in inputs.frames]], default=plain,
+                      sort_keys=True)
+    return hashlib.blake2b(text.encode(), digest_size=16).hexdigest()
+
+
+def _plan_folder(folder: Path, key: str, frames: list[FrameRef], force: bool) -> tuple[list[FrameRef], int]:
+    """The frames still to draw into ``folder``: all of them unless the folder holds this render's pictures."""
+    from volanim_core.io._atomic import atomic_write_text
+
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"{folder} is a file; render to a folder, a .png, an .mp4 or a .gif")
+    folder.mkdir(parents=True, exist_ok=True)
+    old = None
+    try:
+        old = json.loads((folder / KEY_FILE).read_text()).get("key")
+    except (OSError, ValueError, AttributeError):
+        pass
+    if force or old != key:
+        atomic_write_text(folder / KEY_FILE, json.dumps({"key": key, "frames": len(frames)}))
+        return list(frames), 0  # other settings: every picture is redrawn (and replaced)
+    todo = [f for f in frames if not frame_path(folder, f.number).is_file()]
+    return todo, len(frames) - len(todo)
+
+
+def encode(pngs: list[Path], out: Path, fps: float) -> None:
+    """The pictures as one movie: H.264 ``.mp4`` (yuv420p, plays everywhere) or a looping ``.gif``."""
+    import imageio.v2 as iio2
+    import imageio.v3 as iio
+
+    from volanim_core.io._atomic import clean_stale, pending_name
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    clean_stale(out.parent, out.name)
+    tmp = out.parent / (pending_name(out.name) + out.suffix)  # the encoder picks the format by extension
+    try:
+        if out.suffix.lower() == ".mp4":
+            with iio2.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264", quality=8, macro_block_size=16,
+                                 pixelformat="yuv420p", ffmpeg_log_level="error") as writer:
+                for p in pngs:
+                    writer.append_data(iio.imread(p))
+        else:
+            frames = [iio.imread(p) for p in pngs]
+            iio.imwrite(tmp, frames, extension=".gif", duration=1000.0 / fps, loop=0)
+        os.replace(tmp, out)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise

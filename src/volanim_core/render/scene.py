@@ -1,0 +1,207 @@
+"""One off-screen picture per frame, with the same camera, colours and overlay for every frame.
+
+    RenderSettings (style, preset, transfer function, camera, size, background, cut, overlay)
+    Renderer(settings) -- one off-screen plotter, kept for every frame a worker draws
+        .render(volume[x, y, z], origin, number) -> (H, W, 3) uint8
+
+Styles: ``volume`` (ray-cast through a transfer function; the CPU ray caster
+with ``mapper="cpu"``) and ``surface`` (the boundary of the filled voxels,
+coloured by the voxel under it -- the studio's live-preview look, far faster
+in software OpenGL). Presets follow the reconstruction mode: sampled grey,
+categorical bone and mottle colours, a heat map with a colour bar for hotspot.
+Colour ranges are fixed by the settings, never per frame, so a sequence does
+not flicker. A cut-away plane empties the voxels on the side its normal points
+to before drawing, so both styles show the inside of the posed body.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volanim_core.render.camera import Camera
+from volanim_core.render.colours import SKIN, rgb
+from volanim_core.render.transfer import LABEL_MODES, apply_labels, label_colours
+from volanim_core.render.transfer_function import TransferFunction
+
+STYLES = ("surface", "volume")
+MAPPERS = ("auto", "cpu")
+LABELS = 255  # label colours drawn for bone/mottled presets (bone colours repeat every 32, as in the studio)
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    camera: Camera
+    style: str = "surface"
+    preset: str = "sampled"  # a reconstruction mode: how values become colours
+    vmax: float = 255.0  # the top of the colour range (sampled, hotspot), fixed for the whole sequence
+    transfer: TransferFunction | None = None  # replaces the preset's colours (volume and surface)
+    size: tuple[int, int] = (640, 480)
+    background: str = "black"
+    cut: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None  # (point, normal)
+    title: str | None = None
+    frame_numbers: bool = False
+    mapper: str = "auto"  # volume style: "auto" (VTK's smart mapper) or "cpu" (the fixed-point ray caster)
+    spacing: tuple[float, float, float] = field(default=(1.0, 1.0, 1.0))
+
+    def check(self) -> None:
+        if self.style not in STYLES:
+            raise ValueError(f"unknown style {self.style!r}; choose {' or '.join(STYLES)}")
+        if self.mapper not in MAPPERS:
+            raise ValueError(f"unknown mapper {self.mapper!r}; choose {' or '.join(MAPPERS)}")
+        w, h = self.size
+        if not (16 <= w <= 8192 and 16 <= h <= 8192):
+            raise ValueError(f"a picture is 16..8192 pixels each way, got {w}x{h}")
+        if self.cut is not None and not np.any(np.asarray(self.cut[1], np.float64)):
+            raise ValueError("the cut-away plane's normal must not be zero")
+        self.camera.check()
+
+
+def preset_transfer(preset: str, vmax: float) -> TransferFunction:
+    """The volume-style colours and opacities of a continuous preset (sampled grey, hotspot heat)."""
+    top = max(float(vmax), 1.0)
+    if preset == "hotspot":  # 1 sphere: faint dark red ... the most: opaque pale yellow
+        return TransferFunction([0.0, 0.5, 1.0, top / 2 if top > 2 else 1.5, max(top, 2.0)],
+                                [[0, 0, 0, 0], [0, 0, 0, 0], [0.5, 0.0, 0.0, 0.05], [1.0, 0.45, 0.0, 0.35],
+                                 [1.0, 1.0, 0.6, 0.9]])
+    # sampled grey: empty is clear, dim tissue faint, bright tissue nearly opaque
+    return TransferFunction([0.0, 0.5, top * 0.25, top], [[0, 0, 0, 0], [0.15, 0.15, 0.15, 0.0],
+                                                           [0.45, 0.45, 0.45, 0.08], [1, 1, 1, 0.8]])
+
+
+def colour_table(settings: RenderSettings, vmax: float | None = None) -> np.ndarray:
+    """``(L, 3)`` uint8: the surface colour of value v at row v (rounded), for every value up to vmax."""
+    top = int(np.ceil(vmax if vmax is not None else settings.vmax))
+    values = np.arange(max(top, 1) + 1, dtype=np.float64)
+    if settings.transfer is not None:
+        rgb_ = settings.transfer(values)[:, :3]
+    elif settings.preset in LABEL_MODES:
+        colours = label_colours(settings.preset, LABELS)
+        rgb_ = np.vstack([[0, 0, 0], colours[(np.arange(1, len(values)) - 1) % len(colours)]])
+    else:
+        rgb_ = preset_transfer(settings.preset, settings.vmax)(values)[:, :3]
+        if settings.preset == "sampled":  # a surface is opaque: keep the grey, not the near-black of the ramp
+            rgb_ = np.maximum(rgb_, 0.25)
+    return np.round(np.clip(rgb_, 0, 1) * 255).astype(np.uint8)
+
+
+def cut_away(volume: np.ndarray, origin, point, normal) -> np.ndarray:
+    """``volume`` with every voxel on the side ``normal`` points to (from ``point``) emptied."""
+    n = np.asarray(normal, np.float64)
+    d = -float(np.dot(n, np.asarray(point, np.float64) - np.asarray(origin, np.float64)))
+    x, y, z = (np.arange(s, dtype=np.float64) for s in volume.shape)
+    side = (n[0] * x[:, None, None] + n[1] * y[None, :, None]) + (n[2] * z[None, None, :] + d) > 0
+    out = volume.copy()
+    out[side] = 0
+    return out
+
+
+class Renderer:
+    """One off-screen plotter that draws frame after frame with one camera."""
+
+    def __init__(self, settings: RenderSettings):
+        import pyvista as pv
+
+        settings.check()
+        self.settings = settings
+        self.plotter = pv.Plotter(off_screen=True, window_size=tuple(settings.size))
+        self.plotter.set_background(settings.background)
+        if settings.style == "surface":
+            self.plotter.enable_anti_aliasing("ssaa")  # voxel staircases shimmer less between frames
+        self._grid = None  # the volume style's image data, refilled per frame when its shape stays
+        self._table = colour_table(settings)
+        self._bar = None
+        if settings.title:
+            self.plotter.add_text(settings.title, position="upper_left", font_size=12, name="title",
+                                  color=_contrast(settings.background))
+        settings.camera.apply(self.plotter.camera)
+        self.plotter.camera_set = True  # never reset to fit a frame: the camera is the sequence's
+
+    def render(self, volume: np.ndarray, origin, number: int | None = None) -> np.ndarray:
+        s = self.settings
+        if s.cut is not None:
+            volume = cut_away(volume, origin, *s.cut)
+        if s.preset == "binary" and s.transfer is None:
+            volume = (volume > 0).astype(np.uint8)
+        if s.style == "surface":
+            self._draw_surface(volume, origin)
+        else:
+            self._draw_volume(volume, origin)
+        if s.preset == "hotspot" and self._bar is None:
+            self._add_colour_bar()
+        if s.frame_numbers and number is not None:
+            self.plotter.add_text(f"frame {number}", position="upper_right", font_size=12, name="frame",
+                                  color=_contrast(s.background))
+        s.camera.apply(self.plotter.camera)  # adding actors must not have moved it
+        self.plotter.render()
+        return np.asarray(self.plotter.screenshot(return_img=True), np.uint8)[..., :3].copy()
+
+    def close(self) -> None:
+        self.plotter.close()
+
+    def _draw_surface(self, volume, origin) -> None:
+        from volanim_core.render.surfaces import label_surface
+
+        values = volume if np.issubdtype(volume.dtype, np.integer) else np.rint(volume)
+        mesh = label_surface(values, origin, self.settings.spacing, self._table)  # above the range: top colour
+        if mesh.n_points == 0:
+            self.plotter.remove_actor("body", render=False)
+            return
+        self.plotter.add_mesh(mesh, scalars="rgb", rgb=True, name="body", reset_camera=False,
+                              smooth_shading=False, show_scalar_bar=False)
+
+    def _draw_volume(self, volume, origin) -> None:
+        import pyvista as pv
+
+        s = self.settings
+        data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
+        same = (self._grid is not None and tuple(self._grid.dimensions) == volume.shape
+                and np.allclose(self._grid.origin, origin))
+        if same:
+            self._grid.point_data["v"] = data.ravel(order="F")
+            self._grid.Modified()
+            return
+        self._grid = pv.ImageData(dimensions=volume.shape, origin=tuple(float(v) for v in origin),
+                                  spacing=s.spacing)
+        self._grid.point_data["v"] = data.ravel(order="F")
+        actor = self.plotter.add_volume(self._grid, scalars="v", name="body", reset_camera=False,
+                                        show_scalar_bar=False,
+                                        mapper="fixed_point" if s.mapper == "cpu" else "smart")
+        prop = actor.GetProperty()
+        if s.transfer is None and s.preset in LABEL_MODES:
+            colours = (np.array([rgb(SKIN)]) if s.preset == "binary"
+                       else label_colours(s.preset, LABELS))
+            apply_labels(actor, colours, opacity=1.0)
+        else:
+            ctf, otf = (s.transfer or preset_transfer(s.preset, s.vmax)).to_vtk()
+            prop.SetColor(ctf)
+            prop.SetScalarOpacity(otf)
+            prop.SetInterpolationTypeToLinear()
+        prop.ShadeOn()
+        prop.SetAmbient(0.35)
+
+    def _add_colour_bar(self) -> None:
+        import vtk
+
+        s = self.settings
+        ctf, _ = (s.transfer or preset_transfer("hotspot", s.vmax)).to_vtk()
+        bar = vtk.vtkScalarBarActor()
+        bar.SetLookupTable(ctf)
+        bar.SetTitle("spheres per voxel")
+        bar.SetNumberOfLabels(4)
+        bar.SetPosition(0.88, 0.1)
+        bar.SetWidth(0.1)
+        bar.SetHeight(0.8)
+        for text in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+            text.SetColor(*rgb(_contrast(s.background)))
+        self.plotter.renderer.AddActor2D(bar)
+        self._bar = bar
+
+
+def _contrast(background: str) -> str:
+    """White text on a dark background, black on a light one."""
+    from pyvista import Color
+
+    r, g, b = Color(background).float_rgb
+    return "#000000" if 0.2126 * r + 0.7152 * g + 0.0722 * b > 0.5 else "#ffffff"

@@ -1,0 +1,48 @@
+"""A user transfer function: value -> colour and opacity, linear between points (the old icol/MergeMaps maps).
+
+``TransferFunction(values, rgba)``: ``values`` ascending, ``rgba`` rows of red,
+green, blue (0..1) and alpha (opacity, 0..1). Files are ``.tf`` text (io.render_files).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True, eq=False)
+class TransferFunction:
+    values: np.ndarray  # (N,) strictly ascending
+    rgba: np.ndarray  # (N, 4) in 0..1
+
+    def __post_init__(self):
+        v = np.asarray(self.values, np.float64).reshape(-1)
+        c = np.asarray(self.rgba, np.float64).reshape(-1, 4)
+        if len(v) == 0 or len(v) != len(c):
+            raise ValueError(f"a transfer function needs one RGBA per value, got {len(v)} values, {len(c)} colours")
+        if np.any(np.diff(v) <= 0):
+            raise ValueError("transfer function values must be strictly ascending")
+        if np.any((c < 0) | (c > 1)) or not np.all(np.isfinite(c)):
+            raise ValueError("transfer function colours and opacities must be between 0 and 1")
+        object.__setattr__(self, "values", v)
+        object.__setattr__(self, "rgba", c)
+
+    def __eq__(self, other) -> bool:
+        return (isinstance(other, TransferFunction) and np.array_equal(self.values, other.values)
+                and np.array_equal(self.rgba, other.rgba))
+
+    def __call__(self, x) -> np.ndarray:
+        """RGBA of ``x`` (linear between points, held beyond the ends), shape ``x.shape + (4,)``."""
+        x = np.asarray(x, np.float64)
+        return np.stack([np.interp(x, self.values, self.rgba[:, k]) for k in range(4)], axis=-1)
+
+    def to_vtk(self):
+        """``(vtkColorTransferFunction, vtkPiecewiseFunction)`` with exactly these points."""
+        import vtk
+
+        ctf, otf = vtk.vtkColorTransferFunction(), vtk.vtkPiecewiseFunction()
+        for v, (r, g, b, a) in zip(self.values, self.rgba):
+            ctf.AddRGBPoint(float(v), float(r), float(g), float(b))
+            otf.AddPoint(float(v), float(a))
+        return ctf, otf
