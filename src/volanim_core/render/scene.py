@@ -26,7 +26,7 @@ from volanim_core.render.transfer import LABEL_MODES, apply_labels, label_colour
 from volanim_core.render.transfer_function import TransferFunction
 
 STYLES = ("surface", "volume")
-MAPPERS = ("auto", "cpu")
+MAPPERS = ("auto", "cpu", "gpu")
 LABELS = 255  # label colours drawn for bone/mottled presets (bone colours repeat every 32, as in the studio)
 
 
@@ -42,7 +42,7 @@ class RenderSettings:
     cut: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None  # (point, normal)
     title: str | None = None
     frame_numbers: bool = False
-    mapper: str = "auto"  # volume style: "auto" (VTK's smart mapper) or "cpu" (the fixed-point ray caster)
+    mapper: str = "auto"  # volume style: "cpu" (fixed-point ray caster), "gpu" (VTK's smart mapper), "auto"
     spacing: tuple[float, float, float] = field(default=(1.0, 1.0, 1.0))
 
     def check(self) -> None:
@@ -86,6 +86,19 @@ def colour_table(settings: RenderSettings, vmax: float | None = None) -> np.ndar
     return np.round(np.clip(rgb_, 0, 1) * 255).astype(np.uint8)
 
 
+def crop(volume: np.ndarray, origin, pad: int = 1):
+    """The smallest box holding every filled voxel (and ``pad`` empty ones around it), and its origin."""
+    origin = np.asarray(origin, np.float64)
+    columns = np.any(volume, axis=2)
+    xs, ys = np.flatnonzero(columns.any(axis=1)), np.flatnonzero(columns.any(axis=0))
+    if not len(xs):
+        return volume[:1, :1, :1] * 0, origin
+    zs = np.flatnonzero(np.any(volume[xs[0]:xs[-1] + 1, ys[0]:ys[-1] + 1], axis=(0, 1)))
+    lo = np.maximum([xs[0] - pad, ys[0] - pad, zs[0] - pad], 0)
+    hi = np.minimum([xs[-1] + pad + 1, ys[-1] + pad + 1, zs[-1] + pad + 1], volume.shape)
+    return volume[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]], origin + lo
+
+
 def cut_away(volume: np.ndarray, origin, point, normal) -> np.ndarray:
     """``volume`` with every voxel on the side ``normal`` points to (from ``point``) emptied."""
     n = np.asarray(normal, np.float64)
@@ -110,6 +123,8 @@ class Renderer:
         if settings.style == "surface":
             self.plotter.enable_anti_aliasing("ssaa")  # voxel staircases shimmer less between frames
         self._grid = None  # the volume style's image data, refilled per frame when its shape stays
+        self._grid_key = None
+        self._first = True
         self._table = colour_table(settings)
         self._bar = None
         if settings.title:
@@ -125,17 +140,22 @@ class Renderer:
         if s.preset == "binary" and s.transfer is None:
             volume = (volume > 0).astype(np.uint8)
         if s.style == "surface":
-            self._draw_surface(volume, origin)
+            self._draw_surface(*crop(volume, origin))  # a sequence's shared grid is mostly empty
         else:
             self._draw_volume(volume, origin)
         if s.preset == "hotspot" and self._bar is None:
             self._add_colour_bar()
         if s.frame_numbers and number is not None:
             self.plotter.add_text(f"frame {number}", position="upper_right", font_size=12, name="frame",
-                                  color=_contrast(s.background))
+                                  color=_contrast(s.background), render=False)
         s.camera.apply(self.plotter.camera)  # adding actors must not have moved it
-        self.plotter.render()
-        return np.asarray(self.plotter.screenshot(return_img=True), np.uint8)[..., :3].copy()
+        if self._first:  # pyvista renders an off-screen plotter at its first screenshot only
+            self._first = False
+            image = self.plotter.screenshot(return_img=True)
+        else:
+            self.plotter.ren_win.Render()  # exactly one render per frame, then read the pixels
+            image = self.plotter.image
+        return np.asarray(image, np.uint8)[..., :3].copy()
 
     def close(self) -> None:
         self.plotter.close()
@@ -149,25 +169,29 @@ class Renderer:
             self.plotter.remove_actor("body", render=False)
             return
         self.plotter.add_mesh(mesh, scalars="rgb", rgb=True, name="body", reset_camera=False,
-                              smooth_shading=False, show_scalar_bar=False)
+                              smooth_shading=False, show_scalar_bar=False, render=False)
 
     def _draw_volume(self, volume, origin) -> None:
         import pyvista as pv
 
         s = self.settings
         data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
-        same = (self._grid is not None and tuple(self._grid.dimensions) == volume.shape
-                and np.allclose(self._grid.origin, origin))
-        if same:
-            self._grid.point_data["v"] = data.ravel(order="F")
+        # the whole shared grid, refilled frame after frame: a new volume actor costs ~1 s to set up
+        # (bench_render), so cropping each frame to its body would be 15-30x slower than drawing it
+        key = (volume.shape, tuple(float(v) for v in origin), data.dtype.str)
+        if self._grid is not None and self._grid_key == key:
+            from vtkmodules.util.numpy_support import numpy_to_vtk
+
+            values = numpy_to_vtk(data.ravel(order="F"), deep=True)
+            values.SetName("v")
+            self._grid.GetPointData().SetScalars(values)  # the image the mapper reads (add_volume may copy ours)
             self._grid.Modified()
             return
-        self._grid = pv.ImageData(dimensions=volume.shape, origin=tuple(float(v) for v in origin),
-                                  spacing=s.spacing)
-        self._grid.point_data["v"] = data.ravel(order="F")
-        actor = self.plotter.add_volume(self._grid, scalars="v", name="body", reset_camera=False,
-                                        show_scalar_bar=False,
-                                        mapper="fixed_point" if s.mapper == "cpu" else "smart")
+        grid = pv.ImageData(dimensions=volume.shape, origin=key[1], spacing=s.spacing)
+        grid.point_data["v"] = data.ravel(order="F")
+        actor = self.plotter.add_volume(grid, scalars="v", name="body", reset_camera=False, show_scalar_bar=False,
+                                        mapper="fixed_point" if self._cpu_caster() else "smart", render=False)
+        self._grid, self._grid_key = actor.GetMapper().GetInput(), key
         prop = actor.GetProperty()
         if s.transfer is None and s.preset in LABEL_MODES:
             colours = (np.array([rgb(SKIN)]) if s.preset == "binary"
@@ -180,6 +204,11 @@ class Renderer:
             prop.SetInterpolationTypeToLinear()
         prop.ShadeOn()
         prop.SetAmbient(0.35)
+
+    def _cpu_caster(self) -> bool:
+        """``cpu``: the fixed-point ray caster; ``gpu`` and an unresolved ``auto``: VTK's smart mapper.
+        (A sequence's driver resolves ``auto`` by timing both, :func:`volanim_core.render.run.choose_mapper`.)"""
+        return self.settings.mapper == "cpu"
 
     def _add_colour_bar(self) -> None:
         import vtk

@@ -218,3 +218,34 @@ def test_a_dask_cluster_draws_the_same_pictures(tmp_path):
     for n in (100, 102, 104):
         a, b = (iio.imread(frame_path(tmp_path / where, n)) for where in ("dask", "local"))
         assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("style", ["surface", "volume"])
+def test_a_reused_plotter_draws_each_frame_as_a_fresh_one_would(style):
+    cam = named_view("front", (0, 0, 0), (79, 79, 79), aspect=W / H)
+    settings = RenderSettings(cam, style=style, preset="bone", size=(W, H))
+    a, b = ball(centre=(25, 40, 40), radius=12, value=1), ball(centre=(55, 40, 40), radius=12, value=2)
+    reused, fresh = Renderer(settings), Renderer(settings)
+    try:
+        reused.render(a, (0, 0, 0))
+        second = reused.render(b, (0, 0, 0))
+        assert np.array_equal(second, fresh.render(b, (0, 0, 0)))
+        assert lit(second)[:, W // 2 + 10:].sum() > 100 and lit(second)[:, : W // 2 - 10].sum() == 0
+    finally:
+        reused.close()
+        fresh.close()
+
+
+def test_auto_mapper_is_resolved_once_for_the_whole_sequence(tmp_path):
+    from volanim_core.render.run import choose_mapper
+
+    seq = make_sequence(tmp_path / "s.zarr", frames=4)
+    inputs = open_inputs([seq])
+    settings = RenderSettings(named_view("front", inputs.lo, inputs.hi), style="volume", preset="bone",
+                              size=(160, 120))
+    chosen = choose_mapper(inputs, settings)
+    assert chosen.mapper in ("gpu", "cpu") and chosen.style == "volume"
+    rep = render(inputs, settings, tmp_path / "pics", workers=2)
+    assert rep.mapper in ("gpu", "cpu") and rep.drawn == 4
+    surface = RenderSettings(settings.camera, preset="bone")
+    assert choose_mapper(inputs, surface) is surface  # nothing to choose

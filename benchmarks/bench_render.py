@@ -1,0 +1,96 @@
+"""Render benchmark: seconds per frame at 640x480 per style on the frog and the mannequin, the CPU
+ray caster against VTK's default volume mapper, and frames per second with 1 and 2 workers.
+
+Both datasets are real sequences made here first (bench_sequence's cases: the mannequin walking, the
+frog's legs swinging), rendered off-screen from the three-quarter view with their mode's preset.
+Ratios are against a baseline in the same run: the surface style for the two volume mappers, 1 worker
+for 2 (with this machine's own 2-vs-1 throughput on pure CPU work beside it).
+
+    .venv/bin/python benchmarks/bench_render.py [FRAMES]
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _harness import table  # noqa: E402
+from bench_sequence import frog_case, machine_scaling, mannequin_case  # noqa: E402
+
+
+def make_sequence(case, folder: Path, mode: str) -> Path:
+    from volanim_core.sequence.run import run_sequence
+
+    name, conn, frames, source = case
+    out = folder / f"{name.split()[0]}.zarr"
+    run_sequence(conn, frames, out, mode=mode, source=source, workers=2)
+    return out
+
+
+def per_frame(seq: Path, style: str, mapper: str = "gpu") -> float:
+    """Median seconds per frame of one warm plotter (the first frame, which builds it, is not counted)."""
+    from volanim_core.render.camera import named_view
+    from volanim_core.render.run import open_inputs
+    from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.sequence import store
+
+    inputs = open_inputs([seq])
+    settings = RenderSettings(named_view("three-quarter", inputs.lo, inputs.hi), style=style, mapper=mapper,
+                              preset=inputs.mode, vmax=inputs.vmax, size=(640, 480))
+    r = Renderer(settings)
+    origin = store.origin(seq)
+    times = []
+    try:
+        for i, ref in enumerate(inputs.frames):
+            vol = store.read_frame(seq, ref.index)
+            t0 = time.perf_counter()
+            r.render(vol, origin, ref.number)
+            if i:
+                times.append(time.perf_counter() - t0)
+    finally:
+        r.close()
+    return float(np.median(times))
+
+
+def whole_run(seq: Path, folder: Path, workers: int) -> float:
+    from volanim_core.render.camera import named_view
+    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.scene import RenderSettings
+
+    inputs = open_inputs([seq])
+    settings = RenderSettings(named_view("three-quarter", inputs.lo, inputs.hi), preset=inputs.mode,
+                              vmax=inputs.vmax, size=(640, 480))
+    rep = render(inputs, settings, folder / f"pics-{workers}", workers=workers, force=True)
+    return rep.frames / rep.seconds
+
+
+def main() -> None:
+    n = int(sys.argv[1]) if len(sys.argv) > 1 else 12
+    rows, speed = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        for make, mode in ((mannequin_case, "bone"), (frog_case, "sampled")):
+            case = make(n)
+            seq = make_sequence(case, folder, mode)
+            surface = per_frame(seq, "surface")
+            auto = per_frame(seq, "volume", "gpu")  # VTK smart mapper: its GPU ray caster, on Mesa here
+            cpu = per_frame(seq, "volume", "cpu")
+            rows.append([case[0], mode, f"{surface:.3f}", f"{auto:.3f}", f"{cpu:.3f}", f"{auto / surface:.1f}",
+                         f"{cpu / auto:.2f}"])
+            one, two = whole_run(seq, folder, 1), whole_run(seq, folder, 2)
+            speed.append([case[0], f"{n}", f"{one:.2f}", f"{two:.2f}", f"{two / one:.2f}"])
+    print(f"\nrender, 640x480, off-screen (software OpenGL), {n} frames per dataset; seconds per frame, warm plotter")
+    print(table(rows, ["dataset", "preset", "surface s", "volume (VTK smart mapper) s", "volume (CPU ray caster) s",
+                       "volume / surface", "CPU caster / default"]))
+    print(f"\nwhole runs (read, draw, write PNG), surface style; this machine's own 2-vs-1 on pure CPU work: "
+          f"{machine_scaling():.2f}x")
+    print(table(speed, ["dataset", "frames", "1 worker frames/s", "2 workers frames/s", "2 vs 1"]))
+
+
+if __name__ == "__main__":
+    main()
