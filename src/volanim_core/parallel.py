@@ -18,10 +18,12 @@ from contextlib import contextmanager
 
 
 @contextmanager
-def executor(task, payload, install, *, workers: int = 1, scheduler=None):
+def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolate: bool = False):
     """``(submit(*args) -> Future, description, worker count)``; see the module docstring.
 
     ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
+    ``isolate``: never run tasks in this process, even with one worker (the studio: an OpenGL
+    context must not be made on a worker thread of a process whose main thread draws the window).
     """
     if scheduler is not None:
         from distributed import Client
@@ -36,7 +38,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None):
             if client is not scheduler:
                 client.close()
         return
-    if workers <= 1:
+    if workers <= 1 and not isolate:
         install(payload)
         yield (lambda *args: _inline(task, args)), "1 worker (this process)", 1
         return
@@ -47,7 +49,8 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None):
     with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=install,
                              initargs=(payload,)) as pool:
         try:
-            yield (lambda *args: pool.submit(task, None, *args)), f"{workers} local workers", workers
+            label = f"{workers} local worker{'s' if workers > 1 else ''}"
+            yield (lambda *args: pool.submit(task, None, *args)), label, workers
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
 

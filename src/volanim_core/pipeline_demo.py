@@ -8,6 +8,7 @@
       walk.bvh (assets/, real motion capture) --retarget--> walk/walk.NNNN.trans + .tskel
         --> walk/walk.NNNN-sampled.vti for a few frames across the clip     (mannequin only)
       --sequence--> walk.zarr: one walk cycle, then a crumble; one grid, every core (mannequin only)
+      --render--> walk.gif: the sequence from the side, off-screen                  (mannequin only)
 """
 
 from __future__ import annotations
@@ -135,6 +136,7 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     if sample == "mannequin" and clip is not None:
         out["walk"], retarget = _walk(folder / "walk", clip, s, conn)
         out["sequence"] = _sequence(folder / "walk.zarr", retarget, conn, s.volume)
+        out["movie"] = _movie(out["sequence"], folder / "walk.gif")
     out["skeleton"], out["sample"], out["connectivity"] = skel, s, conn
     _say(f"done in {time.perf_counter() - t0:.1f} s; files in {folder}/")
     return out
@@ -184,4 +186,20 @@ def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Pat
     _say(f"[7] sequence: {len(specs) - 10} frames of one walk cycle and 10 of crumbling, one {grid} grid "
          f"at origin {rep.bounds.lo}, {rep.workers}, {rep.seconds:.1f} s ({rep.computed} made, {rep.skipped} "
          f"already there) -> {out.name} (OME-Zarr: t, z, y, x)")
+    return out
+
+
+def _movie(sequence: Path, out: Path) -> Path:
+    """The sequence as a small looping GIF, seen from the side (where a walk reads best), off-screen."""
+    from volanim_core.parallel import default_workers
+    from volanim_core.render.camera import named_view
+    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.scene import RenderSettings
+
+    inputs = open_inputs([sequence])
+    settings = RenderSettings(named_view("side", inputs.lo, inputs.hi, aspect=320 / 240), preset=inputs.mode,
+                              vmax=inputs.vmax, size=(320, 240), background="#1e1e24")
+    rep = render(inputs, settings, out, workers=min(default_workers(), 4))
+    _say(f"[8] render: {rep.frames} frames, 320x240, surface style from the side, {rep.workers}, "
+         f"{rep.seconds:.1f} s -> {out.name}")
     return out

@@ -61,3 +61,51 @@ def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> d
                          progress=progress, cancel=cancel)
     out.update(spacing=s.spacing, sample=s)
     return out
+
+
+def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spacing=(1.0, 1.0, 1.0),
+                 style: str = "surface", size=(640, 480), fps: float = 24.0, frame_numbers: bool = False,
+                 background: str = "#1e1f24", workers: int | None = None, progress=None, cancel=None) -> dict:
+    """The timeline's frames reconstructed (a sequence in one grid) and rendered to ``out`` with the
+    studio's camera: the command line's ``volanim sequence`` + ``volanim render``, in worker processes.
+
+    The sequence is kept beside the movie (``.NAME.zarr``) until the movie is written, and the render's
+    pictures likewise, so a cancelled run picks up where it stopped when started again with the same pose.
+    """
+    import shutil
+    import time
+    from pathlib import Path
+
+    from volanim_core.parallel import default_workers
+    from volanim_core.render.run import open_inputs, output_kind, render
+    from volanim_core.render.scene import RenderSettings
+    from volanim_core.sequence import store
+    from volanim_core.sequence.frames import FrameSpec
+    from volanim_core.sequence.run import plan_key, run_sequence
+
+    t0 = time.perf_counter()
+    report = Reporter(progress, cancel)
+    out = Path(out)
+    kind = output_kind(out)  # a bad name is refused before anything runs
+    frames = [FrameSpec(int(n), np.asarray(m, np.float64)) for n, m in zip(numbers, matrices)]
+    if not frames:
+        raise ValueError("no frames to render")
+    if kind == "png" and len(frames) != 1:
+        raise ValueError(f"{len(frames)} frames do not fit in one .png: choose an .mp4, a .gif or a folder")
+    total = 2 * len(frames)
+    report(0, total)
+    cache = out.parent / f".{out.name}.zarr"
+    src = source if mode == "sampled" else None
+    old = store.read_plan(cache)
+    stale = old is not None and old.get("key") != plan_key(conn, frames, mode, 1, 2, src)
+    workers = workers or default_workers()
+    run_sequence(conn, frames, cache, mode=mode, source=src, fps=fps, workers=workers, force=stale,
+                 on_frame=lambda rec, done, n: report(done, total))
+    inputs = open_inputs([cache])
+    settings = RenderSettings(camera, style=style, preset=mode, vmax=inputs.vmax, size=tuple(size),
+                              background=background, frame_numbers=frame_numbers,
+                              spacing=tuple(float(s) for s in spacing))
+    rep = render(inputs, settings, out, fps=fps, workers=workers, isolate=True,
+                 on_frame=lambda number, done, n: report(len(frames) + done, total))
+    shutil.rmtree(cache, ignore_errors=True)
+    return {"out": out, "frames": len(frames), "seconds": time.perf_counter() - t0, "workers": rep.workers}

@@ -59,6 +59,17 @@ class Camera:
             vtk_camera.SetParallelScale(self.parallel_scale)
         vtk_camera.OrthogonalizeViewUp()
 
+    def scaled(self, factor) -> Camera:
+        """This camera with world coordinates multiplied by ``factor`` per axis (e.g. ``1 / spacing``:
+        a view of a volume with anisotropic voxels, in voxel coordinates as camera files are)."""
+        f = np.asarray(factor, np.float64) * np.ones(3)
+        up = np.asarray(self.view_up, np.float64)
+        up = up / np.linalg.norm(up)
+        stretched = up * f  # the picture's height is measured along view_up: it stretches as up does
+        scale = None if self.parallel_scale is None else self.parallel_scale * float(np.linalg.norm(stretched))
+        return Camera(tuple(np.asarray(self.position) * f), tuple(np.asarray(self.focal_point) * f),
+                      tuple(stretched / np.linalg.norm(stretched)), self.view_angle, scale)
+
     @classmethod
     def of(cls, vtk_camera) -> Camera:
         """The camera a ``vtkCamera`` has now (the studio's view)."""
@@ -67,17 +78,23 @@ class Camera:
                    float(vtk_camera.GetViewAngle()), float(vtk_camera.GetParallelScale()) if parallel else None)
 
 
-def named_view(name: str, lo, hi, aspect: float = 4 / 3, view_angle: float = 30.0) -> Camera:
-    """A camera from direction ``name`` that frames the box ``lo..hi`` (voxel coordinates) whole
-    in a picture of width/height ``aspect``, from far enough that the whole box fits."""
+def named_view(name: str, lo, hi, aspect: float = 4 / 3, view_angle: float = 30.0, margin: float = 0.05) -> Camera:
+    """A camera from direction ``name`` at the distance where the box ``lo..hi`` (voxel coordinates) just
+    fits a picture of width/height ``aspect`` (plus ``margin`` around it): every corner of the box, seen
+    in perspective, is inside the picture."""
     if name not in _DIRECTIONS:
         raise ValueError(f"unknown view {name!r}; choose one of {', '.join(VIEWS)}")
-    lo, hi = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
+    lo, hi = np.asarray(lo, np.float64) - 0.5, np.asarray(hi, np.float64) + 0.5  # voxel centres -> their faces
     centre = (lo + hi) / 2
-    radius = max(float(np.linalg.norm(hi - lo)) / 2, 1.0)  # the box's bounding sphere
-    direction, up = (np.asarray(v) for v in _DIRECTIONS[name])
+    direction, up = (np.asarray(v, np.float64) for v in _DIRECTIONS[name])
     direction = direction / np.linalg.norm(direction)
-    half = np.radians(view_angle) / 2
-    fit = np.arctan(np.tan(half) * min(aspect, 1.0))  # the narrower of the two half-angles
-    distance = radius / np.sin(fit)
+    up = up - np.dot(up, direction) * direction
+    up /= np.linalg.norm(up)
+    right = np.cross(direction, up)
+    tan_v = np.tan(np.radians(view_angle) / 2) / (1 + margin)
+    tan_h = tan_v * aspect
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]) - centre
+    toward = corners @ direction  # how much nearer the camera each corner is than the centre
+    distance = max(1.0, float(np.max(np.maximum(np.abs(corners @ up) / tan_v, np.abs(corners @ right) / tan_h)
+                                     + toward)))
     return Camera(tuple(centre + direction * distance), tuple(centre), tuple(up), float(view_angle))

@@ -228,10 +228,12 @@ class RenderReport:
 
 
 def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | None = None, workers: int = 1,
-           scheduler=None, force: bool = False, keep_frames: bool = False, dims=None, on_frame=None) -> RenderReport:
+           scheduler=None, force: bool = False, keep_frames: bool = False, dims=None, on_frame=None,
+           isolate: bool = False) -> RenderReport:
     """Render every frame of ``inputs`` to ``out``; see the module docstring.
 
-    ``on_frame(number, done, total)`` after each picture (progress).
+    ``on_frame(number, done, total)`` after each picture (progress; it may raise to stop the run).
+    ``isolate``: draw in worker processes only, never in this one (see ``parallel.executor``).
     """
     t0 = time.perf_counter()
     out = Path(out)
@@ -242,13 +244,14 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     if not 0 < fps <= 1000:
         raise ValueError(f"fps must be above 0 and at most 1000, got {fps:g}")
     total = len(inputs.frames)
-    settings = choose_mapper(inputs, settings, dims)
+    if not isolate:  # timing both mappers draws here
+        settings = choose_mapper(inputs, settings, dims)
     if kind == "png" and total != 1:
         raise ValueError(f"{total} frames do not fit in one .png: render to a folder, an .mp4 or a .gif")
     job = RenderJob(settings, dims)
     if kind == "png":
         try:
-            with executor(render_task, job, install, workers=1) as (submit, label, _):
+            with executor(render_task, job, install, workers=1, isolate=isolate) as (submit, label, _):
                 number, image = submit(inputs.frames[0]).result()
         finally:
             release()
@@ -263,7 +266,7 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     label = "nothing to draw"
     if todo:
         try:
-            label = _draw(todo, job, folder, workers, scheduler, on_frame, done, total)
+            label = _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate)
         finally:
             release()
     if kind in ("mp4", "gif"):
@@ -273,10 +276,10 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     return RenderReport(out, total, len(todo), skipped, time.perf_counter() - t0, label, fps, settings.mapper)
 
 
-def _draw(todo, job, folder, workers, scheduler, on_frame, done, total) -> str:
+def _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate) -> str:
     """Draw ``todo`` anywhere; the driver writes each picture as it arrives. Returns where it ran."""
-    with executor(render_task, job, install, workers=min(workers, len(todo)), scheduler=scheduler) as (
-            submit, label, running):
+    with executor(render_task, job, install, workers=min(workers, len(todo)), scheduler=scheduler,
+                  isolate=isolate) as (submit, label, running):
         pending, queue = set(), list(todo)
         while queue or pending:  # two frames per worker in flight: pictures arrive about in order
             while queue and len(pending) < 2 * max(running, 1):
@@ -351,7 +354,11 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
                     writer.append_data(iio.imread(p))
         else:
             frames = [iio.imread(p) for p in pngs]
-            iio.imwrite(tmp, frames, extension=".gif", duration=1000.0 / fps, loop=0)
+            # GIF delays are whole centiseconds: spread the rounding so the clip keeps its length
+            # (24 fps as 4 cs each would play 4 % slow). Identical neighbours are merged by Pillow, their
+            # delays added: the frame count may drop, the timing does not.
+            ticks = np.round(np.arange(len(frames) + 1) * 100.0 / fps)
+            iio.imwrite(tmp, frames, extension=".gif", duration=list(np.diff(ticks) * 10.0), loop=0)
         os.replace(tmp, out)
     except BaseException:
         tmp.unlink(missing_ok=True)

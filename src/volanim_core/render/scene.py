@@ -4,6 +4,10 @@
     Renderer(settings) -- one off-screen plotter, kept for every frame a worker draws
         .render(volume[x, y, z], origin, number) -> (H, W, 3) uint8
 
+Origins and the cut-away plane are in voxels; the camera is in world units,
+voxel x ``spacing`` (1 on the command line: sequences are in voxels; the
+studio's own spacing when it renders with its view's camera).
+
 Styles: ``volume`` (ray-cast through a transfer function; the CPU ray caster
 with ``mapper="cpu"``) and ``surface`` (the boundary of the filled voxels,
 coloured by the voxel under it -- the studio's live-preview look, far faster
@@ -16,7 +20,7 @@ to before drawing, so both styles show the inside of the posed body.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -43,7 +47,7 @@ class RenderSettings:
     title: str | None = None
     frame_numbers: bool = False
     mapper: str = "auto"  # volume style: "cpu" (fixed-point ray caster), "gpu" (VTK's smart mapper), "auto"
-    spacing: tuple[float, float, float] = field(default=(1.0, 1.0, 1.0))
+    spacing: tuple[float, float, float] = (1.0, 1.0, 1.0)  # world units per voxel (origins, cuts: in voxels)
 
     def check(self) -> None:
         if self.style not in STYLES:
@@ -164,7 +168,8 @@ class Renderer:
         from volanim_core.render.surfaces import label_surface
 
         values = volume if np.issubdtype(volume.dtype, np.integer) else np.rint(volume)
-        mesh = label_surface(values, origin, self.settings.spacing, self._table)  # above the range: top colour
+        spacing = np.asarray(self.settings.spacing, np.float64)  # world = voxel x spacing (the camera's units)
+        mesh = label_surface(values, np.asarray(origin) * spacing, spacing, self._table)  # above the range: top colour
         if mesh.n_points == 0:
             self.plotter.remove_actor("body", render=False)
             return
@@ -178,7 +183,7 @@ class Renderer:
         data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
         # the whole shared grid, refilled frame after frame: a new volume actor costs ~1 s to set up
         # (bench_render), so cropping each frame to its body would be 15-30x slower than drawing it
-        key = (volume.shape, tuple(float(v) for v in origin), data.dtype.str)
+        key = (volume.shape, tuple(float(v) for v in np.asarray(origin) * s.spacing), data.dtype.str)
         if self._grid is not None and self._grid_key == key:
             from vtkmodules.util.numpy_support import numpy_to_vtk
 

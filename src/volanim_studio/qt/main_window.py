@@ -224,6 +224,8 @@ class MainWindow(QMainWindow):
         self.previews.fill_menu(bar.addMenu("&Pose"), self._action)
         self.previews.wire(self.pose_panel, self.reconstruct_panel)
         self.timeline.fill_menu(bar.addMenu("&Timeline"), self._action)
+        view = bar.addMenu("&View")
+        self._action("Save view as camera file…", lambda: self.timeline.save_camera_dialog(), menu=view)
         self.timeline.wire(self.timeline_panel)
         self.connect_panel.auto_button.clicked.connect(self.auto_connect)
         self.connect_panel.mirror_button.clicked.connect(self.mirror_connectivity)

@@ -5,6 +5,8 @@
     Pause / scrub released --> the full preview with its report (in Pose mode)
     Scan --> JobRunner(scan_frames) --> ScanDialog (worst first; double-click jumps to the frame)
     Export --> JobRunner(write_frames) --> NAME.0000.trans (+ .tskel)
+    Render movie --> MovieDialog --> JobRunner(tasks.render_movie: sequence + render in worker processes)
+    Save view as camera file --> the view's camera in voxel coordinates (for volanim render --camera)
 """
 
 from __future__ import annotations
@@ -15,12 +17,15 @@ from pathlib import Path
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QDialog, QFileDialog
 
+from volanim_core import io
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frames import write_frames
 from volanim_core.reconstruct.scan import scan_frames, worst_first
+from volanim_core.render.camera import Camera
 
 from .controller import FAILED, Controller
 from .mapping_dialog import MappingDialog
+from .movie_dialog import MovieDialog
 from .scan_dialog import ScanDialog
 
 
@@ -56,6 +61,8 @@ class TimelineController(Controller):
         action("Scan clip for breakage…", lambda: self.scan(), menu=menu)
         action("Export frames (.trans)…", lambda: self.export_dialog(tskel=False), menu=menu)
         action("Export frames (.trans + .tskel)…", lambda: self.export_dialog(tskel=True), menu=menu)
+        menu.addSeparator()
+        action("Render movie…", lambda: self.render_movie_dialog(), menu=menu)
 
     def wire(self, panel) -> None:
         self.panel = panel
@@ -70,6 +77,7 @@ class TimelineController(Controller):
         panel.delete_key.clicked.connect(lambda: self.delete_key())
         panel.scan.clicked.connect(lambda: self.scan())
         panel.export.clicked.connect(lambda: self.export_dialog(tskel=False))
+        panel.movie.clicked.connect(lambda: self.render_movie_dialog())
         panel.scrub_started.connect(self.previews.drag_started)
         panel.scrub_finished.connect(self.previews.drag_finished)
 
@@ -233,3 +241,69 @@ class TimelineController(Controller):
         folder = QFileDialog.getExistingDirectory(self.window, "Folder for the frames")
         if folder:
             self.export(folder, tskel=tskel)
+
+    # ---------------------------------------------------------- movies
+    def camera(self) -> Camera:
+        """The view's camera in world units (voxel x spacing), as the studio draws."""
+        return Camera.of(self.scene.plotter.camera)
+
+    def save_camera(self, path) -> None:
+        """The view's camera in voxel coordinates, for ``volanim render --camera``."""
+        cam = self.camera().scaled(1.0 / self.scene.spacing)
+        self.attempt("Save view as camera file", lambda: io.write_camera(path, cam), f"Saved the view to {path}.")
+
+    def save_camera_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self.window, "Save view as camera file", "view.camera",
+                                              "Camera files (*.camera)")
+        if path:
+            self.save_camera(path)
+
+    def render_movie(self, out, *, first: int = 0, last: int | None = None, step: int = 1, style: str = "surface",
+                     size=(640, 480), frame_numbers: bool = False, workers: int | None = None):
+        """Reconstruct frames ``first..last`` (every ``step``) in the preview's mode and render them with
+        the view's camera, in the background with progress and cancel."""
+        from volanim_studio.tasks import render_movie
+
+        tl, st = self.doc.timeline, self.doc.settings
+        if self.jobs.busy:
+            self.doc.message("A job is running; render when it ends.")
+            return None
+        self.stop()
+        try:
+            if not tl.active:
+                raise ValueError("nothing to render: load a clip or set keys first")
+            conn = self.doc.pose.tskel().connectivity
+            if not len(conn):
+                raise ValueError("no attached points: connect points to bones first (Connect tab)")
+            if st.preview_mode == "sampled" and self.doc.volume is None:
+                raise ValueError("sampled mode needs the volume: open it (File → Open volume)")
+            last = tl.frame_count - 1 if last is None else last
+            frames = list(range(first, last + 1, step))
+            if not frames:
+                raise ValueError(f"frames {first}..{last} are empty: the first frame must not come after the last")
+        except ValueError as exc:
+            self.show_error("Render movie", str(exc))
+            return None
+        mats, numbers = tl.matrices(frames), [tl.frame_number(f) for f in frames]
+        camera, spacing, mode, source = self.camera(), tuple(self.scene.spacing), st.preview_mode, self.doc.volume
+        fps = tl.frame_rate / step
+        return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
+            conn, mats, numbers, out, mode=mode, source=source, camera=camera, spacing=spacing, style=style,
+            size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, progress=progress, cancel=cancel),
+            lambda r: self.doc.message(f"Rendered {r['frames']} frames to {r['out']} in {r['seconds']:.1f} s "
+                                       f"({r['workers']})."))
+
+    def render_movie_dialog(self) -> None:
+        tl = self.doc.timeline
+        if not tl.active:
+            self.show_error("Render movie", "nothing to render: load a clip or set keys first")
+            return
+        stem = tl.clip.name if tl.clip is not None else "keys"
+        dialog = MovieDialog(self.window, tl.frame_count, str(Path.cwd() / f"{stem}.mp4"))
+        if dialog.exec() != QDialog.Accepted:
+            return
+        options = dialog.options()
+        if not options["out"]:
+            self.show_error("Render movie", "choose a file for the movie")
+            return
+        self.render_movie(options.pop("out"), **options)

@@ -91,6 +91,8 @@ class TimelinePanel(QWidget):
         self.fps.setToolTip("Frame rate of the keyed animation")
         self.scan = QPushButton("Scan clip for breakage…")
         self.export = QPushButton("Export frames (.trans)…")
+        self.movie = QPushButton("Render movie…")
+        self.movie.setToolTip("Reconstruct the frames in the preview's mode and render them with this view's camera")
 
         top = QHBoxLayout()
         for w in (self.load_bvh, self.load_trans, self.unload, self.first, self.back, self.play, self.forward,
@@ -103,7 +105,8 @@ class TimelinePanel(QWidget):
         for w in (self.set_key, self.delete_key, self.keys_label):
             bottom.addWidget(w)
         bottom.addStretch(1)
-        for w in (self.ease, QLabel("length"), self.length, QLabel("fps"), self.fps, self.scan, self.export):
+        for w in (self.ease, QLabel("length"), self.length, QLabel("fps"), self.fps, self.scan, self.export,
+                  self.movie):
             bottom.addWidget(w)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 2, 4, 2)

@@ -113,6 +113,15 @@ def test_a_movie_has_its_frames_size_and_rate(tmp_path):
     gif = iio.imread(tmp_path / "m.gif", index=None)
     assert gif.shape[:3] == (5, 100, 200)
     assert iio.immeta(tmp_path / "m.gif")["duration"] == pytest.approx(100)  # ms per frame at 10 fps
+    assert main(["render", str(seq), "-o", str(tmp_path / "f.gif"), "--size", "64x48", "--fps", "24"]) == 0
+    from PIL import Image
+
+    with Image.open(tmp_path / "f.gif") as gif:  # 24 fps in whole centiseconds: 4 and 5 spread, no drift
+        delays = []
+        for k in range(gif.n_frames):
+            gif.seek(k)
+            delays.append(gif.info["duration"])
+    assert sorted(set(delays)) == [40, 50] and sum(delays) == 210  # 5 frames: 208.3 ms, rounded
 
 
 def test_a_rerun_draws_only_the_missing_pictures_and_other_settings_redraw(tmp_path, capsys):

@@ -121,3 +121,66 @@ def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
     other = Document()
     apply_project(other, read_project(tmp_path / "wave.volanim"), tmp_path / "wave.volanim")
     assert sorted(other.timeline.keys) == [0, 11] and other.timeline.length == 12
+
+
+def test_render_a_movie_of_the_keys_with_the_views_camera_and_save_the_view(qtbot, rigged, tmp_path):
+    import imageio.v3 as iio
+
+    from volanim_core.render.camera import Camera
+
+    w = rigged
+    doc = w.doc
+    arm = doc.bones.index("L_UPPERARM")
+    w.timeline_panel.length.setValue(4)
+    w.timeline_panel.length.editingFinished.emit()
+    qtbot.keyClick(w, Qt.Key_S)
+    doc.settings.current_frame = 3
+    doc.pose.set_angles(arm, (0, -90, 0))
+    w.timeline_panel.set_key.click()
+    doc.settings.preview_mode = "bone"
+
+    w.timeline.save_camera(tmp_path / "view.camera")
+    saved = io.read_camera(tmp_path / "view.camera")
+    view = Camera.of(w.scene.plotter.camera)
+    assert np.allclose(saved.position, view.position) and np.allclose(saved.focal_point, view.focal_point)
+
+    worker = w.timeline.render_movie(tmp_path / "wave.gif", first=0, last=3, step=1, size=(160, 120), workers=1)
+    assert worker is not None
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    movie = iio.imread(tmp_path / "wave.gif", index=None)
+    assert movie.shape[:3] == (4, 120, 160) and "Rendered 4 frames" in w.statusBar().currentMessage()
+    assert not np.array_equal(movie[0], movie[3])  # the arm moved
+    assert not (tmp_path / ".wave.gif.zarr").exists() and not (tmp_path / ".wave.gif.frames").exists()
+
+    # a name that is no movie is refused with a message, and nothing is left behind
+    assert w.timeline.render_movie(tmp_path / "bad.avi", first=0, last=1, size=(160, 120), workers=1) is not None
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert "render to a .png, .mp4, .gif or a folder" in w.last_error
+    assert not list(tmp_path.glob("*bad*")) and not list(tmp_path.glob(".bad*"))
+
+
+def test_cancel_a_movie_and_render_it_again(qtbot, rigged, tmp_path):
+    from PySide6.QtWidgets import QPushButton
+
+    w = rigged
+    assert w.timeline.load_bvh(WALK, ask=lambda dialog: True)
+    w.doc.settings.preview_mode = "binary"
+    worker = w.timeline.render_movie(tmp_path / "walk.gif", first=0, last=400, step=10, size=(160, 120), workers=1)
+    qtbot.waitUntil(lambda: (tmp_path / ".walk.gif.zarr" / "volanim-frames.jsonl").is_file()
+                    and (tmp_path / ".walk.gif.zarr" / "volanim-frames.jsonl").stat().st_size > 0,
+                    timeout=JOB_TIMEOUT_MS)
+    w.jobs.dialog.findChild(QPushButton).click()  # Cancel
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert worker.isFinished() and not (tmp_path / "walk.gif").exists()
+    done_before = len((tmp_path / ".walk.gif.zarr" / "volanim-frames.jsonl").read_text().splitlines())
+    assert 1 <= done_before < 41  # cancelled part-way; what was made is kept
+    w.timeline.render_movie(tmp_path / "walk.gif", first=0, last=400, step=10, size=(160, 120), workers=1)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    from PIL import Image
+
+    with Image.open(tmp_path / "walk.gif") as gif:  # identical frames (the figure out of view) are merged
+        delays = []
+        for k in range(gif.n_frames):
+            gif.seek(k)
+            delays.append(gif.info["duration"])
+    assert sum(delays) == pytest.approx(41 * 1000 / 12, abs=10)  # 41 frames at the clip's 120 fps / 10
