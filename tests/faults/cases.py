@@ -83,6 +83,8 @@ MSKEL = "# metric: euclid\n10 10 10 3 0.9\n11 10 10 2.5 0.7\n12 10 10 2 0.5\n"
 BONES = "joint A 0 0 0\njoint B 0 0 10\njoint C 0 0 20\nbone A B\nbone B C\n"
 CONNECT = "# metric: euclid\nRoot: 0 0 0 :: 0 0 10\n10 10 10 3 0.9\nRoot: 0 0 10 :: 0 0 20\n11 10 10 2.5 0.7\n"
 IDENTITY = "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
+CAMERA = "# volanim camera 1\nposition 10 -300 20\nfocal_point 10 20 20\nview_up 0 0 1\nview_angle 30\n"
+TF = "# volanim tf 1\n0 0 0 0 0\n80 0.5 0.4 0.3 0.1\n255 1 1 1 0.9\n"
 TSKEL = f"# metric: euclid\nRoot: 0 0 0 :: 0 0 10\n{IDENTITY}10 10 10 3 0.9\n11 10 10 2.5\n"
 
 
@@ -266,6 +268,31 @@ def hand_written() -> list[Case]:
         Case("skeletonize: --min-thinness nan", "cli:skeletonize", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
              "skeletonize {d}/f.nrrd -o {d}/o.mskel --min-thinness nan"),
         Case("count: --dims full-width", "cli:count", {"f.vol": b"\0" * 24}, "count {d}/f.vol --dims １２ 1 2"),
+        # --- render inputs and settings
+        Case("camera: focal point is the position", "read_camera",
+             {"c.camera": b"position 1 2 3\nfocal_point 1 2 3\n"}, "c.camera"),
+        Case("camera: view_up along the line of sight", "read_camera",
+             {"c.camera": b"position 0 -9 0\nfocal_point 0 0 0\nview_up 0 5 0\n"}, "c.camera"),
+        Case("camera: parallel_scale 0", "read_camera",
+             {"c.camera": t(CAMERA + "parallel_scale 0\n")}, "c.camera"),
+        Case("camera: a vector with 4 numbers", "read_camera",
+             {"c.camera": b"position 0 -9 0 1\nfocal_point 0 0 0\n"}, "c.camera"),
+        Case("camera: binary junk", "read_camera", {"c.camera": b"\x89PNG\r\n\x1a\n\0\0"}, "c.camera"),
+        Case("tf: one point is enough", "read_transfer_function", {"a.tf": b"7 1 0 0 1\n"}, "a.tf", "accept"),
+        Case("tf: values repeat", "read_transfer_function", {"a.tf": b"0 0 0 0 0\n0 1 1 1 1\n"}, "a.tf"),
+        Case("tf: colour 255 (0..1 expected)", "read_transfer_function", {"a.tf": b"0 255 0 0 1\n"}, "a.tf"),
+        Case("render: a folder that is no sequence", "cli:render", {"x.zarr/zarr.json": b"{}"},
+             "render {d}/x.zarr -o {d}/o.png"),
+        Case("render: a sequence whose plan is junk", "cli:render",
+             {"s.zarr/volanim-plan.json": b"\0\1not json"}, "render {d}/s.zarr -o {d}/o"),
+        Case("render: a volume to an .avi", "cli:render", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
+             "render {d}/f.nrrd -o {d}/o.avi"),
+        Case("render: a volume with a nan cut", "cli:render", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
+             "render {d}/f.nrrd -o {d}/o.png --cut 1 1 1 nan 0 0"),
+        Case("render: a zero cut normal", "cli:render", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
+             "render {d}/f.nrrd -o {d}/o.png --cut 1 1 1 0 0 0"),
+        Case("render: one volume to a png", "cli:render", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
+             "render {d}/f.nrrd -o {d}/o.png --size 64x48", "accept"),
     ]
     return cases
 
@@ -289,6 +316,7 @@ def replace_number(text: str, k: int, value: str) -> str:
 
 def mutated(kind: str, k: int, value: str) -> Case:
     """A valid file of ``kind`` with one number made hostile."""
-    base = {"mskel": MSKEL, "bones": BONES, "connect": CONNECT, "tskel": TSKEL}[kind]
+    base = {"mskel": MSKEL, "bones": BONES, "connect": CONNECT, "tskel": TSKEL, "camera": CAMERA, "tf": TF}[kind]
     text = replace_number(base, k, value)
-    return Case(f"{kind}: number #{k} -> {value[:12]}", f"read_{kind}", {f"m.{kind}": text.encode()}, f"m.{kind}")
+    reader = "read_transfer_function" if kind == "tf" else f"read_{kind}"
+    return Case(f"{kind}: number #{k} -> {value[:12]}", reader, {f"m.{kind}": text.encode()}, f"m.{kind}")

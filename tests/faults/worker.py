@@ -24,7 +24,8 @@ def readers() -> dict:
 
     return {"read_volume": io.read_volume, "read_mskel": io.read_mskel, "read_bones": io.read_bones,
             "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
-            "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh}
+            "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh,
+            "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function}
 
 
 CHECKS = {

@@ -34,6 +34,27 @@ def parse_colour(text: str) -> str:
     return text
 
 
+def parse_output(text: str) -> str:
+    from pathlib import Path
+
+    from volanim_core.render.run import output_kind
+
+    try:
+        output_kind(Path(text))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+class CutAction(argparse.Action):
+    """``--cut X Y Z NX NY NZ``: a point and a normal that is not zero."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        if not any(values[3:]):
+            parser.error(f"argument {option_string}: the normal NX NY NZ must not be 0 0 0")
+        setattr(namespace, self.dest, values)
+
+
 def _render(args):
     from volanim_core import io
     from volanim_core.parallel import default_workers
@@ -77,7 +98,8 @@ def register(sub) -> None:
     p = add_command(sub, "render", "Render a volume, several volumes or a zarr sequence to a PNG, a folder of "
                     "PNGs, an .mp4 or a .gif, with one fixed camera, off-screen.", EXAMPLE, _render)
     p.add_argument("inputs", nargs="+", help="a .zarr sequence, or volume files (.vti .nrrd .vol .VOL ...)")
-    p.add_argument("-o", "--output", required=True, help="NAME.png (one frame), a folder, NAME.mp4 or NAME.gif")
+    p.add_argument("-o", "--output", required=True, type=parse_output,
+                   help="NAME.png (one frame), a folder, NAME.mp4 or NAME.gif")
     p.add_argument("--style", choices=STYLES, default="surface",
                    help="surface: the filled voxels' boundary (fast); volume: ray-cast (default surface)")
     p.add_argument("--preset", choices=MODES, help="colours for this reconstruction mode (default: the "
@@ -91,7 +113,7 @@ def register(sub) -> None:
     p.add_argument("--size", type=parse_size, default=(640, 480), metavar="WxH",
                    help="pixels (default 640x480; .mp4 needs multiples of 16)")
     p.add_argument("--background", type=parse_colour, default="black", help="a colour name or #rrggbb")
-    p.add_argument("--cut", nargs=6, type=finite_float, metavar=("X", "Y", "Z", "NX", "NY", "NZ"),
+    p.add_argument("--cut", nargs=6, type=finite_float, action=CutAction, metavar=("X", "Y", "Z", "NX", "NY", "NZ"),
                    help="cut away everything on the side the normal (NX NY NZ) points to from voxel (X Y Z)")
     p.add_argument("--title", help="text in the top left corner")
     p.add_argument("--frame-numbers", action="store_true", help="the frame number in the top right corner")

@@ -65,13 +65,15 @@ class RenderSettings:
 def preset_transfer(preset: str, vmax: float) -> TransferFunction:
     """The volume-style colours and opacities of a continuous preset (sampled grey, hotspot heat)."""
     top = max(float(vmax), 1.0)
-    if preset == "hotspot":  # 1 sphere: faint dark red ... the most: opaque pale yellow
-        return TransferFunction([0.0, 0.5, 1.0, top / 2 if top > 2 else 1.5, max(top, 2.0)],
-                                [[0, 0, 0, 0], [0, 0, 0, 0], [0.5, 0.0, 0.0, 0.05], [1.0, 0.45, 0.0, 0.35],
-                                 [1.0, 1.0, 0.6, 0.9]])
+    if preset == "hotspot":  # 1 sphere: dark red, faint ... the most: opaque pale yellow
+        clear, hottest = [0, 0, 0, 0], [1.0, 1.0, 0.6, 0.9]
+        if top <= 1.0:
+            return TransferFunction([0.0, 0.5, 1.0], [clear, clear, hottest])
+        return TransferFunction([0.0, 0.5, 1.0, (1.0 + top) / 2, top],
+                                [clear, clear, [0.5, 0.0, 0.0, 0.15], [1.0, 0.45, 0.0, 0.4], hottest])
     # sampled grey: empty is clear, dim tissue faint, bright tissue nearly opaque
-    return TransferFunction([0.0, 0.5, top * 0.25, top], [[0, 0, 0, 0], [0.15, 0.15, 0.15, 0.0],
-                                                           [0.45, 0.45, 0.45, 0.08], [1, 1, 1, 0.8]])
+    return TransferFunction([0.0, 0.5, max(top * 0.25, 0.75), max(top, 1.0)],  # ascending even for 0/1 data
+                            [[0, 0, 0, 0], [0.15, 0.15, 0.15, 0.0], [0.45, 0.45, 0.45, 0.08], [1, 1, 1, 0.8]])
 
 
 def colour_table(settings: RenderSettings, vmax: float | None = None) -> np.ndarray:

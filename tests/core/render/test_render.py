@@ -153,6 +153,15 @@ def test_one_volume_file_to_a_png_with_a_transfer_function_and_a_saved_camera(tm
     assert np.array_equal(iio.imread(tmp_path / "c.png"), img)  # the saved camera is the same picture
 
 
+def test_presets_hold_for_any_value_range():
+    from volanim_core.render.scene import preset_transfer
+
+    for vmax in (0.0, 1.0, 2.0, 3.0, 255.0, 1e5):  # a 0/1 volume, a hotspot of 2, a float volume
+        for preset in ("sampled", "hotspot"):
+            tf = preset_transfer(preset, vmax)
+            assert np.all(np.diff(tf.values) > 0) and tf(max(vmax, 1.0))[3] > 0.5
+
+
 def test_camera_and_transfer_function_files_round_trip(tmp_path):
     cam = Camera((1.5, -2.25, 3e2), (0.1, 0.2, 0.3), (0.0, 0.0, 1.0), 25.0, parallel_scale=40.5)
     io.write_camera(tmp_path / "a.camera", cam)
@@ -197,9 +206,13 @@ def test_bad_transfer_function_files_name_the_line(tmp_path, text, line, match):
 def test_render_refusals(tmp_path, capsys):
     seq = make_sequence(tmp_path / "s.zarr")
     for args, match in ((["-o", str(tmp_path / "m.mp4"), "--size", "330x240"], "multiples of 16"),
-                        (["-o", str(tmp_path / "one.png")], "4 frames do not fit in one .png"),
-                        (["-o", str(tmp_path / "m.avi")], "render to a .png, .mp4, .gif or a folder")):
+                        (["-o", str(tmp_path / "one.png")], "4 frames do not fit in one .png")):
         assert main(["render", str(seq), *args]) == 2
+        assert match in capsys.readouterr().err
+    for bad, match in ((["-o", str(tmp_path / "m.avi")], "render to a .png, .mp4, .gif or a folder"),
+                       (["-o", str(tmp_path / "c"), "--cut", "1", "1", "1", "0", "0", "0"], "must not be 0 0 0")):
+        with pytest.raises(SystemExit):
+            main(["render", str(seq), *bad])
         assert match in capsys.readouterr().err
     (tmp_path / "c.camera").write_text("position 1 2 3\n")
     assert main(["render", str(seq), "-o", str(tmp_path / "x"), "--camera", str(tmp_path / "c.camera")]) == 2
