@@ -40,5 +40,12 @@ def test_headless_demo_writes_every_stage(tmp_path, capsys):
     assert o1[1] < o0[1] - 100  # the mannequin walked forward (-y) across the clip
     from volanim_core.sequence import store
 
-    assert "[7] sequence: 24 frames" in text and store.open_frames(out["sequence"]).shape[0] == 24
-    assert len(store.finished(out["sequence"])) == 24
+    assert "[7] sequence: 24 frames of one walk cycle and 10 of crumbling" in text
+    assert store.open_frames(out["sequence"]).shape[0] == 34 and len(store.finished(out["sequence"])) == 34
+    # the movie: every frame, the figure in the picture, and the heap at the end
+    import imageio.v3 as iio
+
+    movie = iio.imread(out["movie"], index=None)
+    assert "[8] render: 34 frames" in text and movie.shape[1:3] == (240, 320) and 30 <= len(movie) <= 34
+    lit = [(m[..., :3].astype(int).sum(-1) > 150).sum() for m in movie]
+    assert min(lit) > 200 and lit[-1] < lit[0] / 2  # a figure in every frame; the heap is smaller

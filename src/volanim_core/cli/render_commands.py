@@ -25,12 +25,12 @@ def parse_size(text: str) -> tuple[int, int]:
 
 
 def parse_colour(text: str) -> str:
-    from pyvista import Color
+    from volanim_core.render.scene import check_colour
 
     try:
-        Color(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a colour: {text!r} (a name like black, or #rrggbb)") from None
+        check_colour(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
     return text
 
 

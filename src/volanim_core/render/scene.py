@@ -235,6 +235,16 @@ class Renderer:
         self._bar = bar
 
 
+def check_colour(text: str) -> None:
+    """Refuse (ValueError) what is not a colour name or ``#rrggbb``."""
+    from pyvista import Color
+
+    try:
+        Color(text)
+    except ValueError:
+        raise ValueError(f"not a colour: {text!r} (a name like black, or #rrggbb)") from None
+
+
 def _contrast(background: str) -> str:
     """White text on a dark background, black on a light one."""
     from pyvista import Color

@@ -43,13 +43,13 @@ class MovieDialog(QDialog):
         form.addRow("First frame", self.first)
         form.addRow("Last frame", self.last)
         form.addRow("Every Nth frame", self.step)
-        self.style = QComboBox()
-        self.style.addItems(["surface", "volume"])
-        self.style.setToolTip("surface: the filled voxels' boundary, fast; volume: ray-cast, slower")
-        form.addRow("Style", self.style)
-        self.size = QComboBox()
-        self.size.addItems(SIZES)
-        form.addRow("Size", self.size)
+        self.style_box = QComboBox()
+        self.style_box.addItems(["surface", "volume"])
+        self.style_box.setToolTip("surface: the filled voxels' boundary, fast; volume: ray-cast, slower")
+        form.addRow("Style", self.style_box)
+        self.size_box = QComboBox()
+        self.size_box.addItems(SIZES)
+        form.addRow("Size", self.size_box)
         self.frame_numbers = QCheckBox("Frame numbers in the corner")
         form.addRow(self.frame_numbers)
         buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
@@ -63,7 +63,7 @@ class MovieDialog(QDialog):
             self.path.setText(path)
 
     def options(self) -> dict:
-        w, h = (int(v) for v in self.size.currentText().split("x"))
+        w, h = (int(v) for v in self.size_box.currentText().split("x"))
         return {"out": self.path.text().strip(), "first": self.first.value(), "last": self.last.value(),
-                "step": self.step.value(), "style": self.style.currentText(), "size": (w, h),
+                "step": self.step.value(), "style": self.style_box.currentText(), "size": (w, h),
                 "frame_numbers": self.frame_numbers.isChecked()}

@@ -184,3 +184,18 @@ def test_cancel_a_movie_and_render_it_again(qtbot, rigged, tmp_path):
             gif.seek(k)
             delays.append(gif.info["duration"])
     assert sum(delays) == pytest.approx(41 * 1000 / 12, abs=10)  # 41 frames at the clip's 120 fps / 10
+
+
+def test_the_movie_dialog_reads_back_what_the_user_chose(qtbot, window):
+    from volanim_studio.qt.movie_dialog import MovieDialog
+
+    dialog = MovieDialog(window, 100, "/tmp/walk.mp4")
+    qtbot.addWidget(dialog)
+    assert dialog.last.value() == 99 and dialog.first.maximum() == 99
+    dialog.first.setValue(10)
+    dialog.step.setValue(5)
+    dialog.style_box.setCurrentText("volume")
+    dialog.size_box.setCurrentText("1280x720")
+    dialog.frame_numbers.setChecked(True)
+    assert dialog.options() == {"out": "/tmp/walk.mp4", "first": 10, "last": 99, "step": 5, "style": "volume",
+                                "size": (1280, 720), "frame_numbers": True}
