@@ -130,3 +130,22 @@ class FrameProgress:
         eta = (total - done) / rate if rate > 0 else 0.0
         print(f"\rframe {done}/{total}  {rate:.2f} frames/s  ETA {int(eta) // 60}:{int(eta) % 60:02d}   ",
               end="", file=sys.stderr, flush=True)
+
+
+def checked_by(target: str, strip: str = ""):
+    """An argparse type that keeps the text when ``MODULE:FUNCTION`` (imported at first use, so the
+    parser stays light) accepts it; the ValueError it raises becomes the argument error (``strip``
+    removed from its front)."""
+    module, name = target.split(":")
+
+    def parse(text: str) -> str:
+        import importlib
+
+        try:
+            getattr(importlib.import_module(module), name)(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc).removeprefix(strip.format(text=text))) from None
+        return text
+
+    parse.__name__ = name  # argparse names the type in "invalid <name> value" messages
+    return parse

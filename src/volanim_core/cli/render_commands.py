@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._common import FrameProgress, add_command, ascii_int, finite_float, positive_float, positive_int
+from ._common import FrameProgress, add_command, ascii_int, checked_by, finite_float, positive_float, positive_int
 
 EXAMPLE = """volanim render walk.zarr -o walk.mp4                          (the sequence's mode picks the colours)
   volanim render walk.zarr -o walk.gif --size 320x240 --view front --frame-numbers
@@ -22,28 +22,6 @@ def parse_size(text: str) -> tuple[int, int]:
     if not (16 <= w <= 8192 and 16 <= h <= 8192):
         raise argparse.ArgumentTypeError(f"a picture is 16..8192 pixels each way, got {text}")
     return w, h
-
-
-def parse_colour(text: str) -> str:
-    from volanim_core.render.scene import check_colour
-
-    try:
-        check_colour(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
-
-
-def parse_output(text: str) -> str:
-    from pathlib import Path
-
-    from volanim_core.render.run import output_kind
-
-    try:
-        output_kind(Path(text))
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
 
 
 class CutAction(argparse.Action):
@@ -98,7 +76,7 @@ def register(sub) -> None:
     p = add_command(sub, "render", "Render a volume, several volumes or a zarr sequence to a PNG, a folder of "
                     "PNGs, an .mp4 or a .gif, with one fixed camera, off-screen.", EXAMPLE, _render)
     p.add_argument("inputs", nargs="+", help="a .zarr sequence, or volume files (.vti .nrrd .vol .VOL ...)")
-    p.add_argument("-o", "--output", required=True, type=parse_output,
+    p.add_argument("-o", "--output", required=True, type=checked_by("volanim_core.render.run:check_output"),
                    help="NAME.png (one frame), a folder, NAME.mp4 or NAME.gif")
     p.add_argument("--style", choices=STYLES, default="surface",
                    help="surface: the filled voxels' boundary (fast); volume: ray-cast (default surface)")
@@ -112,7 +90,8 @@ def register(sub) -> None:
     p.add_argument("--save-camera", metavar="FILE.camera", help="also write the camera used, to edit or reuse")
     p.add_argument("--size", type=parse_size, default=(640, 480), metavar="WxH",
                    help="pixels (default 640x480; .mp4 needs multiples of 16)")
-    p.add_argument("--background", type=parse_colour, default="black", help="a colour name or #rrggbb")
+    p.add_argument("--background", default="black",
+                   type=checked_by("volanim_core.render.scene:check_colour"), help="a colour name or #rrggbb")
     p.add_argument("--cut", nargs=6, type=finite_float, action=CutAction, metavar=("X", "Y", "Z", "NX", "NY", "NZ"),
                    help="cut away everything on the side the normal (NX NY NZ) points to from voxel (X Y Z)")
     p.add_argument("--title", help="text in the top left corner")

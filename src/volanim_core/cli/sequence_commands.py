@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import argparse
 import sys
 
-from ._common import FrameProgress, add_command, ascii_int, positive_float, positive_int
+from ._common import FrameProgress, add_command, ascii_int, checked_by, positive_float, positive_int
 
 EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr
   volanim sequence mannequin.0.50.connect assets/walk.bvh --bones mannequin.bones --frames 0:240:4 \\
@@ -13,26 +12,6 @@ EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source manne
   volanim sequence ... --crumble 36 -o walk.zarr      (after the walk, the body falls into a heap)
   volanim sequence ... --scheduler tcp://10.0.0.5:8786 -o /shared/walk.zarr     (a Dask cluster)
   volanim sequence ... -o walk.zarr      (again: finished frames are skipped; --force starts over)"""
-
-
-def _frame_pattern(text: str) -> str:
-    from volanim_core.sequence.task import check_frame_pattern
-
-    try:
-        check_frame_pattern(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc).removeprefix(f"--every-frame-as {text!r} ")) from None
-    return text
-
-
-def _axis(text: str) -> str:
-    from volanim_core.sequence.effects import parse_axis
-
-    try:
-        parse_axis(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
 
 
 def _sequence(args):
@@ -95,7 +74,8 @@ def register(sub) -> None:
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     p.add_argument("--padding", type=ascii_int, default=2, help="voxels around every frame's spheres (default 2)")
     p.add_argument("-o", "--output", required=True, help="the .zarr store (a folder)")
-    p.add_argument("--every-frame-as", type=_frame_pattern, metavar="DIR/NAME.%%04d.vti",
+    p.add_argument("--every-frame-as", metavar="DIR/NAME.%%04d.vti",
+                   type=checked_by("volanim_core.sequence.task:check_frame_pattern", "--every-frame-as {text!r} "),
                    help="also write each frame as a file (.vti, .nrrd, .vol, .VOL; %%04d = frame number)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--workers", type=positive_int, help="local worker processes (default: every core)")
@@ -110,7 +90,9 @@ def register(sub) -> None:
                         help="after the frames, N more: the body vanishes from the head down")
     effect.add_argument("--crumble", type=positive_int, metavar="N",
                         help="after the frames, N more: the voxels fall and pile into a heap")
-    p.add_argument("--down", type=_axis, default="-z", help="teleport/crumble: the way down (default -z)")
+    p.add_argument("--down", default="-z",
+                   type=checked_by("volanim_core.sequence.effects:parse_axis"),
+                   help="teleport/crumble: the way down (default -z; write --down=-y)")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",

@@ -208,6 +208,11 @@ def output_kind(out: Path) -> str:
     return "folder"
 
 
+def check_output(text: str) -> None:
+    """Refuse (ValueError) a name that is no picture, movie or folder."""
+    output_kind(Path(text))
+
+
 def check_size(size, kind: str) -> None:
     w, h = size
     if kind == "mp4" and (w % 16 or h % 16):
