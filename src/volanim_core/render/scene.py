@@ -231,7 +231,7 @@ class Renderer:
         bar.SetHeight(0.8)
         for text in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
             text.SetColor(*rgb(_contrast(s.background)))
-        self.plotter.renderer.AddActor2D(bar)
+        self.plotter.add_actor(bar, reset_camera=False, name="colour bar", render=False)
         self._bar = bar
 
 

@@ -271,3 +271,19 @@ def test_auto_mapper_is_resolved_once_for_the_whole_sequence(tmp_path):
     assert rep.mapper in ("gpu", "cpu") and rep.drawn == 4
     surface = RenderSettings(settings.camera, preset="bone")
     assert choose_mapper(inputs, surface) is surface  # nothing to choose
+
+
+def test_hotspot_gets_a_heat_colour_bar_and_labels_do_not():
+    counts = ball(radius=15, value=1)
+    counts[ball(radius=8) > 0] = 6  # hot in the middle
+    cam = named_view("front", (0, 0, 0), (79, 79, 79), aspect=W / H)
+    pictures = {}
+    for preset in ("hotspot", "bone"):
+        r = Renderer(RenderSettings(cam, preset=preset, vmax=6, size=(W, H)))
+        try:
+            pictures[preset] = r.render(counts, (0, 0, 0)).astype(int)
+        finally:
+            r.close()
+    bar = pictures["hotspot"][H // 5: 3 * H // 5, int(W * 0.89): int(W * 0.91)]
+    assert (bar[..., 0] > 200).mean() > 0.5 and bar[..., 2].mean() < bar[..., 0].mean()  # warm colours
+    assert not lit(pictures["bone"][:, int(W * 0.89):].astype(np.uint8)).any()  # no bar for labels
