@@ -79,6 +79,15 @@ def describe(exc: BaseException, args) -> str:
     return text
 
 
+def _quiet_stdout() -> None:
+    """Point stdout at /dev/null, so the interpreter's final flush does not fail on the closed pipe."""
+    import os
+
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(join_negative_infinity(list(sys.argv[1:] if argv is None else argv)))
@@ -87,6 +96,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     try:
         result = args.func(args)
+    except BrokenPipeError:  # `volanim count … | head`: the reader had enough; not an error of ours
+        _quiet_stdout()
+        return 0
     except (FormatError, ValueError, OSError, MemoryError) as exc:
         print(f"volanim {args.command}: error: {describe(exc, args)}", file=sys.stderr)
         return 2

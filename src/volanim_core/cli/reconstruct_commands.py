@@ -119,7 +119,11 @@ def _reconstruct(args):
           f"(overdraw {s['overdraw']:.1f}); grid {r.volume.shape[0]}x{r.volume.shape[1]}x{r.volume.shape[2]}, "
           f"origin {r.origin[0]} {r.origin[1]} {r.origin[2]} -> {args.output}")
     if s["clipped"]:
-        print(f"clipped: {s['clipped']} sphere voxels fell outside the given bounds")
+        # what the user loses is body voxels, not sphere coverage (overlapping spheres count many times)
+        whole = reconstruct(t, mode="binary", padding=args.padding, threads=args.threads)
+        lost = whole.stats["filled"] - s["filled"]
+        print(f"clipped: {lost:,} voxels of the body lie outside the given bounds and were not written "
+              f"({100 * lost / max(whole.stats['filled'], 1):.2f} % of {whole.stats['filled']:,})")
     if args.mode == "hotspot":
         print(f"hotspot: max {s['hotspot_max']} spheres on one voxel, mean {s['hotspot_mean']:.2f}")
     if args.loss:

@@ -98,6 +98,25 @@ def test_cli_pose_to_reconstruct_chain(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "clipped:" in out and "hotspot: max" in out and "origin 0 0 0" in out
     assert "clipped to 255" in out and io.read_volume(tmp_path / "hot.VOL").max() == 255
+    # clipped counts the body voxels the bounds cut off (not sphere coverage, which counts overlaps)
+    rest = io.read_tskel(tmp_path / "rest.tskel")
+    whole = int((reconstruct(rest, mode="binary").volume > 0).sum())
+    kept = int((io.read_volume(tmp_path / "hot.VOL") > 0).sum())
+    assert f"clipped: {whole - kept:,} voxels of the body lie outside" in out
+
+
+def test_a_closed_pipe_ends_a_command_quietly(tmp_path):
+    import subprocess
+    import sys
+
+    io.write_volume(tmp_path / "v.VOL", np.arange(4 * 50 * 50, dtype=np.uint8).reshape(4, 50, 50))
+    proc = subprocess.Popen([sys.executable, "-m", "volanim_core.cli", "count", "--all", str(tmp_path / "v.VOL")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.read(10)
+    proc.stdout.close()  # `| head -c 10`
+    with proc.stderr:
+        err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 0 and err == ""  # no "Broken pipe", no traceback
 
 
 def test_cli_errors_are_clear(tmp_path, capsys):
