@@ -120,10 +120,15 @@ def _reconstruct(args):
           f"origin {r.origin[0]} {r.origin[1]} {r.origin[2]} -> {args.output}")
     if s["clipped"]:
         # what the user loses is body voxels, not sphere coverage (overlapping spheres count many times)
-        whole = reconstruct(t, mode="binary", padding=args.padding, threads=args.threads)
-        lost = whole.stats["filled"] - s["filled"]
-        print(f"clipped: {lost:,} voxels of the body lie outside the given bounds and were not written "
-              f"({100 * lost / max(whole.stats['filled'], 1):.2f} % of {whole.stats['filled']:,})")
+        try:
+            whole = reconstruct(t, mode="binary", padding=args.padding, threads=args.threads)
+        except ValueError:  # the unbounded grid is too large to make: say what is known
+            print(f"clipped: the spheres reach outside the given bounds ({s['clipped']:,} sphere voxels, "
+                  "overlaps counted; the whole body's grid is too large to count the voxels lost)")
+        else:
+            lost = whole.stats["filled"] - s["filled"]
+            print(f"clipped: {lost:,} voxels of the body lie outside the given bounds and were not written "
+                  f"({100 * lost / max(whole.stats['filled'], 1):.2f} % of {whole.stats['filled']:,})")
     if args.mode == "hotspot":
         print(f"hotspot: max {s['hotspot_max']} spheres on one voxel, mean {s['hotspot_mean']:.2f}")
     if args.loss:
