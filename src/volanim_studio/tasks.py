@@ -79,9 +79,8 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
     from volanim_core.parallel import default_workers
     from volanim_core.render.run import open_inputs, output_kind, render
     from volanim_core.render.scene import RenderSettings
-    from volanim_core.sequence import store
     from volanim_core.sequence.frames import FrameSpec
-    from volanim_core.sequence.run import plan_key, run_sequence
+    from volanim_core.sequence.run import run_sequence
 
     t0 = time.perf_counter()
     report = Reporter(progress, cancel)
@@ -94,13 +93,10 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
         raise ValueError(f"{len(frames)} frames do not fit in one .png: choose an .mp4, a .gif or a folder")
     total = 2 * len(frames)
     report(0, total)
-    cache = out.parent / f".{out.name}.zarr"
-    src = source if mode == "sampled" else None
-    old = store.read_plan(cache)
-    stale = old is not None and old.get("key") != plan_key(conn, frames, mode, 1, 2, src)
+    cache = out.parent / f".{out.name}.zarr"  # the same frames resume; another pose replaces it
     workers = workers or default_workers()
-    run_sequence(conn, frames, cache, mode=mode, source=src, fps=fps, workers=workers, force=stale,
-                 on_frame=lambda rec, done, n: report(done, total))
+    run_sequence(conn, frames, cache, mode=mode, source=source if mode == "sampled" else None, fps=fps,
+                 workers=workers, replace_other=True, on_frame=lambda rec, done, n: report(done, total))
     inputs = open_inputs([cache])
     settings = RenderSettings(camera, style=style, preset=mode, vmax=inputs.vmax, size=tuple(size),
                               background=background, frame_numbers=frame_numbers,

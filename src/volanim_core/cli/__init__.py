@@ -23,7 +23,7 @@ from . import (
     skeleton_commands,
     volume_commands,
 )
-from ._common import join_negative_infinity
+from ._common import join_dash_values
 
 EPILOG = """examples:
   volanim samples mannequin -o data/          write the demo mannequin
@@ -90,7 +90,7 @@ def _quiet_stdout() -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(join_negative_infinity(list(sys.argv[1:] if argv is None else argv)))
+    args = parser.parse_args(join_dash_values(list(sys.argv[1:] if argv is None else argv)))
     if not getattr(args, "func", None):
         parser.print_help()
         return 0

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import math
 import re
+import sys
+import time
 
 from volanim_core.io import read_volume, write_volume
 from volanim_core.io._text import is_number
@@ -80,13 +82,22 @@ def positive_int(text: str) -> int:
     return value
 
 
-def join_negative_infinity(argv: list[str]) -> list[str]:
-    """``--opt -inf`` -> ``--opt=-inf``: argparse takes ``-inf`` for an option and refuses it."""
+AXIS_OPTIONS = ("--down", "--up", "--forward")  # options whose value is a signed axis such as -z
+_SIGNED_AXIS = re.compile(r"-[xyz]", re.IGNORECASE)
+
+
+def join_dash_values(argv: list[str]) -> list[str]:
+    """``--opt -inf`` -> ``--opt=-inf`` and ``--down -z`` -> ``--down=-z``: argparse takes a value
+    that starts with a dash for an option and refuses it. A signed axis is joined only after the
+    options that take one, so no short option elsewhere is swallowed."""
     out: list[str] = []
     for token in argv:
-        if out and _INFINITY.fullmatch(token) and token.startswith("-") and out[-1].startswith("--") \
-                and "=" not in out[-1]:
-            out[-1] = f"{out[-1]}={token}"
+        prev = out[-1] if out else ""
+        joinable = prev.startswith("--") and "=" not in prev and (
+            (_INFINITY.fullmatch(token) and token.startswith("-"))
+            or (prev in AXIS_OPTIONS and _SIGNED_AXIS.fullmatch(token)))
+        if joinable:
+            out[-1] = f"{prev}={token}"
         else:
             out.append(token)
     return out
@@ -113,19 +124,14 @@ class FrameProgress:
     """
 
     def __init__(self):
-        import time
-
-        self._clock = time.perf_counter
-        self.t0 = self._clock()
+        self.t0 = time.perf_counter()
         self.before = None
 
     def __call__(self, _item, done: int, total: int) -> None:
-        import sys
-
         if self.before is None:
             self.before = done - 1
         made = done - self.before
-        elapsed = self._clock() - self.t0
+        elapsed = time.perf_counter() - self.t0
         rate = made / elapsed if elapsed > 0 else 0.0
         eta = (total - done) / rate if rate > 0 else 0.0
         print(f"\rframe {done}/{total}  {rate:.2f} frames/s  ETA {int(eta) // 60}:{int(eta) % 60:02d}   ",

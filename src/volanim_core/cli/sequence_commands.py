@@ -92,7 +92,7 @@ def register(sub) -> None:
                         help="after the frames, N more: the voxels fall and pile into a heap")
     p.add_argument("--down", default="-z",
                    type=checked_by("volanim_core.sequence.effects:parse_axis"),
-                   help="teleport/crumble: the way down (default -z; write --down=-y)")
+                   help="teleport/crumble: the way down (default -z)")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",

@@ -106,11 +106,14 @@ def check_memory(bounds: Bounds, dtype: np.dtype, workers: int, source) -> int:
 def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str = "binary", source=None,
                  source_origin=(0, 0, 0), kernel: int = 1, padding: int = 2, fps: float = 24.0,
                  every_frame_as: str | None = None, workers: int | None = None, scheduler=None,
-                 force: bool = False, threads_per_worker: int = 1, on_frame=None) -> SequenceReport:
+                 force: bool = False, replace_other: bool = False, threads_per_worker: int = 1,
+                 on_frame=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
     ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
     ``on_frame(record, done, total)`` after each finished frame (progress).
+    ``replace_other``: a store of another sequence at ``out`` is replaced instead of refused (a
+    cache, like the studio's movie); the same sequence still resumes, and ``--force`` redoes it.
     """
     if not frames:
         raise ValueError("no frames to reconstruct")
@@ -141,7 +144,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
         done = store.finished(out)
         rest = int(old["rest_filled"]) if isinstance(old.get("rest_filled"), int) else _rest_filled(conn)
     else:
-        if old is not None and old.get("key") != key and not force:
+        if old is not None and old.get("key") != key and not (force or replace_other):
             raise ValueError(f"{out} holds another sequence (different frames, connectivity, mode or source); "
                              "pass --force to replace it, or choose another -o")
         rest = plan["rest_filled"] = _rest_filled(conn)  # once per store: a resumed run does not redo it

@@ -122,9 +122,17 @@ def test_cli_effects_and_the_down_option(tmp_path, capsys):
     assert main([*base, "--teleport", "2", "-o", str(tmp_path / "t.zarr")]) == 0
     assert "3 made" in capsys.readouterr().out
     assert not store.read_frame(tmp_path / "t.zarr", 2).any()  # gone
-    assert main([*base, "--crumble", "2", "--down=-z", "-o", str(tmp_path / "c.zarr")]) == 0
+    assert main([*base, "--crumble", "2", "--down", "-z", "-o", str(tmp_path / "c.zarr")]) == 0  # a dash value
     assert len(store.finished(tmp_path / "c.zarr")) == 3
     assert [f.number for f in melt(frames_from_files(io.read_connect(CONNECT), [WALK], bones=mannequin_bones(),
                                                      frames=slice(0, 1)), 2)] == [1, 2]
     with pytest.raises(ValueError, match="follows a pose"):
         crumble([], 3)
+
+
+def test_dash_values_are_joined_only_where_an_option_takes_them():
+    from volanim_core.cli._common import join_dash_values
+
+    assert join_dash_values(["x", "--down", "-z", "--min-thinness", "-inf", "--up", "-Y", "-o", "f"]) == \
+        ["x", "--down=-z", "--min-thinness=-inf", "--up=-Y", "-o", "f"]
+    assert join_dash_values(["--force", "-x", "--down=-y"]) == ["--force", "-x", "--down=-y"]  # -x: not an axis here

@@ -123,6 +123,13 @@ def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tm
     assert main(args[:-4] + ["-o", str(out), "--padding", "5"]) == 2
     assert "holds another sequence" in capsys.readouterr().err
     assert main(args[:-4] + ["-o", str(out), "--padding", "5", "--force"]) == 0
+    # a cache (the studio's movie): another sequence there is replaced, the same one resumes
+    conn = io.read_connect(CONNECT)
+    frames = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 20, 10))
+    rep = run_sequence(conn, frames, out, mode="bone", replace_other=True)
+    assert rep.computed == 2 and rep.skipped == 0
+    again = run_sequence(conn, frames, out, mode="bone", replace_other=True)
+    assert again.computed == 0 and again.skipped == 2
 
 
 def test_refusals_name_what_is_wrong(tmp_path, conn, walk):

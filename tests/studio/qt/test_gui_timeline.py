@@ -169,13 +169,23 @@ def test_cancel_a_movie_and_render_it_again(qtbot, rigged, tmp_path):
     qtbot.waitUntil(lambda: (tmp_path / ".walk.gif.zarr" / "volanim-frames.jsonl").is_file()
                     and (tmp_path / ".walk.gif.zarr" / "volanim-frames.jsonl").stat().st_size > 0,
                     timeout=JOB_TIMEOUT_MS)
+    messages = []
+    w.doc.events.message.connect(lambda text: messages.append(text))
     w.jobs.dialog.findChild(QPushButton).click()  # Cancel
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
-    assert worker.isFinished() and not (tmp_path / "walk.gif").exists()
-    done_before = len((tmp_path / ".walk.gif.zarr" / "volanim-frames.jsonl").read_text().splitlines())
-    assert 1 <= done_before < 41  # cancelled part-way; what was made is kept
-    w.timeline.render_movie(tmp_path / "walk.gif", first=0, last=400, step=10, size=(160, 120), workers=1)
+    assert worker.isFinished() and any("cancelled" in m for m in messages)
+    assert not (tmp_path / "walk.gif").exists()
+    from volanim_core.sequence import store
+
+    kept = len(store.finished(tmp_path / ".walk.gif.zarr"))
+    assert kept >= 1, "the frames made before the cancel are kept"
+    assert kept < 41, "the cancel came part-way through the reconstruction"
+    progress = []
+    again = w.timeline.render_movie(tmp_path / "walk.gif", first=0, last=400, step=10, size=(160, 120), workers=1)
+    again.progressed.connect(lambda done, total: progress.append(done))
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    first_made = min(d for d in progress if d > 0)
+    assert first_made == kept + 1, "the second run resumed: its first new frame counts after the kept ones"
     from PIL import Image
 
     with Image.open(tmp_path / "walk.gif") as gif:  # identical frames (the figure out of view) are merged
