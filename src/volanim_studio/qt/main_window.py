@@ -26,6 +26,7 @@ from .bone_panel import BonePanel
 from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .files_controller import FilesController
+from .gui_gc import collect_on_gui_thread
 from .pose_panel import PosePanel
 from .preview_controller import PreviewController
 from .reconstruct_panel import ReconstructPanel
@@ -60,6 +61,7 @@ class MainWindow(QMainWindow):
     def __init__(self, doc: Document | None = None, *, autosave_every_edits: int = 5,
                  autosave_seconds: float = 60.0):
         super().__init__()
+        collect_on_gui_thread()  # before any worker thread runs: garbage holding Qt/VTK objects dies here
         self.doc = doc or Document()
         self.setWindowTitle("volanim studio")
         self.resize(1400, 900)

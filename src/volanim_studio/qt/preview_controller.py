@@ -82,13 +82,23 @@ class PreviewController(Controller):
 
     def _on_pose_changed(self, **_) -> None:
         if self._posing_drag and self.doc.settings.live_preview:
-            self._live_timer.start()  # coalesced: one live preview per event-loop pass
+            self._request_live()
 
     def live_preview_soon(self) -> None:
         """A live preview at the next event-loop pass (the timeline's frame changed), if there is anything
         attached to preview and live previews are on."""
         bone = self.doc.attachments.bone
         if self.doc.settings.live_preview and len(bone) and (bone >= 0).any():
+            self._request_live()
+
+    def _request_live(self) -> None:
+        """Coalesce live previews: one per event-loop pass, drawing the newest pose.
+
+        A pending request is never restarted. Restarting a zero-interval timer pushes its
+        deadline past the playback timer's whenever a frame takes longer than the playback
+        interval to handle (a busy machine), so it never fired: playing showed no preview at all.
+        """
+        if not self._live_timer.isActive():
             self._live_timer.start()
 
     def live_preview(self) -> None:

@@ -78,6 +78,31 @@ def test_play_draws_live_previews_dropping_frames_then_previews_in_full(qtbot, r
     assert np.allclose(w.doc.pose.matrices(), w.doc.timeline.matrices([w.doc.settings.current_frame])[0], atol=1e-6)
 
 
+def test_frames_arriving_faster_than_the_event_loop_still_get_live_previews(qtbot, rigged):
+    """A busy machine: every pass of the event loop brings a new frame before the coalescing timer
+    fired. Restarting that timer on each frame starved it (no preview at all while playing); a pending
+    live preview must run at the next pass whatever keeps arriving."""
+    import time
+
+    from PySide6.QtCore import QTimer
+
+    w = rigged
+    assert w.timeline.load_bvh(WALK)
+    w.set_mode(Mode.POSE)
+
+    def busy_frame():  # what _tick does on a slow machine: drawing the new frame's points takes longer
+        time.sleep(0.012)  # than the playback interval, then the frame asks for its live preview
+        w.previews.live_preview_soon()
+
+    frames = QTimer(w)
+    frames.timeout.connect(busy_frame)
+    frames.start(8)
+    try:
+        qtbot.waitUntil(lambda: len(w.previews.live_timings) >= 3, timeout=5_000)
+    finally:
+        frames.stop()
+
+
 def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
     w = rigged
     doc, tl = w.doc, w.doc.timeline
