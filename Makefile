@@ -10,7 +10,7 @@ APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxc
 	libfontconfig1 libdbus-1-3
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test install install-test system-deps lint bench screenshots clean
+.PHONY: demo test install install-test system-deps lint bench docs screenshots clean
 
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -60,6 +60,10 @@ bench: install-test system-deps
 	$(PY) benchmarks/thesis_tables.py
 	xvfb-run -a $(PY) benchmarks/bench_studio.py
 	xvfb-run -a $(PY) benchmarks/bench_motion.py
+
+# The README's generated tables (volume tools, every benchmark's figures): about 15 minutes on 2 cores.
+docs: install-test system-deps
+	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/update_readme.py
 
 screenshots: install-test system-deps
 	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py

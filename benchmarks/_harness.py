@@ -63,6 +63,15 @@ def measure(script: str, case: str, dataset: str, repeats: int = 3, env=None) ->
 
 
 def table(rows: list[list], header: list[str]) -> str:
+    """A plain-text table, or a Markdown one when ``VOLANIM_BENCH_MARKDOWN`` is set (``make docs``
+    puts the benchmarks' own tables into the README)."""
+    import os
+
+    if os.environ.get("VOLANIM_BENCH_MARKDOWN"):
+        cells = [[str(c).replace("|", "\\|") for c in r] for r in [header, *rows]]
+        lines = ["| " + " | ".join(r) + " |" for r in cells]
+        lines.insert(1, "|" + "---|" * len(header))
+        return "\n".join(lines)
     cols = [header] + [[str(c) for c in r] for r in rows]
     widths = [max(len(r[i]) for r in cols) for i in range(len(header))]
     lines = [" | ".join(c.ljust(w) for c, w in zip(r, widths)) for r in cols]

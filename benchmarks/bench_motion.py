@@ -1,7 +1,7 @@
 """Motion benchmark: the whole walk clip parsed, forward-kinematicked and retargeted; keyframes; playback.
 
 Part 1 (no display): ``read_bvh`` + ``Retarget.build`` + ``matrices()`` for all 1064 frames of
-assets/walk.bvh onto the mannequin, against a per-frame baseline measured in the same run (one
+the bundled walk.bvh onto the mannequin, against a per-frame baseline measured in the same run (one
 scipy ``Rotation`` per joint per frame, the loop a straightforward port would write), and against
 the clip's own duration (how many times faster than real time). Keyframe interpolation of 1000
 frames for the 18 mannequin bones, against calling ``pose_matrices`` once per frame.
@@ -28,7 +28,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from _harness import table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-WALK = ROOT / "assets" / "walk.bvh"
+from volanim_core.samples import walk_clip  # noqa: E402
+
+WALK = walk_clip()
 
 
 def best_of(fn, repeats: int = 5) -> float:

@@ -29,7 +29,7 @@ def mannequin_case(n: int):
     from volanim_core.sequence.frames import frames_from_files
 
     conn = io.read_connect(ROOT / "assets" / "mannequin.0.50.connect")
-    frames = frames_from_files(conn, [ROOT / "assets" / "walk.bvh"], bones=samples.mannequin_bones(),
+    frames = frames_from_files(conn, [samples.walk_clip()], bones=samples.mannequin_bones(),
                                frames=slice(0, 10 * n, 10))
     return "mannequin (walk)", conn, frames, samples.mannequin().volume
 

@@ -120,7 +120,7 @@ def main() -> None:
     grab(w, HERE / "studio-pose-fixed.png")
 
     # Timeline: the real walk clip on the mannequin, mid-stride, previewed in full
-    w.timeline.load_bvh(ROOT.parent / "shared" / "data" / "walk.bvh")
+    w.timeline.load_bvh(samples.walk_clip())
     w.doc.settings.current_frame = 330
     doc.settings.preview_mode = "sampled"
     w.scene.front_view()

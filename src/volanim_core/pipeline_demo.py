@@ -5,7 +5,7 @@
       connectivity (assets/, else nearest bone) --> NAME.0.50.connect
       --identity--> rest.tskel --reconstruct--> rest-sampled.vti
       --pose (left upper arm 45 deg)--> arm.trans --> arm.tskel --> arm-sampled.vti, arm-bone.vti
-      walk.bvh (assets/, real motion capture) --retarget--> walk/walk.NNNN.trans + .tskel
+      walk.bvh (package data, real motion capture) --retarget--> walk/walk.NNNN.trans + .tskel
         --> walk/walk.NNNN-sampled.vti for a few frames across the clip     (mannequin only)
       --sequence--> walk.zarr: one walk cycle, then a crumble; one grid, every core (mannequin only)
       --render--> walk.gif: the sequence from the side, off-screen                  (mannequin only)
@@ -52,8 +52,8 @@ def _say(msg: str) -> None:
 
 
 def bundled_clip() -> Path | None:
-    """The walk clip shipped in ``assets/`` (MIT, licence beside it), when running from the repository."""
-    path = Path(__file__).resolve().parents[2] / "assets" / "walk.bvh"
+    """The walk clip shipped with the package (MIT, licence beside it)."""
+    path = samples.walk_clip()
     return path if path.is_file() else None
 
 

@@ -4,6 +4,7 @@
     aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
     frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
                                          with a two-bone principal-axis chain
+    walk_clip()  the real motion-capture walk (BVH, 1064 frames, MIT licence beside it)
 
 The mannequin faces -y with z up, so its left side (``L_`` bones) is at +x;
 it is mirror-symmetric about the volume's mid-plane x = 79.5.
@@ -22,6 +23,8 @@ import numpy as np
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
 NAMES = ("mannequin", "aliascube", "frog")
+#: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence.
+FILE_SAMPLES = ("walk",)
 
 # Tissue values: distinct so sampled reconstruction shows the interior moving.
 SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
@@ -222,13 +225,26 @@ def load(name: str) -> Sample:
     return makers[name]()
 
 
-def write_sample(name: str, folder: str | Path) -> list[Path]:
-    """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``)."""
-    from volanim_core.io import write_bones, write_connections, write_raw
+def walk_clip() -> Path:
+    """The bundled motion-capture walk (``walk.bvh``, package data; its MIT licence is beside it)."""
+    return Path(__file__).resolve().parent / "sample_data" / "walk.bvh"
 
-    sample = load(name)
+
+def write_sample(name: str, folder: str | Path) -> list[Path]:
+    """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``), or for
+    ``walk`` the clip ``walk.bvh`` and its licence."""
+    from volanim_core.io import write_bones, write_connections, write_raw
+    from volanim_core.io._atomic import atomic_write_bytes
+
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    if name == "walk":
+        clip = walk_clip()
+        written = [folder / clip.name, folder / f"{clip.name}.LICENSE"]
+        for src, dst in zip((clip, clip.with_name(f"{clip.name}.LICENSE")), written):
+            atomic_write_bytes(dst, src.read_bytes())
+        return written
+    sample = load(name)
     written = [folder / f"{name}.VOL"]
     write_raw(written[0], sample.volume)
     if sample.bones is not None:

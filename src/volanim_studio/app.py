@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 EPILOG = """examples:
@@ -35,9 +36,52 @@ def main(argv: list[str] | None = None) -> int:
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("volanim studio")
+    if os.environ.get("VOLANIM_STUDIO_SMOKE"):
+        _quit_when_loaded(app)  # before the window: its threshold dialog may already be waiting
     window = main_window_for(args)
     window.show()
     return app.exec()
+
+
+def _quit_when_loaded(app, seconds: float = 600.0) -> None:
+    """``VOLANIM_STUDIO_SMOKE=1``: a start-up check for scripts and CI (tests/test_readme.py runs the
+    README's studio commands this way). Dialogs are answered with their defaults (OK; No to questions),
+    and once everything asked for on the command line has loaded the studio quits: status 0, or 1
+    if it showed an error."""
+    import time
+
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QDialog, QMessageBox
+
+    from .qt.main_window import MainWindow
+
+    deadline = time.monotonic() + seconds
+    state = {"idle": 0, "errors": []}
+
+    def tick():
+        modal = app.activeModalWidget()
+        if isinstance(modal, QMessageBox):
+            if modal.icon() in (QMessageBox.Critical, QMessageBox.Warning):
+                state["errors"].append(modal.text())
+            modal.reject() if modal.icon() == QMessageBox.Question else modal.accept()
+            return
+        if isinstance(modal, QDialog):
+            modal.accept()
+            return
+        windows = [w for w in app.topLevelWidgets() if isinstance(w, MainWindow)]
+        idle = windows and not windows[0].busy and modal is None
+        state["idle"] = state["idle"] + 1 if idle else 0
+        if state["idle"] >= 3 or time.monotonic() > deadline:
+            window = windows[0] if windows else None
+            errors = state["errors"] + ([window.last_error] if window is not None and window.last_error else [])
+            status = window.statusBar().currentMessage() if window is not None else ""
+            print(f"volanim-studio smoke check: {'FAILED: ' + '; '.join(errors) if errors else 'loaded'}"
+                  + (f" ({status})" if status else ""), flush=True)
+            app.exit(1 if errors or time.monotonic() > deadline else 0)
+
+    timer = QTimer(app)
+    timer.timeout.connect(tick)
+    timer.start(200)
 
 
 if __name__ == "__main__":

@@ -21,15 +21,16 @@ from . import (
     render_commands,
     sequence_commands,
     skeleton_commands,
+    view_command,
     volume_commands,
 )
 from ._common import join_dash_values
 
 EPILOG = """examples:
-  volanim samples mannequin -o data/          write the demo mannequin
-  volanim info data/mannequin.VOL             size, value range, bounds
+  volanim samples all -o data/                # the demo volumes, bones and the walk clip
+  volanim info data/mannequin.VOL             # size, value range, bounds
   volanim threshold data/mannequin.VOL mask.VOL --range 1:255
-  volanim demo -o demo-out/                   run the whole pipeline headless
+  volanim demo -o demo-out/                   # the whole pipeline, headless
 
 Run 'volanim COMMAND --help' for each command's options and an example."""
 
@@ -46,7 +47,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for module in (volume_commands, skeleton_commands, reconstruct_commands, motion_commands, sequence_commands,
-                   render_commands, demo_command):
+                   render_commands, view_command, demo_command):
         module.register(sub)
     return parser
 

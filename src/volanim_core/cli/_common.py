@@ -7,16 +7,24 @@ import math
 import re
 import sys
 import time
+from pathlib import Path
 
-from volanim_core.io import read_volume, write_volume
+from volanim_core.io import raw_name_for, read_volume, write_volume
 from volanim_core.io._text import is_number
 from volanim_core.volume import Bounds
 
+#: What every ``--help`` example assumes; tests/core/cli/test_help_examples.py runs them all, in this order.
+EXAMPLES_HEADER = "examples (in a folder where `volanim samples all -o .` ran; earlier commands' files are used):"
 
-def add_command(sub, name: str, help: str, example: str, func) -> argparse.ArgumentParser:
-    """A subparser whose ``--help`` ends with an example."""
+
+def add_command(sub, name: str, help: str, example: str | tuple[str, ...], func) -> argparse.ArgumentParser:
+    """A subparser whose ``--help`` ends with examples: each one a command that runs as shown
+    (a long one may continue over lines ending in a backslash; ``# ...`` comments)."""
+    examples = (example,) if isinstance(example, str) else example
+    lines = [f"  {line}" if i == 0 else f"      {line.strip()}"
+             for ex in examples for i, line in enumerate(ex.split("\n"))]
     p = sub.add_parser(
-        name, help=help, description=help, epilog=f"example:\n  {example}",
+        name, help=help, description=help, epilog=EXAMPLES_HEADER + "\n" + "\n".join(lines),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.set_defaults(func=func)
@@ -36,9 +44,12 @@ def load(path: str, args) -> object:
     return read_volume(path, dims=getattr(args, "dims", None))
 
 
-def save(path: str, vol, **kw) -> None:
+def save(path: str, vol, **kw) -> Path:
+    """Write a volume and say where; a headerless ``.vol`` is named ``NAME.XxYxZ.vol`` (its size)."""
+    path = raw_name_for(path, vol.shape)
     write_volume(path, vol, **kw)
     print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype})")
+    return path
 
 
 _INFINITY = re.compile(r"[+-]?inf(?:inity)?", re.IGNORECASE)

@@ -8,6 +8,7 @@ import argparse
 import numpy as np
 
 from volanim_core.io import (
+    raw_name_for,
     read_bones,
     read_connect,
     read_mskel,
@@ -113,11 +114,12 @@ def _reconstruct(args):
     volume, note = saturate_for_raw(args.output, r.volume)
     if note:
         print(f"note: {note}")
-    write_volume(args.output, volume, origin=r.origin)
+    output = raw_name_for(args.output, volume.shape)  # a headerless .vol carries its size in its name
+    write_volume(output, volume, origin=r.origin)
     s = r.stats
     print(f"{s['spheres']} spheres -> {s['filled']} voxels filled in {s['seconds']:.3f} s "
           f"(overdraw {s['overdraw']:.1f}); grid {r.volume.shape[0]}x{r.volume.shape[1]}x{r.volume.shape[2]}, "
-          f"origin {r.origin[0]} {r.origin[1]} {r.origin[2]} -> {args.output}")
+          f"origin {r.origin[0]} {r.origin[1]} {r.origin[2]} -> {output}")
     if s["clipped"]:
         # what the user loses is body voxels, not sphere coverage (overlapping spheres count many times)
         try:
@@ -155,13 +157,13 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "connect2tskel", "A .connect plus one .trans frame -> .tskel (root orders must match).",
-                    "volanim connect2tskel man.0.50.connect arm.trans -o arm.tskel", _connect2tskel)
+                    "volanim connect2tskel mannequin.0.50.connect arm.trans -o arm.tskel", _connect2tskel)
     p.add_argument("connect")
     p.add_argument("trans")
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "connect2identitytskel", "The identity (rest) .tskel of a .connect.",
-                    "volanim connect2identitytskel man.0.50.connect -o rest.tskel", _connect2identity)
+                    "volanim connect2identitytskel mannequin.0.50.connect -o rest.tskel", _connect2identity)
     p.add_argument("connect")
     p.add_argument("-o", "--output", required=True)
 
@@ -171,12 +173,15 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "bounds", "Inclusive bounds of the posed spheres of one or more frames (tskelbounds).",
-                    "volanim bounds walk-*.tskel --padding 2", _bounds)
+                    "volanim bounds arm.tskel rest.tskel --padding 2", _bounds)
     p.add_argument("tskel", nargs="+")
     p.add_argument("--padding", type=ascii_int, default=2)
 
     p = add_command(sub, "reconstruct", "Re-grow a volume from a .tskel frame (numba, parallel).",
-                    "volanim reconstruct arm.tskel --source mannequin.VOL --mode sampled -o arm.vti", _reconstruct)
+                    ("volanim reconstruct arm.tskel --source mannequin.VOL --mode sampled -o arm.vti",
+                     "volanim reconstruct arm.tskel --mode hotspot -o arm-hot.nrrd",
+                     "volanim reconstruct arm.tskel --mode bone -o arm-bone.vol   # written as arm-bone.XxYxZ.vol"),
+                    _reconstruct)
     p.add_argument("tskel")
     p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
     p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")

@@ -7,11 +7,13 @@ import sys
 
 from ._common import FrameProgress, add_command, ascii_int, checked_by, finite_float, positive_float, positive_int
 
-EXAMPLE = """volanim render walk.zarr -o walk.mp4                          (the sequence's mode picks the colours)
-  volanim render walk.zarr -o walk.gif --size 320x240 --view front --frame-numbers
-  volanim render arm-sampled.vti -o arm.png --style volume --tf bone-and-skin.tf
-  volanim render walk.zarr -o frames/ --camera studio.camera --cut 64 60 150 0 -1 0   (cut away the front half)
-  volanim render walk.zarr -o walk.mp4 --workers 2        (again after a kill: only missing frames are drawn)"""
+EXAMPLE = (
+    "volanim render walk.zarr -o walk.mp4   # the sequence's mode picks the colours",
+    "volanim render walk.zarr -o walk.gif --size 320x240 --view front --frame-numbers --save-camera front.camera",
+    "volanim render arm.vti -o arm.png --style volume --save-tf arm.tf   # the preset, to edit",
+    "volanim render arm.vti -o arm-edited.png --style volume --tf arm.tf",
+    "volanim render walk.zarr -o frames/ --camera front.camera --cut 80 50 150 0 -1 0   # cut away the front half",
+)
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -38,7 +40,7 @@ def _render(args):
     from volanim_core.parallel import default_workers
     from volanim_core.render.camera import named_view
     from volanim_core.render.run import open_inputs, render
-    from volanim_core.render.scene import RenderSettings
+    from volanim_core.render.scene import RenderSettings, transfer_of
 
     inputs = open_inputs(args.inputs, args.range, dims=args.dims)
     preset = args.preset or inputs.mode or "sampled"
@@ -56,6 +58,9 @@ def _render(args):
                               transfer=io.read_transfer_function(args.tf) if args.tf else None, size=(w, h),
                               background=args.background, cut=cut, title=args.title,
                               frame_numbers=args.frame_numbers, mapper=args.mapper)
+    if args.save_tf:
+        io.write_transfer_function(args.save_tf, transfer_of(settings))
+        print(f"wrote {args.save_tf} (the {'--tf' if args.tf else preset + ' preset'}'s transfer function)")
     workers = None if args.scheduler else (default_workers() if args.workers is None else args.workers)
     rep = render(inputs, settings, args.output, fps=args.fps, workers=workers or 1, scheduler=args.scheduler,
                  force=args.force, keep_frames=args.keep_frames, dims=args.dims, on_frame=FrameProgress())
@@ -88,6 +93,8 @@ def register(sub) -> None:
     where.add_argument("--camera", metavar="FILE.camera", help="a camera file (the studio: View > Save view as "
                        "camera file)")
     p.add_argument("--save-camera", metavar="FILE.camera", help="also write the camera used, to edit or reuse")
+    p.add_argument("--save-tf", metavar="FILE.tf", help="also write the transfer function used (the preset's, "
+                   "for a label preset one colour step per label), to edit and pass to --tf")
     p.add_argument("--size", type=parse_size, default=(640, 480), metavar="WxH",
                    help="pixels (default 640x480; .mp4 needs multiples of 16)")
     p.add_argument("--background", default="black",

@@ -6,12 +6,14 @@ import sys
 
 from ._common import FrameProgress, add_command, ascii_int, checked_by, positive_float, positive_int
 
-EXAMPLE = """volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr
-  volanim sequence mannequin.0.50.connect assets/walk.bvh --bones mannequin.bones --frames 0:240:4 \\
-          --mode bone --melt 24 --workers 2 -o walk.zarr
-  volanim sequence ... --crumble 36 -o walk.zarr      (after the walk, the body falls into a heap)
-  volanim sequence ... --scheduler tcp://10.0.0.5:8786 -o /shared/walk.zarr     (a Dask cluster)
-  volanim sequence ... -o walk.zarr      (again: finished frames are skipped; --force starts over)"""
+EXAMPLE = (
+    "volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr",
+    "volanim sequence mannequin.0.50.connect walk.bvh --bones mannequin.bones --frames 0:240:8 \\\n"
+    "--mode bone --melt 12 --workers 2 -o melt.zarr",
+    "volanim sequence mannequin.0.50.connect walk/*.trans --mode bone --crumble 12 -o crumble.zarr   # into a heap",
+    "volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr"
+    "   # again: done frames are skipped",
+)
 
 
 def _sequence(args):

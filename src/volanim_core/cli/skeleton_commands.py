@@ -55,7 +55,10 @@ def _segment_args(p):
 
 def register(sub) -> None:
     p = add_command(sub, "skeletonize", "Distance transform + thinness -> multi-resolution skeleton (.mskel).",
-                    "volanim skeletonize frog.VOL --threshold 1:255 --fill-cavities -o frog.mskel", _skeletonize)
+                    ("volanim skeletonize mannequin.VOL -o mannequin.mskel",
+                     "volanim skeletonize frog.VOL --threshold 1:255 --fill-cavities -o frog.mskel",
+                     "volanim skeletonize mannequin.VOL --min-thinness -inf -o every-voxel.mskel   # all voxels"),
+                    _skeletonize)
     _segment_args(p)
     p.add_argument("--metric", choices=("euclid", "345"), default="euclid", help="distance metric (default euclid)")
     p.add_argument("--min-thinness", type=ascii_float, default=DEFAULT_MIN_THINNESS,

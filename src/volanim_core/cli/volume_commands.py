@@ -3,6 +3,7 @@ count, diff, reverse, remap, addheader, rmheader, fitpow2, float2uchar, samples.
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 import numpy as np
@@ -129,8 +130,22 @@ def read_remap_table(path: str) -> np.ndarray:
     return table
 
 
+def remap_pair(text: str) -> tuple[int, int]:
+    """``FROM:TO``, two values 0..255 (``--pairs``)."""
+    parts = text.split(":")
+    if len(parts) != 2 or not all(p.isascii() and p.isdigit() and int(p) <= 255 for p in parts):
+        raise argparse.ArgumentTypeError(f"expected FROM:TO with values 0..255, e.g. 3:1, got {text!r}")
+    return int(parts[0]), int(parts[1])
+
+
 def _remap(args):
-    save(args.output, volume.remap(load(args.input, args), read_remap_table(args.table)))
+    if args.table:
+        table = read_remap_table(args.table)
+    else:
+        table = np.arange(256)
+        for a, b in args.pairs:
+            table[a] = b
+    save(args.output, volume.remap(load(args.input, args), table))
 
 
 def _addheader(args):
@@ -155,7 +170,7 @@ def _float2uchar(args):
 
 
 def _samples(args):
-    for name in samples.NAMES if args.name == "all" else [args.name]:
+    for name in (*samples.NAMES, *samples.FILE_SAMPLES) if args.name == "all" else [args.name]:
         for path in samples.write_sample(name, args.output):
             print(f"wrote {path}")
 
@@ -179,20 +194,20 @@ def register(sub) -> None:
     p.add_argument("--rescale", action="store_true", help="map non-uint8 data min..max onto 0..255")
 
     p = add_command(sub, "threshold", "Band-pass threshold to a binary volume (Convert2Binary).",
-                    "volanim threshold ct.VOL bone.VOL --range 180:255", _threshold)
+                    "volanim threshold frog.VOL frog-body.VOL --range 1:255", _threshold)
     _io(p)
     p.add_argument("--range", type=parse_range, required=True, metavar="LO[:HI]", help="keep LO <= v <= HI")
     p.add_argument("--value", type=ascii_int, default=255, help="value of kept voxels (default 255)")
 
     p = add_command(sub, "fill", "Fill enclosed cavities and/or a box (Fill).",
-                    "volanim fill mask.VOL filled.VOL --cavities", _fill)
+                    "volanim fill frog-body.VOL frog-filled.VOL --cavities", _fill)
     _io(p)
     p.add_argument("--cavities", action="store_true", help="fill background regions enclosed by the object")
     p.add_argument("--box", nargs=6, type=ascii_int, metavar="N", help="inclusive box x0 y0 z0 x1 y1 z1 to set")
     p.add_argument("--value", type=ascii_int, default=255, help="value for --box (default 255)")
 
     p = add_command(sub, "crop", "Crop (or pad) to bounds, or to the tight bounds (CropVolume).",
-                    "volanim crop frog.VOL small.VOL --pad 2", _crop)
+                    "volanim crop frog.VOL frog-cropped.VOL --pad 2", _crop)
     _io(p)
     p.add_argument("--bounds", nargs=6, type=ascii_int, metavar="N",
                    help="inclusive x0 y0 z0 x1 y1 z1 (default: tight)")
@@ -203,7 +218,8 @@ def register(sub) -> None:
     _io(p, output=False)
     p.add_argument("--level", type=finite_float, default=0, help="count voxels above this value (default 0)")
 
-    p = add_command(sub, "flip", "Mirror a volume along an axis.", "volanim flip in.VOL out.VOL --axis x", _flip)
+    p = add_command(sub, "flip", "Mirror a volume along an axis.",
+                    "volanim flip mannequin.VOL mirrored.VOL --axis x", _flip)
     _io(p)
     p.add_argument("--axis", choices=("x", "y", "z"), required=True)
 
@@ -213,44 +229,48 @@ def register(sub) -> None:
     p.add_argument("--all", action="store_true", help="list all 256 values, also those with count 0")
 
     p = add_command(sub, "diff", "Compare two volumes: 0 both empty, 100 both, 150 only first, 200 only second "
-                    "(VolumeSuperDiff).", "volanim diff before.VOL after.VOL diff.VOL", _diff)
+                    "(VolumeSuperDiff).",
+                    "volanim diff frog-body.VOL frog-filled.VOL cavities.VOL   # 200: what fill added", _diff)
     add_volume_in(p, "first")
     add_volume_in(p, "second")
     p.add_argument("output", nargs="?", help="optional coded difference volume")
     add_dims(p)
 
     p = add_command(sub, "reverse", "Invert intensities, 255 - v (ReverseData).",
-                    "volanim reverse in.VOL out.VOL", _reverse)
+                    "volanim reverse mannequin.VOL negative.VOL", _reverse)
     _io(p)
 
-    p = add_command(sub, "remap", "Remap values through a table file (remapVolume): 'FROM TO' lines, "
-                    "or 256 lines of one value.", "volanim remap labels.VOL merged.VOL --table merge.txt", _remap)
+    p = add_command(sub, "remap", "Remap values through a table (remapVolume): a file of 'FROM TO' lines or of "
+                    "256 lines of one value, or FROM:TO pairs on the command line; other values are unchanged.",
+                    "volanim remap frog.VOL frog-merged.VOL --pairs 2:1 3:1   # tissues 2 and 3 become 1", _remap)
     _io(p)
-    p.add_argument("--table", required=True, help="table file")
-
-    p = add_command(sub, "addheader", "Add the 100-byte .VOL header, streaming (AddHeader).",
-                    "volanim addheader frog.500x470x136.vol frog.VOL", _addheader)
-    p.add_argument("input", help="headerless .vol")
-    p.add_argument("output", help="output .VOL")
-    add_dims(p)
+    how = p.add_mutually_exclusive_group(required=True)
+    how.add_argument("--table", help="table file: 'FROM TO' lines, or 256 lines of one value (docs/formats.md)")
+    how.add_argument("--pairs", nargs="+", type=remap_pair, metavar="FROM:TO", help="value pairs, e.g. 2:1 3:1")
 
     p = add_command(sub, "rmheader", "Remove the 100-byte .VOL header, streaming (rmhdr).",
                     "volanim rmheader frog.VOL frog.500x470x136.vol", _rmheader)
     p.add_argument("input", help=".VOL with header")
     p.add_argument("output", help="output .vol")
 
+    p = add_command(sub, "addheader", "Add the 100-byte .VOL header, streaming (AddHeader).",
+                    "volanim addheader frog.500x470x136.vol frog-again.VOL", _addheader)
+    p.add_argument("input", help="headerless .vol")
+    p.add_argument("output", help="output .VOL")
+    add_dims(p)
+
     p = add_command(sub, "fitpow2", "Pad every dimension up to a power of two (FitVolume).",
-                    "volanim fitpow2 frog.VOL frog512.VOL --center", _fitpow2)
+                    "volanim fitpow2 mannequin.VOL mannequin-pow2.VOL --center", _fitpow2)
     _io(p)
     p.add_argument("--center", action="store_true", help="centre the data instead of padding at the end")
 
     p = add_command(sub, "float2uchar", "Map a range of float (or 16-bit) data onto 0..255 (float2uchar).",
-                    "volanim float2uchar ct.nii.gz ct.VOL --range -1000 2000", _float2uchar)
+                    "volanim float2uchar frog.vti frog-stretched.VOL --range 0 10", _float2uchar)
     _io(p)
     p.add_argument("--range", nargs=2, type=finite_float, metavar=("LO", "HI"),
                    help="input range (default: data min max)")
 
-    p = add_command(sub, "samples", "Write a demo dataset: mannequin, aliascube, frog or all.",
-                    "volanim samples mannequin -o data/", _samples)
-    p.add_argument("name", choices=(*samples.NAMES, "all"))
+    p = add_command(sub, "samples", "Write a demo dataset: mannequin, aliascube, frog, the walk clip, or all.",
+                    "volanim samples all -o .", _samples)
+    p.add_argument("name", choices=(*samples.NAMES, *samples.FILE_SAMPLES, "all"))
     p.add_argument("-o", "--output", default=".", help="folder (default: current)")

@@ -29,6 +29,26 @@ def dims_from_name(path: str | Path) -> tuple[int, int, int] | None:
     return tuple(int(g) for g in m.groups()) if m else None
 
 
+def raw_name_for(path: str | Path, shape) -> Path:
+    """Where a volume of ``shape`` is written when the user asked for ``path``.
+
+    A headerless ``.vol`` cannot say its size, so one named without it becomes
+    ``NAME.XxYxZ.vol`` (the convention every reader here understands); a name whose
+    size disagrees with the volume is refused. Other names are kept.
+    """
+    path = Path(path)
+    if path.suffix != ".vol":
+        return path
+    named = dims_from_name(path)
+    shape = tuple(int(n) for n in shape)
+    if named is None:
+        return path.with_name(f"{path.name[:-4]}.{shape[0]}x{shape[1]}x{shape[2]}.vol")
+    if named != shape:
+        raise ValueError(f"{path}: the name says {named[0]}x{named[1]}x{named[2]} but the volume is "
+                         f"{shape[0]}x{shape[1]}x{shape[2]}; name it NAME.{shape[0]}x{shape[1]}x{shape[2]}.vol")
+    return path
+
+
 def _check_dims(path, dims, line: int | None = None, allocate: bool = True) -> tuple[int, int, int]:
     return checked_grid(path, dims, line=line, allocate=allocate)
 

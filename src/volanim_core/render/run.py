@@ -162,13 +162,18 @@ def render_task(job: RenderJob | None, ref: FrameRef) -> tuple[int, np.ndarray]:
         if _RENDERER is not None:
             _RENDERER.close()
         _RENDERER, _JOB = Renderer(job.settings), job  # one plotter per worker, reused for every frame
+    volume, origin = read_frame(ref, job.dims)
+    return ref.number, _RENDERER.render(volume, origin, ref.number)
+
+
+def read_frame(ref: FrameRef, dims=None) -> tuple[np.ndarray, tuple]:
+    """One input frame as ``(volume [x, y, z], origin in voxels)``."""
     if ref.index >= 0:
         from volanim_core.sequence import store
 
-        volume, origin = store.read_frame(ref.path, ref.index), store.origin(ref.path)
-    else:
-        volume, origin, _ = _read(ref.path, job.dims)
-    return ref.number, _RENDERER.render(volume, origin, ref.number)
+        return store.read_frame(ref.path, ref.index), store.origin(ref.path)
+    volume, origin, _ = _read(ref.path, dims)
+    return volume, origin
 
 
 def choose_mapper(inputs: RenderInputs, settings: RenderSettings, dims=None) -> RenderSettings:

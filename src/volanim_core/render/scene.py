@@ -92,6 +92,21 @@ def colour_table(settings: RenderSettings, vmax: float | None = None) -> np.ndar
     return np.round(np.clip(rgb_, 0, 1) * 255).astype(np.uint8)
 
 
+def transfer_of(settings: RenderSettings) -> TransferFunction:
+    """The transfer function a volume-style render uses, as a ``.tf`` file can hold it (``--save-tf``):
+    the user's, a continuous preset's, or for a label preset one flat step of colour per label."""
+    if settings.transfer is not None:
+        return settings.transfer
+    if settings.preset not in LABEL_MODES:
+        return preset_transfer(settings.preset, settings.vmax)
+    colours = colour_table(settings).astype(np.float64) / 255
+    values, rgba = [0.0, 0.5], [[0, 0, 0, 0], [0, 0, 0, 0]]
+    for k in range(1, len(colours)):  # label k is its colour over k +- 0.49, a quick blend between labels
+        values += [k - 0.49, k + 0.49]
+        rgba += [[*colours[k], 0.85]] * 2
+    return TransferFunction(values, rgba)
+
+
 def crop(volume: np.ndarray, origin, pad: int = 1):
     """The smallest box holding every filled voxel (and ``pad`` empty ones around it), and its origin."""
     origin = np.asarray(origin, np.float64)
@@ -116,15 +131,30 @@ def cut_away(volume: np.ndarray, origin, point, normal) -> np.ndarray:
     return out
 
 
-class Renderer:
-    """One off-screen plotter that draws frame after frame with one camera."""
+def prefer_egl_without_display() -> None:
+    """Without an X11/Wayland display, ask VTK for its EGL window directly (before VTK makes its
+    first window): its default X window would first fail with a "bad X server connection" warning."""
+    import os
+    import sys
 
-    def __init__(self, settings: RenderSettings):
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+
+class Renderer:
+    """One off-screen plotter that draws frame after frame with one camera.
+
+    ``off_screen=None`` makes an on-screen window instead (``volanim view``; pyvista's
+    ``PYVISTA_OFF_SCREEN`` still turns it off-screen).
+    """
+
+    def __init__(self, settings: RenderSettings, off_screen: bool | None = True):
+        prefer_egl_without_display()
         import pyvista as pv
 
         settings.check()
         self.settings = settings
-        self.plotter = pv.Plotter(off_screen=True, window_size=tuple(settings.size))
+        self.plotter = pv.Plotter(off_screen=off_screen, window_size=tuple(settings.size))
         self.plotter.set_background(settings.background)
         if settings.style == "surface":
             self.plotter.enable_anti_aliasing("ssaa")  # voxel staircases shimmer less between frames
@@ -140,6 +170,18 @@ class Renderer:
         self.plotter.camera_set = True  # never reset to fit a frame: the camera is the sequence's
 
     def render(self, volume: np.ndarray, origin, number: int | None = None) -> np.ndarray:
+        """Draw a frame and return its picture, ``(H, W, 3)`` uint8."""
+        self.draw(volume, origin, number)
+        if self._first:  # pyvista renders an off-screen plotter at its first screenshot only
+            self._first = False
+            image = self.plotter.screenshot(return_img=True)
+        else:
+            self.plotter.ren_win.Render()  # exactly one render per frame, then read the pixels
+            image = self.plotter.image
+        return np.asarray(image, np.uint8)[..., :3].copy()
+
+    def draw(self, volume: np.ndarray, origin, number: int | None = None) -> None:
+        """Put a frame's actors in the scene (no rendering yet)."""
         s = self.settings
         if s.cut is not None:
             volume = cut_away(volume, origin, *s.cut)
@@ -155,13 +197,6 @@ class Renderer:
             self.plotter.add_text(f"frame {number}", position="upper_right", font_size=12, name="frame",
                                   color=_contrast(s.background), render=False)
         s.camera.apply(self.plotter.camera)  # adding actors must not have moved it
-        if self._first:  # pyvista renders an off-screen plotter at its first screenshot only
-            self._first = False
-            image = self.plotter.screenshot(return_img=True)
-        else:
-            self.plotter.ren_win.Render()  # exactly one render per frame, then read the pixels
-            image = self.plotter.image
-        return np.asarray(image, np.uint8)[..., :3].copy()
 
     def close(self) -> None:
         self.plotter.close()

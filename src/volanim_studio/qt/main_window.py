@@ -52,7 +52,8 @@ SHORTCUTS = [
     ("S / Shift+S", "Set / delete the pose key at the current frame"),
     ("Ctrl+Z / Ctrl+Shift+Z", "Undo / redo"),
     ("Ctrl+O", "Open a volume"),
-    ("Ctrl+S", "Save the project"),
+    ("Ctrl+S / Ctrl+Shift+S", "Save the project / save it under a new name"),
+    ("Ctrl+Q", "Quit (a running job is cancelled and waited for)"),
     ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
 ]
 

@@ -7,11 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from paths import ASSETS
+from paths import WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core.errors import FormatError
 from volanim_core.motion.bvh import read_bvh
-
-WALK = ASSETS / "walk.bvh"  # the real clip of ../shared/data, bundled with its MIT licence
 
 
 def clip(order: str, frames: list[str], root_channels: str = "Xposition Yposition Zposition",

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from paths import ASSETS
+from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
@@ -25,7 +25,6 @@ from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import run_sequence, shared_bounds
 
 CONNECT = ASSETS / "mannequin.0.50.connect"
-WALK = ASSETS / "walk.bvh"
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-from paths import ASSETS
+from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core import io
 from volanim_studio.model.modes import Mode
 from volanim_studio.qt.mapping_dialog import UNMAPPED
@@ -16,7 +16,6 @@ from ..conftest import JOB_TIMEOUT_MS
 
 pytestmark = pytest.mark.gui
 
-WALK = ASSETS / "walk.bvh"  # the real clip of ../shared/data, bundled with its MIT licence
 
 
 @pytest.fixture

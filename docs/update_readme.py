@@ -1,0 +1,123 @@
+"""``make docs``: rewrite the README's generated regions from the code and the benchmarks that measure them.
+
+A region is the text between ``<!-- make docs: NAME -->`` and ``<!-- end: NAME -->``:
+
+    commands           the volume-tools table, from the ``volanim`` parser (help text and first example)
+    bench_*, thesis_*  every table a benchmark script prints (run with VOLANIM_BENCH_MARKDOWN=1), followed
+                       by the machine and the date, so figures are never typed by hand
+
+``python docs/update_readme.py [NAME ...]`` regenerates the named regions (default: all; the benchmarks take
+about 15 minutes on 2 cores). ``--check commands`` exits 1 if a region differs from what would be written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import platform
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+SCRIPTS = {  # region -> the benchmark script that measures it
+    "bench_skeleton": "benchmarks/bench_skeleton.py",
+    "bench_studio": "benchmarks/bench_studio.py",
+    "bench_connect": "benchmarks/bench_connect.py",
+    "bench_motion": "benchmarks/bench_motion.py",
+    "bench_reconstruct": "benchmarks/bench_reconstruct.py",
+    "bench_sequence": "benchmarks/bench_sequence.py",
+    "bench_render": "benchmarks/bench_render.py",
+    "thesis_tables": "benchmarks/thesis_tables.py",
+}
+REGION = re.compile(r"(<!-- make docs: (?P<name>[\w-]+) -->\n)(?P<body>.*?)(<!-- end: (?P=name) -->)", re.S)
+
+
+def regions(text: str) -> dict[str, str]:
+    return {m["name"]: m["body"] for m in REGION.finditer(text)}
+
+
+def replace_region(text: str, name: str, body: str) -> str:
+    """``text`` with region ``name``'s body replaced (it must exist exactly once)."""
+    found = [m for m in REGION.finditer(text) if m["name"] == name]
+    if len(found) != 1:
+        raise ValueError(f"README.md: region {name!r} appears {len(found)} times (expected once)")
+    m = found[0]
+    return text[: m.start("body")] + body.rstrip("\n") + "\n" + text[m.end("body"):]
+
+
+def commands_table() -> str:
+    """The volume tools: every subcommand before ``samples`` in ``volanim --help``, with its first example."""
+    import argparse as ap
+
+    from volanim_core.cli import build_parser
+
+    rows = ["| command | what it does (the old tool) | example |", "|---|---|---|"]
+    for action in build_parser()._actions:
+        if not isinstance(action, ap._SubParsersAction):
+            continue
+        for name, sub in action.choices.items():
+            if name == "samples":
+                return "\n".join(rows) + "\n"
+            example = sub.epilog.splitlines()[1].strip().split("   #")[0].strip()
+            rows.append(f"| `{name}` | {sub.description} | `{example}` |")
+    raise RuntimeError("no samples command")
+
+
+def machine() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores ({cpu}), {platform.system()}"
+
+
+def benchmark_tables(script: str) -> str:
+    env = dict(os.environ, VOLANIM_BENCH_MARKDOWN="1")
+    out = subprocess.run([sys.executable, str(ROOT / script)], cwd=ROOT, env=env, capture_output=True, text=True,
+                         check=True).stdout
+    text = re.sub(r"\n{3,}", "\n\n", out.strip())
+    return f"{text}\n\n*Written by `{script}` through `make docs` on {datetime.date.today()}, {machine()}.*\n"
+
+
+def generate(name: str) -> str:
+    if name == "commands":
+        return commands_table()
+    return benchmark_tables(SCRIPTS[name])
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("names", nargs="*", help=f"regions (default all): commands {' '.join(SCRIPTS)}")
+    p.add_argument("--check", action="store_true", help="report regions that differ; write nothing")
+    args = p.parse_args(argv)
+    text = README.read_text(encoding="utf-8")
+    names = args.names or list(regions(text))
+    stale = []
+    for name in names:
+        print(f"make docs: {name} ...", flush=True)
+        body = generate(name)
+        if regions(text).get(name) != body:
+            stale.append(name)
+        text = replace_region(text, name, body)
+    if args.check:
+        if stale:
+            print(f"stale README regions: {', '.join(stale)} (run `make docs`)")
+        return 1 if stale else 0
+    from volanim_core.io._atomic import atomic_write_text
+
+    atomic_write_text(README, text)
+    print(f"README.md: {len(names)} regions written ({', '.join(stale) or 'none'} changed)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(ROOT / "src"))
+    raise SystemExit(main())
