@@ -83,8 +83,32 @@ def benchmark_tables(script: str) -> str:
     env = dict(os.environ, VOLANIM_BENCH_MARKDOWN="1")
     out = subprocess.run([sys.executable, str(ROOT / script)], cwd=ROOT, env=env, capture_output=True, text=True,
                          check=True).stdout
-    text = re.sub(r"\n{3,}", "\n\n", out.strip())
-    return f"{text}\n\n*Written by `{script}` through `make docs` on {datetime.date.today()}, {machine()}.*\n"
+    stamp = f"*Written by `{script}` through `make docs` on {datetime.date.today()}, {machine()}.*"
+    return f"{as_markdown(out)}\n\n{stamp}\n"
+
+
+def as_markdown(output: str) -> str:
+    """A benchmark's output for the README: its Markdown tables as they are, every other run of
+    lines (captions, ratios against targets, notes) in a plain-text block, so columns stay aligned."""
+    blocks, current, kind = [], [], None
+    for line in output.strip().splitlines():
+        k = "table" if line.startswith("|") else "blank" if not line.strip() else "text"
+        if k == "blank":
+            k = kind if kind == "text" else "blank"
+        if k != kind and current:
+            blocks.append((kind, current))
+            current = []
+        kind = k
+        if k != "blank":
+            current.append(line)
+    if current:
+        blocks.append((kind, current))
+    parts = []
+    for k, lines in blocks:
+        while lines and not lines[-1].strip():
+            lines.pop()
+        parts.append("\n".join(lines) if k == "table" else "```text\n" + "\n".join(lines) + "\n```")
+    return "\n\n".join(parts)
 
 
 def generate(name: str) -> str:

@@ -1,6 +1,6 @@
 """Deliberately simple NumPy references for the numba kernels (test oracles).
 
-Slow and obvious on purpose: each follows FORMATS.md's words line by line.
+Slow and obvious on purpose: each follows docs/formats.md's words line by line.
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ def union_of_balls(points, radii, shape, metric="euclid"):
 
 
 def reconstruct(tskel, bounds, *, mode="binary", source=None, source_origin=(0, 0, 0), kernel=1, value=255):
-    """FORMATS.md's reconstruction, sphere by sphere over each sphere's bounding box.
+    """docs/formats.md's reconstruction, sphere by sphere over each sphere's bounding box.
 
     Shares only the definitions of the posed centre, the snapped radius and the
     mottled values with the library (they define the semantics); the voxel

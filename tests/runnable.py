@@ -1,7 +1,7 @@
 """Run documented commands as a newcomer would: in order, in a fresh folder, with the installed scripts.
 
-Used by tests/core/cli/test_help_examples.py (every ``--help`` example) and
-tests/test_readme.py (every shell block of the README).
+Used by tests/test_documented_commands.py (every ``--help`` example and
+every shell block of the README).
 """
 
 from __future__ import annotations

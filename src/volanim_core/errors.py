@@ -11,7 +11,7 @@ from pathlib import Path
 
 
 class FormatError(ValueError):
-    """A file that does not follow ``FORMATS.md``.
+    """A file that does not follow ``docs/formats.md``.
 
     Parameters
     ----------

@@ -30,10 +30,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    import pyvista
     from PySide6.QtWidgets import QApplication
 
     from .qt.main_window import main_window_for
 
+    # The studio is a window: pyvista's PYVISTA_OFF_SCREEN (set for scripts and `volanim view` in CI)
+    # would leave its Qt interactor without an interactor and fail at start.
+    pyvista.OFF_SCREEN = False
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("volanim studio")
     if os.environ.get("VOLANIM_STUDIO_SMOKE"):
@@ -44,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _quit_when_loaded(app, seconds: float = 600.0) -> None:
-    """``VOLANIM_STUDIO_SMOKE=1``: a start-up check for scripts and CI (tests/test_readme.py runs the
+    """``VOLANIM_STUDIO_SMOKE=1``: a start-up check for scripts and CI (tests/test_documented_commands.py runs the
     README's studio commands this way). Dialogs are answered with their defaults (OK; No to questions),
     and once everything asked for on the command line has loaded the studio quits: status 0, or 1
     if it showed an error."""

@@ -293,6 +293,21 @@ def hand_written() -> list[Case]:
              "render {d}/f.nrrd -o {d}/o.png --cut 1 1 1 0 0 0"),
         Case("render: one volume to a png", "cli:render", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
              "render {d}/f.nrrd -o {d}/o.png --size 64x48", "accept"),
+        Case("mesh: empty file", "read_mesh", {"m.ply": b""}, "m.ply"),
+        Case("mesh: a ply header with no faces", "read_mesh",
+             {"m.ply": b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n"}, "m.ply"),
+        Case("mesh: binary junk as .stl", "read_mesh", {"m.stl": b"\x89PNG\r\n\x1a\n" + b"\xff" * 300}, "m.stl"),
+        Case("mesh: an .obj of words", "read_mesh", {"m.obj": b"v one two three\nf a b c\n"}, "m.obj"),
+        Case("mesh: a ply claiming 2^31 vertices", "read_mesh",
+             {"m.ply": b"ply\nformat binary_little_endian 1.0\nelement vertex 2147483647\nproperty float x\n"
+                       b"property float y\nproperty float z\nend_header\n" + b"\0" * 24}, "m.ply"),
+        Case("mesh: a .vtp claiming 2^40 points", "read_mesh",
+             {"m.vtp": b'<VTKFile type="PolyData"><PolyData><Piece NumberOfPoints="1099511627776" '
+                       b'NumberOfPolys="1"></Piece></PolyData></VTKFile>'}, "m.vtp"),
+        Case("view: a mesh that is not one", "cli:view", {"m.vtp": b"<VTKFile junk"},
+             "view {d}/m.vtp --screenshot {d}/o.png"),
+        Case("view: a volume to a picture", "cli:view", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
+             "view {d}/f.nrrd --screenshot {d}/o.png --size 64x48", "accept"),
     ]
     return cases
 

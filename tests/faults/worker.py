@@ -19,13 +19,15 @@ MEMORY_CAP = 6 << 30  # address space; VTK and numpy need ~1-2 GB of it just to 
 
 def readers() -> dict:
     from volanim_core import io
+    from volanim_core.io.mesh_files import read_mesh
     from volanim_core.motion.bvh import read_bvh
     from volanim_studio.model.project import read_project
 
     return {"read_volume": io.read_volume, "read_mskel": io.read_mskel, "read_bones": io.read_bones,
             "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
             "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh,
-            "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function}
+            "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function,
+            "read_mesh": read_mesh}
 
 
 CHECKS = {

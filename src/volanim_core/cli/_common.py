@@ -13,7 +13,7 @@ from volanim_core.io import raw_name_for, read_volume, write_volume
 from volanim_core.io._text import is_number
 from volanim_core.volume import Bounds
 
-#: What every ``--help`` example assumes; tests/core/cli/test_help_examples.py runs them all, in this order.
+#: What every ``--help`` example assumes; tests/test_documented_commands.py runs them all in order.
 EXAMPLES_HEADER = "examples (in a folder where `volanim samples all -o .` ran; earlier commands' files are used):"
 
 

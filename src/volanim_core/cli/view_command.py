@@ -22,46 +22,25 @@ def has_display() -> bool:
 
 
 def _view(args):
-    from pathlib import Path
-
     import numpy as np
 
-    from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh
-    from volanim_core.render.camera import named_view
-    from volanim_core.render.colours import SKIN
-    from volanim_core.render.run import open_inputs, read_frame, write_png
-    from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.render.quicklook import quick_look
+    from volanim_core.render.run import write_png
 
     window = args.screenshot is None
     off_screen_env = os.environ.get("PYVISTA_OFF_SCREEN", "").lower() == "true"
     if window and not has_display() and not off_screen_env:
         raise ValueError("no display to open a window on: add --screenshot FILE.png for a picture instead")
-    w, h = args.size
-    path = Path(args.file)
-    if path.suffix.lower() in MESH_SUFFIXES:
-        mesh = read_mesh(path)
-        lo, hi = np.asarray(mesh.bounds[0::2]), np.asarray(mesh.bounds[1::2])
-        settings = RenderSettings(named_view(args.view, tuple(lo), tuple(hi), aspect=w / h), size=(w, h))
-        renderer = Renderer(settings, off_screen=True if not window else None)
-        renderer.plotter.add_mesh(mesh, color=SKIN, smooth_shading=True, name="body", reset_camera=False)
-        what = f"{mesh.n_points:,} points, {mesh.n_cells:,} faces"
-    else:
-        inputs = open_inputs([path], slice(args.frame, args.frame + 1), dims=args.dims)
-        settings = RenderSettings(named_view(args.view, inputs.lo, inputs.hi, aspect=w / h), style=args.style,
-                                  preset=args.preset or inputs.mode or "sampled", vmax=inputs.vmax, size=(w, h))
-        renderer = Renderer(settings, off_screen=True if not window else None)
-        ref = inputs.frames[0]
-        volume, origin = read_frame(ref, args.dims)
-        renderer.draw(volume, origin, ref.number)
-        what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {settings.preset} colours"
-    settings.camera.apply(renderer.plotter.camera)
+    renderer, what = quick_look(args.file, off_screen=True if not window else None, style=args.style,
+                                preset=args.preset, view=args.view, frame=args.frame, dims=args.dims,
+                                size=args.size)
     if window:
-        print(f"{path}: {what}; drag to turn, wheel to zoom, q to close")
-        renderer.plotter.show(title=f"volanim view {path.name}")
+        print(f"{args.file}: {what}; drag to turn, wheel to zoom, q to close")
+        renderer.plotter.show(title=f"volanim view {args.file}")
     else:
         image = renderer.plotter.screenshot(return_img=True)
         write_png(args.screenshot, np.asarray(image, np.uint8)[..., :3])
-        print(f"wrote {args.screenshot} ({w}x{h}) of {path}: {what}")
+        print(f"wrote {args.screenshot} ({args.size[0]}x{args.size[1]}) of {args.file}: {what}")
     renderer.close()
 
 

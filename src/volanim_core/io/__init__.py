@@ -1,4 +1,4 @@
-"""Readers and writers for every file of FORMATS.md.
+"""Readers and writers for every file of docs/formats.md.
 
 All readers raise :class:`volanim_core.errors.FormatError` (and nothing else)
 for a bad file; all writers are atomic.

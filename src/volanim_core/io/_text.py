@@ -4,7 +4,7 @@
                -> strip '#' comments -> (line number, tokens) records + header comments {key: value}
 
 Tolerant of blank lines, comments, tabs, CRLF and the byte-order mark Windows
-editors write (FORMATS.md); everything else is the caller's to validate, using
+editors write (docs/formats.md); everything else is the caller's to validate, using
 :meth:`TextRecords.error` so messages carry the file and line.
 
 Numbers are ASCII (``NUMBER``): Python's ``int()``/``float()`` also take

@@ -1,7 +1,7 @@
 """``.bones`` (joints and bones in root order) and ``.connections`` files.
 
 ``bone A B`` may carry an optional third token, the bone's name (e.g.
-``bone L_HIP L_KNEE L_THIGH``): FORMATS.md is silent on bone names in
+``bone L_HIP L_KNEE L_THIGH``): the original contract was silent on bone names in
 ``.bones`` but ``.connect`` carries them, so they need a home here.
 """
 

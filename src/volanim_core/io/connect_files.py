@@ -109,7 +109,7 @@ def _read_rooted(path, *, matrices: bool, points: bool):
 
 
 def read_connect(path: str | Path) -> Connectivity:
-    """Read a ``.connect`` file (FORMATS.md)."""
+    """Read a ``.connect`` file (docs/formats.md)."""
     rec, bones, _, arr, owner = _read_rooted(path, matrices=False, points=True)
     threshold = rec.header.get("thinness")
     if threshold is not None:
@@ -150,7 +150,7 @@ def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | Non
     """Write a ``.connect`` file atomically.
 
     When ``thinness`` is given only points with thinness >= it are written and
-    it is recorded in the ``# thinness:`` header (FORMATS.md's convention).
+    it is recorded in the ``# thinness:`` header (docs/formats.md's convention).
     """
     keep = np.ones(len(conn), bool)
     if thinness is not None:

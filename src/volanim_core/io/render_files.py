@@ -1,7 +1,8 @@
 """``.camera`` and ``.tf`` files: a render's fixed camera and a user transfer function.
 
-FORMATS.md does not cover them; they follow its text conventions (``#`` comments,
-blank lines, CRLF, tabs, a byte-order mark are all fine) and errors name the line.
+The original contract did not cover them (docs/formats.md#camera and #tf now do); they
+follow its text conventions (``#`` comments, blank lines, CRLF, tabs, a byte-order mark are
+all fine) and errors name the line.
 
     # volanim camera 1                # volanim tf 1
     position 64.0 -700.0 150.0        # value  red green blue alpha (each 0..1)

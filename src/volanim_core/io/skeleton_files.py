@@ -33,7 +33,7 @@ def write_skel(path: str | Path, skel: Skeleton) -> None:
 def read_mskel(path: str | Path) -> Skeleton:
     """Read a ``.mskel`` file; the result is sorted by decreasing thinness.
 
-    Readers do not rely on the file's order (FORMATS.md), so the points are
+    Readers do not rely on the file's order (docs/formats.md), so the points are
     stably re-sorted if needed.
     """
     rec = read_records(path)

@@ -5,8 +5,9 @@
           --slice_lists--> spheres per z-slice (file order)
           --fill_slices, z-chunks (progress, cancel)--> volume [x, y, z]
 
-Semantics (FORMATS.md, "Reconstruction semantics"), with the two numerical
-details FORMATS.md leaves open pinned down here and in the oracle alike:
+Semantics (docs/formats.md, "Reconstruction semantics"), with the two numerical
+details the original contract left open pinned down here and in the oracle alike
+(docs/formats.md#reconstruction records them):
 
 * a posed centre is snapped to a 2^-20 voxel grid (kills ~1e-15 noise from
   rotation matrices, so a 90-degree turn lands exactly on voxels);
@@ -140,7 +141,7 @@ def posed_centres(tskel: Tskel) -> np.ndarray:
     """Each point's centre moved by its bone's matrix, ``[x y z 1] @ M`` (snapped; 345: rounded).
 
     In the 3-4-5 metric the posed centre is rounded to the nearest voxel
-    (half-way rounds up), as FORMATS.md says.
+    (half-way rounds up), as docs/formats.md says.
     """
     if len(tskel) == 0:
         return np.zeros((0, 3))

@@ -3,7 +3,7 @@
     named_view(name, bounds) --> Camera looking at the middle of ``bounds`` (the shared grid)
     Camera <--> a ``.camera`` text file (io.render_files)
 
-Our figures stand z up and face -y (FORMATS.md's voxel axes), so *front*
+Our figures stand z up and face -y (docs/formats.md's voxel axes), so *front*
 looks from -y, *side* from +x (the figure's left), *top* from +z with the
 figure facing the bottom of the picture, and *three-quarter* from the front
 left, a little above.

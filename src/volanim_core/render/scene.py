@@ -145,16 +145,18 @@ class Renderer:
     """One off-screen plotter that draws frame after frame with one camera.
 
     ``off_screen=None`` makes an on-screen window instead (``volanim view``; pyvista's
-    ``PYVISTA_OFF_SCREEN`` still turns it off-screen).
+    ``PYVISTA_OFF_SCREEN`` still turns it off-screen); ``plotter`` draws into an existing
+    pyvista plotter instead (the studio's quick-look window).
     """
 
-    def __init__(self, settings: RenderSettings, off_screen: bool | None = True):
+    def __init__(self, settings: RenderSettings, off_screen: bool | None = True, plotter=None):
         prefer_egl_without_display()
         import pyvista as pv
 
         settings.check()
         self.settings = settings
-        self.plotter = pv.Plotter(off_screen=off_screen, window_size=tuple(settings.size))
+        self.plotter = plotter if plotter is not None else pv.Plotter(off_screen=off_screen,
+                                                                       window_size=tuple(settings.size))
         self.plotter.set_background(settings.background)
         if settings.style == "surface":
             self.plotter.enable_anti_aliasing("ssaa")  # voxel staircases shimmer less between frames

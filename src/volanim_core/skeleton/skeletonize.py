@@ -9,7 +9,7 @@ frog (500x470x136): ~0.5 s on 2 threads against ~5.7 s and ~1.7 GB for
 ``scipy.ndimage.distance_transform_edt`` (``benchmarks/bench_skeleton.py``).
 Its ``edtsq`` gives squared distances, integers held exactly in float32, so
 ``sqrt`` in float64 yields the exact DT; ``black_border=True`` makes voxels
-outside the volume background (FORMATS.md).
+outside the volume background (docs/formats.md).
 
 Cropping to the tight bounds first is exact -- everything outside them is
 background already -- and shrinks the frog's work from 32 M to ~7 M voxels.

@@ -34,12 +34,33 @@ class FilesController(Controller):
         action("Open &bones…", lambda: self.open_dialog("bones"), menu=menu)
         action("Open connections…", lambda: self.open_dialog("connections"), menu=menu)
         action("Open &project…", lambda: self.open_dialog("project"), menu=menu)
+        action("View volume or &mesh…", lambda: self.view_file_dialog(), menu=menu)
         menu.addSeparator()
         action("&Save project", lambda: self.save_project(), "Ctrl+S", menu=menu)
         action("Save project &as…", lambda: self.save_project(ask=True), "Ctrl+Shift+S", menu=menu)
         action("Save bones…", lambda: self.save_dialog("bones"), menu=menu)
         action("Save connections…", lambda: self.save_dialog("connections"), menu=menu)
         action("Screenshot…", lambda: self.save_dialog("png"), menu=menu)
+
+    # ------------------------------------------------------------ looking
+    def view_file(self, path):
+        """Show a volume, a sequence's first frame or a mesh in a window of its own (the document is untouched)."""
+        from .quicklook_window import QuickLookWindow
+
+        window = self.attempt("View", lambda: QuickLookWindow(path, self.window),
+                              lambda w: f"Viewing {Path(path).name}: {w.what}.")
+        if window is FAILED:
+            return None
+        self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
+        window.show()
+        return window
+
+    def view_file_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(
+            self.window, "View volume or mesh", "",
+            "Volumes and meshes (*.vti *.nrrd *.nii *.nii.gz *.mha *.VOL *.vol *.ply *.vtp *.obj *.stl);;All files (*)")
+        if path:
+            self.view_file(path)
 
     # -------------------------------------------------------------- loading
     def _apply_prepared(self, result: dict, path=None, spacing=None, dims=None) -> None:

@@ -25,7 +25,7 @@ def test_help_lists_every_subcommand_and_each_has_an_example():
     assert len(sub.choices) >= 17
     for name, p in sub.choices.items():
         assert name in r.stdout
-        assert "example:" in p.format_help() and f"volanim {name}" in p.format_help()
+        assert "examples (" in p.format_help() and f"volanim {name}" in p.format_help()
 
 
 @pytest.fixture
@@ -87,3 +87,49 @@ def test_samples_command_writes_files(tmp_path):
     assert main(["samples", "aliascube", "-o", str(tmp_path)]) == 0
     counts = io.histogram_file(tmp_path / "aliascube.VOL")
     assert (counts[0], counts[50], counts[250]) == (872109, 612521, 612522)
+
+
+# spec: docs/formats.md#remap
+def test_remap_pairs_on_the_command_line_equal_the_table_file(tmp_path, vol_file):
+    path, _ = vol_file
+    (tmp_path / "table.txt").write_text("100 7\n200 9\n")
+    assert main(["remap", str(path), str(tmp_path / "t.VOL"), "--table", str(tmp_path / "table.txt")]) == 0
+    assert main(["remap", str(path), str(tmp_path / "p.VOL"), "--pairs", "100:7", "200:9"]) == 0
+    assert np.array_equal(io.read_volume(tmp_path / "t.VOL"), io.read_volume(tmp_path / "p.VOL"))
+    r = run("remap", path, tmp_path / "q.VOL", "--pairs", "300:1")
+    assert r.returncode == 2 and "FROM:TO with values 0..255" in r.stderr
+
+
+# spec: docs/formats.md#vol (a .vol cannot carry its size, so its name does)
+def test_a_headerless_vol_output_is_named_by_its_size(tmp_path, vol_file, capsys):
+    path, v = vol_file
+    assert main(["flip", str(path), str(tmp_path / "out.vol"), "--axis", "x"]) == 0
+    named = tmp_path / f"out.{v.shape[0]}x{v.shape[1]}x{v.shape[2]}.vol"
+    assert named.is_file() and not (tmp_path / "out.vol").exists() and str(named) in capsys.readouterr().out
+    assert np.array_equal(io.read_volume(named), v[::-1])  # readable with no --dims
+    assert main(["flip", str(path), str(named), "--axis", "x"]) == 0  # a matching name is kept
+    r = run("flip", path, tmp_path / "wrong.1x2x3.vol", "--axis", "x")
+    assert r.returncode == 2 and "the name says 1x2x3" in r.stderr and not (tmp_path / "wrong.1x2x3.vol").exists()
+
+
+def test_samples_walk_copies_the_clip_and_its_licence(tmp_path):
+    from volanim_core.motion.bvh import read_bvh
+
+    assert main(["samples", "walk", "-o", str(tmp_path)]) == 0
+    assert read_bvh(tmp_path / "walk.bvh").frames == 1064
+    assert "MIT" in (tmp_path / "walk.bvh.LICENSE").read_text()
+
+
+def test_view_writes_a_picture_of_a_volume_and_of_a_mesh(tmp_path, vol_file, capsys):
+    import imageio.v3 as iio
+
+    path, _ = vol_file
+    assert main(["view", str(path), "--screenshot", str(tmp_path / "v.png"), "--size", "160x120"]) == 0
+    assert main(["isosurface", str(path), "-o", str(tmp_path / "hull.ply")]) == 0
+    assert main(["view", str(tmp_path / "hull.ply"), "--screenshot", str(tmp_path / "m.png")]) == 0
+    for png, size in (("v.png", (120, 160)), ("m.png", (600, 800))):
+        image = iio.imread(tmp_path / png)
+        assert image.shape[:2] == size and image[..., :3].max() > 100  # something drawn on black
+    (tmp_path / "bad.ply").write_text("ply\nformat ascii 1.0\nelement vertex 2\nend_header\n1 2\n")
+    r = run("view", tmp_path / "bad.ply", "--screenshot", tmp_path / "b.png")
+    assert r.returncode == 2 and "bad.ply" in r.stderr and not (tmp_path / "b.png").exists()

@@ -1,4 +1,4 @@
-"""Round trips and malformed input for the text formats of FORMATS.md."""
+"""Round trips and malformed input for the text formats of docs/formats.md."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from volanim_core.rig.connectivity import Trans, Tskel
 from volanim_core.skeleton.points import Skeleton
 
 
+# spec: docs/formats.md#skel
 def test_skel_round_trip(tmp_path, small_skeleton):
     path = tmp_path / "a.skel"
     io.write_skel(path, small_skeleton)
@@ -20,6 +21,7 @@ def test_skel_round_trip(tmp_path, small_skeleton):
     assert np.isnan(back.thinness).all()
 
 
+# spec: docs/formats.md#mskel
 def test_mskel_round_trip_and_sorted(tmp_path, small_skeleton):
     shuffled = Skeleton(small_skeleton.points[::-1], small_skeleton.dt[::-1], small_skeleton.thinness[::-1])
     path = tmp_path / "a.mskel"
@@ -30,12 +32,14 @@ def test_mskel_round_trip_and_sorted(tmp_path, small_skeleton):
     assert io.read_mskel(path) == small_skeleton
 
 
+# spec: docs/formats.md#mskel
 def test_mskel_345_metric_round_trip(tmp_path):
     s = Skeleton([[1, 2, 3], [4, 5, 6]], [6.0, 3.0], [2.0, 1.0], metric="345")
     io.write_mskel(tmp_path / "c.mskel", s)
     assert io.read_mskel(tmp_path / "c.mskel") == s
 
 
+# spec: docs/formats.md#conventions
 def test_reader_tolerates_comments_tabs_crlf_blank_lines(tmp_path):
     path = tmp_path / "t.mskel"
     path.write_bytes(b"# volanim mskel 1\r\n\r\n1\t2 3 1.5 0.7  # trailing comment\r\n\t\n4 5 6 1 0.2\r\n")
@@ -44,12 +48,14 @@ def test_reader_tolerates_comments_tabs_crlf_blank_lines(tmp_path):
     assert s.thinness.tolist() == [0.7, 0.2]
 
 
+# spec: docs/formats.md#mskel
 def test_mskel_reader_does_not_rely_on_order(tmp_path):
     path = tmp_path / "u.mskel"
     path.write_text("1 1 1 1 0.1\n2 2 2 2 0.9\n3 3 3 3 0.5\n")
     assert io.read_mskel(path).thinness.tolist() == [0.9, 0.5, 0.1]
 
 
+# spec: docs/formats.md#bones
 def test_bones_round_trip(tmp_path, small_bones):
     io.write_bones(tmp_path / "b.bones", small_bones)
     assert io.read_bones(tmp_path / "b.bones") == small_bones
@@ -57,6 +63,7 @@ def test_bones_round_trip(tmp_path, small_bones):
     assert "joint L_ANKLE 216.5 160 702" in text and "bone L_HIP L_KNEE L_THIGH" in text
 
 
+# spec: docs/formats.md#bones
 def test_bones_formats_md_example_parses(tmp_path):
     (tmp_path / "x.bones").write_text(
         "# volanim bones 1\njoint L_HIP 212 140 401\njoint L_KNEE 214 152 561\n"
@@ -67,16 +74,19 @@ def test_bones_formats_md_example_parses(tmp_path):
     assert b.parent(1) == 0 and b.parent(0) is None
 
 
+# spec: docs/formats.md#connections
 def test_connections_round_trip(tmp_path, small_bones):
     io.write_connections(tmp_path / "b.connections", small_bones)
     assert io.read_connections(tmp_path / "b.connections") == [("L_HIP", "L_KNEE"), ("L_KNEE", "L_ANKLE")]
 
 
+# spec: docs/formats.md#connect
 def test_connect_round_trip(tmp_path, small_connect):
     io.write_connect(tmp_path / "a.connect", small_connect)
     assert io.read_connect(tmp_path / "a.connect") == small_connect
 
 
+# spec: docs/formats.md#connect
 def test_connect_formats_md_example(tmp_path):
     (tmp_path / "m.1.40.connect").write_text(
         "# volanim connect 1\n# thinness: 1.40\n# metric: euclid\n"
@@ -89,6 +99,7 @@ def test_connect_formats_md_example(tmp_path):
     assert c.bone.tolist() == [0] and c.dt.tolist() == [9.2]
 
 
+# spec: docs/formats.md#connect
 def test_connect_written_at_thinness_keeps_only_points_at_or_above(tmp_path, small_connect):
     t = 0.5
     io.write_connect(tmp_path / "a.connect", small_connect, thinness=t)
@@ -98,10 +109,12 @@ def test_connect_written_at_thinness_keeps_only_points_at_or_above(tmp_path, sma
     assert back.thinness_threshold == t
 
 
+# spec: docs/formats.md#connect
 def test_connect_filename_convention():
     assert io.connect_filename("man", 1.4) == "man.1.40.connect"
 
 
+# spec: docs/formats.md#connect
 def test_connect_empty_bone_is_root_line_alone(tmp_path, small_connect):
     only_first = small_connect.bone == 0
     from volanim_core.rig.connectivity import Connectivity
@@ -120,12 +133,14 @@ def _trans(small_connect, rng):
     return mats
 
 
+# spec: docs/formats.md#trans
 def test_trans_round_trip(tmp_path, small_connect, rng):
     t = Trans(small_connect.bones, _trans(small_connect, rng))
     io.write_trans(tmp_path / "a.trans", t)
     assert io.read_trans(tmp_path / "a.trans") == t
 
 
+# spec: docs/formats.md#tskel
 def test_tskel_round_trip(tmp_path, small_connect, rng):
     c = small_connect
     t = Tskel(c.bones, _trans(c, rng), c.points, c.dt, c.thinness, c.bone, metric="345")
@@ -133,6 +148,7 @@ def test_tskel_round_trip(tmp_path, small_connect, rng):
     assert io.read_tskel(tmp_path / "a.tskel") == t
 
 
+# spec: docs/formats.md#tskel
 def test_tskel_with_zero_points(tmp_path, small_connect):
     t = Tskel(small_connect.bones, np.tile(np.eye(4), (2, 1, 1)), np.zeros((0, 3)), [], None, [])
     io.write_tskel(tmp_path / "z.tskel", t)
@@ -173,6 +189,7 @@ GOOD_TSKEL_HEAD = "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
         (io.read_tskel, GOOD_TSKEL_HEAD + "1 2 3\n", 6, "expected 4 or 5 columns"),
     ],
 )
+# spec: docs/formats.md#conventions
 def test_malformed_text_gives_one_error_type_naming_file_and_line(tmp_path, reader, text, line, words):
     path = tmp_path / "bad.txt"
     path.write_text(text)
@@ -187,6 +204,7 @@ def test_malformed_text_gives_one_error_type_naming_file_and_line(tmp_path, read
 
 @pytest.mark.parametrize("reader", [io.read_skel, io.read_mskel, io.read_bones, io.read_connections,
                                     io.read_connect, io.read_trans, io.read_tskel])
+# spec: docs/formats.md#conventions
 @pytest.mark.parametrize("content", [b"", b"# only a comment\n\n", b"\x00\x01\x02\xff\xfe binary", b"\xff\xfe\xfd"])
 def test_empty_and_binary_files(tmp_path, reader, content):
     path = tmp_path / "f"
@@ -195,6 +213,7 @@ def test_empty_and_binary_files(tmp_path, reader, content):
         reader(path)
 
 
+# spec: docs/formats.md#conventions
 def test_truncated_file_is_an_error(tmp_path, small_connect):
     path = tmp_path / "a.mskel"
     io.write_mskel(path, Skeleton(small_connect.points, small_connect.dt, small_connect.thinness))
@@ -204,11 +223,13 @@ def test_truncated_file_is_an_error(tmp_path, small_connect):
         io.read_mskel(path)
 
 
+# spec: docs/formats.md#conventions
 def test_missing_file(tmp_path):
     with pytest.raises(FormatError, match="cannot read file"):
         io.read_bones(tmp_path / "nope.bones")
 
 
+# spec: docs/formats.md#conventions
 def test_writer_is_atomic_keeps_old_file_on_failure(tmp_path, small_bones, monkeypatch):
     path = tmp_path / "b.bones"
     io.write_bones(path, small_bones)
@@ -229,6 +250,7 @@ def test_writer_is_atomic_keeps_old_file_on_failure(tmp_path, small_bones, monke
     assert [p.name for p in tmp_path.iterdir()] == ["b.bones"]  # no temporary left behind
 
 
+# spec: docs/formats.md#conventions
 def test_written_files_get_normal_permissions(tmp_path, small_bones):
     import os
 
@@ -260,6 +282,7 @@ def _killed_writer(tmp_path, write) -> int:
     return pid
 
 
+# spec: docs/formats.md#conventions
 def test_temporaries_of_killed_writers_are_cleaned_on_the_next_write(tmp_path, small_bones):
     """A kill -9 mid-write leaves a hidden temporary; the next write to the same folder removes it."""
     import os
@@ -282,6 +305,7 @@ def test_temporaries_of_killed_writers_are_cleaned_on_the_next_write(tmp_path, s
     assert io.read_bones(path) == small_bones
 
 
+# spec: docs/formats.md#conventions
 def test_vtk_temporaries_of_killed_writers_are_cleaned(tmp_path):
     import numpy as np
 

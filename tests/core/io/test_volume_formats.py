@@ -15,6 +15,7 @@ def vol(rng):
     return np.asfortranarray(rng.integers(0, 256, size=(7, 5, 3), dtype=np.uint8))
 
 
+# spec: docs/formats.md#vol
 def test_vol_bytes_are_x_fastest(tmp_path):
     v = np.zeros((3, 2, 2), np.uint8)
     v[1, 0, 0], v[0, 1, 0], v[0, 0, 1] = 1, 2, 3
@@ -23,12 +24,14 @@ def test_vol_bytes_are_x_fastest(tmp_path):
     assert data[1] == 1 and data[3] == 2 and data[6] == 3
 
 
+# spec: docs/formats.md#vol
 def test_vol_round_trip_with_name_dims(tmp_path, vol):
     path = tmp_path / "a.7x5x3.vol"
     io.write_volume(path, vol)
     assert np.array_equal(io.read_volume(path), vol)
 
 
+# spec: docs/formats.md#vol
 def test_vol_needs_dims(tmp_path, vol):
     io.write_volume(tmp_path / "a.vol", vol)
     with pytest.raises(FormatError, match="unknown dimensions"):
@@ -36,12 +39,14 @@ def test_vol_needs_dims(tmp_path, vol):
     assert np.array_equal(io.read_volume(tmp_path / "a.vol", dims=(7, 5, 3)), vol)
 
 
+# spec: docs/formats.md#vol
 def test_vol_size_mismatch_states_both_sizes(tmp_path, vol):
     io.write_volume(tmp_path / "a.vol", vol)
     with pytest.raises(FormatError, match=r"file has 105 bytes, expected 120"):
         io.read_volume(tmp_path / "a.vol", dims=(8, 5, 3))
 
 
+# spec: docs/formats.md#vol
 def test_vol_with_header_gets_hint(tmp_path, vol):
     io.write_volume(tmp_path / "a.VOL", vol)
     (tmp_path / "a.VOL").rename(tmp_path / "b.7x5x3.vol")
@@ -49,6 +54,7 @@ def test_vol_with_header_gets_hint(tmp_path, vol):
         io.read_volume(tmp_path / "b.7x5x3.vol")
 
 
+# spec: docs/formats.md#VOL
 def test_VOL_header_layout_and_round_trip(tmp_path, vol):
     path = tmp_path / "a.VOL"
     io.write_volume(path, vol)
@@ -59,12 +65,14 @@ def test_VOL_header_layout_and_round_trip(tmp_path, vol):
     assert np.array_equal(io.read_volume(path), vol)
 
 
+# spec: docs/formats.md#VOL
 def test_VOL_header_reader_ignores_rest(tmp_path, vol):
     head = b"7 5 3 extra words 99\nmore".ljust(100, b"\0")
     (tmp_path / "h.VOL").write_bytes(head + np.ascontiguousarray(vol.T).tobytes())
     assert np.array_equal(io.read_volume(tmp_path / "h.VOL"), vol)
 
 
+# spec: docs/formats.md#VOL
 @pytest.mark.parametrize("head", [b"", b"abc", b"x y z".ljust(100)])
 def test_VOL_bad_header(tmp_path, head):
     (tmp_path / "h.VOL").write_bytes(head)
@@ -72,6 +80,7 @@ def test_VOL_bad_header(tmp_path, head):
         io.read_volume(tmp_path / "h.VOL")
 
 
+# spec: docs/formats.md#VOL
 def test_VOL_truncated(tmp_path, vol):
     io.write_volume(tmp_path / "a.VOL", vol)
     data = (tmp_path / "a.VOL").read_bytes()
@@ -80,6 +89,7 @@ def test_VOL_truncated(tmp_path, vol):
         io.read_volume(tmp_path / "a.VOL")
 
 
+# spec: docs/formats.md#VOL
 def test_header_add_remove_streaming_round_trip(tmp_path, vol, monkeypatch):
     monkeypatch.setattr(raw_volumes, "CHUNK", 16)  # force many chunks
     io.write_volume(tmp_path / "a.7x5x3.vol", vol)
@@ -91,6 +101,7 @@ def test_header_add_remove_streaming_round_trip(tmp_path, vol, monkeypatch):
     assert np.array_equal(counts, np.bincount(vol.ravel(), minlength=256))
 
 
+# spec: docs/formats.md#other-volumes
 @pytest.mark.parametrize("suffix", [".vti", ".nrrd"])
 def test_vtk_format_round_trip(tmp_path, vol, suffix):
     path = tmp_path / f"a{suffix}"
@@ -100,6 +111,7 @@ def test_vtk_format_round_trip(tmp_path, vol, suffix):
     assert np.allclose(origin, (1, 2, 3)) and np.allclose(spacing, (1, 1, 1.5))
 
 
+# spec: docs/formats.md#other-volumes
 @pytest.mark.parametrize("suffix", [".nii", ".nii.gz", ".mha"])
 def test_read_other_vtk_formats(tmp_path, vol, suffix):
     import pyvista as pv
@@ -120,6 +132,7 @@ def test_read_other_vtk_formats(tmp_path, vol, suffix):
     assert np.array_equal(io.read_volume(path), vol)
 
 
+# spec: docs/formats.md#other-volumes
 def test_non_uint8_rescaled_only_when_asked(tmp_path):
     v = np.linspace(-1, 1, 60, dtype=np.float32).reshape((5, 4, 3), order="F")
     io.write_volume(tmp_path / "f.nrrd", v)
@@ -129,6 +142,7 @@ def test_non_uint8_rescaled_only_when_asked(tmp_path):
     assert scaled.dtype == np.uint8 and scaled.min() == 0 and scaled.max() == 255
 
 
+# spec: docs/formats.md#other-volumes
 def test_image_folder_stacks_along_z_in_natural_order(tmp_path, vol):
     from skimage import io as skio
 
@@ -137,6 +151,7 @@ def test_image_folder_stacks_along_z_in_natural_order(tmp_path, vol):
     assert np.array_equal(io.read_volume(tmp_path), vol)  # slice10 after slice5
 
 
+# spec: docs/formats.md#other-volumes
 def test_image_folder_errors(tmp_path):
     with pytest.raises(FormatError, match="no slice images"):
         io.read_volume(tmp_path)
@@ -148,6 +163,7 @@ def test_image_folder_errors(tmp_path):
         io.read_volume(tmp_path)
 
 
+# spec: docs/formats.md#other-volumes
 def test_unknown_and_garbage_volume_files(tmp_path):
     (tmp_path / "x.abc").write_bytes(b"hello")
     with pytest.raises(FormatError, match="unknown volume format"):
@@ -159,6 +175,7 @@ def test_unknown_and_garbage_volume_files(tmp_path):
         io.read_volume(tmp_path / "missing.VOL")
 
 
+# spec: docs/formats.md#vol
 def test_write_raw_refuses_float(tmp_path):
     with pytest.raises(ValueError, match="float2uchar|float_to_uint8"):
         io.write_volume(tmp_path / "a.VOL", np.zeros((2, 2, 2), np.float32) + 0.5)
@@ -170,12 +187,14 @@ def test_write_raw_refuses_float(tmp_path):
     b"NRRD0004\ntype: quaternion\nsizes: 2 2 2\n\n",
     b"NRRD0004\ntype: uchar\nsizes: 2 2\n\n",
 ])
+# spec: docs/formats.md#other-volumes
 def test_bad_nrrd_headers(tmp_path, header):
     (tmp_path / "b.nrrd").write_bytes(header + b"\0" * 8)
     with pytest.raises(FormatError, match="b.nrrd"):
         io.read_volume(tmp_path / "b.nrrd")
 
 
+# spec: docs/formats.md#vol
 def test_saturate_for_raw_clips_counts_and_says_so():
     counts = np.array([0, 7, 300], np.uint16).reshape(3, 1, 1)
     out, note = io.saturate_for_raw("hot.VOL", counts)

@@ -31,6 +31,7 @@ def write(tmp_path, text: str, name: str = "c.bvh") -> Path:
     return p
 
 
+# spec: docs/formats.md#bvh
 def test_rest_frame_places_joints_at_their_offsets(tmp_path):
     m = read_bvh(write(tmp_path, clip("ZXY", ["1 2 3 0 0 0 0 0 0 0 0 0"])))
     assert m.names == ["Root", "Arm", "Hand"] and m.parents.tolist() == [-1, 0, 1]
@@ -44,6 +45,7 @@ def test_rest_frame_places_joints_at_their_offsets(tmp_path):
     ("ZXY", [0, 0, 4]),   # Rx(90) (0 4 0) = (0 0 4); Rz(90) keeps z
     ("XZY", [-4, 0, 0]),  # Rz(90) (0 4 0) = (-4 0 0); Rx(90) keeps x
 ])
+# spec: docs/formats.md#bvh
 def test_channel_order_is_intrinsic_in_the_listed_order(tmp_path, order, expected_arm):
     angles = {"Z": "90", "X": "90", "Y": "0"}
     arm = " ".join(angles[a] for a in order)
@@ -126,6 +128,7 @@ def test_the_real_walk_clip():
     (lambda t: t.replace("Zrotation Xrotation Yrotation\n      End", "Zrotation Xrotation Wrotation\n      End"),
      "unknown channel"),
 ])
+# spec: docs/formats.md#bvh
 def test_bad_files_are_format_errors_naming_file_and_line(tmp_path, mutate, message):
     path = write(tmp_path, mutate(clip("ZXY", ["0 0 0 0 0 0 0 0 0 0 0 0"])), "bad.bvh")
     with pytest.raises(FormatError, match=message) as info:

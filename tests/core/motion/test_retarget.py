@@ -140,6 +140,7 @@ def test_unmapped_bones_follow_their_parent_rigidly():
     assert np.allclose(mats[0, head], mats[0, spine])
 
 
+# spec: docs/formats.md#bvh
 def test_mapping_files(tmp_path):
     (tmp_path / "m.txt").write_text("# ours theirs\nL_UPPERARM LeftArm\nL_FOREARM LeftForeArm\n")
     assert read_mapping(tmp_path / "m.txt") == {"L_UPPERARM": "LeftArm", "L_FOREARM": "LeftForeArm"}

@@ -43,6 +43,7 @@ def random_tskel(rng, n=25, nbones=3, metric="euclid", size=14, quarter_turns=Fa
 MODES = ["binary", "mottled", "bone", "hotspot", "sampled"]
 
 
+# spec: docs/formats.md#reconstruction
 @pytest.mark.parametrize("metric", ["euclid", "345"])
 @pytest.mark.parametrize("mode", MODES)
 def test_kernel_equals_oracle_on_random_cases(rng, metric, mode):
@@ -63,6 +64,7 @@ def test_kernel_equals_oracle_on_random_cases(rng, metric, mode):
             assert r.stats["hotspot_max"] == want.max()
 
 
+# spec: docs/formats.md#reconstruction
 @pytest.mark.parametrize("kernel", [3, 5])
 def test_smoothed_sampling_equals_oracle(rng, kernel):
     source = rng.integers(0, 256, (14, 14, 14)).astype(np.uint8)
@@ -109,6 +111,7 @@ def test_overdraw_cut_changes_nothing_but_visits(rng, mode, monkeypatch):
     assert cut.stats["visits"] < full.stats["visits"]
 
 
+# spec: docs/formats.md#reconstruction
 def test_ties_go_to_the_first_sphere_in_file_order():
     # two equal spheres, centres 2 apart: the mid-plane voxels are equidistant
     bones = [RootBone((0, 0, 0), (1, 0, 0))]

@@ -136,6 +136,7 @@ def test_a_rerun_draws_only_the_missing_pictures_and_other_settings_redraw(tmp_p
     assert json.loads((tmp_path / "pics" / "volanim-render.json").read_text())["frames"] == 4
 
 
+# spec: docs/formats.md#tf
 def test_one_volume_file_to_a_png_with_a_transfer_function_and_a_saved_camera(tmp_path, capsys):
     io.write_volume(tmp_path / "b.vti", ball(radius=15, value=200), origin=(5, 5, 5))
     tf = TransferFunction([0, 100, 255], [[0, 0, 0, 0], [1, 0, 0, 0.2], [1, 0, 0, 1]])
@@ -162,6 +163,7 @@ def test_presets_hold_for_any_value_range():
             assert np.all(np.diff(tf.values) > 0) and tf(max(vmax, 1.0))[3] > 0.5
 
 
+# spec: docs/formats.md#camera
 def test_camera_and_transfer_function_files_round_trip(tmp_path):
     cam = Camera((1.5, -2.25, 3e2), (0.1, 0.2, 0.3), (0.0, 0.0, 1.0), 25.0, parallel_scale=40.5)
     io.write_camera(tmp_path / "a.camera", cam)
@@ -182,6 +184,7 @@ def test_camera_and_transfer_function_files_round_trip(tmp_path):
     ("position 0 -9 0\nfocal_point 0 0 0\nview_up 0 1 0\n", None, "view_up must not"),
     ("position 0 -9 0\nfocal_point 0 0 0\nview_angle 180\n", None, "view_angle must be between"),
 ])
+# spec: docs/formats.md#camera
 def test_bad_camera_files_name_the_line(tmp_path, text, line, match):
     (tmp_path / "bad.camera").write_text(text)
     with pytest.raises(FormatError, match=match) as exc:
@@ -196,6 +199,7 @@ def test_bad_camera_files_name_the_line(tmp_path, text, line, match):
     ("0 0 0 0 nan\n", 1, "finite number for alpha"),
     ("# only a comment\n", None, "empty"),
 ])
+# spec: docs/formats.md#tf
 def test_bad_transfer_function_files_name_the_line(tmp_path, text, line, match):
     (tmp_path / "bad.tf").write_text(text)
     with pytest.raises(FormatError, match=match) as exc:

@@ -82,6 +82,7 @@ def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_gri
     assert translation == [0.0, *map(float, bounds.lo[::-1])]
 
 
+# spec: docs/formats.md#zarr
 def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
     frames = tmp_path / "frames"
     conn = io.read_connect(CONNECT)
@@ -109,6 +110,7 @@ def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
     assert all(np.array_equal(x, y) for x, y in zip(frames_of(out), frames_of(tmp_path / "clean.zarr")))
 
 
+# spec: docs/formats.md#zarr
 def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tmp_path, capsys):
     out = tmp_path / "w.zarr"
     args = ["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "--frames", "0:40:20",

@@ -87,6 +87,7 @@ class Saver:
         return generation_on_disk(self.path)
 
 
+# spec: docs/formats.md#project
 @pytest.mark.parametrize("trials", [40])
 def test_project_save_survives_kill_9_at_any_moment(tmp_path, doc, trials):
     path = tmp_path / "session.volanim"
@@ -124,6 +125,7 @@ def test_autosave_survives_kill_9_and_is_offered(tmp_path, doc):
     assert generation_on_disk(found[0]) == seen[-1]
 
 
+# spec: docs/formats.md#project
 def test_a_damaged_save_opens_the_previous_one_and_deletes_nothing(tmp_path, doc):
     path = tmp_path / "p.volanim"
     make_generation(doc, 3)

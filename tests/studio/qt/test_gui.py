@@ -292,3 +292,25 @@ def test_reopening_a_project_gives_back_the_skeleton_that_was_connected(qtbot, t
     assert second.doc.skeleton == skeleton and second.doc.skeleton.metric == "345"
     assert second.doc.segmentation == params and bool(second.doc.mask[20, 15, 15])  # the cavity is filled
     second.close()
+
+
+def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(qtbot, window, tmp_path):
+    from volanim_core.io import write_volume
+    from volanim_core.io.mesh_files import write_mesh
+    from volanim_core.skeleton.hull import isosurface
+
+    vol = np.zeros((20, 16, 12), np.uint8, order="F")
+    vol[4:15, 3:12, 2:10] = 200
+    write_volume(tmp_path / "posed.vti", vol, origin=(5, 6, 7))
+    verts, faces = isosurface(vol > 0)
+    write_mesh(tmp_path / "hull.ply", verts, faces)
+    points_before = len(window.doc.skeleton)
+    for name in ("posed.vti", "hull.ply"):
+        viewer = window.files.view_file(tmp_path / name)
+        assert viewer is not None and viewer.isVisible() and "body" in viewer.plotter.renderer.actors
+        assert name in viewer.windowTitle() and name in window.statusBar().currentMessage()
+        viewer.close()
+    assert len(window.doc.skeleton) == points_before and window.doc.volume_path != str(tmp_path / "posed.vti")
+    (tmp_path / "bad.ply").write_text("not a mesh")
+    assert window.files.view_file(tmp_path / "bad.ply") is None
+    assert "bad.ply" in window.last_error

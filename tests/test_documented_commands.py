@@ -1,0 +1,128 @@
+"""The documented commands run as printed: every ```sh block of the README, and every example in
+``volanim --help`` and ``volanim COMMAND --help``.
+
+**README.** Every ```sh block, in order, in one fresh folder. The opening block is the two
+commands every newcomer types: ``make demo`` runs against this repository with its output folder
+in the fresh folder (``DEMO_OUT``; later blocks use ``demo-out/``), and ``make test`` is skipped
+because it is the command running this test. Studio commands start the real window, load what
+they were given and quit (``VOLANIM_STUDIO_SMOKE``: status 1 if an error dialog appeared);
+``volanim view`` renders off-screen and returns (``PYVISTA_OFF_SCREEN``). The demo's own results
+are checked here too, so the demo runs once per test session.
+
+**--help examples.** In order in another fresh folder, as a newcomer would try them: first the
+``samples`` example (every other example starts from its files), then each command's examples in
+the order ``volanim --help`` lists the commands; an example may use the files of an earlier one.
+The top-level examples run in a folder of their own. ``volanim demo`` is the one example not run
+there: it is what ``make demo`` runs, and the README chain runs that.
+
+The two chains are independent, so they run side by side (each one in order): the suite stays
+well under ten minutes.
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from paths import REPO
+from runnable import check, help_examples, run, shell_blocks
+from volanim_core import io
+from volanim_core.cli import build_parser
+
+FIRST_BLOCK = ["make demo", "make test"]
+DEMO = "volanim demo -o demo-out/"
+
+
+def _commands(block: str) -> list[str]:
+    return [line.split("#")[0].strip() for line in block.splitlines() if line.split("#")[0].strip()]
+
+
+def _readme_blocks() -> list[str]:
+    return shell_blocks((REPO / "README.md").read_text(encoding="utf-8"))
+
+
+def test_the_readme_opens_with_the_two_commands():
+    blocks = _readme_blocks()
+    assert _commands(blocks[0]) == FIRST_BLOCK
+    assert len(blocks) >= 8, "the workflow's command blocks"
+    commands = [c for b in blocks[1:] for c in _commands(b)]
+    assert not [c for c in commands if "..." in c or "HOST" in c], "a shell block is run: no placeholders in it"
+
+
+def test_the_help_examples_are_commands_of_their_own_program():
+    found = help_examples(build_parser())
+    assert len({name for name, _ in found}) >= 30, "every subcommand has an example"
+    for name, command in found:
+        assert command.split()[0] == "volanim", command
+        assert name == "volanim" or command.split()[1] == name, f"{name}'s example runs another command: {command}"
+        assert "..." not in command and "HOST" not in command, f"placeholders do not run: {command}"
+    demos = [c.split("#")[0].strip() for _, c in found if c.startswith("volanim demo")]
+    assert demos and set(demos) == {DEMO}, "volanim demo is skipped in the examples only because make demo runs it"
+
+
+def test_the_readme_and_every_help_example_run_as_printed_in_fresh_folders(tmp_path):
+    with ThreadPoolExecutor(2) as pool:
+        readme = pool.submit(_run_the_readme, tmp_path / "newcomer")
+        examples = pool.submit(_run_the_help_examples, tmp_path / "examples")
+        readme.result()
+        examples.result()
+
+
+def _run_the_readme(folder) -> None:
+    folder.mkdir()
+    demo = run(f"make -s -C {REPO} demo DEMO_OUT={folder / 'demo-out'}", folder)
+    check(demo, "make demo")
+    _check_demo(demo.stdout, folder / "demo-out")
+    for block in _readme_blocks()[1:]:
+        check(run(block, folder), block)
+    # what the blocks promise, spot-checked
+    assert (folder / "data" / "walk.bvh").is_file() and (folder / "data" / "frog.VOL").is_file()
+    assert (folder / "mannequin.0.50.connect").is_file() and len(list((folder / "walk").glob("*.tskel"))) > 10
+    assert (folder / "walk.mp4").stat().st_size > 0 and (folder / "skin.tf").is_file()
+    assert len(list((folder / "frames").glob("walk.*.vti"))) == len(list((folder / "walk").glob("*.trans")))
+
+
+def _run_the_help_examples(root) -> None:
+    found = help_examples(build_parser())
+    top = [c for name, c in found if name == "volanim" and not c.startswith("volanim demo")]
+    first = [c for n, c in found if n == "samples"]
+    rest = [c for n, c in found if n not in ("volanim", "samples") and not c.startswith("volanim demo")]
+    folder = root / "commands"
+    folder.mkdir(parents=True)
+    for command in first + rest:
+        check(run(command, folder), command)
+    assert len(list(folder.glob("arm-bone.*x*x*.vol"))) == 1  # a headerless .vol is named by its size
+    assert (folder / "walk.mp4").stat().st_size > 0 and (folder / "hull.png").stat().st_size > 0
+    own = root / "top"
+    own.mkdir()
+    for command in top:
+        check(run(command, own), command)
+
+
+def _check_demo(text: str, out) -> None:
+    """What `make demo` promises: every stage's file, sampled values from the source, the walk, the movie."""
+    for stage in ("[1] sample", "[2] skeleton", "[3] connectivity (bundled", "[4] identity", "[5] L_UPPERARM",
+                  "[6] walk.bvh: 1064 frames", "[7] sequence: 24 frames of one walk cycle and 10 of crumbling",
+                  "[8] render: 34 frames"):
+        assert stage in text, stage
+    source = io.read_volume(out / "mannequin.VOL")
+    rest, _, _ = io.read_volume_grid(out / "rest-sampled.vti")
+    posed, origin, _ = io.read_volume_grid(out / "arm-sampled.vti")
+    assert set(np.unique(posed)) <= set(np.unique(source))  # sampled values come from the source
+    assert (rest > 0).sum() > 0.99 * (source > 0).sum()
+    assert origin[0] < 13  # the raised arm reaches further out than the rest pose
+    assert len(list((out / "walk").glob("walk.*.tskel"))) == 8
+    first, o0, _ = io.read_volume_grid(out / "walk" / "walk.0000-sampled.vti")
+    _, o1, _ = io.read_volume_grid(out / "walk" / "walk.0532-sampled.vti")
+    assert abs(int((first > 0).sum()) - int((rest > 0).sum())) < 0.1 * (rest > 0).sum()  # same body, posed
+    assert o1[1] < o0[1] - 100  # the mannequin walked forward (-y) across the clip
+    from volanim_core.sequence import store
+
+    assert store.open_frames(out / "walk.zarr").shape[0] == 34 and len(store.finished(out / "walk.zarr")) == 34
+    import imageio.v3 as iio
+
+    movie = iio.imread(out / "walk.gif", index=None)
+    assert movie.shape[1:3] == (240, 320) and 30 <= len(movie) <= 34
+    lit = [(m[..., :3].astype(int).sum(-1) > 150).sum() for m in movie]
+    assert min(lit) > 200 and lit[-1] < lit[0] / 2  # a figure in every frame; the heap is smaller
