@@ -38,14 +38,16 @@ SHORTCUTS = [
     ("V", "View mode: click points to inspect them"),
     ("B", "Bones mode: click point A, then B to add a bone; keep clicking to chain"),
     ("R", "Root order mode: click bones in order"),
-    ("K", "Cube mode: click a point to place the cube; arrows / PgUp / PgDn nudge, +/- size, C connect, X remove"),
+    ("K", "Cube mode: click a point to place the cube"),
+    ("Up / Down / Left / Right, PgUp / PgDown, + / -", "Cube mode: nudge the cube, resize it"),
+    ("C / X", "Cube mode: connect the points in the cube to the working bone / remove them"),
     ("L", "Lasso mode: drag an outline to connect the points under it to the working bone (Ctrl: remove)"),
     ("Ctrl+A", "Auto-connect"),
     ("P", "Pose mode: click a bone, turn it with the Pose sliders; the preview follows live"),
     ("F5", "Preview the reconstruction at full resolution, with the breakage report"),
     ("Esc", "End the bone chain / restart the root order"),
     ("Right click", "End the bone chain"),
-    ("Delete", "Remove the selected bones"),
+    ("Del", "Remove the selected bones (the Delete key)"),
     ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
     ("Space", "Play / pause the timeline (a BVH clip, .trans frames or keys)"),
     ("Left / Right, Home / End", "Previous / next frame, first / last frame (outside Cube mode)"),
@@ -55,6 +57,7 @@ SHORTCUTS = [
     ("Ctrl+S / Ctrl+Shift+S", "Save the project / save it under a new name"),
     ("Ctrl+Q", "Quit (a running job is cancelled and waited for)"),
     ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
+    ("F1", "This list"),
 ]
 
 

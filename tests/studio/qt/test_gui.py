@@ -314,3 +314,18 @@ def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(q
     (tmp_path / "bad.ply").write_text("not a mesh")
     assert window.files.view_file(tmp_path / "bad.ply") is None
     assert "bad.ply" in window.last_error
+
+
+def test_f1_lists_every_keyboard_shortcut_of_the_menus(window):
+    """The F1 list is typed by hand; every shortcut a menu action has must be in it (it missed
+    Ctrl+Shift+S and Ctrl+Q)."""
+    from PySide6.QtGui import QAction, QKeySequence
+
+    from volanim_studio.qt.main_window import SHORTCUTS
+
+    import re
+
+    listed = {t for k, _ in SHORTCUTS for t in re.split(r" / |, ", k)}
+    keys = {a.shortcut().toString(QKeySequence.PortableText) for a in window.findChildren(QAction)} - {""}
+    assert {"Ctrl+Shift+S", "Ctrl+Q", "F1"} <= keys
+    assert not sorted(keys - listed), f"shortcuts missing from F1: {sorted(keys - listed)}"
