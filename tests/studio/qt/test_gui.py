@@ -319,11 +319,11 @@ def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(q
 def test_f1_lists_every_keyboard_shortcut_of_the_menus(window):
     """The F1 list is typed by hand; every shortcut a menu action has must be in it (it missed
     Ctrl+Shift+S and Ctrl+Q)."""
+    import re
+
     from PySide6.QtGui import QAction, QKeySequence
 
     from volanim_studio.qt.main_window import SHORTCUTS
-
-    import re
 
     listed = {t for k, _ in SHORTCUTS for t in re.split(r" / |, ", k)}
     keys = {a.shortcut().toString(QKeySequence.PortableText) for a in window.findChildren(QAction)} - {""}
