@@ -145,6 +145,8 @@ class Attachments:
     def to_connectivity(self, thinness: float | None = None) -> Connectivity:
         doc = self.doc
         s = doc.skeleton
+        if s is None:  # an empty studio: F5, exports and saves end here, with words instead of a traceback
+            raise ValueError("nothing loaded yet: open a volume, a demo or a project first (File menu)")
         keep = self.bone >= 0
         roots = [RootBone(*doc.bones.segment(i), b.label) for i, b in enumerate(doc.bones.bones)]
         conn = Connectivity(roots, s.points[keep], s.dt[keep], s.thinness[keep], self.bone[keep], s.metric,

@@ -232,6 +232,8 @@ class Document:
         and the skeleton are stored under content names; the manifest is
         replaced last (see :mod:`volanim_studio.model.project`).
         """
+        if self.skeleton is None and not len(self.bones):
+            raise ValueError("nothing to save yet: open a volume, a demo or a project first (File menu)")
         path = Path(path)
         if path.suffix != ".volanim":
             path = path.with_suffix(".volanim")

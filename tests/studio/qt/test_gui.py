@@ -329,3 +329,24 @@ def test_f1_lists_every_keyboard_shortcut_of_the_menus(window):
     keys = {a.shortcut().toString(QKeySequence.PortableText) for a in window.findChildren(QAction)} - {""}
     assert {"Ctrl+Shift+S", "Ctrl+Q", "F1"} <= keys
     assert not sorted(keys - listed), f"shortcuts missing from F1: {sorted(keys - listed)}"
+
+
+def test_an_empty_studio_answers_f5_and_ctrl_s_in_words_and_writes_nothing(qtbot, tmp_path):
+    """F5 on an empty studio printed a traceback; Ctrl+S wrote an empty project (issue #18)."""
+    from volanim_studio.qt.main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitExposed(w)
+    assert w.previews.preview() is None
+    assert "nothing loaded yet: open a volume, a demo or a project first" in w.last_error
+    w.last_error = None
+    w.previews.live_preview()  # what a timeline frame change asks for: a status message, no dialog
+    assert w.last_error is None and "nothing loaded yet" in w.statusBar().currentMessage()
+    out = tmp_path / "out"
+    out.mkdir()
+    assert w.files.save_project(path=out / "empty.volanim") is None
+    assert "nothing to save yet" in w.last_error
+    assert list(out.iterdir()) == [] and not w.busy
+    w.close()
