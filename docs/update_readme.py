@@ -19,6 +19,7 @@ import platform
 import re
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,19 +52,14 @@ def replace_region(text: str, name: str, body: str) -> str:
 
 def commands_table() -> str:
     """The volume tools: every subcommand before ``samples`` in ``volanim --help``, with its first example."""
-    import argparse as ap
-
-    from volanim_core.cli import build_parser
+    from volanim_core.cli import build_parser, subcommands
 
     rows = ["| command | what it does (the old tool) | example |", "|---|---|---|"]
-    for action in build_parser()._actions:
-        if not isinstance(action, ap._SubParsersAction):
-            continue
-        for name, sub in action.choices.items():
-            if name == "samples":
-                return "\n".join(rows) + "\n"
-            example = sub.epilog.splitlines()[1].strip().split("   #")[0].strip()
-            rows.append(f"| `{name}` | {sub.description} | `{example}` |")
+    for name, sub in subcommands(build_parser()).items():
+        if name == "samples":
+            return "\n".join(rows) + "\n"
+        example = sub.epilog.splitlines()[1].strip().split("   #")[0].strip()
+        rows.append(f"| `{name}` | {sub.description} | `{example}` |")
     raise RuntimeError("no samples command")
 
 
@@ -81,7 +77,8 @@ def machine() -> str:
 
 def benchmark_tables(script: str) -> str:
     env = dict(os.environ, VOLANIM_BENCH_MARKDOWN="1")
-    out = subprocess.run([sys.executable, str(ROOT / script)], cwd=ROOT, env=env, capture_output=True, text=True,
+    # stdout is the tables; stderr (a benchmark's own progress, warnings) goes on to the terminal
+    out = subprocess.run([sys.executable, str(ROOT / script)], cwd=ROOT, env=env, stdout=subprocess.PIPE, text=True,
                          check=True).stdout
     stamp = f"*Written by `{script}` through `make docs` on {datetime.date.today()}, {machine()}.*"
     return f"{as_markdown(out)}\n\n{stamp}\n"
@@ -126,8 +123,10 @@ def main(argv=None) -> int:
     names = args.names or list(regions(text))
     stale = []
     for name in names:
-        print(f"make docs: {name} ...", flush=True)
+        print(f"make docs: {name} ...", end=" ", flush=True)
+        t0 = time.perf_counter()
         body = generate(name)
+        print(f"{time.perf_counter() - t0:.0f} s", flush=True)
         if regions(text).get(name) != body:
             stale.append(name)
         text = replace_region(text, name, body)

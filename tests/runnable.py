@@ -57,11 +57,11 @@ def help_examples(parser: argparse.ArgumentParser) -> list[tuple[str, str]]:
             body.append(line)
         found.extend((name, c) for c in join_continuations(body))
 
+    from volanim_core.cli import subcommands
+
     take("volanim", parser.epilog)
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            for name, sub in action.choices.items():
-                take(name, sub.epilog)
+    for name, sub in subcommands(parser).items():
+        take(name, sub.epilog)
     return found
 
 

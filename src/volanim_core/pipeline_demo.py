@@ -51,12 +51,6 @@ def _say(msg: str) -> None:
     print(msg, flush=True)
 
 
-def bundled_clip() -> Path | None:
-    """The walk clip shipped with the package (MIT, licence beside it)."""
-    path = samples.walk_clip()
-    return path if path.is_file() else None
-
-
 def bundled_connect(sample: str) -> Path | None:
     """The connectivity shipped in ``assets/`` for ``sample``, when running from the repository."""
     path = Path(__file__).resolve().parents[2] / "assets" / connect_filename(sample, DEFAULT_MIN_THINNESS)
@@ -132,9 +126,8 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     _say(f"[5] {bone} turned {angles} deg: sampled reconstruction {r.stats['filled']} voxels in "
          f"{r.stats['seconds']:.3f} s (overdraw {r.stats['overdraw']:.1f}), hotspot max {hot.stats['hotspot_max']}, "
          f"origin {r.origin} -> {out['posed'].name}, arm-bone.vti")
-    clip = bundled_clip()
-    if sample == "mannequin" and clip is not None:
-        out["walk"], retarget = _walk(folder / "walk", clip, s, conn)
+    if sample == "mannequin":  # the walk clip is package data: always there
+        out["walk"], retarget = _walk(folder / "walk", samples.walk_clip(), s, conn)
         out["sequence"] = _sequence(folder / "walk.zarr", retarget, conn, s.volume)
         out["movie"] = _movie(out["sequence"], folder / "walk.gif")
     out["skeleton"], out["sample"], out["connectivity"] = skel, s, conn

@@ -78,6 +78,7 @@ def _quit_when_loaded(app, seconds: float = 600.0) -> None:
         if state["idle"] >= 3 or time.monotonic() > deadline:
             window = windows[0] if windows else None
             errors = state["errors"] + ([window.last_error] if window is not None and window.last_error else [])
+            errors = list(dict.fromkeys(errors))  # the dialog's text is also the window's last error
             status = window.statusBar().currentMessage() if window is not None else ""
             print(f"volanim-studio smoke check: {'FAILED: ' + '; '.join(errors) if errors else 'loaded'}"
                   + (f" ({status})" if status else ""), flush=True)

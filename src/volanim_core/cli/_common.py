@@ -9,7 +9,7 @@ import sys
 import time
 from pathlib import Path
 
-from volanim_core.io import raw_name_for, read_volume, write_volume
+from volanim_core.io import read_volume, write_output
 from volanim_core.io._text import is_number
 from volanim_core.volume import Bounds
 
@@ -45,9 +45,10 @@ def load(path: str, args) -> object:
 
 
 def save(path: str, vol, **kw) -> Path:
-    """Write a volume and say where; a headerless ``.vol`` is named ``NAME.XxYxZ.vol`` (its size)."""
-    path = raw_name_for(path, vol.shape)
-    write_volume(path, vol, **kw)
+    """Write a volume and say where (:func:`io.write_output`: a headerless ``.vol`` is named by its size)."""
+    path, note = write_output(path, vol, **kw)
+    if note:
+        print(f"note: {note}")
     print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype})")
     return path
 

@@ -8,18 +8,16 @@ import argparse
 import numpy as np
 
 from volanim_core.io import (
-    raw_name_for,
     read_bones,
     read_connect,
     read_mskel,
     read_trans,
     read_tskel,
     read_volume_grid,
-    saturate_for_raw,
     write_connect,
+    write_output,
     write_trans,
     write_tskel,
-    write_volume,
 )
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
@@ -111,11 +109,9 @@ def _reconstruct(args):
     bar = TextProgress("reconstruct")
     r = reconstruct(t, mode=args.mode, source=source, source_origin=source_origin, kernel=args.kernel,
                     bounds=bounds, padding=args.padding, threads=args.threads, progress=bar)
-    volume, note = saturate_for_raw(args.output, r.volume)
+    output, note = write_output(args.output, r.volume, origin=r.origin)
     if note:
         print(f"note: {note}")
-    output = raw_name_for(args.output, volume.shape)  # a headerless .vol carries its size in its name
-    write_volume(output, volume, origin=r.origin)
     s = r.stats
     print(f"{s['spheres']} spheres -> {s['filled']} voxels filled in {s['seconds']:.3f} s "
           f"(overdraw {s['overdraw']:.1f}); grid {r.volume.shape[0]}x{r.volume.shape[1]}x{r.volume.shape[2]}, "

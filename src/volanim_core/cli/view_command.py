@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import sys
-
 from ._common import add_command, ascii_int
 
 EXAMPLE = (
@@ -14,22 +11,16 @@ EXAMPLE = (
 )
 
 
-def has_display() -> bool:
-    """Whether an on-screen window can open (an X11 or Wayland display on Linux; always elsewhere)."""
-    if sys.platform.startswith("linux"):
-        return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-    return True
-
-
 def _view(args):
     import numpy as np
+    import pyvista
 
     from volanim_core.render.quicklook import quick_look
     from volanim_core.render.run import write_png
+    from volanim_core.render.scene import has_display
 
     window = args.screenshot is None
-    off_screen_env = os.environ.get("PYVISTA_OFF_SCREEN", "").lower() == "true"
-    if window and not has_display() and not off_screen_env:
+    if window and not has_display() and not pyvista.OFF_SCREEN:  # PYVISTA_OFF_SCREEN: a window draws off-screen
         raise ValueError("no display to open a window on: add --screenshot FILE.png for a picture instead")
     renderer, what = quick_look(args.file, off_screen=True if not window else None, style=args.style,
                                 preset=args.preset, view=args.view, frame=args.frame, dims=args.dims,

@@ -33,6 +33,7 @@ from .volume_files import (
     read_volume,
     read_volume_grid,
     saturate_for_raw,
+    write_output,
     write_volume,
 )
 
@@ -61,6 +62,7 @@ __all__ = [
     "read_volume_grid",
     "remove_header",
     "saturate_for_raw",
+    "write_output",
     "write_bones",
     "write_connect",
     "write_connections",

@@ -169,6 +169,20 @@ def saturate_for_raw(path: str | Path, vol: np.ndarray) -> tuple[np.ndarray, str
     return np.minimum(vol, 255).astype(np.uint8), note
 
 
+def write_output(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0),
+                 spacing=(1.0, 1.0, 1.0)) -> tuple[Path, str | None]:
+    """Write a result where the user asked, with what raw formats need: counts above 255 saturate
+    (:func:`saturate_for_raw`) and a headerless ``.vol`` is named ``NAME.XxYxZ.vol``
+    (:func:`raw_volumes.raw_name_for`). Returns the path written and a note for the user, or None.
+
+    Every command and the studio write their results through this, so none forgets either rule.
+    """
+    vol, note = saturate_for_raw(path, np.asarray(vol))
+    path = raw_volumes.raw_name_for(path, vol.shape)
+    write_volume(path, vol, origin=origin, spacing=spacing)
+    return path, note
+
+
 def write_volume(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)) -> None:
     """Write a volume as ``.vol``, ``.VOL``, ``.vti`` or ``.nrrd``, atomically.
 

@@ -1,4 +1,5 @@
-"""What a ``.vti``/``.mha``/``.mhd``/``.nii``/``.nii.gz``/``.vtk`` header claims, read without VTK.
+"""What a ``.vti``/``.mha``/``.mhd``/``.nii``/``.nii.gz``/``.vtk`` header claims, read without VTK
+(and, for meshes, what a ``.ply``/``.stl``/``.vtp`` header claims: :func:`check_mesh_claims`).
 
 VTK allocates whatever a header claims (``std::bad_alloc`` aborts the whole
 process, the studio included) and fills a short file with uninitialised
@@ -19,7 +20,7 @@ import zlib
 from pathlib import Path
 
 from volanim_core.errors import FormatError
-from volanim_core.limits import checked_grid, expect_bytes, whole_number
+from volanim_core.limits import available_bytes, checked_grid, expect_bytes, human_bytes, whole_number
 
 from ._inflate import inflate_capped
 
@@ -199,3 +200,37 @@ def _legacy_vtk(path: Path) -> tuple[int, int, int]:
     if "STRUCTURED_POINTS" not in text or m is None:
         raise FormatError(path, "expected a legacy VTK STRUCTURED_POINTS file with DIMENSIONS")
     return checked_grid(path, m.groups(), 8, what="DIMENSIONS")
+
+
+#: A mesh element takes at least a byte in .ply and .stl; compressed .vtp data may inflate, so its
+#: counts get this much room over the file's size (and must still fit in memory).
+_VTP_INFLATION = 1024
+
+
+def check_mesh_claims(path: Path) -> None:
+    """Refuse counts a mesh header claims but its file cannot hold, before VTK allocates for them
+    (a PLY claiming 2^31 vertices made VTK abort the process). ``.obj`` has no counts to check."""
+    path = Path(path)
+    size = path.stat().st_size
+    head = _head(path)
+    suffix = path.suffix.lower()
+    claims: list[tuple[str, int, int]] = []  # (what, count, the most the file can hold)
+    if suffix == ".ply":
+        end = head.find(b"end_header")
+        if not head.startswith(b"ply") or end < 0:
+            raise FormatError(path, "is not a PLY file (it must start with 'ply' and have an end_header)")
+        for m in re.finditer(rb"^element\s+(\S+)\s+(\d+)", head[:end], flags=re.M):
+            claims.append((f"{m[1].decode('ascii', 'replace')} elements", int(m[2]), size))
+    elif suffix == ".stl" and not head.lstrip().startswith(b"solid"):  # binary: 80 bytes, a count, 50 a triangle
+        if size < 84:
+            raise FormatError(path, f"is {size} bytes: too short for a binary STL (84 bytes of header)")
+        expect_bytes(path, size, 84 + 50 * int.from_bytes(head[80:84], "little"), "the binary STL")
+    elif suffix == ".vtp":
+        for m in re.finditer(rb'NumberOf(Points|Verts|Lines|Strips|Polys)="(\d+)"', head):
+            claims.append((m[1].decode().lower(), int(m[2]), size * _VTP_INFLATION))
+    free = available_bytes()
+    for what, count, most in claims:
+        if count > most:
+            raise FormatError(path, f"claims {count} {what}, more than its {size} bytes can hold")
+        if free is not None and 24 * count > free:
+            raise FormatError(path, f"claims {count} {what} ({human_bytes(24 * count)}), more than the memory free")

@@ -32,6 +32,7 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
         settings = RenderSettings(named_view(view, lo, hi, aspect=w / h), size=(w, h))
         renderer = Renderer(settings, off_screen=off_screen, plotter=plotter)
         renderer.plotter.add_mesh(mesh, color=SKIN, smooth_shading=True, name="body", reset_camera=False)
+        settings.camera.apply(renderer.plotter.camera)  # (a volume's draw() applies it itself)
         what = f"{mesh.n_points:,} points, {mesh.n_cells:,} faces"
     else:
         inputs = open_inputs([path], slice(frame, frame + 1), dims=dims)
@@ -44,5 +45,4 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
         what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {settings.preset} colours"
         if ref.index >= 0:
             what = f"frame {ref.number}: {what}"
-    settings.camera.apply(renderer.plotter.camera)
     return renderer, what

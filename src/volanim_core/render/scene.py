@@ -131,13 +131,20 @@ def cut_away(volume: np.ndarray, origin, point, normal) -> np.ndarray:
     return out
 
 
-def prefer_egl_without_display() -> None:
-    """Without an X11/Wayland display, ask VTK for its EGL window directly (before VTK makes its
-    first window): its default X window would first fail with a "bad X server connection" warning."""
+def has_display() -> bool:
+    """Whether an on-screen window can open (an X11 or Wayland display on Linux; always elsewhere)."""
     import os
     import sys
 
-    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    return not sys.platform.startswith("linux") or bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def prefer_egl_without_display() -> None:
+    """Without a display, ask VTK for its EGL window directly (before VTK makes its first window):
+    its default X window would first fail with a "bad X server connection" warning."""
+    import os
+
+    if not has_display():
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 

@@ -20,15 +20,6 @@ from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import RootBone
 
 
-def rotation_about(joint, rotation: np.ndarray) -> np.ndarray:
-    """Row-vector 4x4 matrix turning points by ``rotation`` (3x3, column convention) about ``joint``."""
-    j = np.asarray(joint, np.float64)
-    m = np.eye(4)
-    m[:3, :3] = np.asarray(rotation, np.float64).T
-    m[3, :3] = j - j @ m[:3, :3]
-    return m
-
-
 def apply_matrices(points: np.ndarray, bone: np.ndarray, matrices: np.ndarray) -> np.ndarray:
     """Each point moved by its bone's matrix, ``[x y z 1] @ M[bone]``: ``(N, 3)`` float64.
 

@@ -116,8 +116,7 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
     if p.every_frame_as:
         from volanim_core import io
 
-        vol, _ = io.saturate_for_raw(frame_file(p.every_frame_as, spec.number), volume)
-        io.write_volume(frame_file(p.every_frame_as, spec.number), vol, origin=r.origin)
+        io.write_output(frame_file(p.every_frame_as, spec.number), volume, origin=r.origin)
     s = r.stats
     return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
             "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),

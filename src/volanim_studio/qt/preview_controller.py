@@ -179,11 +179,13 @@ class PreviewController(Controller):
         if p is None:
             self.show_error("Export", "nothing to export: preview first (F5)")
             return False
-        vol, note = io.saturate_for_raw(path, p.reconstruction.volume)
+        shape = p.reconstruction.volume.shape
         return self.attempt(
-            "Export", lambda: io.write_volume(path, vol, origin=tuple(p.origin_voxels), spacing=p.spacing),
-            f"Exported {vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]} ({p.mode}) to {path}; origin "
-            f"{tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {note}." if note else "")) is not FAILED
+            "Export", lambda: io.write_output(path, p.reconstruction.volume, origin=tuple(p.origin_voxels),
+                                              spacing=p.spacing),
+            lambda written: f"Exported {shape[0]}x{shape[1]}x{shape[2]} ({p.mode}) to {written[0]}; origin "
+            f"{tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {written[1]}." if written[1] else "")
+        ) is not FAILED
 
     def load_trans(self, path) -> bool:
         return self.attempt("Load pose", lambda: self.doc.pose.load_trans(path),

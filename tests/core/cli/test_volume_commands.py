@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from volanim_core import io
-from volanim_core.cli import build_parser, main
+from volanim_core.cli import build_parser, main, subcommands
 
 
 def run(*args):
@@ -21,9 +21,9 @@ def test_help_lists_every_subcommand_and_each_has_an_example():
     r = run("--help")
     assert r.returncode == 0
     parser = build_parser()
-    sub = next(a for a in parser._actions if a.dest == "command")
-    assert len(sub.choices) >= 17
-    for name, p in sub.choices.items():
+    commands = subcommands(parser)
+    assert len(commands) >= 17
+    for name, p in commands.items():
         assert name in r.stdout
         assert "examples (" in p.format_help() and f"volanim {name}" in p.format_help()
 

@@ -158,6 +158,7 @@ def test_tskel_with_zero_points(tmp_path, small_connect):
 GOOD_TSKEL_HEAD = "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
 
 
+# spec: docs/formats.md#conventions
 @pytest.mark.parametrize(
     ("reader", "text", "line", "words"),
     [
@@ -189,7 +190,6 @@ GOOD_TSKEL_HEAD = "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
         (io.read_tskel, GOOD_TSKEL_HEAD + "1 2 3\n", 6, "expected 4 or 5 columns"),
     ],
 )
-# spec: docs/formats.md#conventions
 def test_malformed_text_gives_one_error_type_naming_file_and_line(tmp_path, reader, text, line, words):
     path = tmp_path / "bad.txt"
     path.write_text(text)
@@ -202,9 +202,9 @@ def test_malformed_text_gives_one_error_type_naming_file_and_line(tmp_path, read
         assert f"{path}:{line}:" in str(err.value)
 
 
+# spec: docs/formats.md#conventions
 @pytest.mark.parametrize("reader", [io.read_skel, io.read_mskel, io.read_bones, io.read_connections,
                                     io.read_connect, io.read_trans, io.read_tskel])
-# spec: docs/formats.md#conventions
 @pytest.mark.parametrize("content", [b"", b"# only a comment\n\n", b"\x00\x01\x02\xff\xfe binary", b"\xff\xfe\xfd"])
 def test_empty_and_binary_files(tmp_path, reader, content):
     path = tmp_path / "f"

@@ -181,13 +181,13 @@ def test_write_raw_refuses_float(tmp_path):
         io.write_volume(tmp_path / "a.VOL", np.zeros((2, 2, 2), np.float32) + 0.5)
 
 
+# spec: docs/formats.md#other-volumes
 @pytest.mark.parametrize("header", [
     b"NRRD0004\ntype: uchar\nsizes: 2 2 2\nspace directions: (a,b) x\n\n",
     b"NRRD0004\ntype: uchar\nsizes: 2 2 2\nencoding: gzip\n\n",
     b"NRRD0004\ntype: quaternion\nsizes: 2 2 2\n\n",
     b"NRRD0004\ntype: uchar\nsizes: 2 2\n\n",
 ])
-# spec: docs/formats.md#other-volumes
 def test_bad_nrrd_headers(tmp_path, header):
     (tmp_path / "b.nrrd").write_bytes(header + b"\0" * 8)
     with pytest.raises(FormatError, match="b.nrrd"):

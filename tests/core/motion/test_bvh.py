@@ -40,12 +40,12 @@ def test_rest_frame_places_joints_at_their_offsets(tmp_path):
     assert np.allclose(pos[0], [[1, 2, 3], [1, 12, 3], [1, 16, 3]])
 
 
+# spec: docs/formats.md#bvh
 @pytest.mark.parametrize("order, expected_arm", [
     # intrinsic, listed order: R = R1 @ R2 @ R3 applied to the Hand's offset (0 4 0); Y is 0
     ("ZXY", [0, 0, 4]),   # Rx(90) (0 4 0) = (0 0 4); Rz(90) keeps z
     ("XZY", [-4, 0, 0]),  # Rz(90) (0 4 0) = (-4 0 0); Rx(90) keeps x
 ])
-# spec: docs/formats.md#bvh
 def test_channel_order_is_intrinsic_in_the_listed_order(tmp_path, order, expected_arm):
     angles = {"Z": "90", "X": "90", "Y": "0"}
     arm = " ".join(angles[a] for a in order)
@@ -111,6 +111,7 @@ def test_the_real_walk_clip():
     assert np.allclose(np.linalg.norm(pos[:, head] - pos[:, spine], axis=1), 13.8244, atol=1e-6)
 
 
+# spec: docs/formats.md#bvh
 @pytest.mark.parametrize("mutate, message", [
     (lambda t: t.replace("HIERARCHY", "HIERARCHX"), "starting with HIERARCHY"),
     (lambda t: t.replace("MOTION", "MOTON"), "no MOTION section"),
@@ -128,7 +129,6 @@ def test_the_real_walk_clip():
     (lambda t: t.replace("Zrotation Xrotation Yrotation\n      End", "Zrotation Xrotation Wrotation\n      End"),
      "unknown channel"),
 ])
-# spec: docs/formats.md#bvh
 def test_bad_files_are_format_errors_naming_file_and_line(tmp_path, mutate, message):
     path = write(tmp_path, mutate(clip("ZXY", ["0 0 0 0 0 0 0 0 0 0 0 0"])), "bad.bvh")
     with pytest.raises(FormatError, match=message) as info:

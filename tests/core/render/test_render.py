@@ -174,6 +174,7 @@ def test_camera_and_transfer_function_files_round_trip(tmp_path):
     assert np.allclose(tf([0.1, 3500.05]), [[1 / 3, 2 / 3, 1.0, 0.5], [0.6666666, 0.8333333, 1.0, 0.75]])
 
 
+# spec: docs/formats.md#camera
 @pytest.mark.parametrize("text, line, match", [
     ("position 1 2\nfocal_point 0 0 0\n", 1, "position takes 3 numbers, got 2"),
     ("position 0 -9 0\nfocal_point 0 0 0\nzoom 3\n", 3, "unknown camera key 'zoom'"),
@@ -184,7 +185,6 @@ def test_camera_and_transfer_function_files_round_trip(tmp_path):
     ("position 0 -9 0\nfocal_point 0 0 0\nview_up 0 1 0\n", None, "view_up must not"),
     ("position 0 -9 0\nfocal_point 0 0 0\nview_angle 180\n", None, "view_angle must be between"),
 ])
-# spec: docs/formats.md#camera
 def test_bad_camera_files_name_the_line(tmp_path, text, line, match):
     (tmp_path / "bad.camera").write_text(text)
     with pytest.raises(FormatError, match=match) as exc:
@@ -192,6 +192,7 @@ def test_bad_camera_files_name_the_line(tmp_path, text, line, match):
     assert exc.value.line == line and "bad.camera" in str(exc.value)
 
 
+# spec: docs/formats.md#tf
 @pytest.mark.parametrize("text, line, match", [
     ("0 0 0 0 0\n10 1 1 1\n", 2, "5 numbers"),
     ("0 0 0 0 0\n10 1 1 1 1\n5 1 1 1 1\n", 3, "values must ascend: 5 follows 10"),
@@ -199,7 +200,6 @@ def test_bad_camera_files_name_the_line(tmp_path, text, line, match):
     ("0 0 0 0 nan\n", 1, "finite number for alpha"),
     ("# only a comment\n", None, "empty"),
 ])
-# spec: docs/formats.md#tf
 def test_bad_transfer_function_files_name_the_line(tmp_path, text, line, match):
     (tmp_path / "bad.tf").write_text(text)
     with pytest.raises(FormatError, match=match) as exc:

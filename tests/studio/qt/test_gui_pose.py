@@ -118,3 +118,8 @@ def test_compare_export_and_slices(qtbot, posed_window, tmp_path):
     data, origin, _ = io.read_volume_grid(tmp_path / "posed.vti")
     assert np.array_equal(data, w.doc.preview.reconstruction.volume)
     assert tuple(origin) == tuple(float(v) for v in w.doc.preview.origin_voxels)
+    # a headerless .vol is named by its size, as the command line names it
+    assert w.previews.export_preview(tmp_path / "posed.vol")
+    nx, ny, nz = w.doc.preview.reconstruction.volume.shape
+    assert (tmp_path / f"posed.{nx}x{ny}x{nz}.vol").is_file() and f"posed.{nx}x{ny}x{nz}.vol" in \
+        w.statusBar().currentMessage()
