@@ -13,14 +13,13 @@ EXAMPLE = (
 
 def _view(args):
     import numpy as np
-    import pyvista
 
     from volanim_core.render.quicklook import quick_look
     from volanim_core.render.run import write_png
-    from volanim_core.render.scene import has_display
+    from volanim_core.render.scene import can_open_window
 
     window = args.screenshot is None
-    if window and not has_display() and not pyvista.OFF_SCREEN:  # PYVISTA_OFF_SCREEN: a window draws off-screen
+    if window and not can_open_window():
         raise ValueError("no display to open a window on: add --screenshot FILE.png for a picture instead")
     renderer, what = quick_look(args.file, off_screen=True if not window else None, style=args.style,
                                 preset=args.preset, view=args.view, frame=args.frame, dims=args.dims,

@@ -139,6 +139,14 @@ def has_display() -> bool:
     return not sys.platform.startswith("linux") or bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+def can_open_window() -> bool:
+    """Whether a pyvista window can be shown: a display, or pyvista's ``PYVISTA_OFF_SCREEN``
+    (then ``show()`` draws off-screen and returns)."""
+    import pyvista
+
+    return has_display() or bool(pyvista.OFF_SCREEN)
+
+
 def prefer_egl_without_display() -> None:
     """Without a display, ask VTK for its EGL window directly (before VTK makes its first window):
     its default X window would first fail with a "bad X server connection" warning."""
