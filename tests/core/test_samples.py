@@ -51,6 +51,16 @@ def test_frog_loads_offline():
     assert s.spacing == (1.0, 1.0, 1.5)
 
 
+def test_frog_body_points_at_the_head_and_legs_at_the_legs():
+    """BODY/LEGS were swapped: LEGS pointed at the brain and eyes (issue #18)."""
+    s = samples.frog()
+    head = np.argwhere(np.isin(s.volume, samples.FROG_HEAD_LABELS)).mean(0)
+    body, legs = (s.bones.bones[s.bones.index(n)] for n in ("BODY", "LEGS"))
+    j = s.bones.joints
+    assert body.proximal == legs.proximal == "MID"
+    assert np.linalg.norm(j[body.distal] - head) < 0.5 * np.linalg.norm(j[legs.distal] - head)
+
+
 def test_write_sample_files(tmp_path):
     paths = samples.write_sample("mannequin", tmp_path)
     assert [p.name for p in paths] == ["mannequin.VOL", "mannequin.bones", "mannequin.connections"]

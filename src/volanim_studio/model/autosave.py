@@ -7,6 +7,7 @@
 A save happens after every ``every_edits`` edits and every ``every_seconds``
 while there are unsaved edits. A clean exit removes the folder; a folder whose
 pid is dead on the next start is a crashed session, offered for restore.
+Edits the user discards are first set aside (a declined folder, kept a week).
 A restored session's folder is removed only once the new session has
 autosaved what it restored, and never when the restore failed.
 ROOT is ``$VOLANIM_RECOVERY_DIR`` or ``~/.cache/volanim/recovery``.
@@ -98,14 +99,17 @@ class Autosaver:
         self.every_edits = every_edits
         self.every_seconds = every_seconds
         self.clock = clock
-        root = root or recovery_root()
-        prune(root)
-        self.folder = root / f"{os.getpid()}-{int(time.time() * 1000)}"
-        self.folder.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(self.folder / "session.json", json.dumps({"pid": os.getpid(), "started": time.time()}))
+        self.root = root or recovery_root()
+        prune(self.root)
+        self._new_folder()
         self._saved_edits = doc.undo.edits
         self._saved_at = clock()
         self.saves = 0
+
+    def _new_folder(self) -> None:
+        self.folder = self.root / f"{os.getpid()}-{int(time.time() * 1000)}"
+        self.folder.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(self.folder / "session.json", json.dumps({"pid": os.getpid(), "started": time.time()}))
 
     @property
     def path(self) -> Path:
@@ -134,6 +138,21 @@ class Autosaver:
         self._saved_at = self.clock()
         self.saves += 1
         return True
+
+    def set_aside(self) -> Path:
+        """Keep the document as it is now for a week, out of this session's way, and go on in a new folder.
+
+        For edits the user chose not to save (closing, or opening another volume): a
+        wrong answer to "Save changes?" must not lose an afternoon's work. The kept
+        folder is a declined recovery (never offered again, pruned after a week) and
+        can be opened as a project. Returns the kept project file.
+        """
+        self.save()
+        kept = self.folder.with_name(f"{self.folder.name}-discarded")
+        self.folder.rename(kept)
+        decline(kept / RECOVERY_FILE)
+        self._new_folder()
+        return kept / RECOVERY_FILE
 
     def close(self) -> None:
         """A clean exit: nothing to recover."""

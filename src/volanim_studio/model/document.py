@@ -225,6 +225,40 @@ class Document:
     def message(self, text: str) -> None:
         self.events.message.emit(text=text)
 
+    # ------------------------------------------------------ document state
+    @property
+    def modified(self) -> bool:
+        """Edits since the project was last saved or opened (undoing back to that state clears it)."""
+        return not self.undo.is_clean
+
+    @property
+    def is_empty(self) -> bool:
+        return self.skeleton is None and self.volume is None and not len(self.bones)
+
+    def reset(self) -> None:
+        """A new, empty document in this object (views stay subscribed): nothing loaded, no history.
+
+        Opening a volume, a demo or a project starts here, so nothing of the previous
+        project (bones, connectivity, pose, keys, its path) leaks into the new one.
+        """
+        self.timeline._put_clip(None)
+        self.timeline._set_keys({})
+        self.pose._write({}, {})
+        self.selected_bones = ()
+        self.bone_edits._set_bones(BoneSkeleton())
+        self.only_unconnected = self.only_working = False
+        self.cube_centre = None
+        self.point_selection = np.zeros(0, np.int64)
+        self._symmetry_x = None
+        self.set_preview(None)
+        self.set_hull(None, None)
+        self.set_skeleton(None)
+        self.set_volume(None)
+        self.bones_path = self.project_path = self.demo_name = None
+        self.undo.clear()
+        self.undo.mark_clean()
+        self.events.project.emit(path=None)
+
     def save_project(self, path, camera: dict | None = None) -> Path:
         """Save the project as one unit: ``NAME.volanim`` and its data files in ``NAME.volanim.d/``.
 
@@ -241,6 +275,7 @@ class Document:
         self.bones_path = written["bones"]
         self.mskel_path = written["mskel"]
         self.project_path = str(path)
+        self.undo.mark_clean()
         self.events.project.emit(path=str(path))
         return path
 

@@ -59,7 +59,9 @@ def _store_skeleton(path: Path, skeleton) -> tuple[str, str]:
 def write_project(doc, path, camera: dict | None = None) -> dict:
     """Write ``doc`` as one project save (see the module docstring); returns the absolute paths written."""
     path = Path(path)
-    stored = {"bones": bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones))}
+    stored = {}
+    if len(doc.bones):  # a .bones file with no bones is not a valid file: a project without bones has none
+        stored["bones"] = bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones))
     if doc.skeleton is not None:
         stored["mskel"] = _store_skeleton(path, doc.skeleton)
     if len(doc.attachments.bone) and (doc.attachments.bone >= 0).any():
@@ -183,17 +185,21 @@ def _checked_segmentation(path, seg: dict) -> dict:
     return seg
 
 
-def apply_project(doc, data: dict, path) -> list[str]:
+def apply_project(doc, data: dict, path, *, reset: bool = False) -> list[str]:
     """Load a read project's files and state into ``doc`` (after its volume, if any, is loaded).
 
     Every data file is read before the document is touched, so a bad file
-    (FormatError, naming it) leaves the document as it was. Returns warnings
+    (FormatError, naming it) leaves the document as it was; ``reset`` empties it
+    first (a project without a volume or demo is a new document too). Returns warnings
     for the user (the previous save was used, settings refused, points added).
     """
     warnings = list(data.get("warnings") or [])
-    skeleton = io.read_mskel(data["mskel"]) if data.get("mskel") and doc.skeleton is None else None
+    fresh = reset or doc.skeleton is None
+    skeleton = io.read_mskel(data["mskel"]) if data.get("mskel") and fresh else None
     bones = io.read_bones(data["bones"]) if data.get("bones") else None
     conn = io.read_connect(data["connect"]) if data.get("connect") else None
+    if reset:  # a new document, once every file has been read
+        doc.reset()
     if skeleton is not None:
         doc.set_skeleton(skeleton, data["mskel"])
     elif data.get("mskel"):

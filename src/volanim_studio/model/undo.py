@@ -21,6 +21,9 @@ class Command:
     merge_key: str | None = None  # consecutive commands with this key become one step (a slider drag)
 
 
+_UNREACHABLE = object()  # a clean marker no stack top can ever be
+
+
 class UndoStack:
     """Bounded history; pushing after undos drops the redo branch."""
 
@@ -30,6 +33,28 @@ class UndoStack:
         self._undone: list[Command] = []
         self.events = EventEmitter("changed")
         self.edits = 0  # monotonically counts pushes, undos and redos (autosave watches it)
+        self._clean_top: object = None  # the command on top when the document was last saved or opened
+
+    # The document is unmodified when the command on top is the one that was on top when it was
+    # saved (None: an empty stack). Undoing back to the saved state makes it unmodified again,
+    # like QUndoStack's clean index; an edit merged into the top command replaces it, so it counts.
+    def mark_clean(self) -> None:
+        """The document was saved or opened: this state is unmodified."""
+        self._clean_top = self._top
+        self.events.changed.emit()
+
+    def mark_modified(self) -> None:
+        """This state is saved nowhere (a restored autosave): modified until saved."""
+        self._clean_top = _UNREACHABLE
+        self.events.changed.emit()
+
+    @property
+    def is_clean(self) -> bool:
+        return self._top is self._clean_top
+
+    @property
+    def _top(self) -> Command | None:
+        return self._done[-1] if self._done else None
 
     def push(self, command: Command) -> None:
         top = self._done[-1] if self._done else None
@@ -40,7 +65,10 @@ class UndoStack:
             return
         command.redo()
         self._done.append(command)
-        del self._done[: -self.limit]
+        if len(self._done) > self.limit:
+            if self._clean_top is None or self._clean_top is self._done[0]:
+                self._clean_top = _UNREACHABLE  # the saved state fell off the bottom
+            del self._done[: -self.limit]
         self._undone.clear()
         self._changed()
 
@@ -67,10 +95,14 @@ class UndoStack:
         if self._done and self._done[-1].merge_key:
             top = self._done[-1]
             self._done[-1] = Command(top.label, top.redo, top.undo, None)
+            if self._clean_top is top:
+                self._clean_top = self._done[-1]
 
     def clear(self) -> None:
+        """Forget the history; the state it leaves is modified unless :meth:`mark_clean` follows."""
         self._done.clear()
         self._undone.clear()
+        self._clean_top = _UNREACHABLE
         self._changed()
 
     @property

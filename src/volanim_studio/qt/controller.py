@@ -20,6 +20,16 @@ class Controller:
         self.jobs = window.jobs
         self.show_error = window.show_error
 
+    def folder(self, name: str = "") -> str:
+        """Where a file dialog opens: the project's folder (else the volume's, the skeleton's, the
+        working directory), with ``name`` as the suggested file."""
+        from pathlib import Path
+
+        d = self.doc
+        known = next((p for p in (d.project_path, d.volume_path, d.mskel_path) if p), None)
+        where = Path(known).resolve().parent if known else Path.cwd()
+        return str(where / name) if name else str(where)
+
     def attempt(self, title: str, action: Callable[[], Any], done: str | Callable[[Any], str] | None = None):
         """Run ``action()``: a bad file, a full disk or a refused value is shown under ``title`` (the
         document stays as it was) and :data:`FAILED` returned; otherwise ``done`` (a message, or a

@@ -57,13 +57,14 @@ class FilesController(Controller):
 
     def view_file_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
-            self.window, "View volume or mesh", "",
+            self.window, "View volume or mesh", self.folder(),
             "Volumes and meshes (*.vti *.nrrd *.nii *.nii.gz *.mha *.VOL *.vol *.ply *.vtp *.obj *.stl);;All files (*)")
         if path:
             self.view_file(path)
 
     # -------------------------------------------------------------- loading
     def _apply_prepared(self, result: dict, path=None, spacing=None, dims=None) -> None:
+        self.doc.reset()  # a new volume is a new document: nothing of the old project stays
         self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),
                             path=path, segmentation=result["segmentation"], dims=dims)
         self.doc.set_skeleton(result["skeleton"], result.get("skeleton_path"))
@@ -94,8 +95,12 @@ class FilesController(Controller):
             lambda r: self._apply_prepared(r, path=path, spacing=loaded["spacing"], dims=dims))
 
     def open_volume_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", "", "Volumes (*.vol *.VOL *.vti *.nrrd *.nii "
-                                              "*.nii.gz *.mha *.mhd);;All files (*)")
+        self.window.when_saved_or_discarded(self._ask_volume, "opening another volume")
+
+    def _ask_volume(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", self.folder(),
+                                              "Volumes (*.vol *.VOL *.vti *.nrrd *.nii *.nii.gz *.mha *.mhd);;"
+                                              "All files (*)")
         if path:
             self.open_volume(path)
 
@@ -129,8 +134,8 @@ class FilesController(Controller):
             done(False)
             return None
 
-        def rest(_=None):
-            warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path))
+        def rest(_=None, reset=False):
+            warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path, reset=reset))
             if warnings is FAILED:
                 done(False)
                 return
@@ -138,6 +143,7 @@ class FilesController(Controller):
                 self.show_error("Open project", "\n".join(warnings))
             if data.get("camera"):
                 self.scene.set_camera(data["camera"])
+            self.doc.undo.mark_clean()  # as saved: loading its bones is not an edit to save
             self.doc.message(f"Opened {Path(path).name}.")
             done(True)
 
@@ -155,7 +161,7 @@ class FilesController(Controller):
             worker.failed.connect(lambda *_: done(False))
             worker.was_cancelled.connect(lambda: done(False))
             return worker
-        rest()
+        rest(reset=True)  # a project of bones alone: still a new document
         return None
 
     def open_connect(self, path) -> bool:
@@ -172,7 +178,7 @@ class FilesController(Controller):
         if path is None:
             stem = Path(self.doc.project_path or "untitled").with_suffix("").name
             default = self.doc.attachments.default_filename(stem)
-            path, _ = QFileDialog.getSaveFileName(self.window, "Save connectivity", default, "Connectivity (*.connect)")
+            path, _ = QFileDialog.getSaveFileName(self.window, "Save connectivity", self.folder(default), "Connectivity (*.connect)")
             if not path:
                 return None
         n = self.attempt("Save connectivity", lambda: self.doc.attachments.save(path),
@@ -180,9 +186,16 @@ class FilesController(Controller):
         return None if n is FAILED else Path(path)
 
     def open_dialog(self, kind: str) -> None:
+        if kind == "project":
+            self.window.when_saved_or_discarded(lambda: self._ask_open(kind), "opening another project")
+        else:
+            self._ask_open(kind)
+
+    def _ask_open(self, kind: str) -> None:
         filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
                    "connect": "Connectivity (*.connect)", "connections": "Connections (*.connections)"}
-        path, _ = QFileDialog.getOpenFileName(self.window, f"Open {kind}", "", f"{filters[kind]};;All files (*)")
+        path, _ = QFileDialog.getOpenFileName(self.window, f"Open {kind}", self.folder(),
+                                              f"{filters[kind]};;All files (*)")
         if path:
             {"mskel": self.open_mskel, "bones": self.open_bones, "project": self.open_project,
              "connect": self.open_connect, "connections": self.open_connections}[kind](path)
@@ -192,7 +205,7 @@ class FilesController(Controller):
         if path is None:
             path = self.doc.project_path
             if ask or not path:
-                path, _ = QFileDialog.getSaveFileName(self.window, "Save project", "session.volanim",
+                path, _ = QFileDialog.getSaveFileName(self.window, "Save project", self.folder("session.volanim"),
                                                       "Projects (*.volanim)")
                 if not path:
                     return None
@@ -210,7 +223,7 @@ class FilesController(Controller):
             self.save_connect()
             return
         filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
-        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", f"untitled.{kind}", filters[kind])
+        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", self.folder(f"untitled.{kind}"), filters[kind])
         if not path:
             return
         if kind == "bones":

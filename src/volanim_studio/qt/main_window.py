@@ -115,7 +115,11 @@ class MainWindow(QMainWindow):
         self.doc.events.attachments.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.events.bones.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.undo.events.changed.connect(self._on_undo_changed)
-        self.doc.events.project.connect(lambda path: self.setWindowTitle(f"volanim studio — {Path(path).name}"))
+        self.doc.events.project.connect(self._update_title)
+        self.doc.events.skeleton.connect(self._update_title)
+        self.doc.undo.events.changed.connect(self._update_title)
+        self._close_confirmed = False
+        self._save_box: QMessageBox | None = None
         self.autosaver = autosave.Autosaver(self.doc, every_edits=autosave_every_edits,
                                             every_seconds=autosave_seconds)
         self.doc.undo.events.changed.connect(self._autosave_after_edit)
@@ -123,6 +127,7 @@ class MainWindow(QMainWindow):
         self.autosave_timer.timeout.connect(self._autosave_tick)
         self.autosave_timer.start(int(1000 * min(autosave_seconds, 60.0)))
         self.set_mode(Mode.VIEW)
+        self._update_title()
 
     # ------------------------------------------------------------ autosave
     def _autosave_after_edit(self, **_) -> None:
@@ -163,7 +168,8 @@ class MainWindow(QMainWindow):
                 self.doc.message(f"The autosave in {latest.parent} was not restored; it is kept.")
                 return
             self.doc.project_path = None  # a restored session saves where the user says, not into the cache
-            self.setWindowTitle("volanim studio — restored")
+            self.doc.undo.mark_modified()  # it is saved nowhere yet
+            self._update_title()
             try:
                 self.autosaver.save()  # what was restored is safe in this session's folder ...
             except (OSError, ValueError) as exc:
@@ -174,6 +180,54 @@ class MainWindow(QMainWindow):
             self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones).")
 
         return self.files.open_project(latest, on_opened=opened)
+
+    # ------------------------------------------------------ unsaved changes
+    def _update_title(self, **_) -> None:
+        """``volanim studio — NAME[*]``: Qt shows the ``*`` while the document has unsaved edits."""
+        path = self.doc.project_path
+        name = Path(path).name if path else (None if self.doc.is_empty else "untitled")
+        self.setWindowTitle("volanim studio" + (f" — {name}" if name else "") + "[*]")
+        self.setWindowModified(self.doc.modified)
+
+    def when_saved_or_discarded(self, then, doing: str) -> None:
+        """Run ``then()`` once unsaved edits are saved or discarded; at once when there are none.
+
+        Asks Save / Discard / Cancel without blocking (the window's event loop keeps
+        running, so a job in flight still reports). Discarded edits are set aside for a
+        week in the autosave folder, so a wrong answer loses nothing.
+        """
+        if not self.doc.modified:
+            then()
+            return
+        name = Path(self.doc.project_path).name if self.doc.project_path else "This project"
+        box = QMessageBox(QMessageBox.Warning, "Save changes?",
+                          f"{name} has unsaved changes. Save them before {doing}?",
+                          QMessageBox.Save | QMessageBox.Discard | QMessageBox.Cancel, self)
+        box.setInformativeText("Discarded changes are kept for a week in the autosave folder "
+                               f"({self.autosaver.root}); they can be opened as a project.")
+        box.setDefaultButton(QMessageBox.Save)
+
+        def answered(_result) -> None:
+            self._save_box = None
+            button = box.standardButton(box.clickedButton()) if box.clickedButton() else QMessageBox.Cancel
+            if button == QMessageBox.Save:
+                if self.files.save_project() is None:
+                    return  # not saved (the user cancelled the file dialog, or it failed and said why)
+            elif button == QMessageBox.Discard:
+                try:
+                    kept = self.autosaver.set_aside()
+                except (OSError, ValueError) as exc:
+                    self.show_error("Discard changes", f"The discarded changes could not be set aside ({exc}); "
+                                    "nothing was discarded.")
+                    return
+                self.doc.message(f"Discarded changes are kept in {kept}.")
+            else:
+                return
+            then()
+
+        box.finished.connect(answered)
+        self._save_box = box
+        box.open()
 
     # ------------------------------------------------------------- actions
     def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:
@@ -356,10 +410,19 @@ class MainWindow(QMainWindow):
         """A background job is running (its thread has not ended yet)."""
         return self.jobs.busy
 
+    def _close_now(self) -> None:
+        self._close_confirmed = True
+        self.close()
+
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
 
     def closeEvent(self, event):  # noqa: N802 (Qt name)
+        if self.doc.modified and not self._close_confirmed:
+            event.ignore()  # ask first; close again once the edits are saved or set aside
+            if self._save_box is None:
+                self.when_saved_or_discarded(self._close_now, "closing")
+            return
         self.timeline.stop()
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
         self.autosave_timer.stop()

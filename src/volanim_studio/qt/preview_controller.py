@@ -194,7 +194,7 @@ class PreviewController(Controller):
 
     # -------------------------------------------------------------- dialogs
     def load_trans_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Open pose", "", "Poses (*.trans);;All files (*)")
+        path, _ = QFileDialog.getOpenFileName(self.window, "Open pose", self.folder(), "Poses (*.trans);;All files (*)")
         if path:
             self.load_trans(path)
 
@@ -203,7 +203,7 @@ class PreviewController(Controller):
         filters = {"trans": "Poses (*.trans)", "tskel": "Frames (*.tskel)",
                    "volume": "Volumes (*.vti *.nrrd *.VOL *.vol)"}
         default = {"trans": "pose.trans", "tskel": "pose.tskel", "volume": "preview.vti"}[kind]
-        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", default, filters[kind])
+        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", self.folder(default), filters[kind])
         if not path:
             return
         if kind == "volume":

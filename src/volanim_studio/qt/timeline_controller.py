@@ -167,7 +167,7 @@ class TimelineController(Controller):
         return True
 
     def load_bvh_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Load a motion-capture clip", "",
+        path, _ = QFileDialog.getOpenFileName(self.window, "Load a motion-capture clip", self.folder(),
                                               "BVH clips (*.bvh *.BVH);;All files (*)")
         if path:
             self.load_bvh(path, ask=lambda d: d.exec() == QDialog.Accepted)
@@ -181,7 +181,7 @@ class TimelineController(Controller):
         return True
 
     def load_trans_dialog(self) -> None:
-        folder = QFileDialog.getExistingDirectory(self.window, "Folder of .trans frames")
+        folder = QFileDialog.getExistingDirectory(self.window, "Folder of .trans frames", self.folder())
         if folder:
             self.load_trans(folder)
 
@@ -238,7 +238,7 @@ class TimelineController(Controller):
             lambda paths: self.doc.message(f"Wrote {len(paths)} frames to {folder} ({paths[0].name} …)."))
 
     def export_dialog(self, *, tskel: bool) -> None:
-        folder = QFileDialog.getExistingDirectory(self.window, "Folder for the frames")
+        folder = QFileDialog.getExistingDirectory(self.window, "Folder for the frames", self.folder())
         if folder:
             self.export(folder, tskel=tskel)
 
@@ -253,7 +253,7 @@ class TimelineController(Controller):
         self.attempt("Save view as camera file", lambda: io.write_camera(path, cam), f"Saved the view to {path}.")
 
     def save_camera_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self.window, "Save view as camera file", "view.camera",
+        path, _ = QFileDialog.getSaveFileName(self.window, "Save view as camera file", self.folder("view.camera"),
                                               "Camera files (*.camera)")
         if path:
             self.save_camera(path)

@@ -166,6 +166,12 @@ class SceneView:
         self._press = self.event_position()
 
     def _on_release(self, obj, event) -> None:
+        if event.startswith("Right"):
+            # pyvista hangs release observers on the style, and a style with an observer for an event
+            # skips its own handler: without this the camera stays in dolly after a right click,
+            # zooming on every mouse move and swallowing the next left click. (pyvista's own left
+            # release observer calls OnLeftButtonUp itself.)
+            self.plotter.iren.style.OnRightButtonUp()
         if self._press is None:
             return
         x, y = self.event_position()

@@ -1,0 +1,109 @@
+"""One document per project in the real window: the modified marker, "Save changes?" on close and
+before opening another volume, and nothing lost either way (issue #18)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtWidgets import QMessageBox
+
+from paths import ASSETS
+from volanim_core import io
+from volanim_studio.model import autosave
+from volanim_studio.model.project import read_project
+
+from ..conftest import JOB_TIMEOUT_MS
+
+pytestmark = pytest.mark.gui
+
+
+def _answer(qtbot, window, button) -> None:
+    """Click ``button`` of the window's "Save changes?" box (which must be showing)."""
+    qtbot.waitUntil(lambda: window._save_box is not None and window._save_box.isVisible(), timeout=5000)
+    window._save_box.button(button).click()
+
+
+def _rename_a_joint(window) -> None:
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    window.doc.undo.mark_clean()  # as if the bones came with the project
+    window.doc.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")
+
+
+def test_an_edit_marks_the_window_modified_and_undo_back_to_the_saved_state_clears_it(window, tmp_path):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    path = window.files.save_project(path=tmp_path / "man.volanim")
+    assert not window.isWindowModified() and window.windowTitle() == "volanim studio — man.volanim[*]"
+    window.doc.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")
+    assert window.isWindowModified()
+    window.undo()
+    assert not window.isWindowModified()
+    window.redo()
+    assert window.isWindowModified()
+    assert path.exists()
+
+
+def test_closing_with_unsaved_edits_asks_and_cancel_keeps_the_window(qtbot, window):
+    _rename_a_joint(window)
+    window.close()
+    _answer(qtbot, window, QMessageBox.Cancel)
+    assert window.isVisible() and "L_KNUCKLE" in window.doc.bones.joints
+
+
+def test_discarded_edits_are_set_aside_for_a_week_not_deleted(qtbot, window, recovery_dir):
+    """Rename a joint, Ctrl+Q: the clean exit deleted the autosave and the rename was gone."""
+    _rename_a_joint(window)
+    window.close()
+    _answer(qtbot, window, QMessageBox.Discard)
+    qtbot.waitUntil(lambda: not window.isVisible(), timeout=5000)
+    kept = list(recovery_dir.glob("*-discarded/recovery.volanim"))
+    assert len(kept) == 1 and (kept[0].parent / autosave.DECLINED).exists()
+    assert "L_KNUCKLE" in io.read_bones(read_project(kept[0])["bones"]).joints
+    assert autosave.find_recoveries(recovery_dir) == []  # kept, but not offered as a crash
+    assert not window.autosaver.folder.exists()  # the session's own folder went as before
+
+
+def test_save_from_the_close_prompt_saves_then_closes(qtbot, window, tmp_path):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    path = window.files.save_project(path=tmp_path / "man.volanim")
+    window.doc.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")
+    window.close()
+    _answer(qtbot, window, QMessageBox.Save)
+    qtbot.waitUntil(lambda: not window.isVisible(), timeout=5000)
+    assert "L_KNUCKLE" in io.read_bones(read_project(path)["bones"]).joints
+
+
+def test_a_new_volume_is_a_new_document_and_the_old_project_is_untouched(qtbot, window, tmp_path):
+    """Open man.volanim, open another volume, save: the mannequin's bones floated over the new volume,
+    the title kept man.volanim and Ctrl+S overwrote man.volanim with the new volume."""
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    window.doc.attachments.auto(scope="all")
+    man = window.files.save_project(path=tmp_path / "man.volanim")
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    vol = np.zeros((40, 30, 30), np.uint8)
+    vol[5:35, 5:25, 5:25] = 200
+    io.write_volume(tmp_path / "box.VOL", vol)
+    assert not window.doc.modified
+    window.files.open_volume(tmp_path / "box.VOL", params={"lo": 1, "hi": None, "fill": True})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    doc = window.doc
+    assert len(doc.bones) == 0 and doc.project_path is None and not doc.undo.can_undo
+    assert (doc.attachments.bone == -1).all() and doc.pose.is_rest
+    assert window.windowTitle() == "volanim studio — untitled[*]" and not window.isWindowModified()
+    box = window.files.save_project(path=tmp_path / "box.volanim")  # Ctrl+S asks where: no path is known
+    assert {p: p.read_bytes() for p in before} == before  # man.volanim and its files untouched
+    assert window.windowTitle() == "volanim studio — box.volanim[*]"
+    assert read_project(box).get("bones") is None  # (a project without bones was saved with an empty,
+    window.files.open_project(box)  # unreadable .bones file and could not be reopened)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    assert window.last_error is None and len(window.doc.bones) == 0 and window.doc.skeleton is not None
+
+
+def test_opening_another_volume_with_unsaved_edits_asks_first(qtbot, window):
+    _rename_a_joint(window)
+    asked = []
+    window.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
+    _answer(qtbot, window, QMessageBox.Cancel)
+    assert asked == [] and "L_KNUCKLE" in window.doc.bones.joints
+    window.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
+    _answer(qtbot, window, QMessageBox.Discard)
+    assert asked == ["went on"]

@@ -1,0 +1,40 @@
+"""Camera navigation in the real window: buttons, presets, keys (issue #18)."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QPoint, Qt
+
+import pytest
+
+from volanim_core import samples
+from volanim_studio.model.modes import Mode
+
+from ..conftest import click, clickable_point
+
+
+pytestmark = pytest.mark.gui
+J = samples.mannequin_bones().joints
+
+
+def _style_state(window) -> int:
+    return window.plotter.iren.style.GetState()
+
+
+def test_right_click_leaves_the_camera_idle_and_the_next_left_click_counts(qtbot, window):
+    """The release observer replaced the style's own: the camera stayed in dolly (state 4), zooming on
+    every mouse move, and the next joint click was swallowed."""
+    w = window.plotter
+    cam = window.plotter.renderer.GetActiveCamera()
+    window.set_mode(Mode.BONES)
+    a = clickable_point(window, J["L_SHOULDER"])
+    click(qtbot, window, window.scene.display_of_point(a))
+    click(qtbot, window, window.scene.display_of_point(a), button=Qt.RightButton)  # ends the chain
+    assert _style_state(window) == 0
+    before = cam.GetPosition()
+    qtbot.mouseMove(w, QPoint(w.width() // 2, w.height() // 3))
+    qtbot.mouseMove(w, QPoint(w.width() // 2, w.height() // 4))
+    assert cam.GetPosition() == before, "moving the mouse after a right click must not zoom"
+    b, c = clickable_point(window, J["R_SHOULDER"]), clickable_point(window, J["R_ELBOW"])
+    click(qtbot, window, window.scene.display_of_point(b))
+    click(qtbot, window, window.scene.display_of_point(c))
+    assert len(window.doc.bones) == 1, "the first left click after a right click was swallowed"
