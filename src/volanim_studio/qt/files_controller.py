@@ -178,7 +178,8 @@ class FilesController(Controller):
         if path is None:
             stem = Path(self.doc.project_path or "untitled").with_suffix("").name
             default = self.doc.attachments.default_filename(stem)
-            path, _ = QFileDialog.getSaveFileName(self.window, "Save connectivity", self.folder(default), "Connectivity (*.connect)")
+            path, _ = QFileDialog.getSaveFileName(self.window, "Save connectivity", self.folder(default),
+                                                  "Connectivity (*.connect)")
             if not path:
                 return None
         n = self.attempt("Save connectivity", lambda: self.doc.attachments.save(path),
@@ -223,7 +224,8 @@ class FilesController(Controller):
             self.save_connect()
             return
         filters = {"bones": "Bones (*.bones)", "connections": "Connections (*.connections)", "png": "PNG (*.png)"}
-        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", self.folder(f"untitled.{kind}"), filters[kind])
+        path, _ = QFileDialog.getSaveFileName(self.window, f"Save {kind}", self.folder(f"untitled.{kind}"),
+                                              filters[kind])
         if not path:
             return
         if kind == "bones":

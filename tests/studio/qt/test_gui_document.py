@@ -77,7 +77,7 @@ def test_a_new_volume_is_a_new_document_and_the_old_project_is_untouched(qtbot, 
     the title kept man.volanim and Ctrl+S overwrote man.volanim with the new volume."""
     assert window.files.open_bones(ASSETS / "mannequin.bones")
     window.doc.attachments.auto(scope="all")
-    man = window.files.save_project(path=tmp_path / "man.volanim")
+    window.files.save_project(path=tmp_path / "man.volanim")
     before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
     vol = np.zeros((40, 30, 30), np.uint8)
     vol[5:35, 5:25, 5:25] = 200

@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import QPoint, Qt
-
 import pytest
+from PySide6.QtCore import QPoint, Qt
 
 from volanim_core import samples
 from volanim_studio.model.modes import Mode
 
 from ..conftest import click, clickable_point
-
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
