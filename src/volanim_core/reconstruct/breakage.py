@@ -6,11 +6,21 @@
     identity reconstruction (bone mode): each rest voxel, owned by bone b,
         should reappear at round(v @ M_b) --> lost voxels (a count)
     posed reconstruction --> connected components (26-neighbour) and sizes
+    points lying along another bone than their own, which the pose carries far from
+        where that bone went --> stumps (a piece left behind that stays connected)
 
 Why cracks and not lost voxels rank the joints: points wrongly left on the
 torso stay put as a stump, and their voxels reappear where they were -- nothing
 is "lost" -- but the stump's spheres and the arm's part company: a crack at
 the shoulder, which is where the user must re-attach points.
+
+Why stumps as well: cracks open at every bent joint (the outside of an elbow),
+so their count alone cannot tell a healthy bend from "a part of the upper arm
+fixed to the shoulder while the rest of the arm moves away" (the thesis's
+words). A stump stays one piece with the torso, so the component count misses
+it too. What marks it is geometric: its points lie along the upper arm's
+segment, clearly closer to it than to their own bone's, and the pose puts them
+more than a sphere's diameter away from where the upper arm took that place.
 """
 
 from __future__ import annotations
@@ -22,7 +32,7 @@ from scipy import ndimage
 
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
-from volanim_core.rig.connectivity import Tskel
+from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.pose import apply_matrices
 from volanim_core.rig.tskel import identity_tskel
 
@@ -47,6 +57,7 @@ class BreakageReport:
     joints: list[JointLoss] = field(default_factory=list)
     cracks: int = 0
     pieces: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid) of detached parts
+    stumps: list = field(default_factory=list)  # Stump, largest first
 
     @property
     def loss_percent(self) -> float:
@@ -55,17 +66,105 @@ class BreakageReport:
 
     @property
     def healthy(self) -> bool:
-        return len(self.components) == 1
+        return len(self.components) == 1 and not self.stumps
+
+    @property
+    def verdict(self) -> str:
+        """One line for the status bar: the worst finding first."""
+        if len(self.components) > 1:
+            where = f" (near {self.pieces[0][1]})" if self.pieces else ""
+            return f"BROKEN into {len(self.components)} pieces{where}"
+        if self.stumps:
+            s = self.stumps[0]
+            return f"STUMP left behind near {s.joint}: {s.points} points of {s.attached} lie along {s.lies_along}"
+        return "healthy: one piece, no stump"
 
     def lines(self) -> list[str]:
         out = [f"{len(self.components)} connected component(s)"
-               + ("" if self.healthy else ": " + ", ".join(str(c) for c in self.components[:6]) + " voxels"),
+               + ("" if len(self.components) == 1 else ": " + ", ".join(str(c) for c in self.components[:6])
+                  + " voxels"),
                *(f"detached piece of {n} voxels near {j}" for n, j, _ in self.pieces[:5]),
+               *(s.text() for s in self.stumps[:5]),
                f"{self.posed_voxels} voxels, {self.loss_percent:+.2f} % loss against the rest pose "
                f"({self.lost_voxels} rest voxels not covered in the pose)",
                f"{self.cracks} cracks (sphere pairs of different bones that touched at rest and part in the pose)",
                f"hotspot: up to {self.hotspot_max} spheres on one voxel, mean {self.hotspot_mean:.1f}"]
         return out
+
+
+@dataclass
+class Stump:
+    """Points attached to ``attached`` that lie along ``lies_along`` and were left behind by the pose."""
+
+    points: int
+    joint: str  # the joint nearest to them at rest
+    attached: str
+    lies_along: str
+    posed: np.ndarray  # (K, 3) where the pose put them (their spheres' centres)
+    weight: float  # sum of radius^3: how much volume stays behind, for ranking
+
+    def text(self) -> str:
+        return (f"stump near {self.joint}: {self.points} points attached to {self.attached} lie along "
+                f"{self.lies_along} and stay behind (connect them to {self.lies_along})")
+
+
+def segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 65536) -> np.ndarray:
+    """``(N, B)`` distances from each point to each segment ``a[k]``-``b[k]``."""
+    p = np.asarray(points, np.float64)
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    ab = b - a
+    length2 = np.maximum((ab * ab).sum(1), 1e-12)
+    out = np.empty((len(p), len(a)))
+    for lo in range(0, len(p), chunk):  # bounded temporaries on the frog's 10^5 points
+        d = p[lo:lo + chunk, None, :] - a
+        t = np.clip((d * ab).sum(2) / length2, 0.0, 1.0)
+        out[lo:lo + chunk] = np.linalg.norm(d - t[..., None] * ab, axis=2)
+    return out
+
+
+def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
+    """Points that lie clearly closer to another bone's rest segment than to their own (pose-independent).
+
+    Returns ``(indices, the bone they lie along)``. "Clearly": closer by more than the
+    point's radius, so points near a joint, equally close to both bones, never count.
+    """
+    if not len(conn) or len(conn.bones) < 2:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    a = np.array([b.proximal for b in conn.bones])
+    b = np.array([b.distal for b in conn.bones])
+    d = segment_distances(conn.points, a, b)
+    rows = np.arange(len(d))
+    own = d[rows, conn.bone]
+    d[rows, conn.bone] = np.inf
+    near = d.argmin(1)
+    idx = np.flatnonzero(own > d[rows, near] + conn.dt)
+    return idx, near[idx]
+
+
+def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[Stump]:
+    """Misplaced points the pose carries more than a sphere's diameter from where the bone they lie
+    along went, grouped by (their bone, that bone); largest first.
+
+    ``misplaced``: :func:`misplaced_points` of the same connectivity, when scanning many frames.
+    """
+    idx, along = misplaced_points(tskel) if misplaced is None else misplaced
+    if not len(idx):
+        return []
+    p = tskel.points[idx].astype(np.float64)
+    own = tskel.bone[idx].astype(np.int64)
+    went = apply_matrices(p, own, tskel.matrices)
+    should = apply_matrices(p, along, tskel.matrices)
+    behind = np.linalg.norm(went - should, axis=1) > 2.0 * tskel.dt[idx]
+    names = list(joints)
+    pos = np.array([joints[n] for n in names], np.float64) if names else np.zeros((0, 3))
+    label = [b.name or f"bone {k}" for k, b in enumerate(tskel.bones)]
+    out = []
+    for o, n in sorted({(int(o), int(n)) for o, n in zip(own[behind], along[behind])}):
+        k = np.flatnonzero(behind & (own == o) & (along == n))
+        centre = p[k].mean(0)
+        joint = names[int(((pos - centre) ** 2).sum(1).argmin())] if names else ""
+        out.append(Stump(len(k), joint, label[o], label[n], went[k], float((tskel.dt[idx[k]] ** 3).sum())))
+    return sorted(out, key=lambda s: -s.weight)
 
 
 def components(volume: np.ndarray) -> list[int]:
@@ -186,7 +285,7 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     parts = _components(posed.volume)
     report = BreakageReport([n for n, _ in parts], int(posed.stats["filled"]), int(rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
-                            cracks=len(gaps))
+                            cracks=len(gaps), stumps=stumps(tskel, joints))
     names = list(joints)
     if len(parts) > 1 and names:
         posed_pos = np.array([posed_joints.get(n, joints[n]) for n in names], np.float64)

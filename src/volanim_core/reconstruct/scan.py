@@ -1,7 +1,7 @@
 """Scan a whole animation for breakage: one verdict per frame, so the user jumps to the worst one.
 
     once:       the sphere pairs that touch at rest, the neighbour lists   (pose-independent)
-    per frame:  cracks from the posed sphere centres                        (no voxels: cheap)
+    per frame:  cracks and stumps from the posed sphere centres             (no voxels: cheap)
                 connected components of a ``factor``-times coarser bone reconstruction
 
 The full report (lost voxels, hotspots, detached pieces by joint) stays with
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.progress import Reporter
-from volanim_core.reconstruct.breakage import components, cracks, touching_pairs
+from volanim_core.reconstruct.breakage import components, cracks, misplaced_points, stumps, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.tskel import coarse_tskel, identity_tskel
@@ -32,14 +32,15 @@ class FrameVerdict:
     cracks: int  # sphere pairs of different bones that touched at rest and part here
     gap: float  # their summed opening, voxels
     worst_joint: str  # the joint nearest the widest cracks ('' when none)
+    stump: int = 0  # points left behind along another bone (breakage.stumps), summed
 
     @property
     def healthy(self) -> bool:
-        return self.pieces <= 1 and self.cracks == 0
+        return self.pieces <= 1 and self.cracks == 0 and self.stump == 0
 
     def badness(self) -> tuple:
-        """Sort key, worst first: detached pieces outrank cracks, then how much."""
-        return (-min(self.pieces - 1, 1), -self.detached, -self.gap)
+        """Sort key, worst first: detached pieces outrank stumps, stumps outrank cracks, then how much."""
+        return (-min(self.pieces - 1, 1), -self.detached, -min(self.stump, 1), -self.stump, -self.gap)
 
 
 def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints: dict | None = None,
@@ -53,6 +54,7 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     report = Reporter(progress, cancel)
     rest = identity_tskel(conn)
     pairs = touching_pairs(rest)
+    misplaced = misplaced_points(rest)
     names = list(joints or {})
     near = cKDTree(np.array([joints[n] for n in names], np.float64)) if names else None
     nbrs = sphere_neighbours(coarse_tskel(rest, factor))  # pose-independent: once for the clip
@@ -66,8 +68,10 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
             _, k = near.query(where)
             worst = names[int(np.bincount(k, weights=gaps, minlength=len(names)).argmax())]
         sizes = components(reconstruct(coarse_tskel(posed, factor), mode="bone", neighbours=nbrs, padding=1).volume)
+        behind = stumps(posed, joints or {}, misplaced)
         out.append(FrameVerdict(frame, len(sizes), int(sum(sizes[1:])) * factor ** 3, len(gaps),
-                                float(gaps.sum()), worst))
+                                float(gaps.sum()), worst or (behind[0].joint if behind else ""),
+                                sum(b.points for b in behind)))
     report(len(frames), len(frames))
     return out
 

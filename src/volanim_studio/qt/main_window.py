@@ -32,6 +32,7 @@ from .preview_controller import PreviewController
 from .reconstruct_panel import ReconstructPanel
 from .timeline_controller import TimelineController
 from .timeline_panel import TimelinePanel
+from .verdict_label import VerdictLabel
 from .worker import JobRunner, Worker
 
 SHORTCUTS = [
@@ -108,6 +109,8 @@ class MainWindow(QMainWindow):
         timeline_dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
         self.addDockWidget(Qt.BottomDockWidgetArea, timeline_dock)
         self.point_label = QLabel("")
+        self.verdict_label = VerdictLabel(self.doc)
+        self.statusBar().addPermanentWidget(self.verdict_label)
         self.statusBar().addPermanentWidget(self.point_label)
         self._build_actions()
         self.doc.events.message.connect(lambda text: self.statusBar().showMessage(text, 15000))

@@ -17,6 +17,7 @@ from PySide6.QtWidgets import (
 )
 
 from ..model.document import Document
+from .verdict_label import VerdictLabel
 
 
 class PosePanel(QWidget):
@@ -57,11 +58,14 @@ class PosePanel(QWidget):
         files = QHBoxLayout()
         for b in (self.load_trans, self.save_trans, self.save_tskel):
             files.addWidget(b)
+        self.verdict = VerdictLabel(doc)
+        self.verdict.setWordWrap(True)
         layout = QVBoxLayout(self)
         layout.addWidget(self.bone_label)
         layout.addWidget(box)
         layout.addLayout(buttons)
         layout.addLayout(files)
+        layout.addWidget(self.verdict)
         layout.addStretch(1)
         self.reset_bone.clicked.connect(self._reset_bone)
         self.reset_all.clicked.connect(lambda: doc.pose.reset())

@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
 )
 
 from ..model.document import Document
+from .verdict_label import verdict_html
 from ..model.settings import PREVIEW_MODES
 from .bindings import bind
 
@@ -83,12 +84,16 @@ class ReconstructPanel(QWidget):
         if p is None or p.report is None:
             return
         r = p.report
-        verdict = "healthy: one piece" if r.healthy else "BROKEN into pieces"
-        self.report.setText(f"<b>{verdict}</b><br>" + "<br>".join(r.lines()))
+        self.report.setText(verdict_html(r) + "<br>" + "<br>".join(r.lines()))
         self.joints.clear()
         for size, joint, _ in r.pieces:
             item = QListWidgetItem(f"detached piece: {size} voxels near {joint}")
             item.setData(Qt.UserRole, joint)
+            self.joints.addItem(item)
+        for s in r.stumps:
+            item = QListWidgetItem(f"stump: {s.points} points of {s.attached} near {s.joint} "
+                                   f"(connect them to {s.lies_along})")
+            item.setData(Qt.UserRole, s.joint)
             self.joints.addItem(item)
         total = max(sum(j.gap for j in r.joints), 1e-9)
         for j in r.joints:

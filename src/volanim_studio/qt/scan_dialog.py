@@ -5,7 +5,7 @@ from __future__ import annotations
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QDialog, QLabel, QTableWidget, QTableWidgetItem, QVBoxLayout
 
-COLUMNS = ("frame", "pieces", "detached voxels", "cracks", "gap (voxels)", "worst joint")
+COLUMNS = ("frame", "pieces", "detached voxels", "stump points", "cracks", "gap (voxels)", "worst joint")
 
 
 class ScanDialog(QDialog):
@@ -32,11 +32,11 @@ class ScanDialog(QDialog):
         self.frames = [v.frame for v in verdicts]
         bad = sum(not v.healthy for v in verdicts)
         self.summary.setText(f"{len(verdicts)} frames scanned (half-resolution pieces, exact cracks); {bad} with "
-                             "cracks or detached pieces. Double-click a frame to show it, then F5 for its full report.")
+                             "cracks, stumps or detached pieces. Double-click a frame to show it, then F5 for its full report.")
         self.table.setRowCount(len(verdicts))
         for row, v in enumerate(verdicts):
-            cells = (label(v.frame), v.pieces, v.detached, v.cracks, f"{v.gap:.1f}", v.worst_joint or "—")
+            cells = (label(v.frame), v.pieces, v.detached, v.stump, v.cracks, f"{v.gap:.1f}", v.worst_joint or "—")
             for col, value in enumerate(cells):
                 item = QTableWidgetItem(str(value))
-                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter if col < 5 else Qt.AlignLeft | Qt.AlignVCenter)
+                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter if col < 6 else Qt.AlignLeft | Qt.AlignVCenter)
                 self.table.setItem(row, col, item)

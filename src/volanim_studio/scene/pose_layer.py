@@ -16,6 +16,9 @@ from volanim_core.render.surfaces import label_surface
 from volanim_core.render.transfer import apply_labels, binary_view, volume_style
 
 
+STUMP_COLOUR = "#ff3030"
+
+
 def bone_lines(segments: np.ndarray) -> pv.PolyData:
     """One line cell per ``(proximal, distal)`` world segment, ``segments`` shaped ``(n, 2, 3)``."""
     n = len(segments)
@@ -31,9 +34,11 @@ class PoseLayer:
         self.preview_actor = None
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
         view.doc.events.pose.connect(self.on_pose_changed)
+        view.doc.events.preview.connect(self.on_report)
 
     def on_pose_changed(self, **_) -> None:
         view = self.view
+        view.plotter.remove_actor("stumps", render=False)  # they were where the previous pose put them
         if not view.posing:
             return
         view.plotter.remove_actor("posed_bones", render=False)
@@ -44,6 +49,23 @@ class PoseLayer:
             poly.cell_data["rgb"] = label_table(len(bones))[1:]
             view.plotter.add_mesh(poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True,
                                   name="posed_bones", render=False, reset_camera=False)
+        view.render()
+
+    def on_report(self, **_) -> None:
+        """Mark the last full preview's stumps in 3-D (red), where the pose left them; a pose
+        change hides the marks until the next report."""
+        view = self.view
+        p = view.doc.preview
+        if p is not None and p.report is None:
+            return  # a live preview: the marks of the last report stay until the pose changes
+        view.plotter.remove_actor("stumps", render=False)
+        stumps = [] if p is None else p.report.stumps
+        if stumps:
+            centres = view.world(np.vstack([s.posed for s in stumps])).astype(np.float32)
+            view.plotter.add_mesh(pv.PolyData(centres), color=STUMP_COLOUR, point_size=12,
+                                  render_points_as_spheres=True, name="stumps", render=False, reset_camera=False,
+                                  pickable=False)
+        view.apply_stage()
         view.render()
 
     def _image(self, volume, origin_voxels, spacing_voxels) -> pv.ImageData:

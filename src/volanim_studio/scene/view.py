@@ -39,7 +39,7 @@ class SceneView:
     """
 
     EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube")
-    POSE_ACTORS = ("preview", "posed_bones", "slices")
+    POSE_ACTORS = ("preview", "posed_bones", "slices", "stumps")
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
         self.plotter = plotter

@@ -7,8 +7,8 @@ import pytest
 
 from paths import ASSETS
 from volanim_core import io, samples
-from volanim_core.reconstruct.breakage import breakage_report, components
-from volanim_core.rig.connectivity import Connectivity, Trans
+from volanim_core.reconstruct.breakage import breakage_report, components, misplaced_points, stumps
+from volanim_core.rig.connectivity import Connectivity, RootBone, Trans
 from volanim_core.rig.pose import local_motion, pose_matrices, posed_joints, root_bones, scaled
 from volanim_core.rig.tskel import connect_to_tskel
 
@@ -47,6 +47,40 @@ def test_wrong_shoulder_connectivity_is_reported_at_the_shoulder(man):
     assert not r.healthy and len(r.components) == 2
     assert r.pieces[0][1] == "L_SHOULDER" and "near L_SHOULDER" in "\n".join(r.lines())
     assert r.joints[0].name == "L_SHOULDER"
+
+
+def test_a_stump_that_stays_one_piece_is_not_healthy(man):
+    """Shoulder points left on the torso, arm raised 90 degrees: one component and 59 cracks, and the
+    old report said "healthy" while a piece of the upper arm stayed at the shoulder (issue #18)."""
+    s, conn = man
+    bad, pj = frame(s, shoulder_on_torso(s, conn, radius=12.0), {"L_UPPERARM": (0, -90, 0)})
+    r = breakage_report(bad, s.bones.joints, pj)
+    assert len(r.components) == 1  # what the old verdict looked at
+    assert not r.healthy and r.verdict.startswith("STUMP left behind near L_SHOULDER")
+    st = r.stumps[0]
+    assert (st.attached, st.lies_along, st.joint) == ("SPINE", "L_UPPERARM", "L_SHOULDER")
+    moved = shoulder_on_torso(s, conn, radius=12.0).bone != conn.bone
+    assert moved.sum() / 4 < st.points <= moved.sum()  # those moved onto the torso, less the ones at the joint
+    assert np.linalg.norm(st.posed.mean(0) - s.bones.joints["L_SHOULDER"]) < 12  # where the pose left them
+    assert "stump near L_SHOULDER" in "\n".join(r.lines())
+
+
+@pytest.mark.parametrize("rotations", [{"L_UPPERARM": (0, -90, 0)}, {"L_FOREARM": (90, 0, 0)},
+                                       {"L_THIGH": (90, 0, 0), "R_SHIN": (-90, 0, 0)}, {"SPINE": (0, 0, 45)},
+                                       {"HEAD": (30, 0, 60), "R_UPPERARM": (0, 90, 0), "R_FOREARM": (0, 0, 90)}])
+def test_correct_connectivity_has_no_stump_in_any_pose(man, rotations):
+    s, conn = man
+    t, pj = frame(s, conn, rotations)
+    assert stumps(t, s.bones.joints) == []
+
+
+def test_misplaced_points_ignore_points_near_a_joint():
+    """A point as close to both bones (within its radius) is never counted as lying along the other."""
+    bones = [RootBone([0, 0, 0], [10, 0, 0], "A"), RootBone([10, 0, 0], [20, 0, 0], "B")]
+    pts = np.array([[9.0, 1, 0], [15.0, 1, 0], [18.0, 0, 0]])
+    conn = Connectivity(bones, pts, np.array([2.0, 2.0, 2.0]), None, np.array([0, 0, 1]))
+    idx, along = misplaced_points(conn)
+    assert idx.tolist() == [1] and along.tolist() == [1]  # 5 closer to B than to A, radius 2
 
 
 def test_components_counts_pieces():

@@ -86,6 +86,34 @@ def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
     assert "healthy: one piece" in w.reconstruct_panel.report.text()
 
 
+def test_a_stump_is_the_verdict_in_the_status_bar_the_pose_tab_and_in_3d(qtbot, posed_window):
+    """Shoulder points on the torso, arm raised 90 degrees: one piece, so the report said "healthy"
+    while a piece of the upper arm stayed at the shoulder, and only in the Reconstruct tab (issue #18)."""
+    w = posed_window
+    doc = w.doc
+    ua, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")
+    near = np.flatnonzero((np.linalg.norm(doc.skeleton.points - J["L_SHOULDER"], axis=1) < 12)
+                          & (doc.attachments.bone == ua))
+    doc.attachments.assign(near, spine)
+    doc.select_bones([ua])
+    drag(qtbot, w, 1, range(0, -91, -10))
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    r = w.doc.preview.report
+    assert len(r.components) == 1 and not r.healthy
+    for label in (w.verdict_label, w.pose_panel.verdict):  # where the user is looking
+        assert "STUMP left behind near L_SHOULDER" in label.text() and label.isVisible()
+    assert w.panel_tabs.currentWidget() is w.pose_panel
+    assert "stump" in w.reconstruct_panel.joints.item(0).text()
+    marks = w.plotter.renderer.actors["stumps"]
+    assert marks.GetVisibility() and marks.mapper.GetInput().GetNumberOfPoints() == r.stumps[0].points
+    w.pose_panel.sliders[1].setValue(-80)  # the pose changes: the verdict is stale, the marks go
+    assert "F5 checks again" in w.verdict_label.text() and "stumps" not in w.plotter.renderer.actors
+    doc.attachments.assign(near, ua)  # the fix
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert "healthy: one piece, no stump" in w.verdict_label.text()
+
+
 def test_cancel_preview_leaves_the_gui_responsive(qtbot, posed_window):
     w = posed_window
     w.reconstruct_panel.mode.setCurrentText("sampled")

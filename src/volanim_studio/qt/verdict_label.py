@@ -1,0 +1,43 @@
+"""The breakage verdict of the last full preview, shown where the user looks (status bar, Pose tab).
+
+    doc.events.preview (with a report) --> the verdict, coloured
+    doc.events.pose --> the same words, greyed: the pose changed since (F5 checks again)
+"""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import QLabel
+
+from ..model.document import Document
+
+COLOURS = {"healthy": "#2e9d4f", "broken": "#d33c3c", "stale": "#8a8a8a"}
+
+
+def verdict_html(report) -> str:
+    """The report's verdict in colour: green when healthy, red for pieces or a stump."""
+    colour = COLOURS["healthy" if report.healthy else "broken"]
+    return f"<b style='color:{colour}'>{report.verdict}</b>"
+
+
+class VerdictLabel(QLabel):
+    def __init__(self, doc: Document, parent=None):
+        super().__init__("", parent)
+        self.doc = doc
+        self._report = None
+        self.setToolTip("The breakage verdict of the last full preview (F5); the Reconstruct tab has the report.")
+        doc.events.preview.connect(self._on_preview)
+        doc.events.pose.connect(self._on_pose)
+
+    def _on_preview(self, **_) -> None:
+        p = self.doc.preview
+        if p is None:
+            self._report = None
+            self.setText("")
+        elif p.report is not None:
+            self._report = p.report
+            self.setText(verdict_html(p.report))
+
+    def _on_pose(self, **_) -> None:
+        if self._report is not None:
+            self.setText(f"<span style='color:{COLOURS['stale']}'>{self._report.verdict} "
+                         "(before the last pose change: F5 checks again)</span>")
