@@ -199,7 +199,8 @@ class BoneEdits:
                 t = symmetry.mirror_name(j)
                 if t != j:
                     new.joints[t] = symmetry.snap(pts, symmetry.mirror_point(new.joints[j], self.doc.symmetry_x))
-                    written.append(t)
+                    if t not in written:  # a chain shares joints: each is named once
+                        written.append(t)
                 twin_ends.append(t)
             twin = Bone(twin_ends[0], twin_ends[1], symmetry.mirror_name(b.name) if b.name else "")
             existing = [k for k, x in enumerate(new.bones) if (x.proximal, x.distal) == tuple(twin_ends)]

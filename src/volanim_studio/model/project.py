@@ -38,7 +38,8 @@ from .timeline import Timeline
 
 PROJECT_FORMAT = "volanim project"
 PROJECT_VERSION = 3
-DEFAULT_SEGMENTATION = {"lo": 1, "hi": None, "fill": False, "metric": "euclid", "min_thinness": DEFAULT_MIN_THINNESS}
+DEFAULT_SEGMENTATION = {"lo": 1, "hi": None, "fill": False, "metric": "euclid", "min_thinness": DEFAULT_MIN_THINNESS,
+                        "spacing": None}  # spacing: the voxel size the user confirmed (None: the file's)
 DATA_FILES = ("mskel", "bones", "connect")
 _stored_skeletons: dict = {}  # (store folder, id(skeleton)) -> (skeleton, relative path, sha256): written once
 
@@ -180,6 +181,10 @@ def _checked_segmentation(path, seg: dict) -> dict:
     number("min_thinness")
     if not isinstance(seg["fill"], bool):
         raise FormatError(path, f"\"segmentation\": \"fill\" must be true or false, got {seg['fill']!r}")
+    sp = seg["spacing"]
+    if sp is not None and not (isinstance(sp, list) and len(sp) == 3 and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) and v > 0 for v in sp)):
+        raise FormatError(path, f"\"segmentation\": \"spacing\" must be three positive numbers, got {sp!r}")
     if seg["metric"] not in ("euclid", "345"):
         raise FormatError(path, f"\"segmentation\": \"metric\" must be \"euclid\" or \"345\", got {seg['metric']!r}")
     return seg

@@ -83,6 +83,9 @@ class DisplayPanel(QWidget):
         self.thinness_slider.valueChanged.connect(self._slider_moved)
         self.thinness_slider.sliderPressed.connect(lambda: self.dragging.emit(True))
         self.thinness_slider.sliderReleased.connect(lambda: self.dragging.emit(False))
+        # typed values apply on Enter or focus-out, not per key: "0.7" applied while typing "0.75"
+        # wrote "0.700" back into the box and the "5" was lost
+        self.thinness_spin.setKeyboardTracking(False)
         self.thinness_spin.valueChanged.connect(self._spin_changed)
         doc.events.skeleton.connect(self._on_skeleton_changed)
         doc.events.thinness.connect(self._on_thinness_changed)

@@ -85,14 +85,20 @@ class FilesController(Controller):
         if loaded is FAILED:
             return None
         if params is None:
-            dialog = ThresholdDialog(loaded["volume"], Path(path).name, self.window)
+            dialog = ThresholdDialog(loaded["volume"], Path(path).name, self.window, spacing=loaded["spacing"])
             if dialog.exec() != ThresholdDialog.Accepted:
                 return None
             params = dialog.parameters()
+        params = dict(params)
+        spacing = tuple(float(v) for v in params.pop("spacing", None) or loaded["spacing"])
         vol = loaded["volume"]
+
+        def done(r):
+            r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
+            self._apply_prepared(r, path=path, spacing=spacing, dims=dims)
+
         return self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
-            vol, skeleton_path=skeleton_path, progress=progress, cancel=cancel, **params),
-            lambda r: self._apply_prepared(r, path=path, spacing=loaded["spacing"], dims=dims))
+            vol, skeleton_path=skeleton_path, progress=progress, cancel=cancel, **params), done)
 
     def open_volume_dialog(self) -> None:
         self.window.when_saved_or_discarded(self._ask_volume, "opening another volume")

@@ -19,9 +19,9 @@ from PySide6.QtWidgets import (
 )
 
 from ..model.document import Document
-from .verdict_label import verdict_html
 from ..model.settings import PREVIEW_MODES
 from .bindings import bind
+from .verdict_label import verdict_html
 
 
 class ReconstructPanel(QWidget):

@@ -32,7 +32,8 @@ class ScanDialog(QDialog):
         self.frames = [v.frame for v in verdicts]
         bad = sum(not v.healthy for v in verdicts)
         self.summary.setText(f"{len(verdicts)} frames scanned (half-resolution pieces, exact cracks); {bad} with "
-                             "cracks, stumps or detached pieces. Double-click a frame to show it, then F5 for its full report.")
+                             "cracks, stumps or detached pieces. Double-click a frame to show it, then F5 for its "
+                             "full report.")
         self.table.setRowCount(len(verdicts))
         for row, v in enumerate(verdicts):
             cells = (label(v.frame), v.pieces, v.detached, v.stump, v.cracks, f"{v.gap:.1f}", v.worst_joint or "—")

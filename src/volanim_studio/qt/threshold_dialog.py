@@ -12,6 +12,7 @@ from PySide6.QtWidgets import (
     QDialogButtonBox,
     QDoubleSpinBox,
     QFormLayout,
+    QHBoxLayout,
     QLabel,
     QVBoxLayout,
     QWidget,
@@ -50,7 +51,7 @@ class HistogramWidget(QWidget):
 class ThresholdDialog(QDialog):
     """Choose the object's value range, cavity filling and the skeleton's settings."""
 
-    def __init__(self, volume: np.ndarray, name: str, parent=None):
+    def __init__(self, volume: np.ndarray, name: str, parent=None, spacing=(1.0, 1.0, 1.0)):
         super().__init__(parent)
         self.setWindowTitle(f"Segment {name}")
         vmin, vmax = float(volume.min()), float(volume.max())
@@ -67,12 +68,30 @@ class ThresholdDialog(QDialog):
         self.metric_box.addItems(["euclid", "345"])
         self.min_thinness = QDoubleSpinBox(decimals=2, minimum=-10.0, maximum=10.0, singleStep=0.05)
         self.min_thinness.setValue(DEFAULT_MIN_THINNESS)
+        # the file's voxel size (a raw .vol has none: 1 x 1 x 1); the frog's slices are 1.5 mm apart
+        self.spacing = [QDoubleSpinBox(decimals=3, minimum=0.001, maximum=1e4, singleStep=0.1) for _ in range(3)]
+        spacing_row = QHBoxLayout()
+        for box, value, axis in zip(self.spacing, spacing, "xyz"):
+            box.setValue(float(value))
+            box.setToolTip(f"Size of a voxel along {axis} (mm or any unit; only ratios matter). Read from "
+                           "the file when it says; a raw .vol does not, so check it against the scanner's notes.")
+            spacing_row.addWidget(box)
+        self.lo.setToolTip("Voxels with values from here ...")
+        self.hi.setToolTip("... to here are the object (the orange band of the histogram).")
+        self.fill.setToolTip("Holes inside the object (lungs, a cavity) become object: the skeleton goes "
+                             "through the middle of the body instead of around the hole.")
+        self.metric_box.setToolTip("The distance transform the skeleton's sphere radii come from: exact "
+                                   "Euclidean, or the thesis's 3-4-5 chamfer.")
+        self.min_thinness.setToolTip("Skeleton points thinner than this are not kept. Lower keeps more points "
+                                     "(finer reconstructions, slower studio); the Display tab's slider shows "
+                                     "a prefix of what is kept.")
         form = QFormLayout()
         form.addRow("Object from", self.lo)
         form.addRow("to", self.hi)
         form.addRow(self.fill)
         form.addRow("Distance metric", self.metric_box)
         form.addRow("Keep thinness ≥", self.min_thinness)
+        form.addRow("Voxel spacing x, y, z", spacing_row)
         buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
         buttons.accepted.connect(self.accept)
         buttons.rejected.connect(self.reject)
@@ -92,4 +111,5 @@ class ThresholdDialog(QDialog):
 
     def parameters(self) -> dict:
         return {"lo": self.lo.value(), "hi": self.hi.value(), "fill": self.fill.isChecked(),
-                "metric": self.metric_box.currentText(), "min_thinness": self.min_thinness.value()}
+                "metric": self.metric_box.currentText(), "min_thinness": self.min_thinness.value(),
+                "spacing": [b.value() for b in self.spacing]}

@@ -15,7 +15,6 @@ from volanim_core.render.colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
 from volanim_core.render.transfer import apply_labels, binary_view, volume_style
 
-
 STUMP_COLOUR = "#ff3030"
 
 

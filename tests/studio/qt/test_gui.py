@@ -91,6 +91,8 @@ def test_symmetrize_left_arm_into_right_arm(qtbot, window):
     assert doc.selected_bones == (0, 1)
     qtbot.keyClick(window, Qt.Key_M)
     assert len(doc.bones) == 4
+    # (the message named the shared R_ELBOW twice)
+    assert window.statusBar().currentMessage().startswith("Mirrored to R_SHOULDER, R_ELBOW, R_WRIST across")
     for name in ("SHOULDER", "ELBOW", "WRIST"):
         left, right = doc.bones.joints[f"L_{name}"], doc.bones.joints[f"R_{name}"]
         assert np.allclose(right, [2 * doc.symmetry_x - left[0], left[1], left[2]])
@@ -238,10 +240,43 @@ def test_threshold_dialog_histogram_and_parameters(qtbot):
     dialog.fill.setChecked(False)
     dialog.metric_box.setCurrentText("345")
     assert dialog.parameters() == {"lo": 100, "hi": 240, "fill": False, "metric": "345",
-                                   "min_thinness": 0.5}
+                                   "min_thinness": 0.5, "spacing": [1.0, 1.0, 1.0]}
     dialog.show()
     image = dialog.grab().toImage()  # painting asks QPaintDevice.metric(): it segfaulted while shadowed
     assert image.width() == dialog.width() * image.devicePixelRatio()
+
+
+def test_the_voxel_spacing_is_shown_kept_and_saved(qtbot, tmp_path):
+    """The threshold dialog had no spacing field: a raw .vol's 1.5 mm slices could not be said (issue #18)."""
+    import pyvista as pv
+
+    from volanim_studio.qt.main_window import MainWindow
+    from volanim_studio.qt.threshold_dialog import ThresholdDialog
+
+    vol = np.zeros((30, 20, 16), np.uint8)
+    vol[5:25, 5:15, 4:12] = 200
+    img = pv.ImageData(dimensions=vol.shape, spacing=(1.0, 1.0, 1.5))
+    img.point_data["v"] = vol.ravel(order="F")
+    img.save(tmp_path / "box.vti")
+    dialog = ThresholdDialog(vol, "box.vti", spacing=(1.0, 1.0, 1.5))
+    qtbot.addWidget(dialog)
+    assert [b.value() for b in dialog.spacing] == [1.0, 1.0, 1.5] and dialog.spacing[2].toolTip()
+    dialog.spacing[2].setValue(2.0)
+    params = dialog.parameters()
+    assert params["spacing"] == [1.0, 1.0, 2.0]
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.files.open_volume(tmp_path / "box.vti", params=params)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert w.doc.spacing == (1.0, 1.0, 2.0)
+    path = w.files.save_project(path=tmp_path / "box.volanim")
+    w.close()
+    again = MainWindow()
+    qtbot.addWidget(again)
+    again.files.open_project(path)
+    qtbot.waitUntil(lambda: not again.busy, timeout=JOB_TIMEOUT_MS)
+    assert again.doc.spacing == (1.0, 1.0, 2.0) and again.last_error is None
+    again.close()
 
 
 def test_close_while_a_job_runs_waits_for_it_instead_of_aborting(qtbot):
@@ -290,7 +325,8 @@ def test_reopening_a_project_gives_back_the_skeleton_that_was_connected(qtbot, t
     second.files.open_project(path)
     qtbot.waitUntil(lambda: not second.busy, timeout=JOB_TIMEOUT_MS)
     assert second.doc.skeleton == skeleton and second.doc.skeleton.metric == "345"
-    assert second.doc.segmentation == params and bool(second.doc.mask[20, 15, 15])  # the cavity is filled
+    assert second.doc.segmentation == {**params, "spacing": [1.0, 1.0, 1.0]}
+    assert bool(second.doc.mask[20, 15, 15])  # the cavity is filled
     second.close()
 
 

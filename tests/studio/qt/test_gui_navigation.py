@@ -36,3 +36,14 @@ def test_right_click_leaves_the_camera_idle_and_the_next_left_click_counts(qtbot
     click(qtbot, window, window.scene.display_of_point(b))
     click(qtbot, window, window.scene.display_of_point(c))
     assert len(window.doc.bones) == 1, "the first left click after a right click was swallowed"
+
+
+def test_typing_a_thinness_keeps_every_digit(qtbot, window):
+    """Typing 0.75 gave 0.700: the model wrote 0.7 back into the box mid-typing (issue #18)."""
+    spin = window.display_panel.thinness_spin
+    window.panel_tabs.setCurrentWidget(window.display_panel)
+    spin.setFocus()
+    spin.selectAll()
+    qtbot.keyClicks(spin, "0.75")
+    qtbot.keyClick(spin, Qt.Key_Return)
+    assert spin.text() == "0.750" and window.doc.thinness == 0.75
