@@ -15,7 +15,15 @@ from pathlib import Path
 
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
-from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMessageBox, QTabWidget
+from PySide6.QtWidgets import (
+    QAbstractSpinBox,
+    QDockWidget,
+    QLabel,
+    QLineEdit,
+    QMainWindow,
+    QMessageBox,
+    QTabWidget,
+)
 from pyvistaqt import QtInteractor
 
 from ..model import autosave
@@ -27,6 +35,7 @@ from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .files_controller import FilesController
 from .gui_gc import collect_on_gui_thread
+from .mode_keys import LettersPastNumberFields
 from .pose_panel import PosePanel
 from .preview_controller import PreviewController
 from .reconstruct_panel import ReconstructPanel
@@ -58,6 +67,8 @@ SHORTCUTS = [
     ("Ctrl+S / Ctrl+Shift+S", "Save the project / save it under a new name"),
     ("Ctrl+Q", "Quit (a running job is cancelled and waited for)"),
     ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
+    ("Ctrl+1 / Ctrl+3 / Ctrl+7 / Ctrl+5 / Ctrl+Shift+1", "Front / side / top / three-quarter / back view"),
+    ("F / Shift+F / Ctrl+0", "Frame the selection / frame everything / reset the view"),
     ("F1", "This list"),
 ]
 
@@ -131,6 +142,10 @@ class MainWindow(QMainWindow):
         self.autosave_timer.start(int(1000 * min(autosave_seconds, 60.0)))
         self.set_mode(Mode.VIEW)
         self._update_title()
+        self._letters = LettersPastNumberFields(self)
+        for box in self.findChildren(QAbstractSpinBox):
+            box.installEventFilter(self._letters)
+            box.findChild(QLineEdit).installEventFilter(self._letters)
 
     # ------------------------------------------------------------ autosave
     def _autosave_after_edit(self, **_) -> None:
@@ -288,6 +303,14 @@ class MainWindow(QMainWindow):
         self.previews.wire(self.pose_panel, self.reconstruct_panel)
         self.timeline.fill_menu(bar.addMenu("&Timeline"), self._action)
         view = bar.addMenu("&View")
+        for name, key in (("front", "Ctrl+1"), ("side", "Ctrl+3"), ("top", "Ctrl+7"), ("three-quarter", "Ctrl+5"),
+                          ("back", "Ctrl+Shift+1")):
+            self._action(f"{name.capitalize()} view", lambda _=False, n=name: self.scene.view_preset(n), key, menu=view)
+        view.addSeparator()
+        self._action("Frame all", self.scene.frame_all, "Shift+F", menu=view)
+        self._action("Frame selected", self.frame_selected, "F", menu=view)
+        self._action("Reset view", self.scene.front_view, "Ctrl+0", menu=view)
+        view.addSeparator()
         self._action("Save view as camera file…", lambda: self.timeline.save_camera_dialog(), menu=view)
         self.timeline.wire(self.timeline_panel)
         self.connect_panel.auto_button.clicked.connect(self.auto_connect)
@@ -306,6 +329,8 @@ class MainWindow(QMainWindow):
         self.scene.set_posing(self.mode == Mode.POSE)
         if self.mode == Mode.POSE:
             self.panel_tabs.setCurrentWidget(self.pose_panel)
+        elif self.mode in (Mode.BONES, Mode.ROOT_ORDER):
+            self.panel_tabs.setCurrentWidget(self.bone_panel)
         for a in getattr(self, "cube_actions", []):
             a.setEnabled(self.mode == Mode.CUBE)
         for a in self.timeline.step_actions:  # the arrows nudge the cube in Cube mode, step frames elsewhere
@@ -375,6 +400,10 @@ class MainWindow(QMainWindow):
         self.undo_action.setText(f"Undo {u.undo_label}" if u.can_undo else "Undo")
         self.redo_action.setEnabled(u.can_redo)
         self.redo_action.setText(f"Redo {u.redo_label}" if u.can_redo else "Redo")
+
+    def frame_selected(self) -> None:
+        if not self.scene.frame_selected():
+            self.doc.message("Nothing selected to frame: click a bone or a point first (Shift+F frames everything).")
 
     def symmetrize(self) -> None:
         try:

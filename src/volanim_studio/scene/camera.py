@@ -13,19 +13,34 @@ def composite_matrix(renderer) -> tuple[np.ndarray, tuple[float, float, float, f
     return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)]), (x0, y0, width, height)
 
 
-def front_view(renderer) -> bool:
-    """Look along +y (from the front of a figure facing -y), z up, everything in view.
+def preset_view(renderer, name: str = "front") -> bool:
+    """Look from a named direction (``volanim_core.render.camera.VIEWS``) with everything in view,
+    the object stood up by its shape (``natural_axes``: the frog lies flat, the mannequin stands).
 
     Returns False when nothing is visible (the camera is left alone)."""
+    from volanim_core.render.camera import named_view, natural_axes
+
     b = renderer.ComputeVisiblePropBounds()
     if b[0] > b[1]:
         return False
-    c = [(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2]
-    cam = renderer.GetActiveCamera()
-    cam.SetFocalPoint(*c)
-    cam.SetPosition(c[0], c[1] - 3 * max(b[1] - b[0], b[5] - b[4], 1.0), c[2])
-    cam.SetViewUp(0, 0, 1)
-    renderer.ResetCamera()
+    lo, hi = np.array(b[0::2]), np.array(b[1::2])
+    w, h = renderer.GetSize()
+    cam = named_view(name, lo, hi, aspect=w / h if w and h else 4 / 3, view_angle=30.0, axes=natural_axes(lo, hi))
+    cam.apply(renderer.GetActiveCamera())
+    renderer.ResetCameraClippingRange()
+    return True
+
+
+def frame(renderer, lo=None, hi=None) -> bool:
+    """Keep the direction, move so that the box ``lo..hi`` (world; default everything shown) fills the view."""
+    if lo is None:
+        b = renderer.ComputeVisiblePropBounds()
+        if b[0] > b[1]:
+            return False
+    else:
+        pad = 0.15 * max(float(np.max(np.asarray(hi) - np.asarray(lo))), 10.0)  # a point or a joint: some room
+        b = [v for lo_, hi_ in zip(lo, hi) for v in (lo_ - pad, hi_ + pad)]
+    renderer.ResetCamera(*b)
     return True
 
 

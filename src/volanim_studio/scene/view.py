@@ -57,6 +57,9 @@ class SceneView:
         self._render_pending = False
         plotter.set_background("#1e1f24")
         self._fix_pixel_ratio()
+        self._quiet_keys()
+        # the orientation widget: which way is x, y, z (pyvista's, drawn in a corner viewport)
+        plotter.add_axes(interactive=False, line_width=2, color="white")
         iren = plotter.iren
         iren.add_observer("LeftButtonPressEvent", self._on_press)
         iren.add_observer("LeftButtonReleaseEvent", self._on_release)
@@ -86,6 +89,14 @@ class SceneView:
         widget = self.plotter
         if hasattr(widget, "_getPixelRatio"):
             widget._getPixelRatio = lambda: float(widget.devicePixelRatioF())
+
+    def _quiet_keys(self) -> None:
+        """No keys of VTK's or pyvista's own: W turned everything to wireframe, Q and V snapped
+        the camera, +/- changed the point size behind the Display tab's back. The window's
+        actions (Qt shortcuts) are the only keys."""
+        self.plotter.iren.clear_key_event_callbacks()
+        # a style with an observer for an event skips its own handler (OnChar: w, s, e, q, f, r, 3, p, j, t)
+        self.plotter.iren.style.AddObserver("CharEvent", lambda *_: None)
 
     # ---------------------------------------------------------- coordinates
     @property
@@ -119,9 +130,39 @@ class SceneView:
         self.render()
 
     def front_view(self) -> None:
-        """Look along +y (from the front of a figure facing -y), z up, everything in view."""
-        if camera.front_view(self.plotter.renderer):
+        """The front of the object (stood up by its shape), everything in view."""
+        self.view_preset("front")
+
+    def view_preset(self, name: str) -> None:
+        """``front``, ``side``, ``top``, ``three-quarter`` or ``back``, everything in view."""
+        if camera.preset_view(self.plotter.renderer, name):
             self.render()
+
+    def frame_all(self) -> None:
+        if camera.frame(self.plotter.renderer):
+            self.render()
+
+    def frame_selected(self) -> bool:
+        """Fill the view with the selected bones, else the picked point, else the cube/lasso selection."""
+        doc = self.doc
+        pts = []
+        if doc.selected_bones and len(doc.bones):
+            segs = doc.bones.segments()[[i for i in doc.selected_bones if i < len(doc.bones)]]
+            if self.posing:
+                pj = doc.pose.posed_joints()
+                segs = np.array([[pj[doc.bones.bones[i].proximal], pj[doc.bones.bones[i].distal]]
+                                 for i in doc.selected_bones if i < len(doc.bones)])
+            pts = segs.reshape(-1, 3)
+        elif doc.picked_point is not None:
+            pts = doc.skeleton.points[[doc.picked_point]]
+        elif len(doc.point_selection):
+            pts = doc.skeleton.points[doc.point_selection]
+        if not len(pts):
+            return False
+        world = self.world(pts)
+        camera.frame(self.plotter.renderer, world.min(0), world.max(0))
+        self.render()
+        return True
 
     def jump_to(self, voxel_xyz) -> None:
         """Centre the view on a point and move closer."""

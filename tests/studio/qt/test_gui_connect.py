@@ -18,7 +18,7 @@ from volanim_core.skeleton.points import Skeleton
 from volanim_studio.model.modes import Mode
 from volanim_studio.model.project import read_project
 
-from ..conftest import JOB_TIMEOUT_MS, click, clickable_point
+from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view
 
 pytestmark = pytest.mark.gui
 
@@ -81,7 +81,7 @@ def depth_scene(window):
     doc.bone_edits.add_bone((45, 30, 120), (45, 30, 160))
     doc.select_bones([0])
     window.plotter.enable_parallel_projection()
-    window.scene.front_view()
+    front_view(window)  # along +y, whatever the scene's shape (the studio's presets go by the shape)
     window.set_mode(Mode.LASSO)
     window.display_panel.point_size.setValue(10)
     n = len(front)
