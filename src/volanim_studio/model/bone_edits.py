@@ -60,6 +60,8 @@ class BoneEdits:
     def _set_bones(self, bones: BoneSkeleton) -> None:
         self.doc.bones = bones
         self.doc.selected_bones = tuple(i for i in self.doc.selected_bones if i < len(bones))
+        if self.doc.picked_joint not in bones.joints:
+            self.doc.picked_joint = None  # renamed or removed (an undo of a rename)
         self.doc.events.bones.emit()
         self.doc.events.selection.emit(indices=self.doc.selected_bones)
 
@@ -141,7 +143,76 @@ class BoneEdits:
         new.joints = {(new_name if k == old else k): v for k, v in new.joints.items()}
         new.bones = [Bone(new_name if b.proximal == old else b.proximal, new_name if b.distal == old else b.distal,
                           b.name) for b in new.bones]
+        picked = self.doc.picked_joint == old
         self._apply_bones(f"Rename joint {old} to {new_name}", new)
+        if picked:  # the renamed joint stays the picked one
+            self.doc.pick_joint(new_name)
+
+    def chain_from(self, joint: str) -> list[str]:
+        """The joints of the chain that starts at ``joint``: follow the one bone leaving each joint
+        until a joint has no bone or several (a fork: the neck, the pelvis)."""
+        if joint not in self.doc.bones.joints:
+            raise ValueError(f"no joint named {joint!r}")
+        chain = [joint]
+        while True:
+            out = [b.distal for b in self.doc.bones.bones if b.proximal == chain[-1]]
+            if len(out) != 1 or out[0] in chain:
+                return chain
+            chain.append(out[0])
+
+    def chain_through(self, bone: int) -> list[str]:
+        """The joints of the unbranched chain that holds ``bone``, from its top: up while a joint has one
+        bone in and one out, down while it has one out. A fork ends it and is included (the neck
+        starts an arm's chain: NECK, L_SHOULDER, L_ELBOW, L_WRIST, L_FINGERS)."""
+        bones = self.doc.bones.bones
+        leaving = {j: [b.distal for b in bones if b.proximal == j] for j in self.doc.bones.joints}
+        entering = {j: [b.proximal for b in bones if b.distal == j] for j in self.doc.bones.joints}
+        chain = [bones[bone].proximal, bones[bone].distal]
+        while len(entering[chain[0]]) == 1 and len(leaving[chain[0]]) == 1 and entering[chain[0]][0] not in chain:
+            chain.insert(0, entering[chain[0]][0])
+        while len(leaving[chain[-1]]) == 1 and leaving[chain[-1]][0] not in chain:
+            chain.append(leaving[chain[-1]][0])
+        return chain
+
+    def side_prefix(self, joint: str, tolerance: float = 2.0) -> str:
+        """``L_`` or ``R_`` by the joint's side of the symmetry plane (the figure's left is +x), ``""`` on it."""
+        dx = float(self.doc.bones.joints[joint][0]) - self.doc.symmetry_x
+        return "" if abs(dx) <= tolerance else ("L_" if dx > 0 else "R_")
+
+    def rename_chain(self, chain: list[str], names, *, sided: bool = True) -> list[str]:
+        """Name the joints of ``chain`` (:meth:`chain_through`, :meth:`chain_from`) in order, one undo
+        step; returns the new names.
+
+        ``names`` (a list, or one string split at commas and spaces) may be shorter than the chain
+        (the rest keep their names). With ``sided``, a name without ``L_``/``R_`` gets the side of
+        its joint: "SHOULDER, ELBOW, WRIST" on the left arm gives L_SHOULDER, L_ELBOW, L_WRIST.
+        """
+        if isinstance(names, str):
+            names = names.replace(",", " ").split()
+        names = [n.strip() for n in names if n.strip()]
+        if not names:
+            raise ValueError("type the names of the chain's joints, e.g. SHOULDER, ELBOW, WRIST")
+        if len(names) > len(chain):
+            raise ValueError(f"{len(names)} names for a chain of {len(chain)} joints ({', '.join(chain)})")
+        if sided:
+            names = [n if n[:2] in ("L_", "R_") else self.side_prefix(j) + n for n, j in zip(names, chain)]
+        mapping = {old: new for old, new in zip(chain, names) if old != new}
+        if len(set(names)) != len(names):
+            raise ValueError(f"a name appears twice: {', '.join(names)}")
+        clash = [n for n in mapping.values() if n in self.doc.bones.joints and n not in mapping]
+        if clash:
+            raise ValueError(f"there is already a joint named {clash[0]!r} outside this chain")
+        if not mapping:
+            return names
+        new = self._edited()
+        new.joints = {mapping.get(k, k): v for k, v in new.joints.items()}
+        new.bones = [Bone(mapping.get(b.proximal, b.proximal), mapping.get(b.distal, b.distal), b.name)
+                     for b in new.bones]
+        picked = mapping.get(self.doc.picked_joint)
+        self._apply_bones(f"Name chain {', '.join(names)}", new)
+        if picked is not None:
+            self.doc.pick_joint(picked)
+        return names
 
     def rename_bone(self, index: int, name: str) -> None:
         name = name.strip()

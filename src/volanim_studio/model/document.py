@@ -58,6 +58,7 @@ class Document:
         self.bones_path: str | None = None
         self.selected_bones: tuple[int, ...] = ()
         self.picked_point: int | None = None
+        self.picked_joint: str | None = None  # the last joint clicked (F2 renames it, chains are named from it)
         self._symmetry_x: float | None = None
         self.project_path: str | None = None
         self.demo_name: str | None = None  # a session opened on a demo dataset reopens it
@@ -162,6 +163,12 @@ class Document:
         self.picked_point = index
         self.events.picked.emit(index=index)
 
+    def pick_joint(self, name: str | None) -> None:
+        if name is not None and name not in self.bones.joints:
+            raise ValueError(f"no joint named {name!r}")
+        self.picked_joint = name
+        self.events.picked.emit(index=self.picked_point)
+
     def point_info(self, index: int) -> dict:
         """What the status bar shows for a point: position, DT, thinness, its bone."""
         s = self.skeleton
@@ -245,6 +252,7 @@ class Document:
         self.timeline._set_keys({})
         self.pose._write({}, {})
         self.selected_bones = ()
+        self.picked_joint = None
         self.bone_edits._set_bones(BoneSkeleton())
         self.only_unconnected = self.only_working = False
         self.cube_centre = None

@@ -57,6 +57,8 @@ class ModeHandler:
             return
         if ev.point is not None:
             self.doc.pick_point(ev.point)
+        if ev.joint is not None:
+            self.doc.pick_joint(ev.joint)
         if ev.bone is not None:
             self.doc.select_bones([ev.bone])
 
@@ -101,6 +103,8 @@ class BonesMode(ModeHandler):
             return
         if ev.point is not None:
             self.doc.pick_point(ev.point)
+        if ev.joint is not None:
+            self.doc.pick_joint(ev.joint)
         if self.remove:
             if ev.bone is not None:
                 self.doc.bone_edits.remove_bones([ev.bone])
@@ -120,8 +124,18 @@ class BonesMode(ModeHandler):
             self.doc.message(str(exc))
             return
         self.pending = self.doc.bones.bones[index].distal
+        self.doc.pick_joint(self.pending)
         self.doc.select_bones([index])
         self.doc.message(f"Added bone {self.doc.bones.bones[index].label}; click to continue, Esc to end.")
+
+    def pending_position(self) -> np.ndarray | None:
+        """Where the next bone starts (voxels), for the line drawn to the cursor; None between chains."""
+        if self.pending is None:
+            return None
+        if isinstance(self.pending, str):
+            j = self.doc.bones.joints.get(self.pending)
+            return None if j is None else np.asarray(j, np.float64)
+        return np.asarray(self.pending, np.float64)
 
     def end_chain(self) -> None:
         if self.pending is not None:

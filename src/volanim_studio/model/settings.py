@@ -71,6 +71,7 @@ SETTINGS: dict[str, Setting] = {
     "point_size": Setting(6.0, number(1, 30), "skeleton point size, pixels"),
     "spheres": Setting(True, flag, "draw points as shaded spheres"),
     "hull_visible": Setting(True, flag, "show the translucent hull"),
+    "names_visible": Setting(True, flag, "joint and bone names in the viewport"),
     "hull_opacity": Setting(0.15, number(0, 1), "hull opacity"),
     "clip_axis": Setting(None, axis_or_none, "axis of the hull's clipping plane (None: no clipping)"),
     "clip_position": Setting(0.5, number(0, 1), "clipping plane position along its axis, 0..1"),

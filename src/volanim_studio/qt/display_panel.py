@@ -43,6 +43,7 @@ class DisplayPanel(QWidget):
         self.colour_by = QComboBox()
         self.colour_by.addItems(COLOUR_BY)
         self.spheres = QCheckBox("Points as spheres")
+        self.names_visible = QCheckBox("Joint and bone names")
         self.hull_visible = QCheckBox("Show hull")
         self.hull_opacity = QSlider(Qt.Horizontal)
         self.hull_opacity.setRange(0, 100)
@@ -54,6 +55,7 @@ class DisplayPanel(QWidget):
         bind(self.point_size, s, "point_size", on_error=doc.message)
         bind(self.colour_by, s, "colour_by", on_error=doc.message)
         bind(self.spheres, s, "spheres")
+        bind(self.names_visible, s, "names_visible")
         bind(self.hull_visible, s, "hull_visible")
         bind(self.hull_opacity, s, "hull_opacity", scale=0.01)
         bind(self.clip_axis, s, "clip_axis", to_value=lambda text: CLIP_CHOICES.index(text) - 1 if text in
@@ -70,6 +72,7 @@ class DisplayPanel(QWidget):
         form.addRow("Point size", self.point_size)
         form.addRow("Colour by", self.colour_by)
         form.addRow(self.spheres)
+        form.addRow(self.names_visible)
         hull = QGroupBox("Hull")
         hform = QFormLayout(hull)
         hform.addRow(self.hull_visible)

@@ -18,6 +18,7 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractSpinBox,
     QDockWidget,
+    QInputDialog,
     QLabel,
     QLineEdit,
     QMainWindow,
@@ -59,6 +60,8 @@ SHORTCUTS = [
     ("Right click", "End the bone chain"),
     ("Del", "Remove the selected bones (the Delete key)"),
     ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
+    ("F2", "Rename the joint clicked last"),
+    ("Ctrl+F2", "Name the selected bone's chain in one line: SHOULDER, ELBOW, WRIST (L_/R_ added by side)"),
     ("Space", "Play / pause the timeline (a BVH clip, .trans frames or keys)"),
     ("Left / Right, Home / End", "Previous / next frame, first / last frame (outside Cube mode)"),
     ("S / Shift+S", "Set / delete the pose key at the current frame"),
@@ -71,6 +74,15 @@ SHORTCUTS = [
     ("F / Shift+F / Ctrl+0", "Frame the selection / frame everything / reset the view"),
     ("F1", "This list"),
 ]
+
+
+#: What Name chain offers (it keeps as many names as the chain has joints; the side's L_/R_ is added)
+CHAIN_PRESETS = {
+    "arm": ("SHOULDER", "ELBOW", "WRIST", "FINGERS"),
+    "arm from the neck": ("NECK", "SHOULDER", "ELBOW", "WRIST", "FINGERS"),
+    "leg": ("HIP", "KNEE", "ANKLE", "TOE"),
+    "spine": ("PELVIS", "NECK", "HEAD"),
+}
 
 
 class MainWindow(QMainWindow):
@@ -101,6 +113,8 @@ class MainWindow(QMainWindow):
         self.pose_panel = PosePanel(self.doc)
         self.reconstruct_panel = ReconstructPanel(self.doc)
         self.scene.lasso.on_lasso = self.handle_lasso
+        bones_mode = self.handlers[Mode.BONES]
+        self.scene.names.pending = lambda: bones_mode.pending_position() if self.mode == Mode.BONES else None
         tabs = self.panel_tabs = QTabWidget()
         tabs.addTab(self.bone_panel, "Bones")
         tabs.addTab(self.connect_panel, "Connect")
@@ -272,6 +286,9 @@ class MainWindow(QMainWindow):
         self._action("Delete selected bones", lambda: self.key("Delete"), "Delete", menu=edit)
         self._action("Symmetrize selected bones", self.symmetrize, "M", menu=edit)
         self._action("End chain", lambda: self.key("Escape"), "Esc")
+        edit.addSeparator()
+        self._action("Rename joint…", self.rename_joint_dialog, "F2", menu=edit)
+        self._action("Name chain…", self.name_chain_dialog, "Ctrl+F2", menu=edit)
         modes = bar.addMenu("&Mode")
         toolbar = self.addToolBar("Modes")
         group = QActionGroup(self)
@@ -379,12 +396,71 @@ class MainWindow(QMainWindow):
             self.handlers[self.mode].press(ev)
         except ValueError as exc:
             self.doc.message(str(exc))
+        if self.handlers[Mode.BONES].pending is None:
+            self.scene.names.clear_chain_preview()
 
     def key(self, name: str) -> None:
         if name == "Delete" and self.mode != Mode.BONES and self.doc.selected_bones:
             self.doc.bone_edits.remove_bones(self.doc.selected_bones)
             return
         self.handlers[self.mode].key(name)
+        if self.handlers[Mode.BONES].pending is None:
+            self.scene.names.clear_chain_preview()
+
+    # ---------------------------------------------------------------- naming
+    def _named_joint(self, what: str) -> str | None:
+        joint = self.doc.picked_joint
+        if joint is None:
+            self.doc.message(f"Click a joint first, then {what}.")
+        return joint
+
+    def rename_joint_dialog(self) -> QInputDialog | None:
+        """F2: rename the joint clicked last (a non-blocking dialog; Enter applies, one undo step)."""
+        joint = self._named_joint("press F2 to rename it")
+        if joint is None:
+            return None
+        box = QInputDialog(self)
+        box.setWindowTitle("Rename joint")
+        box.setLabelText(f"New name for {joint}:")
+        box.setTextValue(joint)
+        box.textValueSelected.connect(lambda text: self._apply_name(
+            lambda: self.doc.bone_edits.rename_joint(joint, text), f"Renamed {joint} to {text.strip()}."))
+        self._name_box = box
+        box.open()
+        return box
+
+    def name_chain_dialog(self) -> QInputDialog | None:
+        """Ctrl+F2: name the chain of the selected bone (the one just built), else the chain that starts
+        at the joint clicked last, in one line: "SHOULDER, ELBOW, WRIST"."""
+        edits = self.doc.bone_edits
+        if self.doc.selected_bones:
+            chain = edits.chain_through(self.doc.selected_bones[0])
+        elif self.doc.picked_joint is not None:
+            chain = edits.chain_from(self.doc.picked_joint)
+        else:
+            self.doc.message("Select a bone of the chain (or click its first joint), then Ctrl+F2.")
+            return None
+        side = edits.side_prefix(chain[-1])
+        box = QInputDialog(self)
+        box.setWindowTitle("Name chain")
+        box.setLabelText(f"Names for the {len(chain)} joints {' → '.join(chain)}, in order\n"
+                         f"(commas or spaces; {side or 'no prefix'} is added on this side when left out):")
+        box.setComboBoxEditable(True)
+        box.setComboBoxItems([""] + [", ".join(p[:len(chain)]) for p in CHAIN_PRESETS.values()
+                                     if len(p) >= len(chain)])
+        box.textValueSelected.connect(lambda text: self._apply_name(
+            lambda: edits.rename_chain(chain, text), None))
+        self._name_box = box
+        box.open()
+        return box
+
+    def _apply_name(self, action, done: str | None) -> None:
+        try:
+            result = action()
+        except ValueError as exc:
+            self.show_error("Name", str(exc))
+            return
+        self.doc.message(done or f"Named the chain {', '.join(result)}.")
 
     def undo(self) -> None:
         label = self.doc.undo.undo()

@@ -22,6 +22,8 @@ from ..model.document import Document
 from ..model.modes import PickEvent
 from . import camera
 from .hull_layer import HullLayer
+from .names_layer import ACTORS as NAME_ACTORS
+from .names_layer import NamesLayer
 from .overlays import CubeOverlay, LassoOverlay
 from .pose_layer import PoseLayer, bone_lines
 from .projection import nearest_in_radius, project, segment_distance_2d
@@ -38,7 +40,7 @@ class SceneView:
     (selection overlays) and ``pose_layer`` (posed bones, previews).
     """
 
-    EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube")
+    EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube", *NAME_ACTORS)
     POSE_ACTORS = ("preview", "posed_bones", "slices", "stumps")
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
@@ -81,6 +83,7 @@ class SceneView:
         self.cube = CubeOverlay(self)
         self.lasso = LassoOverlay(self)
         self.pose_layer = PoseLayer(self)
+        self.names = NamesLayer(self)
 
     def _fix_pixel_ratio(self) -> None:
         # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen
@@ -176,12 +179,21 @@ class SceneView:
     def pick(self, x: float, y: float) -> PickEvent:
         """What is under display position ``(x, y)``: point, joint and bone (each may be None)."""
         radius = PICK_RADIUS * self.pixel_ratio()
-        point = joint = bone = None
+        point = None
         shown = self._shown
         if len(shown):
             xy, depth = self.project_world(self._world[shown])
             k = nearest_in_radius(xy, depth, (x, y), radius)
             point = None if k is None else int(shown[k])
+        joint, bone = self.joint_and_bone_at(x, y)
+        return PickEvent(point=point, joint=joint, bone=bone)
+
+    def joint_and_bone_at(self, x: float, y: float) -> tuple[str | None, int | None]:
+        """The joint and the bone within the pick radius of display ``(x, y)`` (each may be None).
+
+        No skeleton points are projected: cheap enough for every mouse move (hover)."""
+        radius = PICK_RADIUS * self.pixel_ratio()
+        joint = bone = None
         names = list(self.doc.bones.joints)
         if names:
             jw = self.world(np.array([self.doc.bones.joints[k] for k in names]))
@@ -195,7 +207,7 @@ class SceneView:
                 d = segment_distance_2d((x, y), a, b)
                 if d.min() <= radius:
                     bone = int(np.argmin(d))
-        return PickEvent(point=point, joint=joint, bone=bone)
+        return joint, bone
 
     def event_position(self) -> tuple[int, int]:
         # pyvista hangs button observers on the interactor *style*; the position is the interactor's
@@ -383,6 +395,8 @@ class SceneView:
         for name in self.POSE_ACTORS:
             if name in actors:
                 actors[name].SetVisibility(self.posing)
+        if hasattr(self, "names"):  # (the names layer is made after the first stage switch)
+            self.names.show(not self.posing)
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once.

@@ -1,0 +1,148 @@
+"""Names in the viewport, the joint or bone under the cursor, and the line of the bone being built.
+
+    doc.events.bones / picked, settings.names_visible --> joint labels (white), named bones' labels
+        (their colour), the picked joint ringed in cyan
+    mouse move (no button held) --> the joint or bone under the cursor, drawn yellow, named in the
+        status bar; in Bones mode with a chain started, a line from its last joint to the cursor
+
+Owned by :class:`~volanim_studio.scene.view.SceneView`; its actors belong to the edit stage.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pyvista as pv
+
+from volanim_core.render.colours import bone_colour
+
+from .pose_layer import bone_lines
+
+HOVER = "#ffe14d"
+PICKED_JOINT = "#00ffff"
+ACTORS = ("hover", "chain_preview", "picked_joint")  # by name; the labels are kept in ``label_actors``
+
+
+class NamesLayer:
+    def __init__(self, view):
+        self.view = view
+        self.hovered: tuple[str, object] | None = None  # ("joint", name) or ("bone", index)
+        self.shown_names: list[str] = []  # the joint and bone names drawn, in that order
+        # pyvista files label actors under names of its own (not ``name=``): kept here to remove and hide
+        self.label_actors: list = []
+        #: where the chain being built continues from (voxels), or None; the window sets it to the
+        #: Bones mode's ``pending_position``
+        self.pending: Callable[[], np.ndarray | None] = lambda: None
+        doc = view.doc
+        doc.events.bones.connect(self.update_labels)
+        doc.events.picked.connect(self._on_picked)
+        view.settings.events.names_visible.connect(self.update_labels)
+        view.plotter.iren.add_observer("MouseMoveEvent", self._on_move)
+
+    # ---------------------------------------------------------------- labels
+    def update_labels(self, **_) -> None:
+        view, plotter = self.view, self.view.plotter
+        for actor in self.label_actors:
+            plotter.remove_actor(actor, render=False)
+        self.label_actors = []
+        bones = view.doc.bones
+        self.shown_names = []
+        if view.settings.names_visible and len(bones.joints):
+            names = list(bones.joints)
+            self.shown_names = names + [b.name for b in bones.bones if b.name]
+            self.label_actors.append(plotter.add_point_labels(
+                view.world(np.array([bones.joints[n] for n in names])).astype(np.float32), names, font_size=13,
+                text_color="white", shape=None, show_points=False, always_visible=True, render=False,
+                reset_camera=False, justification_vertical="bottom", shadow=True))
+            named = [i for i, b in enumerate(bones.bones) if b.name]
+            if named:
+                mid = view.world(bones.segments()[named].mean(1)).astype(np.float32)
+                self.label_actors.append(plotter.add_point_labels(
+                    mid, [bones.bones[i].name for i in named], font_size=11, bold=False, italic=True,
+                    text_color="#d0d0d0", shape=None, show_points=False, always_visible=True, render=False,
+                    reset_camera=False, shadow=True))
+        self.hovered = None
+        plotter.remove_actor("hover", render=False)
+        self._on_picked()
+
+    def show(self, on: bool) -> None:
+        """The labels' part of the stage switch (the named actors follow ``SceneView.EDIT_ACTORS``)."""
+        for actor in self.label_actors:
+            actor.SetVisibility(on)
+
+    def _on_picked(self, **_) -> None:
+        view, plotter = self.view, self.view.plotter
+        plotter.remove_actor("picked_joint", render=False)
+        name = view.doc.picked_joint
+        if name is not None and name in view.doc.bones.joints:
+            plotter.add_mesh(pv.PolyData(view.world(view.doc.bones.joints[name][None]).astype(np.float32)),
+                             color=PICKED_JOINT, point_size=22, render_points_as_spheres=True, name="picked_joint",
+                             render=False, reset_camera=False, pickable=False)
+        view.apply_stage()
+        view.render()
+
+    # ----------------------------------------------------------------- hover
+    def under_cursor(self, x: float, y: float) -> tuple[str, object] | None:
+        """``("joint", name)`` or else ``("bone", index)`` under display ``(x, y)``, or None."""
+        joint, bone = self.view.joint_and_bone_at(x, y)
+        return ("joint", joint) if joint is not None else ("bone", bone) if bone is not None else None
+
+    def _on_move(self, *_) -> None:
+        view = self.view
+        if view._press is not None or view.posing:
+            return  # a button is held: the camera turns; the pose stage has no edit actors
+        x, y = view.event_position()
+        self._hover(self.under_cursor(x, y))
+        self._chain_preview(x, y)
+
+    def _hover(self, what) -> None:
+        if what == self.hovered:
+            return
+        self.hovered = what
+        view, plotter = self.view, self.view.plotter
+        plotter.remove_actor("hover", render=False)
+        bones = view.doc.bones
+        if what is not None and what[0] == "joint":
+            plotter.add_mesh(pv.PolyData(view.world(bones.joints[what[1]][None]).astype(np.float32)), color=HOVER,
+                             point_size=20, render_points_as_spheres=True, name="hover", render=False,
+                             reset_camera=False, pickable=False)
+            view.doc.message(f"Joint {what[1]}: click to pick it, then F2 renames it and "
+                             "Ctrl+F2 names its chain.")
+        elif what is not None:
+            b = bones.bones[what[1]]
+            plotter.add_mesh(bone_lines(view.world(bones.segments()[[what[1]]])), color=HOVER, line_width=10,
+                             render_lines_as_tubes=True, name="hover", render=False, reset_camera=False,
+                             pickable=False)
+            view.doc.message(f"Bone {b.label} ({b.proximal} → {b.distal}, root {what[1]}, "
+                             f"colour {bone_colour(what[1])}): click to select it.")
+        view.render()
+
+    def _chain_preview(self, x: float, y: float) -> None:
+        view, plotter = self.view, self.view.plotter
+        start = self.pending()
+        had = "chain_preview" in plotter.renderer.actors
+        if start is None:
+            if had:
+                plotter.remove_actor("chain_preview", render=False)
+                view.render()
+            return
+        a = view.world(start[None])[0]
+        _, depth = view.project_world(a[None])
+        r = plotter.renderer
+        r.SetDisplayPoint(float(x), float(y), float(depth[0]))  # the cursor, at the chain end's depth
+        r.DisplayToWorld()
+        w = np.array(r.GetWorldPoint())
+        b = w[:3] / w[3] if w[3] else w[:3]
+        line = pv.Line(a, b)
+        if had:
+            plotter.renderer.actors["chain_preview"].mapper.SetInputData(line)
+        else:
+            plotter.add_mesh(line, color=HOVER, line_width=3, name="chain_preview", render=False,
+                             reset_camera=False, pickable=False)
+        view.render()
+
+    def clear_chain_preview(self) -> None:
+        if "chain_preview" in self.view.plotter.renderer.actors:
+            self.view.plotter.remove_actor("chain_preview", render=False)
+            self.view.render()

@@ -1,0 +1,82 @@
+"""Names in the viewport, hover, F2 and Ctrl+F2 with real widgets (issue #18)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+from volanim_core import samples
+from volanim_studio.model.modes import Mode
+
+from ..conftest import click, clickable_point
+
+pytestmark = pytest.mark.gui
+J = samples.mannequin_bones().joints
+
+
+def _qt_pos(window, display_xy) -> QPoint:
+    w = window.plotter
+    s = w.devicePixelRatioF()
+    return QPoint(int(round(display_xy[0] / s)), int(round(w.height() - 1 - display_xy[1] / s)))
+
+
+def test_build_a_chain_with_a_line_to_the_cursor_then_name_it_in_one_line(qtbot, window):
+    def actors():  # pyvista builds this dict anew on each access
+        return window.plotter.renderer.actors
+
+    qtbot.keyClick(window, Qt.Key_B)
+    pts = [clickable_point(window, J[n]) for n in ("L_SHOULDER", "L_ELBOW", "L_WRIST")]
+    click(qtbot, window, window.scene.display_of_point(pts[0]))
+    target = window.scene.display_of_point(pts[1])
+    qtbot.mouseMove(window.plotter, _qt_pos(window, target))
+    qtbot.waitUntil(lambda: "chain_preview" in actors(), timeout=5000)
+    line = actors()["chain_preview"].mapper.GetInput()
+    assert line.n_points == 2 and actors()["chain_preview"].GetVisibility()
+    start, end = np.asarray(line.points)
+    assert np.allclose(start, window.doc.skeleton.points[pts[0]] * window.scene.spacing)
+    xy, _ = window.scene.project_world(end[None])
+    assert np.linalg.norm(xy[0] - target) < 3  # the line ends under the cursor
+    for p in pts[1:]:
+        click(qtbot, window, window.scene.display_of_point(p))
+    qtbot.keyClick(window, Qt.Key_Escape)
+    assert "chain_preview" not in actors()  # the chain ended: no line
+    labels = window.scene.names.label_actors
+    assert len(window.doc.bones) == 2 and len(labels) == 1 and labels[0] in actors().values()
+    qtbot.keyClick(window, Qt.Key_F2, Qt.ControlModifier)  # the selected (last built) bone's chain
+    box = window._name_box
+    assert box.isVisible() and "3 joints" in box.labelText()
+    box.setTextValue("SHOULDER, ELBOW, WRIST")
+    box.accept()
+    assert {"L_SHOULDER", "L_ELBOW", "L_WRIST"} == set(window.doc.bones.joints)  # L_ from the side
+    assert window.scene.names.shown_names == ["L_SHOULDER", "L_ELBOW", "L_WRIST"]
+    qtbot.keyClick(window, Qt.Key_Z, Qt.ControlModifier)  # one undo step
+    assert "L_ELBOW" not in window.doc.bones.joints
+
+
+def test_hover_names_a_joint_click_picks_it_and_f2_renames_it(qtbot, window):
+    window.doc.bone_edits.add_bone(J["L_SHOULDER"], J["L_ELBOW"])
+    elbow = next(n for n, p in window.doc.bones.joints.items() if np.allclose(p, J["L_ELBOW"]))
+    at = window.scene.project_world(window.scene.world(J["L_ELBOW"][None]))[0][0]
+    qtbot.mouseMove(window.plotter, _qt_pos(window, at))
+    qtbot.waitUntil(lambda: window.scene.names.hovered is not None, timeout=5000)
+    assert window.scene.names.hovered == ("joint", elbow) and "hover" in window.plotter.renderer.actors
+    assert elbow in window.statusBar().currentMessage()
+    click(qtbot, window, at)  # View mode: picks the joint
+    assert window.doc.picked_joint == elbow and "picked_joint" in window.plotter.renderer.actors
+    qtbot.keyClick(window, Qt.Key_F2)
+    box = window._name_box
+    assert box.textValue() == elbow
+    box.setTextValue("L_ELBOW")
+    box.accept()
+    assert "L_ELBOW" in window.doc.bones.joints and window.doc.picked_joint == "L_ELBOW"
+    window.display_panel.names_visible.setChecked(False)  # the Display tab hides the names
+    assert window.scene.names.label_actors == [] and window.scene.names.shown_names == []
+    assert not any(type(a).__name__ == "vtkActor2D" and a.GetMapper() is not None and "Label" in
+                   a.GetMapper().GetClassName() for a in window.plotter.renderer.actors.values())
+
+
+def test_f2_with_no_joint_clicked_says_what_to_do(qtbot, window):
+    window.set_mode(Mode.VIEW)
+    qtbot.keyClick(window, Qt.Key_F2)
+    assert "Click a joint first" in window.statusBar().currentMessage()
