@@ -20,13 +20,13 @@ def front_view(window) -> None:
     window.plotter.render()
 
 
-def click(qtbot, window, display_xy, button=Qt.LeftButton) -> None:
+def click(qtbot, window, display_xy, button=Qt.LeftButton, modifier=Qt.NoModifier) -> None:
     """Click at VTK display coordinates (device pixels, origin bottom-left) through Qt."""
     w = window.plotter
     s = w.devicePixelRatioF()
     qx = int(round(display_xy[0] / s))
     qy = int(round(w.height() - 1 - display_xy[1] / s))
-    qtbot.mouseClick(w, button, pos=QPoint(qx, qy))
+    qtbot.mouseClick(w, button, modifier, QPoint(qx, qy))
 
 
 def clickable_point(window, near_voxel) -> int:

@@ -35,6 +35,7 @@ class PickEvent:
     joint: str | None = None
     bone: int | None = None
     button: str = "left"
+    shift: bool = False
 
 
 class ModeHandler:
@@ -190,6 +191,21 @@ class RootOrderMode(ModeHandler):
             self.doc.message("Root order: start again from root 0.")
 
 
+def choose_working_bone(doc: Document, ev: PickEvent) -> bool:
+    """Shift+click in Cube and Lasso modes: the bone under the cursor, or else the bone of the point
+    under it, becomes the working bone. Returns whether one was chosen."""
+    bone = ev.bone
+    if bone is None and ev.point is not None:
+        b = int(doc.attachments.bone[ev.point])
+        bone = b if b >= 0 else None
+    if bone is None:
+        doc.message("Shift+click a bone, or a connected point, to choose the working bone.")
+        return False
+    doc.select_bones([bone])
+    doc.message(f"Working bone: {doc.bones.bones[bone].label}.")
+    return True
+
+
 def _working(doc: Document, remove: bool) -> int | None:
     """The bone to attach to (-1 to detach), or None with a message when no bone is chosen."""
     if remove:
@@ -208,14 +224,16 @@ class CubeMode(ModeHandler):
 
     name = Mode.CUBE
     help = ("Cube: click a point to place the cube (arrows, PgUp/PgDn nudge; +/- size), then Connect (C) "
-            "or Remove (X) the shown points inside it for the working bone.")
+            "or Remove (X) the shown points inside it for the working bone (Shift+click a bone to choose it).")
     NUDGE = {"Left": (-1, 0, 0), "Right": (1, 0, 0), "Up": (0, 0, 1), "Down": (0, 0, -1),
              "PageUp": (0, 1, 0), "PageDown": (0, -1, 0)}
 
     def press(self, ev: PickEvent) -> None:
         if ev.button != "left":
             return
-        if ev.point is not None:
+        if ev.shift:
+            choose_working_bone(self.doc, ev)
+        elif ev.point is not None:
             self.doc.pick_point(ev.point)
             self.doc.set_cube(self.doc.skeleton.points[ev.point])
         elif ev.bone is not None:
@@ -267,7 +285,12 @@ class LassoMode(ModeHandler):
 
     name = Mode.LASSO
     help = ("Lasso: drag an outline around points to connect them to the working bone (Ctrl: remove). "
-            "Depth: through / visible / slab.")
+            "Depth: through / visible / slab. A click (Shift+click) on a bone chooses the working bone.")
+
+    def press(self, ev: PickEvent) -> None:
+        """A click without dragging an outline: choose the working bone (a modifier is not needed here)."""
+        if ev.button == "left":
+            choose_working_bone(self.doc, ev)
 
     def finish(self, polygon, xy, depth, view_depth, shown, remove: bool | None = None) -> int:
         """Apply a closed outline: ``xy``/``depth``/``view_depth`` are the projections of ``shown`` points."""

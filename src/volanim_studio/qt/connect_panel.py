@@ -36,6 +36,7 @@ class ConnectPanel(QWidget):
         self.cube_size = QSlider(Qt.Horizontal)
         self.cube_size.setRange(1, 200)
         self.cube_size_label = QLabel()
+        self.cube_count = QLabel("click a point to place it")
         self.cube_connect = QPushButton("Connect (C)")
         self.cube_remove = QPushButton("Remove (X)")
 
@@ -63,6 +64,7 @@ class ConnectPanel(QWidget):
         row.addWidget(self.cube_size)
         row.addWidget(self.cube_size_label)
         cf.addRow("Size", row)
+        cf.addRow("Inside", self.cube_count)
         buttons = QHBoxLayout()
         buttons.addWidget(self.cube_connect)
         buttons.addWidget(self.cube_remove)
@@ -95,6 +97,10 @@ class ConnectPanel(QWidget):
                              (self.overwrite, "auto_overwrite")):
             bind(widget, st, name, on_error=doc.message)
         st.events.cube_size.connect(self._on_cube_size_changed)
+        st.events.cube_size.connect(self._count_cube)
+        for event in (doc.events.cube, doc.events.thinness, doc.events.filter, doc.events.attachments,
+                      doc.events.skeleton):
+            event.connect(self._count_cube)
         self._on_cube_size_changed(st.cube_size)
         self.cube_connect.clicked.connect(lambda: cube.apply())
         self.cube_remove.clicked.connect(lambda: cube.apply(remove=True))
@@ -109,6 +115,15 @@ class ConnectPanel(QWidget):
 
     def _on_cube_size_changed(self, value: float, **_) -> None:
         self.cube_size_label.setText(f"{value:g}")
+
+    def _count_cube(self, **_) -> None:
+        """How many shown points the cube holds, and how many of them are connected already."""
+        if self.doc.cube_centre is None or self.doc.skeleton is None:
+            self.cube_count.setText("click a point to place it")
+            return
+        inside = self.cube.inside()
+        done = int((self.doc.attachments.bone[inside] >= 0).sum())
+        self.cube_count.setText(f"{len(inside)} shown points ({done} connected already)")
 
     def _on_filter_changed(self, **_) -> None:
         for box, on in ((self.only_unconnected, self.doc.only_unconnected), (self.only_working, self.doc.only_working)):

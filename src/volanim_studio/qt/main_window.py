@@ -370,9 +370,30 @@ class MainWindow(QMainWindow):
         except ValueError as exc:
             self.show_error("Auto-connect", str(exc))
             return
+        self.doc.settings.colour_by = "bone"  # what was connected to what is the thing to look at now
         self.doc.message(f"Auto-connect: {report}.")
-        if report.unattached:
-            self.show_error("Auto-connect", f"Auto-connect {report}. Connect the rest with the cube or lasso.")
+        if not report.unattached:
+            return
+        text = f"Auto-connect {report}. Connect the rest with the cube or lasso."
+        if st.auto_method == "path" and report.unattached > report.attached:
+            # most points found no straight path inside the volume to a bone (a crude rig, a curled
+            # body): the fallback method attaches those to the nearest bone instead
+            text += ("\n\nMost points found no path. The method path-or-nearest connects those to the "
+                     "nearest bone: use it now?")
+            box = QMessageBox(QMessageBox.Question, "Auto-connect", text, QMessageBox.Yes | QMessageBox.No, self)
+            box.button(QMessageBox.Yes).setText("Use path-or-nearest")
+
+            def answered(_result):
+                if box.standardButton(box.clickedButton()) == QMessageBox.Yes:
+                    st.auto_method = "path-or-nearest"
+                    self.auto_connect()
+
+            box.finished.connect(answered)
+            self.last_error = text
+            self._error_box = box
+            box.open()
+            return
+        self.show_error("Auto-connect", text)
 
     def mirror_connectivity(self) -> None:
         try:

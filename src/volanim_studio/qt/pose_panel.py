@@ -33,14 +33,14 @@ class PosePanel(QWidget):
         self.sliders, self.spins = [], []
         box = QGroupBox("Rotate about the proximal joint (children follow)")
         form = QFormLayout(box)
-        for axis in "xyz":
+        for axis, colour, name in (("x", "#e63c3c", "red"), ("y", "#3cc850", "green"), ("z", "#4678ff", "blue")):
             slider = QSlider(Qt.Horizontal)
             slider.setRange(-180, 180)
             spin = QDoubleSpinBox(decimals=1, minimum=-180.0, maximum=180.0, singleStep=1.0)
             row = QHBoxLayout()
             row.addWidget(slider)
             row.addWidget(spin)
-            form.addRow(f"{axis} °", row)
+            form.addRow(QLabel(f"<b style='color:{colour}'>{axis}</b> ° ({name} arrow)"), row)
             slider.valueChanged.connect(self._slider_changed)
             slider.sliderPressed.connect(self.drag_started.emit)
             slider.sliderReleased.connect(self._released)

@@ -13,6 +13,8 @@ from collections.abc import Callable
 import numpy as np
 import pyvista as pv
 
+from .projection import CLICK_SLOP
+
 
 class CubeOverlay:
     """The wireframe connect cube, following ``doc.events.cube`` and ``settings.cube_size``."""
@@ -80,6 +82,9 @@ class LassoOverlay:
         polygon = np.asarray(self.points + [self.view.event_position()], np.float64)
         self.points = None
         self.draw()
+        if np.ptp(polygon, axis=0).max() <= CLICK_SLOP:  # a click, not an outline: it chooses the working bone
+            self.view.click_at(*polygon[-1])
+            return
         ctrl = bool(self.view.plotter.iren.interactor.GetControlKey())
         if self.on_lasso is not None and len(polygon) >= 3:
             self.on_lasso(polygon, ctrl)

@@ -16,6 +16,7 @@ from volanim_core.render.surfaces import label_surface
 from volanim_core.render.transfer import apply_labels, binary_view, volume_style
 
 STUMP_COLOUR = "#ff3030"
+AXIS_COLOURS = ((230, 60, 60), (60, 200, 80), (70, 120, 255))  # x, y, z: the Pose tab names them so
 
 
 def bone_lines(segments: np.ndarray) -> pv.PolyData:
@@ -34,6 +35,7 @@ class PoseLayer:
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
         view.doc.events.pose.connect(self.on_pose_changed)
         view.doc.events.preview.connect(self.on_report)
+        view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
 
     def on_pose_changed(self, **_) -> None:
         view = self.view
@@ -48,6 +50,33 @@ class PoseLayer:
             poly.cell_data["rgb"] = label_table(len(bones))[1:]
             view.plotter.add_mesh(poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True,
                                   name="posed_bones", render=False, reset_camera=False)
+        self.draw_axes()
+
+    def draw_axes(self) -> None:
+        """The axes the Pose sliders turn the working bone about, at its posed proximal joint: x red,
+        y green, z blue (the rest axes carried by the parent's pose, as ``pose_frames`` composes them)."""
+        view = self.view
+        view.plotter.remove_actor("rot_axes", render=False)
+        doc = view.doc
+        b = doc.working_bone
+        if b is not None and b < len(doc.bones):
+            mats = doc.pose.matrices()
+            parent = doc.bones.parents()[b]
+            frame = np.eye(3) if parent is None else mats[parent][:3, :3]  # row k: where axis k points now
+            bone = doc.bones.bones[b]
+            origin = doc.pose.posed_joints()[bone.proximal]
+            length = 0.6 * float(np.linalg.norm(np.subtract(*doc.bones.segment(b))))
+            length = max(length, 8.0)
+            arrows = []
+            for k, colour in enumerate(AXIS_COLOURS):
+                d = frame[k] / np.linalg.norm(frame[k])
+                arrow = pv.Arrow(start=view.world(origin[None])[0], direction=view.world(d[None])[0] * length,
+                                 scale="auto", tip_length=0.2, shaft_radius=0.03, tip_radius=0.08)
+                arrow.cell_data["rgb"] = np.tile(np.array(colour, np.uint8), (arrow.n_cells, 1))
+                arrows.append(arrow)
+            view.plotter.add_mesh(pv.merge(arrows), scalars="rgb", rgb=True, name="rot_axes", render=False,
+                                  reset_camera=False, pickable=False)
+        view.apply_stage()
         view.render()
 
     def on_report(self, **_) -> None:

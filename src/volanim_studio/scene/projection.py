@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+CLICK_SLOP = 4.0  # display pixels: a press and release further apart is a drag (camera, lasso), not a click
 
 def project(points: np.ndarray, matrix: np.ndarray, viewport: tuple[float, float, float, float]):
     """Display coordinates and depth of world points.

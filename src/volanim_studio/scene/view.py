@@ -26,11 +26,10 @@ from .names_layer import ACTORS as NAME_ACTORS
 from .names_layer import NamesLayer
 from .overlays import CubeOverlay, LassoOverlay
 from .pose_layer import PoseLayer, bone_lines
-from .projection import nearest_in_radius, project, segment_distance_2d
+from .projection import CLICK_SLOP, nearest_in_radius, project, segment_distance_2d
 
 LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
 PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
-CLICK_SLOP = 4.0  # a press and release further apart than this is a drag (camera), not a click
 
 
 class SceneView:
@@ -41,7 +40,7 @@ class SceneView:
     """
 
     EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube", *NAME_ACTORS)
-    POSE_ACTORS = ("preview", "posed_bones", "slices", "stumps")
+    POSE_ACTORS = ("preview", "posed_bones", "slices", "stumps", "rot_axes")
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
         self.plotter = plotter
@@ -232,10 +231,14 @@ class SceneView:
         self._press = None
         if abs(x - px) > CLICK_SLOP or abs(y - py) > CLICK_SLOP:
             return  # a drag moved the camera
+        self.click_at(x, y, "right" if event.startswith("Right") else "left")
+
+    def click_at(self, x: float, y: float, button: str = "left") -> None:
+        """A click at display ``(x, y)``: what is there, and the Shift key, to the ``on_pick`` callback."""
         ev = self.pick(x, y)
-        button = "right" if event.startswith("Right") else "left"
+        shift = bool(self.plotter.iren.interactor.GetShiftKey())
         if self.on_pick is not None:
-            self.on_pick(PickEvent(ev.point, ev.joint, ev.bone, button))
+            self.on_pick(PickEvent(ev.point, ev.joint, ev.bone, button, shift))
 
     # ---------------------------------------------------------------- cloud
     def _on_skeleton_changed(self, **_) -> None:

@@ -10,6 +10,7 @@ import textwrap
 import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, Qt
+from PySide6.QtWidgets import QMessageBox
 
 from paths import ASSETS
 from volanim_core import io, samples
@@ -249,3 +250,41 @@ def test_cube_size_slider_follows_the_plus_minus_keys(qtbot, window):
     assert window.connect_panel.cube_size_label.text() == f"{before + 4:g}"
     window.connect_panel.cube_size.setValue(7)  # and the other way round
     assert window.doc.settings.cube_size == 7
+
+
+def test_auto_connect_colours_by_bone_and_offers_path_or_nearest_when_path_leaves_most(qtbot, window):
+    """One bone at the left hand: a straight path inside the body reaches it from 358 of 4380 points."""
+    window.doc.bone_edits.add_bone(J["L_WRIST"], J["L_FINGERS"])
+    window.connect_panel.scope.setCurrentText("all")
+    assert window.doc.settings.colour_by == "thinness"
+    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    assert window.doc.settings.colour_by == "bone" and window.display_panel.colour_by.currentText() == "bone"
+    box = window._error_box
+    assert box.isVisible() and "path-or-nearest" in box.text()
+    shown = window.doc.visible_count
+    assert (window.doc.attachments.bone[:shown] >= 0).sum() < shown / 2
+    box.button(QMessageBox.Yes).click()  # "Use path-or-nearest"
+    assert window.doc.settings.auto_method == "path-or-nearest"
+    assert (window.doc.attachments.bone[:shown] >= 0).all()
+
+
+def test_the_cube_counts_its_points_and_shift_click_chooses_the_working_bone(qtbot, window):
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    window.doc.attachments.auto(scope="all")
+    qtbot.keyClick(window, Qt.Key_K)
+    assert window.connect_panel.cube_count.text() == "click a point to place it"
+    p = clickable_point(window, J["L_ELBOW"])
+    click(qtbot, window, window.scene.display_of_point(p))
+    inside = window.handlers[Mode.CUBE].inside()
+    assert len(inside) and window.connect_panel.cube_count.text().startswith(f"{len(inside)} shown points")
+    thigh = window.doc.bones.index("R_THIGH")
+    q = clickable_point(window, (J["R_HIP"] + J["R_KNEE"]) / 2)
+    assert window.doc.attachments.bone[q] == thigh
+    centre = window.doc.cube_centre.copy()
+    click(qtbot, window, window.scene.display_of_point(q), modifier=Qt.ShiftModifier)
+    assert window.doc.working_bone == thigh and np.array_equal(window.doc.cube_centre, centre)  # cube stays
+    qtbot.keyClick(window, Qt.Key_L)  # Lasso: a click (no outline) chooses the working bone too
+    forearm = window.doc.bones.index("L_FOREARM")
+    r = clickable_point(window, (J["L_ELBOW"] + J["L_WRIST"]) / 2)
+    click(qtbot, window, window.scene.display_of_point(r))
+    assert window.doc.working_bone == forearm

@@ -151,3 +151,30 @@ def test_compare_export_and_slices(qtbot, posed_window, tmp_path):
     nx, ny, nz = w.doc.preview.reconstruction.volume.shape
     assert (tmp_path / f"posed.{nx}x{ny}x{nz}.vol").is_file() and f"posed.{nx}x{ny}x{nz}.vol" in \
         w.statusBar().currentMessage()
+
+
+def test_the_axes_the_sliders_turn_about_are_drawn_on_the_selected_bone(qtbot, posed_window):
+    """Which slider raises the arm? The working bone shows its x (red), y (green), z (blue) axes."""
+    w = posed_window
+    doc = w.doc
+    ua, fa = doc.bones.index("L_UPPERARM"), doc.bones.index("L_FOREARM")
+    doc.select_bones([ua])
+    drag(qtbot, w, 1, range(0, -91, -30))
+    doc.select_bones([fa])  # its axes are the rest axes turned with the upper arm
+
+    def red_tip():
+        mesh = w.plotter.renderer.actors["rot_axes"].mapper.dataset
+        red = mesh.extract_cells(np.flatnonzero((mesh.cell_data["rgb"] == [230, 60, 60]).all(1)))
+        start = w.scene.world(doc.pose.posed_joints()["L_ELBOW"][None])[0]
+        far = red.points[np.argmax(np.linalg.norm(red.points - start, axis=1))]
+        return (far - start) / np.linalg.norm(far - start)
+
+    assert w.plotter.renderer.actors["rot_axes"].GetVisibility()
+    x_now = doc.pose.matrices()[ua][0, :3]  # where the rest x axis points after the upper arm's turn
+    assert np.allclose(red_tip(), x_now / np.linalg.norm(x_now), atol=0.02)
+    assert not np.allclose(x_now, [1, 0, 0], atol=0.1)  # (so the test tells the frames apart)
+    for slider, end in ((w.pose_panel.sliders[0], 180), (w.pose_panel.sliders[2], -180)):
+        slider.setValue(end)  # the ends of the sliders are exactly +-180 degrees
+    assert doc.pose.angles_of(fa)[0] == 180 and doc.pose.angles_of(fa)[2] == -180
+    qtbot.keyClick(w, Qt.Key_V)  # leaving Pose hides them with the pose stage
+    assert not w.plotter.renderer.actors["rot_axes"].GetVisibility()
