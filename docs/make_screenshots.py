@@ -127,6 +127,7 @@ def main() -> None:
     preview_and_wait()
     w.panel_tabs.setCurrentWidget(w.pose_panel)
     grab(w, HERE / "studio-timeline.png")
+    w.doc.undo.mark_clean()  # the session's edits are not for keeping: no "Save changes?", no autosave left
     w.close()
 
 

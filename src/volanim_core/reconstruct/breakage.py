@@ -102,6 +102,7 @@ class Stump:
     lies_along: str
     posed: np.ndarray  # (K, 3) where the pose put them (their spheres' centres)
     weight: float  # sum of radius^3: how much volume stays behind, for ranking
+    margin: float = 0.0  # their largest sphere radius: posed +- margin encloses the stump's voxels
 
     def text(self) -> str:
         return (f"stump near {self.joint}: {self.points} points attached to {self.attached} lie along "
@@ -163,7 +164,8 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
         k = np.flatnonzero(behind & (own == o) & (along == n))
         centre = p[k].mean(0)
         joint = names[int(((pos - centre) ** 2).sum(1).argmin())] if names else ""
-        out.append(Stump(len(k), joint, label[o], label[n], went[k], float((tskel.dt[idx[k]] ** 3).sum())))
+        out.append(Stump(len(k), joint, label[o], label[n], went[k], float((tskel.dt[idx[k]] ** 3).sum()),
+                         float(tskel.dt[idx[k]].max())))
     return sorted(out, key=lambda s: -s.weight)
 
 

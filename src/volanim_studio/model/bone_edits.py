@@ -174,8 +174,11 @@ class BoneEdits:
             chain.append(leaving[chain[-1]][0])
         return chain
 
-    def side_prefix(self, joint: str, tolerance: float = 2.0) -> str:
-        """``L_`` or ``R_`` by the joint's side of the symmetry plane (the figure's left is +x), ``""`` on it."""
+    def side_prefix(self, joint: str) -> str:
+        """``L_`` or ``R_`` by the joint's side of the symmetry plane (the figure's left is +x), ``""`` near
+        it: within 5 % of the volume's width (a click at the pelvis lands a few voxels off the middle)."""
+        shape = self.doc.shape
+        tolerance = max(2.0, 0.05 * shape[0]) if shape else 2.0
         dx = float(self.doc.bones.joints[joint][0]) - self.doc.symmetry_x
         return "" if abs(dx) <= tolerance else ("L_" if dx > 0 else "R_")
 
@@ -194,8 +197,8 @@ class BoneEdits:
             raise ValueError("type the names of the chain's joints, e.g. SHOULDER, ELBOW, WRIST")
         if len(names) > len(chain):
             raise ValueError(f"{len(names)} names for a chain of {len(chain)} joints ({', '.join(chain)})")
-        if sided:
-            names = [n if n[:2] in ("L_", "R_") else self.side_prefix(j) + n for n, j in zip(names, chain)]
+        if sided:  # a joint already called so keeps its name (the pelvis that starts a leg's chain)
+            names = [n if n[:2] in ("L_", "R_") or n == j else self.side_prefix(j) + n for n, j in zip(names, chain)]
         mapping = {old: new for old, new in zip(chain, names) if old != new}
         if len(set(names)) != len(names):
             raise ValueError(f"a name appears twice: {', '.join(names)}")

@@ -81,6 +81,7 @@ CHAIN_PRESETS = {
     "arm": ("SHOULDER", "ELBOW", "WRIST", "FINGERS"),
     "arm from the neck": ("NECK", "SHOULDER", "ELBOW", "WRIST", "FINGERS"),
     "leg": ("HIP", "KNEE", "ANKLE", "TOE"),
+    "leg from the pelvis": ("PELVIS", "HIP", "KNEE", "ANKLE", "TOE"),
     "spine": ("PELVIS", "NECK", "HEAD"),
 }
 

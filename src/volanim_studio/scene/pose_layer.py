@@ -80,7 +80,7 @@ class PoseLayer:
         view.render()
 
     def on_report(self, **_) -> None:
-        """Mark the last full preview's stumps in 3-D (red), where the pose left them; a pose
+        """Mark the last full preview's stumps in 3-D (red boxes), where the pose left them; a pose
         change hides the marks until the next report."""
         view = self.view
         p = view.doc.preview
@@ -89,10 +89,14 @@ class PoseLayer:
         view.plotter.remove_actor("stumps", render=False)
         stumps = [] if p is None else p.report.stumps
         if stumps:
-            centres = view.world(np.vstack([s.posed for s in stumps])).astype(np.float32)
-            view.plotter.add_mesh(pv.PolyData(centres), color=STUMP_COLOUR, point_size=12,
-                                  render_points_as_spheres=True, name="stumps", render=False, reset_camera=False,
-                                  pickable=False)
+            # a red box around each stump: its spheres sit inside the preview, which would hide points
+            boxes = []
+            for st in stumps:
+                lo = view.world(st.posed.min(0)[None] - st.margin)[0]
+                hi = view.world(st.posed.max(0)[None] + st.margin)[0]
+                boxes.append(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).extract_all_edges())
+            view.plotter.add_mesh(pv.merge(boxes), color=STUMP_COLOUR, line_width=3, name="stumps", render=False,
+                                  reset_camera=False, pickable=False)
         view.apply_stage()
         view.render()
 

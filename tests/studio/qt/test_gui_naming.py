@@ -80,3 +80,61 @@ def test_f2_with_no_joint_clicked_says_what_to_do(qtbot, window):
     window.set_mode(Mode.VIEW)
     qtbot.keyClick(window, Qt.Key_F2)
     assert "Click a joint first" in window.statusBar().currentMessage()
+
+
+def test_the_readme_walkthrough_builds_and_names_the_mannequin_in_about_36_actions(qtbot, window):
+    """The README's "Build a bone skeleton" with real clicks and keys; every action is counted
+    (issue #18: about 100 clicks and keys, 43 of them to name joints)."""
+    actions = 0
+
+    def act(n=1):
+        nonlocal actions
+        actions += n
+
+    window.display_panel.thinness_slider.setValue(window.display_panel._step_of(0.75))
+    act()  # one drag of the thinness slider
+    qtbot.keyClick(window, Qt.Key_B)
+    act()
+
+    def chain(start, names):
+        """Click ``start`` (a joint name already there, or a position), then each joint; Esc."""
+        for n in [start, *names]:
+            if n in window.doc.bones.joints:
+                at = window.scene.project_world(window.scene.world(window.doc.bones.joints[n][None]))[0][0]
+            else:
+                at = window.scene.display_of_point(clickable_point(window, J[n]))
+            click(qtbot, window, at)
+            act()
+        qtbot.keyClick(window, Qt.Key_Escape)
+        act()
+
+    def name_chain(preset: str):
+        qtbot.keyClick(window, Qt.Key_F2, Qt.ControlModifier)
+        box = window._name_box
+        box.setTextValue(preset)  # opening the preset list and clicking the line: two clicks
+        box.accept()  # Enter
+        act(4)
+
+    chain("PELVIS", ["NECK", "HEAD"])
+    name_chain("PELVIS, NECK, HEAD")
+    chain("NECK", ["L_SHOULDER", "L_ELBOW", "L_WRIST", "L_FINGERS"])
+    name_chain("NECK, SHOULDER, ELBOW, WRIST, FINGERS")
+    chain("PELVIS", ["L_HIP", "L_KNEE", "L_ANKLE", "L_TOE"])
+    name_chain("PELVIS, HIP, KNEE, ANKLE, TOE")
+    tree = window.bone_panel.tree
+    left = [i for i, b in enumerate(window.doc.bones.bones) if b.distal.startswith("L_")]
+    assert left == list(range(left[0], left[-1] + 1))  # rows next to each other: click, Shift+click
+    tree.clearSelection()
+    for i in left:
+        tree.topLevelItem(i).setSelected(True)
+    act(2)
+    window.activateWindow()
+    qtbot.keyClick(window, Qt.Key_M)
+    act()
+    want = samples.mannequin_bones()
+    assert set(window.doc.bones.joints) == set(want.joints)
+    assert {(b.proximal, b.distal) for b in window.doc.bones.bones} == {(b.proximal, b.distal) for b in want.bones}
+    for n, p in window.doc.bones.joints.items():
+        assert np.linalg.norm(p - want.joints[n]) < 20, n  # near the real joints (a skeleton ends short of a tip)
+    act(3)  # Ctrl+S, type a file name, Enter
+    assert actions == 36, actions

@@ -105,7 +105,9 @@ def test_a_stump_is_the_verdict_in_the_status_bar_the_pose_tab_and_in_3d(qtbot, 
     assert w.panel_tabs.currentWidget() is w.pose_panel
     assert "stump" in w.reconstruct_panel.joints.item(0).text()
     marks = w.plotter.renderer.actors["stumps"]
-    assert marks.GetVisibility() and marks.mapper.GetInput().GetNumberOfPoints() == r.stumps[0].points
+    lo, hi = (w.scene.world(f(r.stumps[0].posed, axis=0)[None])[0] for f in (np.min, np.max))
+    b = np.reshape(marks.GetBounds(), (3, 2))
+    assert marks.GetVisibility() and (b[:, 0] <= lo).all() and (b[:, 1] >= hi).all()  # a box around the stump
     w.pose_panel.sliders[1].setValue(-80)  # the pose changes: the verdict is stale, the marks go
     assert "F5 checks again" in w.verdict_label.text() and "stumps" not in w.plotter.renderer.actors
     doc.attachments.assign(near, ua)  # the fix
