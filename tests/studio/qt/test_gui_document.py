@@ -107,3 +107,13 @@ def test_opening_another_volume_with_unsaved_edits_asks_first(qtbot, window):
     window.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
     _answer(qtbot, window, QMessageBox.Discard)
     assert asked == ["went on"]
+
+
+def test_file_dialogs_open_in_the_project_folder(window, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert window.files.folder() == str(tmp_path.resolve())  # nothing saved yet: the working directory
+    folder = tmp_path / "work"
+    folder.mkdir()
+    window.files.save_project(path=folder / "man.volanim")
+    assert window.files.folder("a.bones") == str(folder.resolve() / "a.bones")
+    assert window.timeline.folder() == window.previews.folder() == str(folder.resolve())  # every controller
