@@ -20,13 +20,16 @@ def front_view(window) -> None:
     window.plotter.render()
 
 
-def click(qtbot, window, display_xy, button=Qt.LeftButton, modifier=Qt.NoModifier) -> None:
-    """Click at VTK display coordinates (device pixels, origin bottom-left) through Qt."""
+def qt_pos(window, display_xy) -> QPoint:
+    """The Qt widget position of VTK display coordinates (device pixels, origin bottom-left)."""
     w = window.plotter
     s = w.devicePixelRatioF()
-    qx = int(round(display_xy[0] / s))
-    qy = int(round(w.height() - 1 - display_xy[1] / s))
-    qtbot.mouseClick(w, button, modifier, QPoint(qx, qy))
+    return QPoint(int(round(display_xy[0] / s)), int(round(w.height() - 1 - display_xy[1] / s)))
+
+
+def click(qtbot, window, display_xy, button=Qt.LeftButton, modifier=Qt.NoModifier) -> None:
+    """Click at VTK display coordinates through Qt."""
+    qtbot.mouseClick(window.plotter, button, modifier, qt_pos(window, display_xy))
 
 
 def clickable_point(window, near_voxel) -> int:

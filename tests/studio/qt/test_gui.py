@@ -246,6 +246,19 @@ def test_threshold_dialog_histogram_and_parameters(qtbot):
     assert image.width() == dialog.width() * image.devicePixelRatio()
 
 
+def save_close_reopen(qtbot, window, path):
+    """Save ``window``'s project to ``path``, close it, and open the project in a new window."""
+    from volanim_studio.qt.main_window import MainWindow
+
+    saved = window.files.save_project(path=path)
+    window.close()
+    again = MainWindow()
+    qtbot.addWidget(again)
+    again.files.open_project(saved)
+    qtbot.waitUntil(lambda: not again.busy, timeout=JOB_TIMEOUT_MS)
+    return again
+
+
 def test_the_voxel_spacing_is_shown_kept_and_saved(qtbot, tmp_path):
     """The threshold dialog had no spacing field: a raw .vol's 1.5 mm slices could not be said (issue #18)."""
     import pyvista as pv
@@ -269,12 +282,7 @@ def test_the_voxel_spacing_is_shown_kept_and_saved(qtbot, tmp_path):
     w.files.open_volume(tmp_path / "box.vti", params=params)
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert w.doc.spacing == (1.0, 1.0, 2.0)
-    path = w.files.save_project(path=tmp_path / "box.volanim")
-    w.close()
-    again = MainWindow()
-    qtbot.addWidget(again)
-    again.files.open_project(path)
-    qtbot.waitUntil(lambda: not again.busy, timeout=JOB_TIMEOUT_MS)
+    again = save_close_reopen(qtbot, w, tmp_path / "box.volanim")
     assert again.doc.spacing == (1.0, 1.0, 2.0) and again.last_error is None
     again.close()
 
@@ -318,12 +326,7 @@ def test_reopening_a_project_gives_back_the_skeleton_that_was_connected(qtbot, t
     first.files.open_volume(tmp_path / "box.VOL", params=params)
     qtbot.waitUntil(lambda: not first.busy, timeout=JOB_TIMEOUT_MS)
     skeleton = first.doc.skeleton
-    path = first.files.save_project(path=tmp_path / "box.volanim")
-    first.close()
-    second = MainWindow()
-    qtbot.addWidget(second)
-    second.files.open_project(path)
-    qtbot.waitUntil(lambda: not second.busy, timeout=JOB_TIMEOUT_MS)
+    second = save_close_reopen(qtbot, first, tmp_path / "box.volanim")
     assert second.doc.skeleton == skeleton and second.doc.skeleton.metric == "345"
     assert second.doc.segmentation == {**params, "spacing": [1.0, 1.0, 1.0]}
     assert bool(second.doc.mask[20, 15, 15])  # the cavity is filled

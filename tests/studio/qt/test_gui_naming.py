@@ -4,21 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QPoint, Qt
+from PySide6.QtCore import Qt
 
 from volanim_core import samples
 from volanim_studio.model.modes import Mode
 
-from ..conftest import click, clickable_point
+from ..conftest import click, clickable_point, qt_pos
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
-
-
-def _qt_pos(window, display_xy) -> QPoint:
-    w = window.plotter
-    s = w.devicePixelRatioF()
-    return QPoint(int(round(display_xy[0] / s)), int(round(w.height() - 1 - display_xy[1] / s)))
 
 
 def test_build_a_chain_with_a_line_to_the_cursor_then_name_it_in_one_line(qtbot, window):
@@ -29,7 +23,7 @@ def test_build_a_chain_with_a_line_to_the_cursor_then_name_it_in_one_line(qtbot,
     pts = [clickable_point(window, J[n]) for n in ("L_SHOULDER", "L_ELBOW", "L_WRIST")]
     click(qtbot, window, window.scene.display_of_point(pts[0]))
     target = window.scene.display_of_point(pts[1])
-    qtbot.mouseMove(window.plotter, _qt_pos(window, target))
+    qtbot.mouseMove(window.plotter, qt_pos(window, target))
     qtbot.waitUntil(lambda: "chain_preview" in actors(), timeout=5000)
     line = actors()["chain_preview"].mapper.GetInput()
     assert line.n_points == 2 and actors()["chain_preview"].GetVisibility()
@@ -58,7 +52,7 @@ def test_hover_names_a_joint_click_picks_it_and_f2_renames_it(qtbot, window):
     window.doc.bone_edits.add_bone(J["L_SHOULDER"], J["L_ELBOW"])
     elbow = next(n for n, p in window.doc.bones.joints.items() if np.allclose(p, J["L_ELBOW"]))
     at = window.scene.project_world(window.scene.world(J["L_ELBOW"][None]))[0][0]
-    qtbot.mouseMove(window.plotter, _qt_pos(window, at))
+    qtbot.mouseMove(window.plotter, qt_pos(window, at))
     qtbot.waitUntil(lambda: window.scene.names.hovered is not None, timeout=5000)
     assert window.scene.names.hovered == ("joint", elbow) and "hover" in window.plotter.renderer.actors
     assert elbow in window.statusBar().currentMessage()
