@@ -101,7 +101,7 @@ class FilesController(Controller):
             vol, skeleton_path=skeleton_path, progress=progress, cancel=cancel, **params), done)
 
     def open_volume_dialog(self) -> None:
-        self.window.when_saved_or_discarded(self._ask_volume, "opening another volume")
+        self.window.session.when_saved_or_discarded(self._ask_volume, "opening another volume")
 
     def _ask_volume(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", self.folder(),
@@ -194,7 +194,7 @@ class FilesController(Controller):
 
     def open_dialog(self, kind: str) -> None:
         if kind == "project":
-            self.window.when_saved_or_discarded(lambda: self._ask_open(kind), "opening another project")
+            self.window.session.when_saved_or_discarded(lambda: self._ask_open(kind), "opening another project")
         else:
             self._ask_open(kind)
 

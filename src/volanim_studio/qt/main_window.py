@@ -11,14 +11,11 @@ clicks and keys to the mode table; it keeps no view or tool state of its own.
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractSpinBox,
     QDockWidget,
-    QInputDialog,
     QLabel,
     QLineEdit,
     QMainWindow,
@@ -27,23 +24,25 @@ from PySide6.QtWidgets import (
 )
 from pyvistaqt import QtInteractor
 
-from ..model import autosave
 from ..model.document import Document
 from ..model.modes import HANDLERS, Mode, PickEvent
 from ..scene.view import SceneView
 from .bone_panel import BonePanel
+from .connect_controller import ConnectController
 from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .files_controller import FilesController
 from .gui_gc import collect_on_gui_thread
 from .mode_keys import LettersPastNumberFields
+from .naming_controller import NamingController
 from .pose_panel import PosePanel
 from .preview_controller import PreviewController
 from .reconstruct_panel import ReconstructPanel
+from .session_controller import SessionController
 from .timeline_controller import TimelineController
 from .timeline_panel import TimelinePanel
 from .verdict_label import VerdictLabel
-from .worker import JobRunner, Worker
+from .worker import JobRunner
 
 SHORTCUTS = [
     ("V", "View mode: click points to inspect them"),
@@ -76,16 +75,6 @@ SHORTCUTS = [
 ]
 
 
-#: What Name chain offers (it keeps as many names as the chain has joints; the side's L_/R_ is added)
-CHAIN_PRESETS = {
-    "arm": ("SHOULDER", "ELBOW", "WRIST", "FINGERS"),
-    "arm from the neck": ("NECK", "SHOULDER", "ELBOW", "WRIST", "FINGERS"),
-    "leg": ("HIP", "KNEE", "ANKLE", "TOE"),
-    "leg from the pelvis": ("PELVIS", "HIP", "KNEE", "ANKLE", "TOE"),
-    "spine": ("PELVIS", "NECK", "HEAD"),
-}
-
-
 class MainWindow(QMainWindow):
     def __init__(self, doc: Document | None = None, *, autosave_every_edits: int = 5,
                  autosave_seconds: float = 60.0):
@@ -106,6 +95,8 @@ class MainWindow(QMainWindow):
 
         self.files = FilesController(self)
         self.previews = PreviewController(self)
+        self.naming = NamingController(self)
+        self.connecting = ConnectController(self)
         self.previews.in_pose_mode = lambda: self.mode == Mode.POSE
         self.display_panel = DisplayPanel(self.doc)
         self.display_panel.dragging.connect(self.scene.set_dragging)
@@ -144,123 +135,12 @@ class MainWindow(QMainWindow):
         self.doc.events.attachments.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.events.bones.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.undo.events.changed.connect(self._on_undo_changed)
-        self.doc.events.project.connect(self._update_title)
-        self.doc.events.skeleton.connect(self._update_title)
-        self.doc.undo.events.changed.connect(self._update_title)
-        self._close_confirmed = False
-        self._save_box: QMessageBox | None = None
-        self.autosaver = autosave.Autosaver(self.doc, every_edits=autosave_every_edits,
-                                            every_seconds=autosave_seconds)
-        self.doc.undo.events.changed.connect(self._autosave_after_edit)
-        self.autosave_timer = QTimer(self)
-        self.autosave_timer.timeout.connect(self._autosave_tick)
-        self.autosave_timer.start(int(1000 * min(autosave_seconds, 60.0)))
+        self.session = SessionController(self, every_edits=autosave_every_edits, every_seconds=autosave_seconds)
         self.set_mode(Mode.VIEW)
-        self._update_title()
         self._letters = LettersPastNumberFields(self)
         for box in self.findChildren(QAbstractSpinBox):
             box.installEventFilter(self._letters)
             box.findChild(QLineEdit).installEventFilter(self._letters)
-
-    # ------------------------------------------------------------ autosave
-    def _autosave_after_edit(self, **_) -> None:
-        try:
-            self.autosaver.edited()
-        except (OSError, ValueError) as exc:
-            self.doc.message(f"Autosave failed: {exc}")
-
-    def _autosave_tick(self) -> None:
-        try:
-            self.autosaver.tick()
-        except (OSError, ValueError) as exc:
-            self.doc.message(f"Autosave failed: {exc}")
-
-    def offer_recovery(self, ask=None) -> Worker | None:
-        """If an earlier session crashed, offer to restore its last autosave.
-
-        ``ask(path) -> bool`` replaces the question dialog (tests).
-        """
-        found = autosave.find_recoveries()
-        if not found:
-            return None
-        latest = found[0]
-        if ask is None:
-            answer = QMessageBox.question(
-                self, "Restore unsaved work?", f"volanim studio did not close properly last time.\n"
-                f"Restore the session autosaved at {latest.parent.name}?", QMessageBox.Yes | QMessageBox.No)
-            restore = answer == QMessageBox.Yes
-        else:
-            restore = ask(latest)
-        if not restore:
-            for f in found:
-                autosave.decline(f)  # kept a week (the folder can still be opened as a project), not asked again
-            return None
-
-        def opened(ok: bool) -> None:
-            if not ok:  # nothing is deleted: the next start offers it again
-                self.doc.message(f"The autosave in {latest.parent} was not restored; it is kept.")
-                return
-            self.doc.project_path = None  # a restored session saves where the user says, not into the cache
-            self.doc.undo.mark_modified()  # it is saved nowhere yet
-            self._update_title()
-            try:
-                self.autosaver.save()  # what was restored is safe in this session's folder ...
-            except (OSError, ValueError) as exc:
-                self.doc.message(f"Restored, but the autosave of it failed ({exc}); the old autosave is kept.")
-                return
-            for f in found:  # ... before the crashed sessions' folders go
-                autosave.discard(f)
-            self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones).")
-
-        return self.files.open_project(latest, on_opened=opened)
-
-    # ------------------------------------------------------ unsaved changes
-    def _update_title(self, **_) -> None:
-        """``volanim studio — NAME[*]``: Qt shows the ``*`` while the document has unsaved edits."""
-        path = self.doc.project_path
-        name = Path(path).name if path else (None if self.doc.is_empty else "untitled")
-        self.setWindowTitle("volanim studio" + (f" — {name}" if name else "") + "[*]")
-        self.setWindowModified(self.doc.modified)
-
-    def when_saved_or_discarded(self, then, doing: str) -> None:
-        """Run ``then()`` once unsaved edits are saved or discarded; at once when there are none.
-
-        Asks Save / Discard / Cancel without blocking (the window's event loop keeps
-        running, so a job in flight still reports). Discarded edits are set aside for a
-        week in the autosave folder, so a wrong answer loses nothing.
-        """
-        if not self.doc.modified:
-            then()
-            return
-        name = Path(self.doc.project_path).name if self.doc.project_path else "This project"
-        box = QMessageBox(QMessageBox.Warning, "Save changes?",
-                          f"{name} has unsaved changes. Save them before {doing}?",
-                          QMessageBox.Save | QMessageBox.Discard | QMessageBox.Cancel, self)
-        box.setInformativeText("Discarded changes are kept for a week in the autosave folder "
-                               f"({self.autosaver.root}); they can be opened as a project.")
-        box.setDefaultButton(QMessageBox.Save)
-
-        def answered(_result) -> None:
-            self._save_box = None
-            button = box.standardButton(box.clickedButton()) if box.clickedButton() else QMessageBox.Cancel
-            if button == QMessageBox.Save:
-                if self.files.save_project() is None:
-                    return  # not saved (the user cancelled the file dialog, or it failed and said why)
-            elif button == QMessageBox.Discard:
-                try:
-                    kept = self.autosaver.set_aside()
-                except (OSError, ValueError) as exc:
-                    self.show_error("Discard changes", f"The discarded changes could not be set aside ({exc}); "
-                                    "nothing was discarded.")
-                    return
-                self.doc.message(f"Discarded changes are kept in {kept}.")
-            else:
-                return
-            then()
-
-        box.finished.connect(answered)
-        self._save_box = box
-        box.open()
 
     # ------------------------------------------------------------- actions
     def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:
@@ -288,8 +168,7 @@ class MainWindow(QMainWindow):
         self._action("Symmetrize selected bones", self.symmetrize, "M", menu=edit)
         self._action("End chain", lambda: self.key("Escape"), "Esc")
         edit.addSeparator()
-        self._action("Rename joint…", self.rename_joint_dialog, "F2", menu=edit)
-        self._action("Name chain…", self.name_chain_dialog, "Ctrl+F2", menu=edit)
+        self.naming.fill_menu(edit, self._action)
         modes = bar.addMenu("&Mode")
         toolbar = self.addToolBar("Modes")
         group = QActionGroup(self)
@@ -313,8 +192,7 @@ class MainWindow(QMainWindow):
                               ("PageUp", "PgUp"), ("PageDown", "PgDown"), ("Plus", "+"), ("Minus", "-"),
                               ("C", "C"), ("X", "X"))]
         connect_menu = bar.addMenu("&Connect")
-        self._action("Auto-connect", self.auto_connect, "Ctrl+A", menu=connect_menu)
-        self._action("Mirror connectivity of selected bones", self.mirror_connectivity, menu=connect_menu)
+        self.connecting.fill_menu(connect_menu, self._action)
         self._action("Save .connect…", lambda: self.files.save_dialog("connect"), menu=connect_menu)
         self._action("Open .connect…", lambda: self.files.open_dialog("connect"), menu=connect_menu)
         self.previews.fill_menu(bar.addMenu("&Pose"), self._action)
@@ -331,8 +209,8 @@ class MainWindow(QMainWindow):
         view.addSeparator()
         self._action("Save view as camera file…", lambda: self.timeline.save_camera_dialog(), menu=view)
         self.timeline.wire(self.timeline_panel)
-        self.connect_panel.auto_button.clicked.connect(self.auto_connect)
-        self.connect_panel.mirror_button.clicked.connect(self.mirror_connectivity)
+        self.connect_panel.auto_button.clicked.connect(self.connecting.auto_connect)
+        self.connect_panel.mirror_button.clicked.connect(self.connecting.mirror_connectivity)
         help_menu = bar.addMenu("&Help")
         self._action("&Shortcuts", self.show_shortcuts, "F1", menu=help_menu)
         self._on_undo_changed()
@@ -363,50 +241,6 @@ class MainWindow(QMainWindow):
         lasso = self.handlers[Mode.LASSO]
         lasso.finish(polygon, xy, depth, view_depth, shown, remove=True if ctrl else None)
 
-    def auto_connect(self) -> None:
-        st = self.doc.settings
-        try:
-            report = self.doc.attachments.auto(scope=st.auto_scope, overwrite=st.auto_overwrite,
-                                               selection=self.doc.point_selection, method=st.auto_method)
-        except ValueError as exc:
-            self.show_error("Auto-connect", str(exc))
-            return
-        self.doc.settings.colour_by = "bone"  # what was connected to what is the thing to look at now
-        self.doc.message(f"Auto-connect: {report}.")
-        if not report.unattached:
-            return
-        text = f"Auto-connect {report}. Connect the rest with the cube or lasso."
-        if st.auto_method == "path" and report.unattached > report.attached:
-            # most points found no straight path inside the volume to a bone (a crude rig, a curled
-            # body): the fallback method attaches those to the nearest bone instead
-            text += ("\n\nMost points found no path. The method path-or-nearest connects those to the "
-                     "nearest bone: use it now?")
-            box = QMessageBox(QMessageBox.Question, "Auto-connect", text, QMessageBox.Yes | QMessageBox.No, self)
-            box.button(QMessageBox.Yes).setText("Use path-or-nearest")
-
-            def answered(_result):
-                if box.standardButton(box.clickedButton()) == QMessageBox.Yes:
-                    st.auto_method = "path-or-nearest"
-                    self.auto_connect()
-
-            box.finished.connect(answered)
-            self.last_error = text
-            self._error_box = box
-            box.open()
-            return
-        self.show_error("Auto-connect", text)
-
-    def mirror_connectivity(self) -> None:
-        try:
-            copied, lonely = self.doc.attachments.mirror()
-        except ValueError as exc:
-            self.show_error("Mirror connectivity", str(exc))
-            return
-        text = f"Mirrored {copied} attachments"
-        if lonely:
-            text += f"; {lonely} points found no partner on the other side (connect them by hand)"
-        self.doc.message(text + ".")
-
     def _toggle_remove(self, on: bool) -> None:
         self.handlers[Mode.BONES].remove = on
         if on:
@@ -428,61 +262,6 @@ class MainWindow(QMainWindow):
         self.handlers[self.mode].key(name)
         if self.handlers[Mode.BONES].pending is None:
             self.scene.names.clear_chain_preview()
-
-    # ---------------------------------------------------------------- naming
-    def _named_joint(self, what: str) -> str | None:
-        joint = self.doc.picked_joint
-        if joint is None:
-            self.doc.message(f"Click a joint first, then {what}.")
-        return joint
-
-    def rename_joint_dialog(self) -> QInputDialog | None:
-        """F2: rename the joint clicked last (a non-blocking dialog; Enter applies, one undo step)."""
-        joint = self._named_joint("press F2 to rename it")
-        if joint is None:
-            return None
-        box = QInputDialog(self)
-        box.setWindowTitle("Rename joint")
-        box.setLabelText(f"New name for {joint}:")
-        box.setTextValue(joint)
-        box.textValueSelected.connect(lambda text: self._apply_name(
-            lambda: self.doc.bone_edits.rename_joint(joint, text), f"Renamed {joint} to {text.strip()}."))
-        self._name_box = box
-        box.open()
-        return box
-
-    def name_chain_dialog(self) -> QInputDialog | None:
-        """Ctrl+F2: name the chain of the selected bone (the one just built), else the chain that starts
-        at the joint clicked last, in one line: "SHOULDER, ELBOW, WRIST"."""
-        edits = self.doc.bone_edits
-        if self.doc.selected_bones:
-            chain = edits.chain_through(self.doc.selected_bones[0])
-        elif self.doc.picked_joint is not None:
-            chain = edits.chain_from(self.doc.picked_joint)
-        else:
-            self.doc.message("Select a bone of the chain (or click its first joint), then Ctrl+F2.")
-            return None
-        side = edits.side_prefix(chain[-1])
-        box = QInputDialog(self)
-        box.setWindowTitle("Name chain")
-        box.setLabelText(f"Names for the {len(chain)} joints {' → '.join(chain)}, in order\n"
-                         f"(commas or spaces; {side or 'no prefix'} is added on this side when left out):")
-        box.setComboBoxEditable(True)
-        box.setComboBoxItems([""] + [", ".join(p[:len(chain)]) for p in CHAIN_PRESETS.values()
-                                     if len(p) >= len(chain)])
-        box.textValueSelected.connect(lambda text: self._apply_name(
-            lambda: edits.rename_chain(chain, text), None))
-        self._name_box = box
-        box.open()
-        return box
-
-    def _apply_name(self, action, done: str | None) -> None:
-        try:
-            result = action()
-        except ValueError as exc:
-            self.show_error("Name", str(exc))
-            return
-        self.doc.message(done or f"Named the chain {', '.join(result)}.")
 
     def undo(self) -> None:
         label = self.doc.undo.undo()
@@ -540,23 +319,16 @@ class MainWindow(QMainWindow):
         """A background job is running (its thread has not ended yet)."""
         return self.jobs.busy
 
-    def _close_now(self) -> None:
-        self._close_confirmed = True
-        self.close()
-
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
 
     def closeEvent(self, event):  # noqa: N802 (Qt name)
-        if self.doc.modified and not self._close_confirmed:
-            event.ignore()  # ask first; close again once the edits are saved or set aside
-            if self._save_box is None:
-                self.when_saved_or_discarded(self._close_now, "closing")
+        if not self.session.may_close():
+            event.ignore()  # "Save changes?" is asked; a Save or Discard closes the window again
             return
         self.timeline.stop()
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
-        self.autosave_timer.stop()
-        self.autosaver.close()
+        self.session.close()
         self.plotter.close()
         super().closeEvent(event)
 
@@ -585,7 +357,7 @@ def main_window_for(args) -> MainWindow:
     else:
         then()
     if not (args.project or args.demo or args.volume or args.mskel or args.connect or args.bones):
-        w.offer_recovery()  # a plain start: offer a crashed session's autosave
+        w.session.offer_recovery()  # a plain start: offer a crashed session's autosave
     return w
 
 

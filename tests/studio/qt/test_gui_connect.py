@@ -180,14 +180,14 @@ def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
     w = MainWindow()
     qtbot.addWidget(w)
     asked = []
-    w.offer_recovery(ask=lambda p: asked.append(p) or True)
+    w.session.offer_recovery(ask=lambda p: asked.append(p) or True)
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert asked, listing
     assert len(w.doc.bones) == 18, (listing, w.last_error)
     assert int((w.doc.attachments.bone >= 0).sum()) == attached, (listing, w.last_error)
     # the restored state is autosaved in this session's folder; then the crashed session's copy goes
     saved = list(recovery_dir.glob("*/recovery.volanim"))
-    assert len(saved) == 1 and saved[0].parent == w.autosaver.folder
+    assert len(saved) == 1 and saved[0].parent == w.session.autosaver.folder
     again = read_project(saved[0])
     assert io.read_connect(again["connect"]).bone.size == attached
     assert w.isWindowModified() and w.doc.project_path is None  # saved nowhere yet: Ctrl+S asks where
@@ -214,7 +214,7 @@ def test_a_restore_that_fails_deletes_nothing(qtbot, tmp_path, recovery_dir):
 
     w = MainWindow()
     qtbot.addWidget(w)
-    w.offer_recovery(ask=lambda p: True)
+    w.session.offer_recovery(ask=lambda p: True)
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert "changed or damaged" in (w.last_error or "")
     assert sorted(p.name for p in saver.folder.rglob("*")) == before  # nothing deleted

@@ -19,8 +19,8 @@ pytestmark = pytest.mark.gui
 
 def _answer(qtbot, window, button) -> None:
     """Click ``button`` of the window's "Save changes?" box (which must be showing)."""
-    qtbot.waitUntil(lambda: window._save_box is not None and window._save_box.isVisible(), timeout=5000)
-    window._save_box.button(button).click()
+    qtbot.waitUntil(lambda: window.session.save_box is not None and window.session.save_box.isVisible(), timeout=5000)
+    window.session.save_box.button(button).click()
 
 
 def _rename_a_joint(window) -> None:
@@ -59,7 +59,7 @@ def test_discarded_edits_are_set_aside_for_a_week_not_deleted(qtbot, window, rec
     assert len(kept) == 1 and (kept[0].parent / autosave.DECLINED).exists()
     assert "L_KNUCKLE" in io.read_bones(read_project(kept[0])["bones"]).joints
     assert autosave.find_recoveries(recovery_dir) == []  # kept, but not offered as a crash
-    assert not window.autosaver.folder.exists()  # the session's own folder went as before
+    assert not window.session.autosaver.folder.exists()  # the session's own folder went as before
 
 
 def test_save_from_the_close_prompt_saves_then_closes(qtbot, window, tmp_path):
@@ -101,10 +101,10 @@ def test_a_new_volume_is_a_new_document_and_the_old_project_is_untouched(qtbot, 
 def test_opening_another_volume_with_unsaved_edits_asks_first(qtbot, window):
     _rename_a_joint(window)
     asked = []
-    window.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
+    window.session.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
     _answer(qtbot, window, QMessageBox.Cancel)
     assert asked == [] and "L_KNUCKLE" in window.doc.bones.joints
-    window.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
+    window.session.when_saved_or_discarded(lambda: asked.append("went on"), "opening another volume")
     _answer(qtbot, window, QMessageBox.Discard)
     assert asked == ["went on"]
 

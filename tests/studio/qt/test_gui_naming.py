@@ -38,7 +38,7 @@ def test_build_a_chain_with_a_line_to_the_cursor_then_name_it_in_one_line(qtbot,
     labels = window.scene.names.label_actors
     assert len(window.doc.bones) == 2 and len(labels) == 1 and labels[0] in actors().values()
     qtbot.keyClick(window, Qt.Key_F2, Qt.ControlModifier)  # the selected (last built) bone's chain
-    box = window._name_box
+    box = window.naming.box
     assert box.isVisible() and "3 joints" in box.labelText()
     box.setTextValue("SHOULDER, ELBOW, WRIST")
     box.accept()
@@ -59,7 +59,7 @@ def test_hover_names_a_joint_click_picks_it_and_f2_renames_it(qtbot, window):
     click(qtbot, window, at)  # View mode: picks the joint
     assert window.doc.picked_joint == elbow and "picked_joint" in window.plotter.renderer.actors
     qtbot.keyClick(window, Qt.Key_F2)
-    box = window._name_box
+    box = window.naming.box
     assert box.textValue() == elbow
     box.setTextValue("L_ELBOW")
     box.accept()
@@ -104,7 +104,7 @@ def test_the_readme_walkthrough_builds_and_names_the_mannequin_in_about_36_actio
 
     def name_chain(preset: str):
         qtbot.keyClick(window, Qt.Key_F2, Qt.ControlModifier)
-        box = window._name_box
+        box = window.naming.box
         box.setTextValue(preset)  # opening the preset list and clicking the line: two clicks
         box.accept()  # Enter
         act(4)

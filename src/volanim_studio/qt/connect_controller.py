@@ -1,0 +1,64 @@
+"""The Connect menu's whole-skeleton actions: auto-connect and mirror (the modes do cube and lasso).
+
+    Ctrl+A / the Connect tab's button --> Attachments.auto --> colour by bone; a report, and when
+        *path* left most points unattached an offer to use *path-or-nearest*
+    Mirror --> Attachments.mirror --> how many points found no partner
+
+Owned by the main window.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import QMessageBox
+
+from .controller import Controller
+
+
+class ConnectController(Controller):
+    def fill_menu(self, menu, action) -> None:
+        action("Auto-connect", self.auto_connect, "Ctrl+A", menu=menu)
+        action("Mirror connectivity of selected bones", self.mirror_connectivity, menu=menu)
+
+    def auto_connect(self) -> None:
+        st = self.doc.settings
+        try:
+            report = self.doc.attachments.auto(scope=st.auto_scope, overwrite=st.auto_overwrite,
+                                               selection=self.doc.point_selection, method=st.auto_method)
+        except ValueError as exc:
+            self.show_error("Auto-connect", str(exc))
+            return
+        st.colour_by = "bone"  # what was connected to what is the thing to look at now
+        self.doc.message(f"Auto-connect: {report}.")
+        if not report.unattached:
+            return
+        text = f"Auto-connect {report}. Connect the rest with the cube or lasso."
+        if st.auto_method != "path" or report.unattached <= report.attached:
+            self.show_error("Auto-connect", text)
+            return
+        # most points found no straight path inside the volume to a bone (a crude rig, a curled
+        # body): the fallback method attaches those to the nearest bone instead
+        text += ("\n\nMost points found no path. The method path-or-nearest connects those to the nearest bone: "
+                 "use it now?")
+        box = QMessageBox(QMessageBox.Question, "Auto-connect", text, QMessageBox.Yes | QMessageBox.No, self.window)
+        box.button(QMessageBox.Yes).setText("Use path-or-nearest")
+
+        def answered(_result):
+            if box.standardButton(box.clickedButton()) == QMessageBox.Yes:
+                st.auto_method = "path-or-nearest"
+                self.auto_connect()
+
+        box.finished.connect(answered)
+        self.window.last_error = text
+        self.window._error_box = box
+        box.open()
+
+    def mirror_connectivity(self) -> None:
+        try:
+            copied, lonely = self.doc.attachments.mirror()
+        except ValueError as exc:
+            self.show_error("Mirror connectivity", str(exc))
+            return
+        text = f"Mirrored {copied} attachments"
+        if lonely:
+            text += f"; {lonely} points found no partner on the other side (connect them by hand)"
+        self.doc.message(text + ".")
