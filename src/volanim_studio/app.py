@@ -82,6 +82,8 @@ def _quit_when_loaded(app, seconds: float = 600.0) -> None:
             status = window.statusBar().currentMessage() if window is not None else ""
             print(f"volanim-studio smoke check: {'FAILED: ' + '; '.join(errors) if errors else 'loaded'}"
                   + (f" ({status})" if status else ""), flush=True)
+            if window is not None:
+                window.session.close()  # a start-up check is no session to offer for recovery
             app.exit(1 if errors or time.monotonic() > deadline else 0)
 
     timer = QTimer(app)

@@ -117,3 +117,19 @@ def test_file_dialogs_open_in_the_project_folder(window, tmp_path, monkeypatch):
     window.files.save_project(path=folder / "man.volanim")
     assert window.files.folder("a.bones") == str(folder.resolve() / "a.bones")
     assert window.timeline.folder() == window.previews.folder() == str(folder.resolve())  # every controller
+
+
+def test_files_named_on_the_command_line_are_not_unsaved_edits(qtbot, tmp_path):
+    """``volanim-studio --demo mannequin --bones B`` then Ctrl+Q asked "Save changes?" about nothing."""
+    from volanim_studio.app import build_parser
+    from volanim_studio.qt.main_window import main_window_for
+
+    w = main_window_for(build_parser().parse_args(["--demo", "mannequin", "--bones",
+                                                   str(ASSETS / "mannequin.bones")]))
+    qtbot.addWidget(w)
+    qtbot.waitUntil(lambda: not w.busy and len(w.doc.bones) == 18, timeout=JOB_TIMEOUT_MS)
+    assert not w.doc.modified and not w.isWindowModified()
+    w.doc.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")  # an edit is one
+    assert w.isWindowModified()
+    w.doc.undo.mark_clean()
+    w.close()
