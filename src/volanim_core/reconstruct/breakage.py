@@ -32,6 +32,7 @@ from scipy import ndimage
 
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
+from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.pose import apply_matrices
 from volanim_core.rig.tskel import identity_tskel
@@ -109,20 +110,6 @@ class Stump:
                 f"{self.lies_along} and stay behind (connect them to {self.lies_along})")
 
 
-def segment_distances(points: np.ndarray, a: np.ndarray, b: np.ndarray, chunk: int = 65536) -> np.ndarray:
-    """``(N, B)`` distances from each point to each segment ``a[k]``-``b[k]``."""
-    p = np.asarray(points, np.float64)
-    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
-    ab = b - a
-    length2 = np.maximum((ab * ab).sum(1), 1e-12)
-    out = np.empty((len(p), len(a)))
-    for lo in range(0, len(p), chunk):  # bounded temporaries on the frog's 10^5 points
-        d = p[lo:lo + chunk, None, :] - a
-        t = np.clip((d * ab).sum(2) / length2, 0.0, 1.0)
-        out[lo:lo + chunk] = np.linalg.norm(d - t[..., None] * ab, axis=2)
-    return out
-
-
 def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
     """Points that lie clearly closer to another bone's rest segment than to their own (pose-independent).
 
@@ -131,9 +118,9 @@ def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
     """
     if not len(conn) or len(conn.bones) < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
-    a = np.array([b.proximal for b in conn.bones])
-    b = np.array([b.distal for b in conn.bones])
-    d = segment_distances(conn.points, a, b)
+    segs = np.array([[b.proximal, b.distal] for b in conn.bones])
+    d = np.vstack([segment_distances(conn.points[s:s + 65536], segs)  # bounded temporaries on 10^5 points
+                   for s in range(0, len(conn), 65536)])
     rows = np.arange(len(d))
     own = d[rows, conn.bone]
     d[rows, conn.bone] = np.inf

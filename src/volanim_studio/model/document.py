@@ -248,7 +248,7 @@ class Document:
         Opening a volume, a demo or a project starts here, so nothing of the previous
         project (bones, connectivity, pose, keys, its path) leaks into the new one.
         """
-        self.timeline._put_clip(None)
+        self.timeline.unload()
         self.timeline._set_keys({})
         self.pose._write({}, {})
         self.selected_bones = ()

@@ -57,7 +57,7 @@ class UndoStack:
         return self._done[-1] if self._done else None
 
     def push(self, command: Command) -> None:
-        top = self._done[-1] if self._done else None
+        top = self._top
         if command.merge_key and top is not None and top.merge_key == command.merge_key and not self._undone:
             command.redo()
             self._done[-1] = Command(command.label, command.redo, top.undo, command.merge_key)

@@ -252,14 +252,17 @@ class MainWindow(QMainWindow):
             self.handlers[self.mode].press(ev)
         except ValueError as exc:
             self.doc.message(str(exc))
-        if self.handlers[Mode.BONES].pending is None:
-            self.scene.names.clear_chain_preview()
+        self._drop_ended_chain_line()
 
     def key(self, name: str) -> None:
         if name == "Delete" and self.mode != Mode.BONES and self.doc.selected_bones:
             self.doc.bone_edits.remove_bones(self.doc.selected_bones)
             return
         self.handlers[self.mode].key(name)
+        self._drop_ended_chain_line()
+
+    def _drop_ended_chain_line(self) -> None:
+        """A click or key that ended the chain (right click, Esc) removes its line at once, not at the next move."""
         if self.handlers[Mode.BONES].pending is None:
             self.scene.names.clear_chain_preview()
 

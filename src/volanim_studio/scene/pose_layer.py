@@ -14,6 +14,7 @@ from matplotlib.colors import ListedColormap
 from volanim_core.render.colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
 from volanim_core.render.transfer import apply_labels, binary_view, volume_style
+from volanim_core.rig.pose import apply_matrices
 
 STUMP_COLOUR = "#ff3030"
 AXIS_COLOURS = ((230, 60, 60), (60, 200, 80), (70, 120, 255))  # x, y, z: the Pose tab names them so
@@ -60,13 +61,12 @@ class PoseLayer:
         doc = view.doc
         b = doc.working_bone
         if b is not None and b < len(doc.bones):
-            mats = doc.pose.matrices()
+            mats = doc.pose.matrices()  # once: this runs on every step of a slider drag
             parent = doc.bones.parents()[b]
             frame = np.eye(3) if parent is None else mats[parent][:3, :3]  # row k: where axis k points now
-            bone = doc.bones.bones[b]
-            origin = doc.pose.posed_joints()[bone.proximal]
-            length = 0.6 * float(np.linalg.norm(np.subtract(*doc.bones.segment(b))))
-            length = max(length, 8.0)
+            proximal = doc.bones.joints[doc.bones.bones[b].proximal]
+            origin = apply_matrices(proximal[None], np.array([b]), mats)[0]  # the joint turns with its bone
+            length = max(0.6 * float(np.linalg.norm(np.subtract(*doc.bones.segment(b)))), 8.0)
             arrows = []
             for k, colour in enumerate(AXIS_COLOURS):
                 d = frame[k] / np.linalg.norm(frame[k])

@@ -78,11 +78,11 @@ class SceneView:
         st.colour_by.connect(self._on_colour_by_changed)
         st.point_size.connect(lambda **_: self._update_cloud())
         st.spheres.connect(lambda **_: self._update_cloud())
+        self.names = NamesLayer(self)  # first: the other layers switch stages, which the labels follow
         self.hull = HullLayer(self)
         self.cube = CubeOverlay(self)
         self.lasso = LassoOverlay(self)
         self.pose_layer = PoseLayer(self)
-        self.names = NamesLayer(self)
 
     def _fix_pixel_ratio(self) -> None:
         # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen
@@ -149,12 +149,9 @@ class SceneView:
         doc = self.doc
         pts = []
         if doc.selected_bones and len(doc.bones):
-            segs = doc.bones.segments()[[i for i in doc.selected_bones if i < len(doc.bones)]]
-            if self.posing:
-                pj = doc.pose.posed_joints()
-                segs = np.array([[pj[doc.bones.bones[i].proximal], pj[doc.bones.bones[i].distal]]
-                                 for i in doc.selected_bones if i < len(doc.bones)])
-            pts = segs.reshape(-1, 3)
+            joints = doc.pose.posed_joints() if self.posing else doc.bones.joints
+            pts = np.array([joints[j] for i in doc.selected_bones if i < len(doc.bones)
+                            for j in (doc.bones.bones[i].proximal, doc.bones.bones[i].distal)])
         elif doc.picked_point is not None:
             pts = doc.skeleton.points[[doc.picked_point]]
         elif len(doc.point_selection):
@@ -398,8 +395,7 @@ class SceneView:
         for name in self.POSE_ACTORS:
             if name in actors:
                 actors[name].SetVisibility(self.posing)
-        if hasattr(self, "names"):  # (the names layer is made after the first stage switch)
-            self.names.show(not self.posing)
+        self.names.show(not self.posing)
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once.
