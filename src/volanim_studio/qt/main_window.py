@@ -17,7 +17,6 @@ from PySide6.QtWidgets import (
     QAbstractSpinBox,
     QDockWidget,
     QLabel,
-    QLineEdit,
     QMainWindow,
     QMessageBox,
     QTabWidget,
@@ -140,7 +139,6 @@ class MainWindow(QMainWindow):
         self._letters = LettersPastNumberFields(self)
         for box in self.findChildren(QAbstractSpinBox):
             box.installEventFilter(self._letters)
-            box.findChild(QLineEdit).installEventFilter(self._letters)
 
     # ------------------------------------------------------------- actions
     def _action(self, text, slot, shortcut=None, checkable=False, menu=None) -> QAction:
