@@ -65,8 +65,9 @@ def reconstruct(tskel, bounds, *, mode="binary", source=None, source_origin=(0, 
     Returns ``(volume[x, y, z], stencil, ties)``: ``ties`` marks sampled voxels whose
     source position is within 1e-6 of half-way between voxels (either rounding is right).
     """
-    from volanim_core.reconstruct.engine import gaussian_weights, mottled_values, posed_centres
+    from volanim_core.reconstruct.engine import mottled_values, posed_centres
     from volanim_core.reconstruct.radii import radius_squared
+    from volanim_core.reconstruct.sampling import gaussian_weights
 
     lo = np.asarray(bounds.lo)
     shape = tuple(int(v) for v in np.asarray(bounds.hi) - lo + 1)

@@ -1,6 +1,7 @@
 """Demo data: a procedural mannequin, the thesis's aliascube, and the real frog.
 
     mannequin()  (160, 100, 300) uint8  layered humanoid + BoneSkeleton + part labels
+    mannequin_colour()  (160, 100, 300, 3) uint8  the same body in anatomical colours (RGB)
     aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
     frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
                                          with a two-bone principal-axis chain
@@ -22,7 +23,7 @@ import numpy as np
 
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
-NAMES = ("mannequin", "aliascube", "frog")
+NAMES = ("mannequin", "mannequin-colour", "aliascube", "frog")
 #: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence.
 FILE_SAMPLES = ("walk",)
 
@@ -44,7 +45,8 @@ class Sample:
 
     @property
     def mask(self) -> np.ndarray:
-        return self.volume >= self.mask_level
+        grey = self.volume.max(axis=3) if self.volume.ndim == 4 else self.volume
+        return grey >= self.mask_level
 
 
 MID_X = (MANNEQUIN_SHAPE[0] - 1) / 2  # 79.5: the volume's mid-plane, the studio's default symmetry plane
@@ -153,6 +155,30 @@ def mannequin() -> Sample:
     return Sample("mannequin", vol, bones, part)
 
 
+#: sRGB of each mannequin tissue: skin, fat, two muscle stripes, bone, skull, brain (two stripes).
+TISSUE_COLOURS = {SKIN: (222, 170, 140), FAT: (238, 214, 128), MUSCLE_A: (178, 48, 46), MUSCLE_B: (132, 30, 38),
+                  BONE: (236, 230, 212), SKULL: (226, 216, 192), BRAIN: (206, 150, 156), BRAIN + 12: (182, 122, 132)}
+
+
+def mannequin_colour() -> Sample:
+    """The mannequin in anatomical colours, ``[x, y, z, 3]`` uint8 RGB (black background).
+
+    Each tissue has its colour, shaded lighter towards the head and with a little
+    per-voxel grain, so the volume has thousands of distinct colours, as a
+    photographed cryosection does, and a palette has to be built for it.
+    """
+    grey = mannequin()
+    table = np.zeros((256, 3), np.float32)
+    for value, colour in TISSUE_COLOURS.items():
+        table[value] = colour
+    body = grey.volume > 0
+    shade = np.linspace(0.88, 1.08, grey.volume.shape[2], dtype=np.float32)
+    grain = np.random.default_rng(15).normal(0.0, 4.0, grey.volume.shape + (3,)).astype(np.float32)
+    rgb = table[grey.volume] * shade[None, None, :, None] + grain
+    rgb = np.where(body[..., None], np.clip(np.rint(rgb), 1, 255), 0).astype(np.uint8)
+    return Sample("mannequin-colour", rgb, grey.bones, grey.part)
+
+
 ALIAS_SIZE, ALIAS_CUBE, ALIAS_BLOCK = 128, 107, 9
 
 
@@ -229,8 +255,8 @@ def _deepest_near(mask: np.ndarray, target, radius: float = 60.0, step: int = 4)
 
 
 def load(name: str) -> Sample:
-    """A demo dataset by name: 'mannequin', 'aliascube' or 'frog'."""
-    makers = {"mannequin": mannequin, "aliascube": aliascube, "frog": frog}
+    """A demo dataset by name: 'mannequin', 'mannequin-colour', 'aliascube' or 'frog'."""
+    makers = {"mannequin": mannequin, "mannequin-colour": mannequin_colour, "aliascube": aliascube, "frog": frog}
     if name not in makers:
         raise ValueError(f"unknown sample {name!r}; choose one of {', '.join(NAMES)}")
     return makers[name]()

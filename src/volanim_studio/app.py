@@ -9,6 +9,7 @@ import sys
 EPILOG = """examples:
   volanim-studio --demo mannequin                    the demo mannequin, ready for bone building
   volanim-studio --volume frog.VOL                   segment, skeletonize and view a volume
+  volanim-studio --demo mannequin-colour             a colour body: posed previews in its colours
   volanim-studio --mskel man.mskel --bones man.bones continue from files
   volanim-studio session.volanim                     reopen a saved project
 
@@ -16,11 +17,13 @@ Press F1 in the window for the keyboard shortcuts."""
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from volanim_core import samples  # light: numpy only
+
     p = argparse.ArgumentParser(prog="volanim-studio", description="Build bone skeletons for volumes, connect, "
                                 "pose and preview reconstructions.", epilog=EPILOG,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("project", nargs="?", help="a .volanim project to open")
-    p.add_argument("--demo", choices=("mannequin", "frog", "aliascube"), help="open a demo dataset")
+    p.add_argument("--demo", choices=samples.NAMES, help="open a demo dataset")
     p.add_argument("--volume", help="a volume to segment and skeletonize")
     p.add_argument("--mskel", help="a multi-resolution skeleton")
     p.add_argument("--bones", help="a .bones file")

@@ -11,6 +11,7 @@ import numpy as np
 
 from volanim_core import samples
 from volanim_core.io import read_mskel, read_volume_grid
+from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter
 from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
@@ -27,7 +28,8 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     """
     report = Reporter(progress, cancel)
     report(0, 100)
-    mask = threshold(volume, lo, hi).view(bool)
+    grey = to_grey(volume) if is_colour(volume) else volume  # a colour scan is segmented on its luminance
+    mask = threshold(grey, lo, hi).view(bool)
     if fill:
         mask = fill_cavities(mask)
     if not mask.any():
@@ -49,9 +51,10 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
 
 
 def load_volume_file(path: str, dims=None) -> dict:
-    """Read any supported volume (fast; the heavy part is :func:`prepare_volume`)."""
-    data, origin, spacing = read_volume_grid(path, dims=dims)
-    return {"volume": data, "spacing": spacing, "path": path}
+    """Read any supported volume (fast; the heavy part is :func:`prepare_volume`). A colour volume
+    stays in colour (``volume``); ``grey`` is what its threshold is chosen on."""
+    data, origin, spacing = read_volume_grid(path, dims=dims, colour=True)
+    return {"volume": data, "grey": to_grey(data) if is_colour(data) else data, "spacing": spacing, "path": path}
 
 
 def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> dict:

@@ -66,3 +66,15 @@ def test_write_sample_files(tmp_path):
     assert [p.name for p in paths] == ["mannequin.VOL", "mannequin.bones", "mannequin.connections"]
     assert np.array_equal(io.read_volume(paths[0]), samples.mannequin().volume)
     assert io.read_bones(paths[1]) == samples.mannequin_bones()
+
+
+def test_colour_mannequin_is_the_mannequin_in_colour():
+    grey, colour = samples.mannequin(), samples.mannequin_colour()
+    assert colour.volume.shape == (*grey.volume.shape, 3) and colour.volume.dtype == np.uint8
+    assert np.array_equal(colour.mask, grey.mask)  # black exactly where the grey body is empty
+    skin = colour.volume[grey.volume == samples.SKIN].astype(float).mean(axis=0)
+    muscle = colour.volume[grey.volume == samples.MUSCLE_A].astype(float).mean(axis=0)
+    assert skin[0] > skin[2] + 40 and muscle[0] > 2 * muscle[1]  # warm skin, red muscle
+    from volanim_core.colour.palette import unique_colours
+
+    assert len(unique_colours(colour.volume)[0]) > 10_000  # grain: a palette has to be built

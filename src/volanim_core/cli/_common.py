@@ -49,7 +49,7 @@ def save(path: str, vol, **kw) -> Path:
     path, note = write_output(path, vol, **kw)
     if note:
         print(f"note: {note}")
-    print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype})")
+    print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype}{' RGB' if vol.ndim == 4 else ''})")
     return path
 
 

@@ -101,7 +101,7 @@ def _reconstruct(args):
     t = read_tskel(args.tskel)
     source, source_origin = None, (0, 0, 0)
     if args.source:
-        source, origin, _ = read_volume_grid(args.source, dims=args.dims)
+        source, origin, _ = read_volume_grid(args.source, dims=args.dims, colour=True)
         source_origin = tuple(int(round(v)) for v in origin)
     elif args.mode == "sampled":
         raise ValueError("sampled mode needs --source VOLUME")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.io import add_header, float_to_uint8, histogram_file, remove_header
+from volanim_core.io import add_header, float_to_uint8, histogram_file, read_volume, remove_header
 
 from .. import samples, volume
 from ..io._text import parse_int, read_records
@@ -27,15 +27,18 @@ from ._common import (
 
 
 def _info(args):
-    vol = load(args.volume, args)
+    vol = read_volume(args.volume, dims=args.dims, colour=True)
+    kind = f"{vol.dtype} RGB" if vol.ndim == 4 else str(vol.dtype)
+    if vol.ndim == 4:  # values and bounds of a colour volume: of its brightest channel
+        vol = vol.max(axis=3)
     b = volume.tight_bounds(vol)
-    print(f"{args.volume}: {vol.shape[0]} x {vol.shape[1]} x {vol.shape[2]} voxels, {vol.dtype}")
+    print(f"{args.volume}: {vol.shape[0]} x {vol.shape[1]} x {vol.shape[2]} voxels, {kind}")
     print(f"values {vol.min()} .. {vol.max()}, non-zero {int(np.count_nonzero(vol))}")
     print(f"tight bounds (inclusive x0 y0 z0 x1 y1 z1): {b if b else 'none (all zero)'}")
 
 
 def _convert(args):
-    vol = load(args.input, args)
+    vol = read_volume(args.input, dims=args.dims, colour=not args.grey)  # colour stays colour unless asked
     if args.rescale:
         vol = float_to_uint8(vol)
     save(args.output, vol)
@@ -192,6 +195,7 @@ def register(sub) -> None:
                     "volanim convert frog.VOL frog.vti", _convert)
     _io(p)
     p.add_argument("--rescale", action="store_true", help="map non-uint8 data min..max onto 0..255")
+    p.add_argument("--grey", action="store_true", help="write a colour volume as grey (luminance)")
 
     p = add_command(sub, "threshold", "Band-pass threshold to a binary volume (Convert2Binary).",
                     "volanim threshold frog.VOL frog-body.VOL --range 1:255", _threshold)

@@ -114,9 +114,15 @@ def _read_nrrd(path: Path, fh):
     dtype = np.dtype(_TYPES[fields["type"].lower()])
     if "sizes" not in fields:
         raise FormatError(path, "the NRRD header lacks 'sizes'")
-    sizes = checked_grid(path, fields["sizes"].split(), dtype.itemsize, line=lines["sizes"], what="NRRD sizes")
-    if fields.get("dimension", "3").strip() != "3":
-        raise FormatError(path, f"expected a 3-D NRRD, got dimension {fields['dimension']!r}", lines["dimension"])
+    words = fields["sizes"].split()
+    # An RGB volume is 4-D with the colour axis first (kinds: RGB-color domain domain domain).
+    channels = 3 if fields.get("dimension", "").strip() == "4" and words[:1] == ["3"] and dtype.itemsize == 1 else 1
+    if channels == 3:
+        words = words[1:]
+    elif fields.get("dimension", "3").strip() != "3":
+        raise FormatError(path, f"expected a 3-D NRRD (or a 4-D one with 3 colour components first), got "
+                                f"dimension {fields['dimension']!r}", lines["dimension"])
+    sizes = checked_grid(path, words, dtype.itemsize * channels, line=lines["sizes"], what="NRRD sizes")
     endian = fields.get("endian", "little").lower()
     if endian not in ("little", "big"):
         raise FormatError(path, f"NRRD endian must be little or big, got {endian!r}", lines.get("endian"))
@@ -129,7 +135,7 @@ def _read_nrrd(path: Path, fh):
     except (ValueError, IndexError, ZeroDivisionError):
         raise FormatError(path, "bad 'space directions', 'spacings' or 'space origin' in the NRRD header: "
                                 "expected three finite vectors (x,y,z) with non-zero length") from None
-    want = math.prod(sizes) * dtype.itemsize
+    want = math.prod(sizes) * dtype.itemsize * channels
     encoding = fields.get("encoding", "raw").lower()
     if encoding in ("gzip", "gz"):
         body = _inflate(path, fh, want)
@@ -140,14 +146,16 @@ def _read_nrrd(path: Path, fh):
     else:
         raise FormatError(path, f"NRRD encoding {encoding!r} is not supported (raw, gzip)", lines.get("encoding"))
     expect_bytes(path, len(body), want, "the NRRD data")
-    data = np.frombuffer(body, dtype).astype(dtype.newbyteorder("="), copy=True).reshape(sizes, order="F")
-    return data, origin, spacing
+    data = np.frombuffer(body, dtype).astype(dtype.newbyteorder("="), copy=True)
+    if channels == 3:  # bytes: channel fastest, then x, y, z
+        return data.reshape(*sizes[::-1], 3).transpose(2, 1, 0, 3), origin, spacing
+    return data.reshape(sizes, order="F"), origin, spacing
 
 
 def _geometry(fields: dict) -> tuple[tuple, tuple]:
     spacing = [1.0, 1.0, 1.0]
     if "space directions" in fields:
-        text = fields["space directions"]
+        text = re.sub(r"^\s*none\s+", "", fields["space directions"])  # a colour axis has no direction
         vecs = re.findall(r"\([^()]*\)", text)
         if len(vecs) != 3 or re.sub(r"\([^()]*\)", "", text).strip():
             raise ValueError("need three vectors and nothing else")
@@ -173,14 +181,16 @@ def write_nrrd(path: str | Path, vol: np.ndarray, origin=(0, 0, 0), spacing=(1, 
     if name is None:
         raise ValueError(f"cannot write {vol.dtype} to .nrrd")
     sx, sy, sz = (float(s) for s in spacing)
+    rgb = vol.ndim == 4  # [x, y, z, 3]: written with the colour axis first, as NRRD readers expect
     header = (
         "NRRD0004\n# written by volanim\n"
-        f"type: {name}\ndimension: 3\nspace dimension: 3\n"
-        f"sizes: {vol.shape[0]} {vol.shape[1]} {vol.shape[2]}\n"
-        f"space directions: ({sx!r},0,0) (0,{sy!r},0) (0,0,{sz!r})\n"
-        "kinds: domain domain domain\nendian: little\nencoding: raw\n"
+        f"type: {name}\ndimension: {4 if rgb else 3}\nspace dimension: 3\n"
+        f"sizes: {'3 ' if rgb else ''}{vol.shape[0]} {vol.shape[1]} {vol.shape[2]}\n"
+        f"space directions: {'none ' if rgb else ''}({sx!r},0,0) (0,{sy!r},0) (0,0,{sz!r})\n"
+        f"kinds: {'RGB-color ' if rgb else ''}domain domain domain\nendian: little\nencoding: raw\n"
         f"space origin: ({float(origin[0])!r},{float(origin[1])!r},{float(origin[2])!r})\n\n"
     )
+    data = vol.transpose(2, 1, 0, 3) if rgb else vol.T
     with atomic_open(path, "wb") as fh:
         fh.write(header.encode("ascii"))
-        fh.write(np.ascontiguousarray(vol.T).astype(vol.dtype.newbyteorder("<")).tobytes())
+        fh.write(np.ascontiguousarray(data).astype(vol.dtype.newbyteorder("<")).tobytes())

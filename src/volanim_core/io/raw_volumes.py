@@ -1,7 +1,9 @@
 """Raw volumes: ``.vol`` (bare uint8 voxels) and ``.VOL`` (100-byte header).
 
 Bytes are x fastest, then y, then z; in memory ``vol[x, y, z]`` is the bytes
-viewed with ``order="F"``. Header add/remove and counting stream in chunks so
+viewed with ``order="F"``. A colour volume has 3 bytes per voxel (R, G, B, then
+the next voxel) and the same names and header; the file size tells which it is,
+and in memory it is ``vol[x, y, z, channel]``. Header add/remove and counting stream in chunks so
 they never hold a whole volume (the old AddHeader / rmhdr / Count).
 """
 
@@ -92,40 +94,62 @@ def read_header_dims(path: str | Path, allocate: bool = True) -> tuple[int, int,
         raise FormatError(path, f"cannot read file: {exc.strerror or exc}") from exc
 
 
-def raw_layout(path: str | Path, dims=None, *, allocate: bool = True) -> tuple[tuple[int, int, int], int]:
-    """``(dims, byte offset of the voxels)`` of a raw volume, checked against the file size
-    (and, with ``allocate``, against the input limits)."""
+def raw_layout(path: str | Path, dims=None, *, allocate: bool = True) -> tuple[tuple[int, int, int], int, int]:
+    """``(dims, byte offset of the voxels, bytes per voxel)`` of a raw volume, checked against the
+    file size (and, with ``allocate``, against the input limits). Bytes per voxel is 1 (grey) or 3
+    (RGB): the file size decides, since the name and the header only give the dimensions."""
     path = Path(path)
     if not path.is_file():
         raise FormatError(path, "no such file")
     size = path.stat().st_size
     if has_header(path):
         dims = _check_dims(path, dims, None, allocate) if dims is not None else read_header_dims(path, allocate)
-        want = math.prod(dims) + HEADER_BYTES
-        if size != want:
-            raise FormatError(path, f"file has {size} bytes, expected {want} "
-                              f"({HEADER_BYTES}-byte header + {dims[0]}x{dims[1]}x{dims[2]} voxels)")
-        return dims, HEADER_BYTES
+        n = math.prod(dims)
+        for channels in (1, 3):
+            if size == n * channels + HEADER_BYTES:
+                return _checked_channels(path, dims, channels, allocate), HEADER_BYTES, channels
+        raise FormatError(path, f"file has {size} bytes, expected {n + HEADER_BYTES} "
+                          f"({HEADER_BYTES}-byte header + {dims[0]}x{dims[1]}x{dims[2]} voxels) "
+                          f"or {3 * n + HEADER_BYTES} (the same in RGB, 3 bytes a voxel)")
     dims = dims if dims is not None else dims_from_name(path)
     if dims is None:
         raise FormatError(path, "unknown dimensions: give them (e.g. --dims X Y Z) or name the file NAME.XxYxZ.vol")
     dims = _check_dims(path, dims, None, allocate)
-    want = math.prod(dims)
-    if size == want + HEADER_BYTES:
-        raise FormatError(path, f"file has {size} bytes = {dims[0]}x{dims[1]}x{dims[2]} + {HEADER_BYTES}: "
+    n = math.prod(dims)
+    for channels in (1, 3):
+        if size == n * channels:
+            return _checked_channels(path, dims, channels, allocate), 0, channels
+    if size in (n + HEADER_BYTES, 3 * n + HEADER_BYTES):
+        raise FormatError(path, f"file has {size} bytes = {dims[0]}x{dims[1]}x{dims[2]}"
+                          f"{' x 3' if size > 3 * n else ''} + {HEADER_BYTES}: "
                           "it looks like a .VOL with a 100-byte header; rename it to .VOL or strip "
                           "the header with 'volanim rmheader'")
-    if size != want:
-        raise FormatError(path, f"file has {size} bytes, expected {want} for {dims[0]}x{dims[1]}x{dims[2]} voxels")
-    return dims, 0
+    raise FormatError(path, f"file has {size} bytes, expected {n} for {dims[0]}x{dims[1]}x{dims[2]} voxels "
+                      f"(or {3 * n} in RGB, 3 bytes a voxel)")
+
+
+def _checked_channels(path, dims, channels: int, allocate: bool):
+    """An RGB file holds three times the bytes: check those against memory too."""
+    if channels == 3 and allocate:
+        checked_grid(path, dims, 3)
+    return dims
 
 
 def read_raw(path: str | Path, dims=None, *, mmap: bool = False) -> np.ndarray:
-    """Read a ``.vol`` or ``.VOL`` file as a ``(X, Y, Z)`` uint8 array indexed ``[x, y, z]``.
+    """Read a ``.vol`` or ``.VOL`` file as a ``(X, Y, Z)`` uint8 array indexed ``[x, y, z]``
+    (``(X, Y, Z, 3)`` for an RGB file).
 
-    ``mmap=True`` maps the file read-only instead of loading it.
+    ``mmap=True`` maps the file read-only instead of loading it (streaming tools).
     """
-    dims, offset = raw_layout(path, dims)
+    dims, offset, channels = raw_layout(path, dims, allocate=not mmap)
+    if channels == 3:  # bytes R G B per voxel, x fastest: C order is [z, y, x, c]
+        if mmap:
+            data = np.memmap(path, np.uint8, "r", offset=offset, shape=(*dims[::-1], 3))
+        else:
+            with Path(path).open("rb") as fh:
+                fh.seek(offset)
+                data = np.fromfile(fh, np.uint8, count=3 * math.prod(dims)).reshape(*dims[::-1], 3)
+        return data.transpose(2, 1, 0, 3)
     if mmap:
         return np.memmap(path, np.uint8, "r", offset=offset, shape=dims, order="F")
     with Path(path).open("rb") as fh:
@@ -142,8 +166,8 @@ def header_bytes(dims) -> bytes:
 
 def _as_uint8(vol: np.ndarray) -> np.ndarray:
     vol = np.asarray(vol)
-    if vol.ndim != 3:
-        raise ValueError(f"a volume must be 3-D, got shape {vol.shape}")
+    if vol.ndim != 3 and not (vol.ndim == 4 and vol.shape[3] == 3):
+        raise ValueError(f"a volume must be 3-D (or 3-D with 3 colour channels), got shape {vol.shape}")
     if vol.dtype != np.uint8:
         if vol.dtype == bool or (vol.size and vol.min() >= 0 and vol.max() <= 255
                                  and np.issubdtype(vol.dtype, np.integer)):
@@ -163,8 +187,9 @@ def write_raw(path: str | Path, vol: np.ndarray, *, header: bool | None = None) 
     with atomic_open(path, "wb") as fh:
         if header:
             fh.write(header_bytes(vol.shape))
-        # Transposing the F-order view gives C order: bytes x fastest.
-        fh.write(np.ascontiguousarray(vol.T).tobytes())
+        # Transposing the F-order view gives C order: bytes x fastest (RGB: channel, then x).
+        axes = (2, 1, 0, 3) if vol.ndim == 4 else (2, 1, 0)
+        fh.write(np.ascontiguousarray(vol.transpose(axes)).tobytes())
 
 
 def _copy_stream(src, dst, remaining: int) -> None:
@@ -178,31 +203,34 @@ def _copy_stream(src, dst, remaining: int) -> None:
 
 def add_header(src: str | Path, dst: str | Path, dims=None) -> tuple[int, int, int]:
     """Stream a ``.vol`` into a ``.VOL`` with a header (AddHeader)."""
-    dims, offset = raw_layout(src, dims, allocate=False)
+    dims, offset, channels = raw_layout(src, dims, allocate=False)
     if offset:
         raise FormatError(src, "already has a .VOL header")
     with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
         fout.write(header_bytes(dims))
-        _copy_stream(fin, fout, math.prod(dims))
+        _copy_stream(fin, fout, math.prod(dims) * channels)
     return dims
 
 
 def remove_header(src: str | Path, dst: str | Path) -> tuple[int, int, int]:
     """Stream a ``.VOL`` into a bare ``.vol`` (rmhdr)."""
     dims = read_header_dims(src, allocate=False)
-    want = math.prod(dims) + HEADER_BYTES
-    size = Path(src).stat().st_size
-    if size != want:
-        raise FormatError(src, f"file has {size} bytes, expected {want} for header + {dims} voxels")
+    n, size = math.prod(dims), Path(src).stat().st_size
+    channels = 3 if size == 3 * n + HEADER_BYTES else 1
+    if size != n * channels + HEADER_BYTES:
+        raise FormatError(src, f"file has {size} bytes, expected {n + HEADER_BYTES} for header + {dims} voxels")
     with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
         fin.seek(HEADER_BYTES)
-        _copy_stream(fin, fout, math.prod(dims))
+        _copy_stream(fin, fout, math.prod(dims) * channels)
     return dims
 
 
 def histogram_file(path: str | Path, dims=None) -> np.ndarray:
     """Counts of each value 0..255 in a raw volume, streamed in chunks (Count)."""
-    dims, offset = raw_layout(path, dims, allocate=False)
+    dims, offset, channels = raw_layout(path, dims, allocate=False)
+    if channels != 1:
+        raise FormatError(path, "is an RGB volume (3 bytes a voxel); counting values needs a grey or an "
+                                "index volume ('volanim palette apply' makes one)")
     counts = np.zeros(256, np.int64)
     remaining = math.prod(dims)
     with Path(path).open("rb") as fh:

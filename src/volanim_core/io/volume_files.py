@@ -5,6 +5,11 @@
     .nrrd                                     nrrd_files (ours: VTK's reader mangles 3-D scalars)
     folder of 2-D images                      scikit-image, stacked along z
 
+Colour (RGB) volumes are ``vol[x, y, z, channel]`` uint8 arrays: RGB slice images,
+3- or 4-component ``.vti``, an RGB NRRD and a raw ``.vol``/``.VOL`` of 3 bytes a voxel.
+Readers return them only when asked (``colour=True``); otherwise colour becomes
+grey (Rec. 709 luminance), so every grey tool works on a colour volume unchanged.
+
 VTK stores x fastest, exactly like ``.vol``, so its flat scalars reshape with
 ``order="F"`` to ``vol[x, y, z]``.
 """
@@ -48,6 +53,25 @@ def float_to_uint8(vol: np.ndarray, lo: float | None = None, hi: float | None = 
     return np.clip(np.rint(out), 0, 255).astype(np.uint8)
 
 
+LUMA = np.array([0.2125, 0.7154, 0.0721])  # Rec. 709, as skimage.color.rgb2gray
+
+
+def to_grey(rgb: np.ndarray) -> np.ndarray:
+    """Luminance of ``[..., 3]`` colour data, rounded, in the input's dtype."""
+    rgb = np.asarray(rgb)
+    if rgb.ndim < 4:
+        return np.rint(rgb[..., :3] @ LUMA).astype(rgb.dtype)
+    out = np.empty(rgb.shape[:-1], rgb.dtype, order="F")
+    for z in range(rgb.shape[2]):  # a slice at a time: float64 of a whole volume is 24 bytes a voxel
+        out[:, :, z] = np.rint(rgb[:, :, z, :3] @ LUMA)
+    return out
+
+
+def is_colour(vol) -> bool:
+    """Whether ``vol`` is a colour volume ``[x, y, z, 3]``."""
+    return np.ndim(vol) == 4 and np.shape(vol)[3] == 3
+
+
 def _read_vtk(path: Path):
     import pyvista as pv  # lazy: VTK only when a VTK format is used
 
@@ -62,7 +86,11 @@ def _read_vtk(path: Path):
     if tuple(img.dimensions) != tuple(claimed):
         raise FormatError(path, f"VTK read a {img.dimensions} grid, the header says {claimed}")
     scalars = np.asarray(img.point_data.active_scalars)
-    if scalars.ndim > 1:  # vector data: take the first component
+    if scalars.ndim > 1 and scalars.shape[1] in (3, 4) and scalars.dtype == np.uint8:  # RGB(A): drop alpha
+        nx, ny, nz = img.dimensions
+        data = scalars[:, :3].reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
+        return data, tuple(img.origin), tuple(img.spacing)
+    if scalars.ndim > 1:  # other vector data: take the first component
         scalars = scalars[:, 0]
     data = scalars.reshape(img.dimensions, order="F")
     return data, tuple(img.origin), tuple(img.spacing)
@@ -72,37 +100,66 @@ def _natural_key(name: str):
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
 
 
-def read_image_folder(folder: str | Path) -> np.ndarray:
-    """Stack a folder of 2-D slice images along z (combineToGrayVolume).
-
-    Files are taken in natural order (``s2`` before ``s10``). Colour images are
-    converted to grey (luminance). Image rows are y, columns x.
-    """
-    from skimage import io as skio
-
+def slice_files(folder: str | Path) -> list[Path]:
+    """The slice images of a folder in natural order (``s2`` before ``s10``)."""
     folder = Path(folder)
     files = sorted((f for f in folder.iterdir() if f.suffix.lower() in IMAGE_SUFFIXES),
                    key=lambda f: _natural_key(f.name))
     if not files:
         raise FormatError(folder, f"no slice images ({', '.join(IMAGE_SUFFIXES)}) in this folder")
-    slices = []
-    for f in files:
-        try:
-            img = np.asarray(skio.imread(f))
-        except Exception as exc:  # imageio/PIL raise many types
-            raise FormatError(f, f"cannot read image: {exc}") from exc
-        if img.ndim == 3:
-            rgb = img[..., :3].astype(np.float64)
-            img = np.rint(rgb @ [0.2125, 0.7154, 0.0721]).astype(img.dtype)
-        if img.ndim != 2:
-            raise FormatError(f, f"expected a 2-D image, got shape {img.shape}")
-        if slices and img.shape != slices[0].shape[::-1]:
-            raise FormatError(f, f"slice is {img.shape}, expected {slices[0].shape[::-1]} like {files[0].name}")
-        slices.append(img.T)
+    return files
+
+
+def read_slice(path: Path, *, colour: bool = False, expect=None) -> np.ndarray:
+    """One slice image as ``[x, y]`` (``[x, y, 3]`` with ``colour``; grey images then repeat in R, G, B).
+
+    ``expect`` is the first slice's ``(X, Y)``: every slice must have it.
+    """
+    from skimage import io as skio
+
+    try:
+        img = np.asarray(skio.imread(path))
+    except Exception as exc:  # imageio/PIL raise many types
+        raise FormatError(path, f"cannot read image: {exc}") from exc
+    if img.ndim == 3 and img.shape[2] in (3, 4):
+        img = img[..., :3] if colour else to_grey(img)
+    elif img.ndim == 2 and colour:
+        img = np.repeat(img[..., None], 3, axis=2)
+    if img.ndim != (3 if colour else 2):
+        raise FormatError(path, f"expected a 2-D image, got shape {img.shape}")
+    img = img.swapaxes(0, 1)  # image rows are y, columns x
+    if expect is not None and img.shape[:2] != tuple(expect):
+        raise FormatError(path, f"slice is {img.shape[1]}x{img.shape[0]} (rows x columns), expected "
+                                f"{expect[1]}x{expect[0]} like the first slice")
+    return img
+
+
+def folder_is_colour(files: list[Path]) -> bool:
+    """Whether the first slice of a folder is a colour image (the slices of one scan agree)."""
+    from skimage import io as skio
+
+    try:
+        img = skio.imread(files[0])
+    except Exception as exc:  # imageio/PIL raise many types
+        raise FormatError(files[0], f"cannot read image: {exc}") from exc
+    return np.ndim(img) == 3 and np.shape(img)[2] in (3, 4)
+
+
+def read_image_folder(folder: str | Path, *, colour: bool = False) -> np.ndarray:
+    """Stack a folder of 2-D slice images along z (combineToGrayVolume).
+
+    Files are taken in natural order (``s2`` before ``s10``). Image rows are y,
+    columns x. Colour images become grey (luminance) unless ``colour``, which keeps
+    them as ``[x, y, z, 3]`` (a folder of grey images stays ``[x, y, z]``).
+    """
+    files = slice_files(folder)
+    colour = colour and folder_is_colour(files)
+    first = read_slice(files[0], colour=colour)
+    slices = [first] + [read_slice(f, colour=colour, expect=first.shape[:2]) for f in files[1:]]
     return np.stack(slices, axis=2)
 
 
-def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False):
+def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False, colour: bool = False):
     """Read any supported volume: ``(data[x, y, z], origin, spacing)``.
 
     Parameters
@@ -114,20 +171,25 @@ def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False):
     rescale : bool
         Map non-uint8 data onto 0..255 (min..max). Off by default: data keep
         their type unless the user asks.
+    colour : bool
+        Return a colour volume as ``data[x, y, z, channel]`` (uint8 RGB); without it
+        colour is read as grey (luminance).
     """
     path = Path(path)
     try:
-        data, origin, spacing = _read_any(path, dims)
+        data, origin, spacing = _read_any(path, dims, colour)
     except OSError as exc:  # permissions, a file that vanished, disk errors: one error type, the file named
         raise FormatError(getattr(exc, "filename", None) or path, f"cannot read: {exc.strerror or exc}") from exc
+    if is_colour(data) and not colour:
+        data = np.asfortranarray(to_grey(data))
     if rescale and data.dtype != np.uint8:
         data = float_to_uint8(data)
     return data, origin, spacing
 
 
-def _read_any(path: Path, dims):
+def _read_any(path: Path, dims, colour: bool):
     if path.is_dir():
-        data, origin, spacing = read_image_folder(path), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
+        data, origin, spacing = read_image_folder(path, colour=colour), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
     elif not path.exists():
         raise FormatError(path, "no such file or folder")
     elif path.suffix.lower() == ".vol":
@@ -142,16 +204,19 @@ def _read_any(path: Path, dims):
     return data, origin, spacing
 
 
-def read_volume(path: str | Path, *, dims=None, rescale: bool = False) -> np.ndarray:
-    """Read any supported volume as an array indexed ``[x, y, z]``."""
-    return read_volume_grid(path, dims=dims, rescale=rescale)[0]
+def read_volume(path: str | Path, *, dims=None, rescale: bool = False, colour: bool = False) -> np.ndarray:
+    """Read any supported volume as an array indexed ``[x, y, z]`` (``[x, y, z, 3]`` for colour with ``colour``)."""
+    return read_volume_grid(path, dims=dims, rescale=rescale, colour=colour)[0]
 
 
 def _write_vti(path: Path, vol: np.ndarray, origin, spacing) -> None:
     import pyvista as pv
 
-    img = pv.ImageData(dimensions=vol.shape, origin=origin, spacing=spacing)
-    img.point_data["values"] = vol.ravel(order="F")
+    img = pv.ImageData(dimensions=vol.shape[:3], origin=origin, spacing=spacing)
+    if is_colour(vol):  # one RGB tuple per point, x fastest
+        img.point_data["rgb"] = np.ascontiguousarray(vol.transpose(2, 1, 0, 3)).reshape(-1, 3)
+    else:
+        img.point_data["values"] = vol.ravel(order="F")
     atomic_vtk_save(path, img)
 
 
@@ -178,7 +243,7 @@ def write_output(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0),
     Every command and the studio write their results through this, so none forgets either rule.
     """
     vol, note = saturate_for_raw(path, np.asarray(vol))
-    path = raw_volumes.raw_name_for(path, vol.shape)
+    path = raw_volumes.raw_name_for(path, vol.shape[:3])
     write_volume(path, vol, origin=origin, spacing=spacing)
     return path, note
 
@@ -190,8 +255,8 @@ def write_volume(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0), s
     """
     path = Path(path)
     vol = np.asarray(vol)
-    if vol.ndim != 3:
-        raise ValueError(f"a volume must be 3-D, got shape {vol.shape}")
+    if vol.ndim != 3 and not is_colour(vol):
+        raise ValueError(f"a volume must be 3-D (or 3-D with 3 colour channels), got shape {vol.shape}")
     suffix = _suffix(path)
     if suffix == ".vol":
         raw_volumes.write_raw(path, vol)

@@ -40,6 +40,7 @@ from volanim_core.reconstruct.neighbours import (
     sphere_neighbours,
 )
 from volanim_core.reconstruct.radii import radius_squared
+from volanim_core.reconstruct.sampling import sample_source
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.pose import apply_matrices
 from volanim_core.volume import Bounds
@@ -232,14 +233,6 @@ def mottled_values(n: int) -> np.ndarray:
     return (1 + (np.arange(n, dtype=np.int64) * 97) % 255).astype(np.uint8)
 
 
-def gaussian_weights(kernel: int) -> np.ndarray:
-    """Normalised ``kernel**3`` Gaussian weights (sigma = kernel / 4), ``[z, y, x]``."""
-    half = kernel // 2
-    g = np.exp(-0.5 * (np.arange(-half, half + 1) / (kernel / 4.0)) ** 2)
-    w = g[:, None, None] * g[None, :, None] * g[None, None, :]
-    return w / w.sum()
-
-
 def reconstruct(
     tskel: Tskel,
     *,
@@ -264,7 +257,8 @@ def reconstruct(
         Points with their bone's matrix (rest voxel coordinates -> posed).
     mode : {'binary', 'mottled', 'bone', 'sampled', 'hotspot'}
     source : (X, Y, Z) ndarray indexed ``[x, y, z]``, required for 'sampled'
-        The rest-pose volume; positions outside it read 0.
+        The rest-pose volume; positions outside it read 0. A colour source
+        ``(X, Y, Z, 3)`` uint8 gives a colour result (:mod:`.sampling`).
     source_origin : 3 ints
         Rest-frame voxel of ``source[0, 0, 0]`` (non-zero for a cropped source).
     kernel : {1, 3, 5}
@@ -325,7 +319,7 @@ def reconstruct(
     final_dtype = source.dtype if mode == "sampled" else out_dtype
     relax = mode not in ("hotspot", "binary")  # binary is a union and hotspot a count: no stencil
     per_voxel = np.dtype(out_dtype).itemsize + (4 if relax else 0) + \
-        (np.dtype(final_dtype).itemsize if final_dtype != out_dtype else 0)
+        (np.dtype(final_dtype).itemsize if final_dtype != out_dtype else 0) + (3 if np.ndim(source) == 4 else 0)
     check_output_grid(bounds.shape, per_voxel)
     out = _output_array(out, (nz, ny, nx), out_dtype, final_dtype)
     stencil = _WORKSPACE.stencil_for((nz, ny, nx) if relax else (1, 1, 1))  # rows set on first use
@@ -356,15 +350,8 @@ def reconstruct(
                           _MODE_CODE[mode], plane_start, planes, row_ready, filled, visits)
             report(z1, total)
         if mode == "sampled":
-            minv = _grid_to_source(minv_rest, origin, source_origin)
-            src = np.ascontiguousarray(source.T)  # [z, y, x]; free for an F-ordered source
-            owner = out
-            out = owner if src.dtype == owner.dtype else np.zeros((nz, ny, nx), src.dtype)
-            weights = gaussian_weights(kernel) if kernel > 1 else np.ones((1, 1, 1))
-            for z0 in range(0, nz, chunk):
-                z1 = min(nz, z0 + chunk)
-                K.sample_rows(owner, out, z0, z1, nthreads, row_ready, minv, src, weights, kernel // 2)
-                report(nz + z1, total)
+            out = sample_source(out, source, _grid_to_source(minv_rest, origin, source_origin), kernel, row_ready,
+                                nthreads, chunk, lambda done: report(nz + done, total))
     finally:
         numba.set_num_threads(previous)
 
@@ -373,7 +360,8 @@ def reconstruct(
     stats = _stats(len(tskel), filled, visits, int(round(clipped)), out if mode == "hotspot" else None)
     stats["clipped_estimated"] = bool(estimated)
     stats["seconds"] = time.perf_counter() - t0
-    return Reconstruction(out.T, tuple(int(v) for v in bounds.lo), stats)  # [x, y, z] view: no copy
+    volume = out.transpose(2, 1, 0, 3) if out.ndim == 4 else out.T  # [x, y, z] view: no copy
+    return Reconstruction(volume, tuple(int(v) for v in bounds.lo), stats)
 
 
 def _check_arguments(mode, kernel, source, value) -> None:
@@ -386,8 +374,11 @@ def _check_arguments(mode, kernel, source, value) -> None:
     if mode == "sampled":
         if source is None:
             raise ValueError("sampled mode needs the source volume (source=...)")
-        if np.ndim(source) != 3:
-            raise ValueError(f"source must be a 3-D volume, got shape {np.shape(source)}")
+        colour = np.ndim(source) == 4 and np.shape(source)[3] == 3
+        if np.ndim(source) != 3 and not colour:
+            raise ValueError(f"source must be a 3-D volume (or 3-D RGB, [x, y, z, 3]), got shape {np.shape(source)}")
+        if colour and np.asarray(source).dtype != np.uint8:
+            raise ValueError(f"a colour source holds 8-bit RGB, got {np.asarray(source).dtype}")
         kind = np.asarray(source).dtype.kind
         if kind not in "buif":
             raise ValueError(f"source voxels must be numbers (bool, integer or float), got {np.asarray(source).dtype}")

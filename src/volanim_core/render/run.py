@@ -110,7 +110,7 @@ def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
         vol, origin, _ = _read(p, dims)
         o = np.rint(np.asarray(origin, np.float64)).astype(int)
         los.append(o)
-        his.append(o + np.array(vol.shape) - 1)
+        his.append(o + np.array(vol.shape[:3]) - 1)
         if vol.size:
             vmax = max(vmax, float(vol.max()))
         st = p.stat()
@@ -123,7 +123,7 @@ def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
 def _read(path, dims=None):
     from volanim_core.io import read_volume_grid
 
-    return read_volume_grid(path, dims=dims)
+    return read_volume_grid(path, dims=dims, colour=True)  # a colour volume is drawn in its colours
 
 
 @dataclass

@@ -24,9 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.io.volume_files import to_grey
 from volanim_core.render.camera import Camera
 from volanim_core.render.colours import SKIN, rgb
-from volanim_core.render.transfer import LABEL_MODES, apply_labels, label_colours
+from volanim_core.render.transfer import LABEL_MODES, apply_labels, apply_rgba, label_colours, rgba_points
 from volanim_core.render.transfer_function import TransferFunction
 
 STYLES = ("surface", "volume")
@@ -124,7 +125,7 @@ def cut_away(volume: np.ndarray, origin, point, normal) -> np.ndarray:
     """``volume`` with every voxel on the side ``normal`` points to (from ``point``) emptied."""
     n = np.asarray(normal, np.float64)
     d = -float(np.dot(n, np.asarray(point, np.float64) - np.asarray(origin, np.float64)))
-    x, y, z = (np.arange(s, dtype=np.float64) for s in volume.shape)
+    x, y, z = (np.arange(s, dtype=np.float64) for s in volume.shape[:3])
     side = (n[0] * x[:, None, None] + n[1] * y[None, :, None]) + (n[2] * z[None, None, :] + d) > 0
     out = volume.copy()
     out[side] = 0
@@ -202,7 +203,9 @@ class Renderer:
         s = self.settings
         if s.cut is not None:
             volume = cut_away(volume, origin, *s.cut)
-        if s.preset == "binary" and s.transfer is None:
+        if volume.ndim == 4 and (s.style == "surface" or s.transfer is not None):
+            volume = to_grey(volume)  # surfaces and a user's transfer function read one value a voxel
+        if s.preset == "binary" and s.transfer is None and volume.ndim == 3:
             volume = (volume > 0).astype(np.uint8)
         if s.style == "surface":
             self._draw_surface(*crop(volume, origin))  # a sequence's shared grid is mostly empty
@@ -234,25 +237,31 @@ class Renderer:
         import pyvista as pv
 
         s = self.settings
-        data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
+        if volume.ndim == 4:  # colour: RGB drawn as it is, black (the background) transparent
+            data = rgba_points(volume)
+        else:
+            data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
+            data = data.ravel(order="F")
         # the whole shared grid, refilled frame after frame: a new volume actor costs ~1 s to set up
         # (bench_render), so cropping each frame to its body would be 15-30x slower than drawing it
         key = (volume.shape, tuple(float(v) for v in np.asarray(origin) * s.spacing), data.dtype.str)
         if self._grid is not None and self._grid_key == key:
             from vtkmodules.util.numpy_support import numpy_to_vtk
 
-            values = numpy_to_vtk(data.ravel(order="F"), deep=True)
+            values = numpy_to_vtk(data, deep=True)
             values.SetName("v")
             self._grid.GetPointData().SetScalars(values)  # the image the mapper reads (add_volume may copy ours)
             self._grid.Modified()
             return
-        grid = pv.ImageData(dimensions=volume.shape, origin=key[1], spacing=s.spacing)
-        grid.point_data["v"] = data.ravel(order="F")
+        grid = pv.ImageData(dimensions=volume.shape[:3], origin=key[1], spacing=s.spacing)
+        grid.point_data["v"] = data
         actor = self.plotter.add_volume(grid, scalars="v", name="body", reset_camera=False, show_scalar_bar=False,
                                         mapper="fixed_point" if self._cpu_caster() else "smart", render=False)
         self._grid, self._grid_key = actor.GetMapper().GetInput(), key
         prop = actor.GetProperty()
-        if s.transfer is None and s.preset in LABEL_MODES:
+        if volume.ndim == 4:
+            apply_rgba(actor)
+        elif s.transfer is None and s.preset in LABEL_MODES:
             colours = (np.array([rgb(SKIN)]) if s.preset == "binary"
                        else label_colours(s.preset, LABELS))
             apply_labels(actor, colours, opacity=1.0)

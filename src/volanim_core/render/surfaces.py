@@ -15,7 +15,8 @@ def label_surface(volume: np.ndarray, origin, spacing, table: np.ndarray | None 
 
     Parameters
     ----------
-    volume : (X, Y, Z) ndarray of labels (0 = empty)
+    volume : (X, Y, Z) ndarray of labels (0 = empty), or (X, Y, Z, 3) uint8 colour (black = empty),
+        whose surface is coloured by its voxels (``table`` is not used)
     origin, spacing : world position of voxel [0, 0, 0] and the voxel size
     table : (L, 3) uint8, optional
         Colour of label value v at row v (e.g. :func:`~volanim_core.render.colours.label_table`);
@@ -29,20 +30,31 @@ def label_surface(volume: np.ndarray, origin, spacing, table: np.ndarray | None 
 
     origin = np.asarray(origin, np.float64)
     spacing = np.asarray(spacing, np.float64)
-    img = pv.ImageData(dimensions=volume.shape, origin=origin, spacing=spacing)
-    img.point_data["values"] = (np.asarray(volume) > 0).astype(np.uint8).ravel(order="F")
+    volume = np.asarray(volume)
+    colour = volume.ndim == 4
+    img = pv.ImageData(dimensions=volume.shape[:3], origin=origin, spacing=spacing)
+    filled = volume.any(axis=3) if colour else volume > 0
+    img.point_data["values"] = filled.astype(np.uint8).ravel(order="F")
     surf = img.contour([0.5], scalars="values", method="flying_edges")
-    if surf.n_points and table is not None:
-        # a surface point lies on a grid edge between a filled and an empty voxel: colour it by the
-        # filled one (rounding picked the empty one half the time, speckling the surface with row 0)
-        at = (np.asarray(surf.points) - origin) / spacing
-        top = np.array(volume.shape) - 1
-        lo = np.clip(np.floor(at).astype(np.int64), 0, top)
-        hi = np.clip(np.ceil(at).astype(np.int64), 0, top)
-        vol = np.asarray(volume)
-        labels = np.maximum(vol[tuple(lo.T)], vol[tuple(hi.T)]).astype(np.int64)
-        surf.point_data["rgb"] = table[np.clip(labels, 0, len(table) - 1)].astype(np.uint8)
+    if surf.n_points and (table is not None or colour):
+        values = filled_voxel_values(volume, (np.asarray(surf.points) - origin) / spacing)
+        surf.point_data["rgb"] = values if colour else table[np.clip(values.astype(np.int64), 0, len(table) - 1)]
     return surf
+
+
+def filled_voxel_values(volume: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """The value (label or RGB) of the filled voxel each surface point came from.
+
+    A point at voxel coordinates ``at`` lies on a grid edge between a filled and an empty voxel:
+    of the voxels at its floor and ceiling, the filled one (rounding picked the empty one half the
+    time, speckling the surface with the background).
+    """
+    top = np.array(volume.shape[:3]) - 1
+    lo = volume[tuple(np.clip(np.floor(at).astype(np.int64), 0, top).T)]
+    hi = volume[tuple(np.clip(np.ceil(at).astype(np.int64), 0, top).T)]
+    if volume.ndim == 4:
+        return np.where(hi.any(axis=1, keepdims=True), hi, lo).astype(np.uint8)
+    return np.maximum(lo, hi)
 
 
 def flying_edges(box: np.ndarray, origin=(0, 0, 0), level: float = 0.5) -> tuple[np.ndarray, np.ndarray]:

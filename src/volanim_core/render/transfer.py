@@ -61,6 +61,27 @@ def apply_labels(volume_actor, colours: np.ndarray, opacity: float = 0.85) -> No
     prop.SetInterpolationTypeToNearest()
 
 
+def rgba_points(volume: np.ndarray) -> np.ndarray:
+    """A colour volume ``[x, y, z, 3]`` as VTK point scalars ``(N, 4)`` uint8, x fastest: its RGB and
+    an alpha of 255 where a voxel is filled, 0 where it is black (the background)."""
+    opaque = (volume.max(axis=3, keepdims=True) > 0).astype(np.uint8) * 255
+    return np.ascontiguousarray(np.concatenate([volume, opaque], axis=3).transpose(2, 1, 0, 3)).reshape(-1, 4)
+
+
+def apply_rgba(volume_actor, opacity: float = 0.9) -> None:
+    """Draw :func:`rgba_points` scalars as they are: RGB straight to the screen (no transfer function),
+    the 4th component through the opacity (VTK's dependent components)."""
+    import vtk
+
+    prop = volume_actor.GetProperty()
+    prop.SetIndependentComponents(False)
+    otf = vtk.vtkPiecewiseFunction()
+    otf.AddPoint(0.0, 0.0)
+    otf.AddPoint(255.0, opacity)
+    prop.SetScalarOpacity(otf)
+    prop.SetInterpolationTypeToLinear()
+
+
 def binary_view(volume: np.ndarray) -> np.ndarray:
     """A binary-mode volume as labels 0/1 (one colour for every filled voxel)."""
     return (volume > 0).astype(np.uint8)

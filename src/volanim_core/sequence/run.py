@@ -126,6 +126,10 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
         check_frame_pattern(every_frame_as)
     if mode == "sampled" and source is None:
         raise ValueError("sampled mode needs the source volume (--source)")
+    if source is not None and np.ndim(source) != 3:
+        raise ValueError("a sequence samples a grey source (one value a voxel); for a colour volume make an "
+                         "index volume with 'volanim palette build' and 'palette apply', sequence that, and "
+                         "render it with the palette's transfer function ('volanim alpha merge', render --tf)")
     t0 = time.perf_counter()
     out = Path(out)
     bounds = shared_bounds(conn, frames, padding)

@@ -112,7 +112,7 @@ class Document:
     @property
     def shape(self) -> tuple[int, int, int] | None:
         if self.volume is not None:
-            return tuple(self.volume.shape)
+            return tuple(self.volume.shape[:3])  # a colour volume has its channels last
         if self.skeleton is not None and len(self.skeleton):
             return tuple(int(v) + 1 for v in self.skeleton.points.max(0))
         return None

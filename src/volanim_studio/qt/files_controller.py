@@ -85,7 +85,7 @@ class FilesController(Controller):
         if loaded is FAILED:
             return None
         if params is None:
-            dialog = ThresholdDialog(loaded["volume"], Path(path).name, self.window, spacing=loaded["spacing"])
+            dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"])
             if dialog.exec() != ThresholdDialog.Accepted:
                 return None
             params = dialog.parameters()
@@ -105,7 +105,8 @@ class FilesController(Controller):
 
     def _ask_volume(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", self.folder(),
-                                              "Volumes (*.vol *.VOL *.vti *.nrrd *.nii *.nii.gz *.mha *.mhd);;"
+                                              "Volumes, grey or RGB "
+                                              "(*.vol *.VOL *.vti *.nrrd *.nii *.nii.gz *.mha *.mhd);;"
                                               "All files (*)")
         if path:
             self.open_volume(path)

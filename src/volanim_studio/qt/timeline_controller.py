@@ -18,6 +18,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QDialog, QFileDialog
 
 from volanim_core import io
+from volanim_core.io.volume_files import to_grey
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frames import write_frames
 from volanim_core.reconstruct.scan import scan_frames, worst_first
@@ -286,6 +287,9 @@ class TimelineController(Controller):
             return None
         mats, numbers = tl.matrices(frames), [tl.frame_number(f) for f in frames]
         camera, spacing, mode, source = self.camera(), tuple(self.scene.spacing), st.preview_mode, self.doc.volume
+        if source is not None and source.ndim == 4:  # sequences hold one value a voxel: a colour body's luminance
+            source = to_grey(source)
+            self.doc.message("The movie samples the colour volume's luminance (grey); the preview shows its colours.")
         fps = tl.frame_rate / step
         return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
             conn, mats, numbers, out, mode=mode, source=source, camera=camera, spacing=spacing, style=style,

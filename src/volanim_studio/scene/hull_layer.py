@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 
+from volanim_core.render.surfaces import filled_voxel_values
+
 HULL_COLOUR = "#d8c8b0"
 
 
@@ -30,10 +32,15 @@ class HullLayer:
         verts, faces = view.doc.hull
         cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
         mesh = pv.PolyData(view.world(verts).astype(np.float32), cells)
+        volume = view.doc.volume
+        colour = volume is not None and volume.ndim == 4 and len(verts)
+        if colour:  # a colour scan's hull shows the colours of its surface voxels
+            mesh.point_data["rgb"] = filled_voxel_values(volume, np.asarray(verts, np.float64))
         # not pickable: a click must reach the skeleton points inside it
         self.actor = view.plotter.add_mesh(
-            mesh, color=HULL_COLOUR, opacity=view.settings.hull_opacity, pickable=False, smooth_shading=True,
-            name="hull", render=False, reset_camera=False)
+            mesh, color=None if colour else HULL_COLOUR, scalars="rgb" if colour else None, rgb=bool(colour),
+            opacity=view.settings.hull_opacity, pickable=False, smooth_shading=True, name="hull", render=False,
+            reset_camera=False)
         self._apply_state()
         view.apply_stage()
         view.front_view()

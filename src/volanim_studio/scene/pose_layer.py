@@ -13,7 +13,7 @@ from matplotlib.colors import ListedColormap
 
 from volanim_core.render.colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
-from volanim_core.render.transfer import apply_labels, binary_view, volume_style
+from volanim_core.render.transfer import apply_labels, apply_rgba, binary_view, rgba_points, volume_style
 from volanim_core.rig.pose import apply_matrices
 
 STUMP_COLOUR = "#ff3030"
@@ -103,8 +103,9 @@ class PoseLayer:
     def _image(self, volume, origin_voxels, spacing_voxels) -> pv.ImageData:
         world_origin = self.view.world(origin_voxels)
         world_spacing = np.asarray(spacing_voxels, np.float64) * self.view.spacing
-        img = pv.ImageData(dimensions=volume.shape, origin=world_origin, spacing=world_spacing)
-        img.point_data["values"] = np.asarray(volume).ravel(order="F")
+        img = pv.ImageData(dimensions=volume.shape[:3], origin=world_origin, spacing=world_spacing)
+        colour = np.ndim(volume) == 4  # RGB with an alpha for the background (drawn as it is)
+        img.point_data["values"] = rgba_points(volume) if colour else np.asarray(volume).ravel(order="F")
         return img
 
     def show_volume(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
@@ -122,16 +123,21 @@ class PoseLayer:
             plotter.remove_actor("preview", render=False)
             if plotter.scalar_bars:
                 plotter.remove_scalar_bar()
-            style = volume_style(mode, volume, n_bones)
+            style = volume_style(mode, volume, n_bones) if volume.ndim == 3 else {"show_scalar_bar": False}
             labels = style.pop("categories", None)
             self.preview_actor = plotter.add_volume(img, scalars="values", name="preview", render=False,
                                                     reset_camera=False, **style)
             if labels is not None:
                 apply_labels(self.preview_actor, labels)
+            if volume.ndim == 4:
+                apply_rgba(self.preview_actor)
             self.preview_key = key
         self.preview_actor.SetVisibility(view.posing)
         plotter.remove_actor("slices", render=False)
-        if view.settings.slices:
+        if view.settings.slices and volume.ndim == 4:
+            plotter.add_mesh(img.slice_orthogonal(), scalars="values", rgb=True, name="slices", render=False,
+                             reset_camera=False)
+        elif view.settings.slices:
             style = volume_style(mode, volume, n_bones)
             labels = style.get("categories")
             cmap = style["cmap"] if labels is None else ListedColormap(np.vstack([[0.1, 0.1, 0.1], labels]))
@@ -148,9 +154,9 @@ class PoseLayer:
         world_origin = view.world(origin_voxels)
         world_spacing = np.asarray(spacing_voxels, np.float64) * view.spacing
         table = label_table(len(view.doc.bones)) if mode == "bone" else None
-        surf = label_surface(volume, world_origin, world_spacing, table)
+        surf = label_surface(volume, world_origin, world_spacing, table)  # colour: its voxels' colours
         self.clear(render=False)
-        if surf.n_points and table is not None:
+        if surf.n_points and "rgb" in surf.point_data:
             plotter.add_mesh(surf, scalars="rgb", rgb=True, name="preview", render=False, reset_camera=False)
         elif surf.n_points:
             plotter.add_mesh(surf, color=SKIN, name="preview", render=False, reset_camera=False)

@@ -1,0 +1,63 @@
+"""Colour volumes in every format: raw RGB .vol/.VOL (3 bytes a voxel), RGB .vti, RGB NRRD and
+RGB slice folders round-trip; grey readers see luminance; sizes that fit neither are refused."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from volanim_core import io
+from volanim_core.errors import FormatError
+from volanim_core.io.volume_files import to_grey
+
+
+@pytest.fixture
+def rgb(rng):
+    return rng.integers(0, 256, (7, 5, 4, 3)).astype(np.uint8)
+
+
+@pytest.mark.parametrize("name", ["c.VOL", "c.7x5x4.vol", "c.vti", "c.nrrd"])
+# spec: docs/formats.md#colour-volumes
+def test_colour_round_trips(tmp_path, rgb, name):
+    io.write_volume(tmp_path / name, rgb)
+    assert np.array_equal(io.read_volume(tmp_path / name, colour=True), rgb)
+    grey = io.read_volume(tmp_path / name)
+    assert grey.shape == (7, 5, 4) and np.array_equal(grey, to_grey(rgb))
+
+
+# spec: docs/formats.md#colour-volumes
+def test_raw_rgb_bytes_are_r_g_b_per_voxel_x_fastest(tmp_path, rgb):
+    io.write_volume(tmp_path / "c.7x5x4.vol", rgb)
+    data = np.frombuffer((tmp_path / "c.7x5x4.vol").read_bytes(), np.uint8)
+    assert data.size == 7 * 5 * 4 * 3
+    assert data[:3].tolist() == rgb[0, 0, 0].tolist() and data[3:6].tolist() == rgb[1, 0, 0].tolist()
+    assert data[3 * 7:3 * 8].tolist() == rgb[0, 1, 0].tolist()
+
+
+def test_header_files_carry_rgb_through_rmheader_and_addheader(tmp_path, rgb):
+    io.write_volume(tmp_path / "c.VOL", rgb)
+    io.remove_header(tmp_path / "c.VOL", tmp_path / "c.7x5x4.vol")
+    io.add_header(tmp_path / "c.7x5x4.vol", tmp_path / "d.VOL")
+    assert np.array_equal(io.read_volume(tmp_path / "d.VOL", colour=True), rgb)
+
+
+def test_a_raw_file_of_neither_one_nor_three_bytes_a_voxel_is_refused(tmp_path):
+    (tmp_path / "c.4x4x4.vol").write_bytes(bytes(64 * 2))
+    with pytest.raises(FormatError, match=r"c\.4x4x4\.vol.*128 bytes, expected 64.*or 192 in RGB"):
+        io.read_volume(tmp_path / "c.4x4x4.vol")
+
+
+def test_counting_a_colour_file_says_why_not(tmp_path, rgb):
+    io.write_volume(tmp_path / "c.VOL", rgb)
+    with pytest.raises(FormatError, match="RGB volume"):
+        io.histogram_file(tmp_path / "c.VOL")
+
+
+def test_a_4_component_vti_reads_as_rgb(tmp_path, rgb):
+    import pyvista as pv
+
+    img = pv.ImageData(dimensions=(7, 5, 4))
+    rgba = np.concatenate([rgb, np.full((7, 5, 4, 1), 9, np.uint8)], axis=3)
+    img.point_data["rgba"] = np.ascontiguousarray(rgba.transpose(2, 1, 0, 3)).reshape(-1, 4)
+    img.save(tmp_path / "a.vti")
+    assert np.array_equal(io.read_volume(tmp_path / "a.vti", colour=True), rgb)
