@@ -60,6 +60,7 @@ bench: install-test system-deps
 	$(PY) benchmarks/thesis_tables.py
 	xvfb-run -a $(PY) benchmarks/bench_studio.py
 	xvfb-run -a $(PY) benchmarks/bench_motion.py
+	$(PY) benchmarks/bench_colour.py
 
 # The README's generated tables (volume tools, every benchmark's figures): about 15 minutes on 2 cores.
 docs: install-test system-deps
@@ -67,6 +68,7 @@ docs: install-test system-deps
 
 screenshots: install-test system-deps
 	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py
+	$(PY) docs/make_colour_renders.py
 
 clean:
 	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache

@@ -127,6 +127,25 @@ def main() -> None:
     preview_and_wait()
     w.panel_tabs.setCurrentWidget(w.pose_panel)
     grab(w, HERE / "studio-timeline.png")
+
+    # A colour scan: the colour mannequin, arm raised, its sampled preview in colour and the hull tinted
+    w.timeline.stop()
+    w.doc.undo.mark_clean()
+    w.files.load_demo("mannequin-colour")
+    while w.busy:
+        app.processEvents()
+        time.sleep(0.01)
+    w.files.open_bones(ROOT / "assets" / "mannequin.bones")
+    w.files.open_connect(ROOT / "assets" / "mannequin.0.50.connect")
+    w.set_mode(M.POSE)
+    doc = w.doc
+    doc.settings.preview_mode = "sampled"
+    doc.settings.preview_kernel = 3
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -60, 0), merge=False)
+    w.scene.front_view()
+    preview_and_wait()
+    w.panel_tabs.setCurrentWidget(w.reconstruct_panel)
+    grab(w, HERE / "studio-colour.png")
     w.doc.undo.mark_clean()  # the session's edits are not for keeping: no "Save changes?", no autosave left
     w.close()
 

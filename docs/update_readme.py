@@ -32,6 +32,7 @@ SCRIPTS = {  # region -> the benchmark script that measures it
     "bench_reconstruct": "benchmarks/bench_reconstruct.py",
     "bench_sequence": "benchmarks/bench_sequence.py",
     "bench_render": "benchmarks/bench_render.py",
+    "bench_colour": "benchmarks/bench_colour.py",
     "thesis_tables": "benchmarks/thesis_tables.py",
 }
 REGION = re.compile(r"(<!-- make docs: (?P<name>[\w-]+) -->\n)(?P<body>.*?)(<!-- end: (?P=name) -->)", re.S)
