@@ -253,14 +253,14 @@ class Document:
         self.pose._write({}, {})
         self.selected_bones = ()
         self.picked_joint = None
-        self.bone_edits._set_bones(BoneSkeleton())
+        self.set_preview(None)
+        self.set_hull(None, None)
+        self.set_skeleton(None)  # points (and their attachments) before the bones they name: views index
+        self.bone_edits._set_bones(BoneSkeleton())  # the bone colours with the attachments
         self.only_unconnected = self.only_working = False
         self.cube_centre = None
         self.point_selection = np.zeros(0, np.int64)
         self._symmetry_x = None
-        self.set_preview(None)
-        self.set_hull(None, None)
-        self.set_skeleton(None)
         self.set_volume(None)
         self.bones_path = self.project_path = self.demo_name = None
         self.undo.clear()

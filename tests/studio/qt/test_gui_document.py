@@ -10,6 +10,7 @@ from PySide6.QtWidgets import QMessageBox
 from paths import ASSETS
 from volanim_core import io
 from volanim_studio.model import autosave
+from volanim_studio.model.modes import Mode
 from volanim_studio.model.project import read_project
 
 from ..conftest import JOB_TIMEOUT_MS
@@ -133,3 +134,21 @@ def test_files_named_on_the_command_line_are_not_unsaved_edits(qtbot, tmp_path):
     assert w.isWindowModified()
     w.doc.undo.mark_clean()
     w.close()
+
+
+def test_a_new_volume_after_connecting_and_posing_opens_cleanly(qtbot, window, tmp_path):
+    """Opening a volume over a connected, posed project raised IndexError in the view: the reset emptied
+    the bones while the points still named them (found making the README's colour screenshot)."""
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    window.doc.settings.colour_by = "bone"  # points coloured by their bone: the colours index the bones
+    window.set_mode(Mode.POSE)
+    window.doc.pose.set_angles(window.doc.bones.index("L_UPPERARM"), (0, -40, 0), merge=False)
+    vol = np.zeros((40, 30, 30), np.uint8)
+    vol[5:35, 5:25, 5:25] = 200
+    io.write_volume(tmp_path / "box.VOL", vol)
+    window.doc.undo.mark_clean()
+    window.files.open_volume(tmp_path / "box.VOL", params={"lo": 1, "hi": None, "fill": True})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    assert window.doc.shape == (40, 30, 30) and len(window.doc.bones) == 0 and window.doc.pose.is_rest
+    assert len(window.doc.attachments.bone) == len(window.doc.skeleton) and (window.doc.attachments.bone == -1).all()
