@@ -62,6 +62,16 @@ def measure(script: str, case: str, dataset: str, repeats: int = 3, env=None) ->
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+def best_of(fn, repeats: int = 5) -> float:
+    """The fastest of ``repeats`` calls, in seconds (the least disturbed by the shared machine)."""
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
 def table(rows: list[list], header: list[str]) -> str:
     """A plain-text table, or a Markdown one when ``VOLANIM_BENCH_MARKDOWN`` is set (``make docs``
     puts the benchmarks' own tables into the README)."""

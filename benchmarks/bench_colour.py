@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from _harness import table  # noqa: E402
+from _harness import best_of, table  # noqa: E402
 
 ORDERINGS = ("unsorted", "intensity", "rgb-radix", "cluster-seeds", "gradient-penalty", "supergradient", "ramp", "path")
 
@@ -43,15 +43,6 @@ def datasets():
         index = NearestColour(palette)(rgb)
         out[name] = (palette, index if index.ndim == 3 else index[:, :, None])
     return out
-
-
-def best_of(fn, repeats=3) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def bench_orderings(sets) -> None:

@@ -25,21 +25,12 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 sys.path.insert(0, str(Path(__file__).parent))
-from _harness import table  # noqa: E402
+from _harness import best_of, table  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 from volanim_core.samples import walk_clip  # noqa: E402
 
 WALK = walk_clip()
-
-
-def best_of(fn, repeats: int = 5) -> float:
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def per_frame_baseline(motion):

@@ -85,6 +85,8 @@ CONNECT = "# metric: euclid\nRoot: 0 0 0 :: 0 0 10\n10 10 10 3 0.9\nRoot: 0 0 10
 IDENTITY = "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
 CAMERA = "# volanim camera 1\nposition 10 -300 20\nfocal_point 10 20 20\nview_up 0 0 1\nview_angle 30\n"
 TF = "# volanim tf 1\n0 0 0 0 0\n80 0.5 0.4 0.3 0.1\n255 1 1 1 0.9\n"
+PALETTE = "# volanim palette 1\n0 0 0\n222 170 140\n178 48 46\n"
+ALPHA = "# volanim alpha 1\n0 0\n1 0.02\n254 0.6\n"
 TSKEL = f"# metric: euclid\nRoot: 0 0 0 :: 0 0 10\n{IDENTITY}10 10 10 3 0.9\n11 10 10 2.5\n"
 
 
@@ -293,6 +295,44 @@ def hand_written() -> list[Case]:
              "render {d}/f.nrrd -o {d}/o.png --cut 1 1 1 0 0 0"),
         Case("render: one volume to a png", "cli:render", {"f.nrrd": nrrd("6 6 6", b"\1" * 216)},
              "render {d}/f.nrrd -o {d}/o.png --size 64x48", "accept"),
+        # --- colour: RGB volumes, palettes, alpha maps and the commands that read them
+        Case("rgb vol: 3 bytes a voxel reads (as grey)", "read_volume", {"c.2x3x4.vol": bytes(range(72))},
+             "c.2x3x4.vol", "accept", "grey_of_rgb_2_3_4"),
+        Case("rgb vol: 2 bytes a voxel", "read_volume", {"c.2x3x4.vol": b"\1" * 48}, "c.2x3x4.vol"),
+        Case("rgb VOL: a byte short", "read_volume", {"c.VOL": b"2 3 4".ljust(99) + b"\n" + b"\1" * 71}, "c.VOL"),
+        Case("rgb nrrd: 3 components of 16 bits", "read_volume",
+             {"c.nrrd": b"NRRD0004\ntype: short\ndimension: 4\nsizes: 3 2 2 2\nencoding: raw\n\n" + b"\0" * 48},
+             "c.nrrd"),
+        Case("palette: no colours", "read_palette", {"p.txt": b"# volanim palette 1\n"}, "p.txt"),
+        Case("palette: 257 colours", "read_palette", {"p.txt": b"1 2 3\n" * 257}, "p.txt"),
+        Case("palette: a negative value", "read_palette", {"p.txt": b"1 2 3\n-1 2 3\n"}, "p.txt"),
+        Case("palette: a fraction", "read_palette", {"p.txt": b"1 2 3.5\n"}, "p.txt"),
+        Case("palette: four numbers", "read_palette", {"p.txt": b"1 2 3 4\n"}, "p.txt"),
+        Case("palette: binary junk", "read_palette", {"p.txt": b"\x89PNG\r\n\x1a\n\0\0"}, "p.txt"),
+        Case("palette: 256 colours with CRLF and a BOM", "read_palette",
+             {"p.txt": b"\xef\xbb\xbf" + b"1 2 3\r\n" * 256}, "p.txt", "accept"),
+        Case("alpha: indices descend", "read_alpha_map", {"a.alpha": b"5 0\n3 1\n"}, "a.alpha"),
+        Case("alpha: nan", "read_alpha_map", {"a.alpha": b"0 nan\n"}, "a.alpha"),
+        Case("alpha: one number", "read_alpha_map", {"a.alpha": b"0\n"}, "a.alpha"),
+        Case("palette apply: a grey volume", "cli:palette", {"g.VOL": b"2 2 2".ljust(99) + b"\n" + b"\1" * 8,
+                                                             "p.txt": b"1 2 3\n"},
+             "palette apply {d}/g.VOL {d}/p.txt -o {d}/i.VOL"),
+        Case("palette apply: a truncated RGB file", "cli:palette",
+             {"c.VOL": b"4 4 4".ljust(99) + b"\n" + b"\1" * 100, "p.txt": b"1 2 3\n"},
+             "palette apply {d}/c.VOL {d}/p.txt -o {d}/i.VOL"),
+        Case("palette build: 0 colours", "cli:palette", {"c.2x2x2.vol": b"\7" * 24},
+             "palette build {d}/c.2x2x2.vol -o {d}/p.txt --colours 0"),
+        Case("palette build: a tiny RGB volume", "cli:palette", {"c.2x2x2.vol": bytes(range(24))},
+             "palette build {d}/c.2x2x2.vol -o {d}/p.txt", "accept"),
+        Case("palette sort: a palette of one colour", "cli:palette", {"p.txt": b"1 2 3\n"},
+             "palette sort {d}/p.txt -o {d}/s.txt --remap {d}/r.txt", "accept"),
+        Case("palette sort: an index volume past the palette", "cli:palette",
+             {"p.txt": b"1 2 3\n4 5 6\n", "i.2x2x2.vol": b"\5" * 8},
+             "palette sort {d}/p.txt -o {d}/s.txt --remap {d}/r.txt --volume {d}/i.2x2x2.vol"),
+        Case("alpha merge: an alpha map of words", "cli:alpha", {"p.txt": b"1 2 3\n", "a.alpha": b"zero one\n"},
+             "alpha merge {d}/p.txt {d}/a.alpha -o {d}/t.tf"),
+        Case("alpha merge: --clear past the palette", "cli:alpha", {"p.txt": b"1 2 3\n"},
+             "alpha merge {d}/p.txt 0.5 --clear 9 -o {d}/t.tf"),
         Case("mesh: empty file", "read_mesh", {"m.ply": b""}, "m.ply"),
         Case("mesh: a ply header with no faces", "read_mesh",
              {"m.ply": b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n"}, "m.ply"),
@@ -331,7 +371,8 @@ def replace_number(text: str, k: int, value: str) -> str:
 
 def mutated(kind: str, k: int, value: str) -> Case:
     """A valid file of ``kind`` with one number made hostile."""
-    base = {"mskel": MSKEL, "bones": BONES, "connect": CONNECT, "tskel": TSKEL, "camera": CAMERA, "tf": TF}[kind]
+    base = {"mskel": MSKEL, "bones": BONES, "connect": CONNECT, "tskel": TSKEL, "camera": CAMERA, "tf": TF,
+            "palette": PALETTE, "alpha": ALPHA}[kind]
     text = replace_number(base, k, value)
-    reader = "read_transfer_function" if kind == "tf" else f"read_{kind}"
+    reader = {"tf": "read_transfer_function", "alpha": "read_alpha_map"}.get(kind, f"read_{kind}")
     return Case(f"{kind}: number #{k} -> {value[:12]}", reader, {f"m.{kind}": text.encode()}, f"m.{kind}")

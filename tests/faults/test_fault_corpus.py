@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from .cases import HOSTILE_NUMBERS, hand_written, mutated
 from .run import run_corpus, table
 
-KINDS = ("mskel", "bones", "connect", "tskel", "camera", "tf")
+KINDS = ("mskel", "bones", "connect", "tskel", "camera", "tf", "palette", "alpha")
 MUTATIONS = st.lists(st.tuples(st.sampled_from(KINDS), st.integers(0, 40), st.sampled_from(HOSTILE_NUMBERS)),
                      min_size=40, max_size=40, unique=True)
 

@@ -20,6 +20,7 @@ MEMORY_CAP = 6 << 30  # address space; VTK and numpy need ~1-2 GB of it just to 
 def readers() -> dict:
     from volanim_core import io
     from volanim_core.io.mesh_files import read_mesh
+    from volanim_core.io.palette_files import read_alpha_map, read_palette
     from volanim_core.motion.bvh import read_bvh
     from volanim_studio.model.project import read_project
 
@@ -27,12 +28,13 @@ def readers() -> dict:
             "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
             "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh,
             "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function,
-            "read_mesh": read_mesh}
+            "read_mesh": read_mesh, "read_palette": read_palette, "read_alpha_map": read_alpha_map}
 
 
 CHECKS = {
     "shape_3_4_5": lambda r: tuple(r.shape) == (3, 4, 5),
     "shape_2_3_4": lambda r: tuple(r.shape) == (2, 3, 4) and r[1, 0, 0] == 1 and r[0, 1, 0] == 2,
+    "grey_of_rgb_2_3_4": lambda r: tuple(r.shape) == (2, 3, 4) and r[0, 0, 0] == 1 and r[1, 0, 0] == 4,
     "len_3": lambda r: len(r) == 3,
     "first_pair_A_B": lambda r: r[0] == ("A", "B"),
     "len_3000": lambda r: len(r) == 3000,
