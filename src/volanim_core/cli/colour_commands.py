@@ -6,6 +6,7 @@ AlphaFactor and MergeMaps (docs/formats.md#palette for the files).
 
 from __future__ import annotations
 
+import re
 import time
 from pathlib import Path
 
@@ -53,7 +54,7 @@ def _build(args):
 
 def _apply(args):
     from volanim_core.colour.slabs import ColourSlabs, apply_palette
-    from volanim_core.io.palette_files import read_palette
+    from volanim_core.io.palette_files import read_palette, write_palette
 
     palette = read_palette(args.palette)
     slabs = ColourSlabs.open(args.volume, args.dims)
@@ -61,8 +62,16 @@ def _apply(args):
     path, counts = apply_palette(slabs, palette, args.output, progress=TextProgress("mapping slices"))
     seconds = time.perf_counter() - t0
     voxels = int(np.prod(slabs.shape))
+    beside = palette_beside(path)  # an index volume means nothing without its palette: they travel together
+    write_palette(beside, palette, f"the palette of {path.name} (from {Path(args.palette).name})")
     print(f"wrote {path} ({'x'.join(map(str, slabs.shape))}, indices 0..{len(palette) - 1}; "
-          f"{np.count_nonzero(counts)} used) at {voxels / max(seconds, 1e-9) / 1e6:.1f} M voxels/s")
+          f"{np.count_nonzero(counts)} used) at {voxels / max(seconds, 1e-9) / 1e6:.1f} M voxels/s, and {beside}")
+
+
+def palette_beside(index_volume: Path) -> Path:
+    """``NAME.palette.txt`` next to ``NAME.VOL`` / ``NAME.XxYxZ.vol`` / ``NAME.vti`` / ``NAME.nrrd``."""
+    name = re.sub(r"(\.\d+x\d+x\d+)?\.(vol|vti|nrrd)$", "", index_volume.name, flags=re.IGNORECASE)
+    return index_volume.with_name(f"{name}.palette.txt")
 
 
 def _sort(args):

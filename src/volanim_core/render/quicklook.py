@@ -42,7 +42,8 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
         ref = inputs.frames[0]
         volume, origin = read_frame(ref, dims)
         renderer.draw(volume, origin, ref.number)
-        what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {settings.preset} colours"
+        shown = "RGB" if volume.ndim == 4 else settings.preset
+        what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {shown} colours"
         if ref.index >= 0:
             what = f"frame {ref.number}: {what}"
     return renderer, what

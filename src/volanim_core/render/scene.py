@@ -111,13 +111,14 @@ def transfer_of(settings: RenderSettings) -> TransferFunction:
 def crop(volume: np.ndarray, origin, pad: int = 1):
     """The smallest box holding every filled voxel (and ``pad`` empty ones around it), and its origin."""
     origin = np.asarray(origin, np.float64)
-    columns = np.any(volume, axis=2)
+    filled = volume.any(axis=3) if volume.ndim == 4 else volume  # colour: black is empty
+    columns = np.any(filled, axis=2)
     xs, ys = np.flatnonzero(columns.any(axis=1)), np.flatnonzero(columns.any(axis=0))
     if not len(xs):
         return volume[:1, :1, :1] * 0, origin
-    zs = np.flatnonzero(np.any(volume[xs[0]:xs[-1] + 1, ys[0]:ys[-1] + 1], axis=(0, 1)))
+    zs = np.flatnonzero(np.any(filled[xs[0]:xs[-1] + 1, ys[0]:ys[-1] + 1], axis=(0, 1)))
     lo = np.maximum([xs[0] - pad, ys[0] - pad, zs[0] - pad], 0)
-    hi = np.minimum([xs[-1] + pad + 1, ys[-1] + pad + 1, zs[-1] + pad + 1], volume.shape)
+    hi = np.minimum([xs[-1] + pad + 1, ys[-1] + pad + 1, zs[-1] + pad + 1], volume.shape[:3])
     return volume[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]], origin + lo
 
 
@@ -203,8 +204,8 @@ class Renderer:
         s = self.settings
         if s.cut is not None:
             volume = cut_away(volume, origin, *s.cut)
-        if volume.ndim == 4 and (s.style == "surface" or s.transfer is not None):
-            volume = to_grey(volume)  # surfaces and a user's transfer function read one value a voxel
+        if volume.ndim == 4 and s.transfer is not None:
+            volume = to_grey(volume)  # a user's transfer function reads one value a voxel
         if s.preset == "binary" and s.transfer is None and volume.ndim == 3:
             volume = (volume > 0).astype(np.uint8)
         if s.style == "surface":

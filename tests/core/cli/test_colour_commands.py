@@ -52,6 +52,7 @@ def test_build_apply_sort_remap_merge_render(scan):
     index, remapped = io.read_volume(folder / "index.VOL"), io.read_volume(folder / "sorted.VOL")
     assert len(palette) <= 64 and sorted(map(tuple, palette)) == sorted(map(tuple, sorted_palette))
     assert np.array_equal(index, NearestColour(palette)(vol))
+    assert np.array_equal(read_palette(folder / "index.palette.txt"), palette)  # the index volume's palette beside it
     assert np.array_equal(sorted_palette[remapped], palette[index])  # every voxel keeps its colour
 
     tf = io.read_transfer_function(folder / "body.tf")

@@ -10,15 +10,15 @@ from volanim_core.render.camera import Camera
 from volanim_core.render.scene import Renderer, RenderSettings
 
 
-@pytest.mark.parametrize("mapper", ["gpu", "cpu"])
-def test_a_red_and_a_blue_half_ball_show_red_and_blue(mapper):
+@pytest.mark.parametrize(("style", "mapper"), [("volume", "gpu"), ("volume", "cpu"), ("surface", "gpu")])
+def test_a_red_and_a_blue_half_ball_show_red_and_blue(style, mapper):
     body = ball() > 0
     rgb = np.zeros((*body.shape, 3), np.uint8)
     rgb[:40, ..., 0] = 220  # x < 40 red, the rest blue
     rgb[40:, ..., 2] = 220
     rgb[~body] = 0
     cam = Camera((40.0, -260.0, 40.0), (40.0, 40.0, 40.0), (0.0, 0.0, 1.0), 30.0)
-    r = Renderer(RenderSettings(cam, style="volume", mapper=mapper, size=(W, H), background="black"))
+    r = Renderer(RenderSettings(cam, style=style, mapper=mapper, size=(W, H), background="black"))
     try:
         image = r.render(rgb, (0, 0, 0)).astype(int)
     finally:
