@@ -2,7 +2,8 @@
 
     compile_kernels()
         skeletonize (euclid, 345) --> auto_connect (path) --> reconstruct
-        (every mode x metric, sampled with kernel 1 and 3) --> breakage report --> a crumble's heap
+        (every mode x metric, sampled with kernel 1 and 3, and a colour source) --> palette
+        orderings --> breakage report --> a crumble's heap
 
 The kernels are ``@njit(cache=True)``: the machine code lands in the package's
 ``__pycache__`` and later processes load it in well under a second. A fresh
@@ -33,6 +34,7 @@ def compile_kernels(progress=None) -> float:
 
     ``progress(done, total)`` is called after each step (for a message or a bar).
     """
+    from volanim_core.colour.sort import sort_palette
     from volanim_core.reconstruct.breakage import breakage_report
     from volanim_core.reconstruct.engine import MODES, reconstruct
     from volanim_core.rig.attach import auto_connect
@@ -64,6 +66,10 @@ def compile_kernels(progress=None) -> float:
                 reconstruct(tskel, mode=mode, source=source if mode == "sampled" else None, kernel=kernel)
             done += 1
             _report(progress, done, total)
+    rgb = np.repeat(source[..., None], 3, axis=3)
+    reconstruct(tskel, mode="sampled", source=rgb, kernel=3)  # a colour source: float32 linear light
+    sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "path")  # all moves
+    sort_palette(np.arange(12, dtype=np.uint8).repeat(3).reshape(-1, 3), "cluster-seeds")
     breakage_report(tskel, dict(bones.joints), dict(bones.joints))
     fall(np.pad(source, ((8, 8), (8, 8), (0, 8))), 1.0)  # a crumble's heap (room for it around the bar)
     _report(progress, total, total)

@@ -325,7 +325,8 @@ def reconstruct(
     stencil = _WORKSPACE.stencil_for((nz, ny, nx) if relax else (1, 1, 1))  # rows set on first use
     row_ready = np.zeros((nz, ny) if relax else (1, 1), np.bool_)
     if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
-        nbrs = sphere_neighbours(tskel) if neighbours is None else reorder_neighbours(neighbours, order)
+        nbrs = sphere_neighbours(tskel, min_radius=CUT_MIN_RADIUS) if neighbours is None \
+            else reorder_neighbours(neighbours, order)
         plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 4))
