@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-
 from test_engine import random_tskel
+
 from volanim_core.reconstruct.neighbours import CUT_MIN_RADIUS, sphere_neighbours
 from volanim_core.reconstruct.radii import radius_squared
 
