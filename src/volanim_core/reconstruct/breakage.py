@@ -257,7 +257,7 @@ def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, 
 
 def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: dict[str, np.ndarray], *,
                     posed: Reconstruction | None = None, rest_bone: Reconstruction | None = None,
-                    top: int = 5, cancel=None) -> BreakageReport:
+                    pairs=None, top: int = 5, cancel=None) -> BreakageReport:
     """The breakage report of one posed frame.
 
     Parameters
@@ -265,6 +265,7 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     tskel : the posed frame
     joints, posed_joints : joint name -> rest / posed position
     posed, rest_bone : reconstructions already made (bone or any mode; rest in bone mode), reused
+    pairs : :func:`touching_pairs` of the frame's points, when the caller keeps them (pose-independent)
     cancel : callable, optional
         ``cancel() -> True`` raises :class:`~volanim_core.errors.Cancelled` between phases.
     """
@@ -276,7 +277,7 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     hot = reconstruct(tskel, mode="hotspot", bounds=posed.bounds, cancel=cancel)
     check(0, 1)
     lost = lost_voxels(rest_bone, posed, tskel.matrices)
-    where, gaps = cracks(tskel)
+    where, gaps = cracks(tskel, pairs=pairs)
     check(0, 1)
     parts = _components(posed.volume)
     report = BreakageReport([n for n, _ in parts], int(posed.stats["filled"]), int(rest_bone.stats["filled"]),

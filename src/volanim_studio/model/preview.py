@@ -11,10 +11,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volanim_core.reconstruct.breakage import BreakageReport, breakage_report
+from volanim_core.reconstruct.breakage import BreakageReport, breakage_report, touching_pairs
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.tskel import coarse_tskel, identity_tskel
+
+
+@dataclass
+class RestParts:
+    """What the breakage report needs that no pose changes: the rest bone volume and the sphere pairs
+    that touch at rest (on the frog about a third of a full preview). The studio keeps them until
+    the attachments or the slider change (:meth:`Posing.rest_parts`)."""
+
+    rest_bone: Reconstruction
+    pairs: tuple
 
 
 @dataclass
@@ -23,6 +33,7 @@ class Preview:
     factor: int
     mode: str
     report: BreakageReport | None = None
+    rest_parts: RestParts | None = None  # what the report used, for the caller to keep
 
     @property
     def spacing(self) -> tuple[float, float, float]:
@@ -36,10 +47,12 @@ class Preview:
 
 def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,
                  factor: int = 1, joints=None, posed_joints=None, report: bool = False, neighbours=None,
-                 progress=None, cancel=None) -> Preview:
+                 rest_parts: RestParts | None = None, progress=None, cancel=None) -> Preview:
     """Reconstruct the frame (and, when asked, the breakage report at full resolution).
 
     ``neighbours``: the frame's ``sphere_neighbours`` if the caller has them (computed when None).
+    ``rest_parts``: a previous report's :class:`RestParts` of the same attachments (made when None;
+    the result carries them either way).
     """
     if not len(tskel):
         raise ValueError("no attached points to reconstruct: connect points to bones first")
@@ -52,7 +65,10 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     if report:  # three more reconstructions: each checks ``cancel`` between its chunks
         posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", neighbours=nbrs,
                                                                               cancel=cancel)
-        rest = reconstruct(identity_tskel(tskel.connectivity), mode="bone", neighbours=nbrs, cancel=cancel)
-        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone, rest_bone=rest,
-                                     cancel=cancel)
+        if rest_parts is None:
+            rest_parts = RestParts(reconstruct(identity_tskel(tskel.connectivity), mode="bone", neighbours=nbrs,
+                                               cancel=cancel), touching_pairs(tskel))
+        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone,
+                                     rest_bone=rest_parts.rest_bone, pairs=rest_parts.pairs, cancel=cancel)
+        out.rest_parts = rest_parts
     return out

@@ -136,9 +136,15 @@ class PreviewController(Controller):
         posed = self.doc.pose.posed_joints()
         source = self.doc.volume if settings["mode"] == "sampled" else None
         nbrs = self.doc.pose.neighbours(tskel, compute=False)  # None: the worker computes them
+        rest, version = self.doc.pose.rest_parts(tskel), self.doc.pose.rest_version  # None: the worker makes them
+
+        def done(p) -> None:
+            self.doc.pose.keep_rest_parts(tskel, p.rest_parts, version)
+            self.doc.set_preview(p)
+
         worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
             tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report, neighbours=nbrs,
-            progress=progress, cancel=cancel), self.doc.set_preview)
+            rest_parts=rest, progress=progress, cancel=cancel), done)
         worker.is_preview = True
         return worker
 

@@ -86,3 +86,28 @@ def test_neighbour_lists_are_cached_until_the_frame_changes(doc):
     assert doc.pose.neighbours(t) is not first
     doc.thinness = 0.8
     assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None
+
+
+def test_a_report_made_with_kept_rest_parts_equals_a_fresh_one_and_edits_drop_them(doc):
+    joints = dict(doc.bones.joints)
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -45, 0), merge=False)
+    t = doc.pose.tskel()
+    assert doc.pose.rest_parts(t) is None
+    version = doc.pose.rest_version
+    first = make_preview(t, report=True, joints=joints, posed_joints=doc.pose.posed_joints())
+    doc.pose.keep_rest_parts(t, first.rest_parts, version)
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -80, 0), merge=False)  # a pose change keeps them
+    t = doc.pose.tskel()
+    kept = doc.pose.rest_parts(t)
+    assert kept is first.rest_parts
+    again = make_preview(t, report=True, joints=joints, posed_joints=doc.pose.posed_joints(), rest_parts=kept)
+    fresh = make_preview(t, report=True, joints=joints, posed_joints=doc.pose.posed_joints())
+    assert again.report == fresh.report and again.rest_parts is kept
+    # an attachment edit drops them, and a report asked for before the edit is not kept after it
+    version = doc.pose.rest_version
+    doc.attachments.assign([0], doc.bones.index("HEAD"))
+    assert doc.pose.rest_parts(doc.pose.tskel()) is None
+    doc.pose.keep_rest_parts(doc.pose.tskel(), fresh.rest_parts, version)
+    assert doc.pose.rest_parts(doc.pose.tskel()) is None
+    doc.thinness = 0.8  # another slider position is another frame
+    assert doc.pose.rest_parts(doc.pose.tskel()) is None
