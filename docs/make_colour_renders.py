@@ -35,7 +35,7 @@ def palettes() -> None:
     from skimage import io as skio
 
     from volanim_core import samples, volume
-    from volanim_core.colour.alpha import merge_maps
+    from volanim_core.colour.alpha import black_indices, merge_maps
     from volanim_core.colour.palette import NearestColour, build_palette, unique_colours
     from volanim_core.colour.sort import remap_table, sort_palette
     from volanim_core.render.camera import named_view
@@ -47,10 +47,8 @@ def palettes() -> None:
     order = sort_palette(palette, "ramp")
     ramp = volume.remap(index, remap_table(order))
 
-    def tf(p):
-        t = merge_maps(p, (np.array([0.0]), np.array([0.6])))
-        t.rgba[~p.any(axis=1), 3] = 0.0  # black is the background
-        return t
+    def tf(p):  # one opacity, black (the background) see-through: `volanim alpha merge P 0.6 --clear-black`
+        return merge_maps(p, (np.array([0.0]), np.array([0.6])), black_indices(p))
 
     pictures = [render(rgb, (0, 0, 0), camera), render(index, (0, 0, 0), camera, tf(palette)),
                 render(ramp, (0, 0, 0), camera, tf(palette[order]))]

@@ -41,12 +41,15 @@ def main() -> None:
     w = MainWindow()
     w.resize(1500, 900)
     w.show()
-    w.files.load_demo("mannequin")
     import time
 
-    while w.busy:  # (sleep: every processEvents() call from Python costs; see tests/studio/test_qt_binding.py)
-        app.processEvents()
-        time.sleep(0.01)
+    def wait_idle():
+        while w.busy:  # (sleep: every processEvents() call from Python costs; see tests/studio/test_qt_binding.py)
+            app.processEvents()
+            time.sleep(0.01)
+
+    w.files.load_demo("mannequin")
+    wait_idle()
     w.files.open_bones(ROOT / "assets" / "mannequin.bones")
     w.scene.front_view()
     w.set_mode(Mode.BONES)
@@ -80,7 +83,6 @@ def main() -> None:
     w.scene.lasso.draw()
 
     # Pose: a deliberate mistake (the shoulder's points on the torso), the break, the fix
-    import time
 
     from volanim_studio.model.modes import Mode as M
 
@@ -96,9 +98,7 @@ def main() -> None:
 
     def preview_and_wait():
         w.previews.preview()
-        while w.busy:
-            app.processEvents()
-            time.sleep(0.01)
+        wait_idle()
         for _ in range(5):
             app.processEvents()
 
@@ -132,9 +132,7 @@ def main() -> None:
     w.timeline.stop()
     w.doc.undo.mark_clean()
     w.files.load_demo("mannequin-colour")
-    while w.busy:
-        app.processEvents()
-        time.sleep(0.01)
+    wait_idle()
     w.files.open_bones(ROOT / "assets" / "mannequin.bones")
     w.files.open_connect(ROOT / "assets" / "mannequin.0.50.connect")
     w.set_mode(M.POSE)

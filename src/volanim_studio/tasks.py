@@ -19,16 +19,18 @@ from volanim_core.volume import fill_cavities, threshold
 
 
 def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: bool, metric: str = "euclid",
-                   min_thinness: float = DEFAULT_MIN_THINNESS, skeleton_path=None, progress=None,
+                   min_thinness: float = DEFAULT_MIN_THINNESS, skeleton_path=None, grey=None, progress=None,
                    cancel=None) -> dict:
     """Segment, skeletonize and isosurface a loaded volume.
 
     ``skeleton_path``: a saved ``.mskel`` of this segmentation (a reopened
-    project) is read instead of skeletonizing again.
+    project) is read instead of skeletonizing again. ``grey``: a colour volume's
+    luminance when the caller has it (:func:`load_volume_file` made it already).
     """
     report = Reporter(progress, cancel)
     report(0, 100)
-    grey = to_grey(volume) if is_colour(volume) else volume  # a colour scan is segmented on its luminance
+    if grey is None:  # a colour scan is segmented on its luminance
+        grey = to_grey(volume) if is_colour(volume) else volume
     mask = threshold(grey, lo, hi).view(bool)
     if fill:
         mask = fill_cavities(mask)

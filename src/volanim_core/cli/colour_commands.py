@@ -31,21 +31,23 @@ ALPHA_EXAMPLES = (
 
 
 def _build(args):
-    from volanim_core.colour.palette import build_palette, quantisation_error
+    from volanim_core.colour.palette import build_palette, colour_errors, weighted_error
     from volanim_core.colour.slabs import ColourSlabs, sample_colours
     from volanim_core.io.palette_files import write_palette
 
     slabs = ColourSlabs.open(args.volume, args.dims)
     colours, counts = sample_colours(slabs, args.sample, progress=TextProgress("sampling slices"))
     t0 = time.perf_counter()
-    palette = build_palette(colours, counts, args.colours, method=args.method)
+    palette = build_palette(colours, counts, args.colours, method=args.method,
+                            progress=TextProgress(f"building ({args.method})"))
     built = time.perf_counter() - t0
     summary = (f"{len(palette)} colours from {int(counts.sum()):,} sampled voxels ({len(colours):,} distinct) "
                f"by {args.method} in {built:.1f} s\nCIEDE2000 of voxels to their palette colour:")
+    errors = colour_errors(colours, palette)
     body = colours.any(axis=1)  # black is the background of a scan; its voxels would flatter the mean
     for name, keep in (("all voxels", slice(None)), ("not black", body)):
         if counts[keep].sum():
-            mean, p95 = quantisation_error(colours[keep], counts[keep], palette)
+            mean, p95 = weighted_error(errors[keep], counts[keep])
             summary += f"\n  {name:11s} mean {mean:.2f}, 95th percentile {p95:.2f}"
     write_palette(args.output, palette, f"from {Path(args.volume).name}\n{summary}")
     print(summary)
@@ -80,13 +82,14 @@ def _sort(args):
     from volanim_core.io.palette_files import read_palette, write_palette, write_remap_table
 
     palette = read_palette(args.palette)
-    pairs = weights = None
     if args.volume:
         index = read_volume(args.volume, dims=args.dims)
         if index.dtype != np.uint8 or (index.size and int(index.max()) >= len(palette)):
             raise ValueError(f"{args.volume}: not an index volume of this {len(palette)}-colour palette "
                              f"(values up to {int(index.max()) if index.size else 0})")
         pairs, weights = sort.colour_pairs(index, len(palette))
+    else:
+        pairs, weights = sort.near_pairs(palette)  # once, for both scores
     before = sort.score(palette, np.arange(len(palette)), pairs, weights)
     t0 = time.perf_counter()
     order = sort.sort_palette(palette, args.method, keep_first=args.keep_first)
@@ -104,32 +107,27 @@ def _sort(args):
 
 def _alpha_arg(text: str):
     """An alpha map file, or one opacity for every index."""
+    import argparse
+
     from volanim_core.io.palette_files import read_alpha_map
 
     if Path(text).exists():
         return read_alpha_map(text)
     try:
         value = finite_float(text)
-    except Exception:
+    except argparse.ArgumentTypeError:
         raise ValueError(f"{text}: neither an alpha map file nor an opacity 0..1") from None
     return np.array([0.0]), np.array([value])
 
 
 def _merge(args):
-    from volanim_core.colour.alpha import merge_maps
+    from volanim_core.colour.alpha import black_indices, merge_maps
     from volanim_core.io import write_transfer_function
     from volanim_core.io.palette_files import read_palette
 
     palette = read_palette(args.palette)
-    values, alphas = _alpha_arg(args.alpha)
-    tf = merge_maps(palette, (values, alphas))
-    clear = list(args.clear or ())
-    if args.clear_black:
-        clear += np.flatnonzero(~palette.any(axis=1)).tolist()
-    for index in clear:
-        if index >= len(palette):
-            raise ValueError(f"--clear {index}: the palette has indices 0..{len(palette) - 1}")
-        tf.rgba[index, 3] = 0.0
+    clear = list(args.clear or ()) + (black_indices(palette).tolist() if args.clear_black else [])
+    tf = merge_maps(palette, _alpha_arg(args.alpha), clear)
     write_transfer_function(args.output, tf)
     print(f"wrote {args.output} ({len(palette)} colours; render with: volanim render INDEX.VOL --tf {args.output})")
 

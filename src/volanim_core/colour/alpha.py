@@ -45,12 +45,25 @@ def alpha_factor(alpha_map, factor: float) -> tuple[np.ndarray, np.ndarray]:
     return v, np.clip(a * factor, 0.0, 1.0)
 
 
-def merge_maps(palette: np.ndarray, alpha_map) -> TransferFunction:
-    """A palette and an alpha map as one RGBA transfer function, a point per index (MergeMaps)."""
+def black_indices(palette: np.ndarray) -> np.ndarray:
+    """Indices of pure black in a palette: a scan's background, usually made transparent."""
+    return np.flatnonzero(~np.asarray(palette).reshape(-1, 3).any(axis=1))
+
+
+def merge_maps(palette: np.ndarray, alpha_map, clear=()) -> TransferFunction:
+    """A palette and an alpha map as one RGBA transfer function, a point per index (MergeMaps).
+
+    ``clear``: indices made fully transparent whatever the alpha map says (e.g. :func:`black_indices`).
+    """
     palette = np.asarray(palette, np.float64).reshape(-1, 3)
     v, a = _check(*alpha_map)
     index = np.arange(len(palette), dtype=np.float64)
-    rgba = np.column_stack([palette / 255.0, np.interp(index, v, a)])
+    alpha = np.interp(index, v, a)
+    clear = np.asarray(clear, np.int64).reshape(-1)
+    if clear.size and (clear.min() < 0 or clear.max() >= len(palette)):
+        raise ValueError(f"indices to clear must be 0..{len(palette) - 1}, got {clear.min()}..{clear.max()}")
+    alpha[clear] = 0.0
+    rgba = np.column_stack([palette / 255.0, alpha])
     if len(index) == 1:  # a transfer function needs ascending values: one colour spans 0..1
         return TransferFunction(np.array([0.0, 1.0]), np.repeat(rgba, 2, axis=0))
     return TransferFunction(index, rgba)

@@ -16,6 +16,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from volanim_core.colour.space import delta_e, from_lab, to_lab
+from volanim_core.progress import CancelFn, ProgressFn, Reporter
 
 METHODS = ("kmeans", "median-cut")
 
@@ -42,7 +43,8 @@ def unique_colours(rgb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def build_palette(colours: np.ndarray, counts: np.ndarray, n: int = 255, *, method: str = "kmeans",
-                  seed: int = 0, iterations: int = 40) -> np.ndarray:
+                  seed: int = 0, iterations: int = 40, progress: ProgressFn | None = None,
+                  cancel: CancelFn | None = None) -> np.ndarray:
     """At most ``n`` colours (``(N, 3)`` uint8) standing for ``colours`` weighted by ``counts``.
 
     ``kmeans``: weighted k-means in CIELAB (k-means++ seeds, Lloyd steps); ``median-cut``:
@@ -51,6 +53,7 @@ def build_palette(colours: np.ndarray, counts: np.ndarray, n: int = 255, *, meth
 
     The colours come in the order the method made them, which is no order a renderer can
     blend (the thesis's MapImages palettes were the same): :mod:`.sort` orders them.
+    ``progress``/``cancel`` are called after each k-means step (a few seconds on a large sample).
     """
     if method not in METHODS:
         raise ValueError(f"palette method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -63,13 +66,14 @@ def build_palette(colours: np.ndarray, counts: np.ndarray, n: int = 255, *, meth
         return colours
     if method == "median-cut":
         return _median_cut(colours, counts, n)
-    return _kmeans(colours, counts, n, np.random.default_rng(seed), iterations)
+    return _kmeans(colours, counts, n, np.random.default_rng(seed), iterations, Reporter(progress, cancel))
 
 
-def _kmeans(colours, weights, n, rng, iterations) -> np.ndarray:
+def _kmeans(colours, weights, n, rng, iterations, report) -> np.ndarray:
     lab = to_lab(colours)
     centres = _kmeans_pp(lab, weights, n, rng)
-    for _ in range(iterations):
+    for step in range(iterations):
+        report(step, iterations)
         _, label = cKDTree(centres).query(lab)
         mass = np.bincount(label, weights, minlength=n)
         sums = np.stack([np.bincount(label, weights * lab[:, k], minlength=n) for k in range(3)], axis=1)
@@ -82,6 +86,7 @@ def _kmeans(colours, weights, n, rng, iterations) -> np.ndarray:
         centres = new
         if moved < 0.05:  # well under one sRGB step
             break
+    report(iterations, iterations)
     return _lab_to_palette(centres)
 
 
@@ -145,7 +150,13 @@ class NearestColour:
         if not 1 <= len(self.palette) <= 256:
             raise ValueError(f"a palette has 1..256 colours, got {len(self.palette)}")
         self.tree = cKDTree(to_lab(self.palette))
-        self.table = np.full(1 << 24, -1, np.int16)
+        self._table = None  # made at the first volume: per_voxel() callers never need its 32 MiB
+
+    @property
+    def table(self) -> np.ndarray:
+        if self._table is None:
+            self._table = np.full(1 << 24, -1, np.int16)
+        return self._table
 
     def __call__(self, rgb: np.ndarray) -> np.ndarray:
         keys = pack(rgb)
@@ -171,11 +182,20 @@ class NearestColour:
         return self.table
 
 
+def colour_errors(colours: np.ndarray, palette: np.ndarray) -> np.ndarray:
+    """CIEDE2000 between each colour and the palette colour it maps to (one tree query a colour)."""
+    palette = np.asarray(palette, np.uint8).reshape(-1, 3)
+    return delta_e(colours, palette[NearestColour(palette).per_voxel(colours)])
+
+
+def weighted_error(errors: np.ndarray, counts: np.ndarray) -> tuple[float, float]:
+    """Mean and 95th percentile of per-colour ``errors`` weighted by how many voxels have each colour."""
+    order = np.argsort(errors)
+    cum = np.cumsum(np.asarray(counts, np.float64)[order])
+    p95 = float(errors[order][np.searchsorted(cum, 0.95 * cum[-1])])
+    return float(np.average(errors, weights=counts)), p95
+
+
 def quantisation_error(colours: np.ndarray, counts: np.ndarray, palette: np.ndarray) -> tuple[float, float]:
     """Mean and 95th-percentile CIEDE2000 between voxels and their palette colour (weighted by counts)."""
-    mapped = np.asarray(palette)[NearestColour(palette)(colours)]
-    de = delta_e(colours, mapped)
-    order = np.argsort(de)
-    cum = np.cumsum(np.asarray(counts, np.float64)[order])
-    p95 = float(de[order][np.searchsorted(cum, 0.95 * cum[-1])])
-    return float(np.average(de, weights=counts)), p95
+    return weighted_error(colour_errors(colours, palette), counts)

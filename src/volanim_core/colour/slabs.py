@@ -39,9 +39,9 @@ class ColourSlabs:
         path = Path(path)
         if path.is_dir():
             files = volume_files.slice_files(path)
-            if not volume_files.folder_is_colour(files):
+            first = volume_files.read_slice(files[0], colour=None)
+            if first.ndim != 3:
                 raise FormatError(files[0], "is a grey image; the palette tools need colour (RGB) slices")
-            first = volume_files.read_slice(files[0], colour=True)
             return cls(path, (first.shape[0], first.shape[1], len(files)), None, files)
         if path.suffix.lower() == ".vol":
             vol = raw_volumes.read_raw(path, dims, mmap=True)
@@ -51,13 +51,6 @@ class ColourSlabs:
             raise FormatError(path, "is a grey volume (one value a voxel); the palette tools need colour "
                                     "(RGB: 3 bytes a voxel, RGB slices, or a 3-component .vti/.nrrd)")
         return cls(path, tuple(int(n) for n in vol.shape[:3]), vol)
-
-    @classmethod
-    def of(cls, vol: np.ndarray, name: str = "volume") -> ColourSlabs:
-        """An in-memory ``[x, y, z, 3]`` volume."""
-        if not volume_files.is_colour(vol):
-            raise ValueError(f"{name}: expected a colour volume [x, y, z, 3], got shape {np.shape(vol)}")
-        return cls(Path(name), tuple(int(n) for n in vol.shape[:3]), np.asarray(vol, np.uint8))
 
     @property
     def depth(self) -> int:

@@ -79,7 +79,8 @@ def write_alpha_map(path: str | Path, values, alphas) -> None:
 
 
 def write_remap_table(path: str | Path, table) -> None:
-    """``FROM TO`` for every index a table moves (and the rest unchanged), as ``volanim remap --table`` reads."""
+    """``table`` (old index -> new index, one entry per palette colour) as ``FROM TO`` lines, every
+    index listed, as ``volanim remap --table`` reads them (indices past the table stay as they are)."""
     lines = ["# volanim remap 1", "# old-index new-index; apply with: volanim remap INDEX.vol OUT.vol --table THIS"]
     lines += [f"{a} {int(b)}" for a, b in enumerate(table)]
     atomic_write_text(path, "\n".join(lines) + "\n")

@@ -105,9 +105,9 @@ def raw_layout(path: str | Path, dims=None, *, allocate: bool = True) -> tuple[t
     if has_header(path):
         dims = _check_dims(path, dims, None, allocate) if dims is not None else read_header_dims(path, allocate)
         n = math.prod(dims)
-        for channels in (1, 3):
-            if size == n * channels + HEADER_BYTES:
-                return _checked_channels(path, dims, channels, allocate), HEADER_BYTES, channels
+        channels = channels_for(size - HEADER_BYTES, n)
+        if channels:
+            return _checked_channels(path, dims, channels, allocate), HEADER_BYTES, channels
         raise FormatError(path, f"file has {size} bytes, expected {n + HEADER_BYTES} "
                           f"({HEADER_BYTES}-byte header + {dims[0]}x{dims[1]}x{dims[2]} voxels) "
                           f"or {3 * n + HEADER_BYTES} (the same in RGB, 3 bytes a voxel)")
@@ -116,9 +116,9 @@ def raw_layout(path: str | Path, dims=None, *, allocate: bool = True) -> tuple[t
         raise FormatError(path, "unknown dimensions: give them (e.g. --dims X Y Z) or name the file NAME.XxYxZ.vol")
     dims = _check_dims(path, dims, None, allocate)
     n = math.prod(dims)
-    for channels in (1, 3):
-        if size == n * channels:
-            return _checked_channels(path, dims, channels, allocate), 0, channels
+    channels = channels_for(size, n)
+    if channels:
+        return _checked_channels(path, dims, channels, allocate), 0, channels
     if size in (n + HEADER_BYTES, 3 * n + HEADER_BYTES):
         raise FormatError(path, f"file has {size} bytes = {dims[0]}x{dims[1]}x{dims[2]}"
                           f"{' x 3' if size > 3 * n else ''} + {HEADER_BYTES}: "
@@ -126,6 +126,11 @@ def raw_layout(path: str | Path, dims=None, *, allocate: bool = True) -> tuple[t
                           "the header with 'volanim rmheader'")
     raise FormatError(path, f"file has {size} bytes, expected {n} for {dims[0]}x{dims[1]}x{dims[2]} voxels "
                       f"(or {3 * n} in RGB, 3 bytes a voxel)")
+
+
+def channels_for(data_bytes: int, voxels: int) -> int | None:
+    """Bytes per voxel of raw data of this size: 1 (grey), 3 (RGB), or None (neither fits)."""
+    return next((c for c in (1, 3) if data_bytes == c * voxels), None)
 
 
 def _checked_channels(path, dims, channels: int, allocate: bool):
@@ -216,12 +221,13 @@ def remove_header(src: str | Path, dst: str | Path) -> tuple[int, int, int]:
     """Stream a ``.VOL`` into a bare ``.vol`` (rmhdr)."""
     dims = read_header_dims(src, allocate=False)
     n, size = math.prod(dims), Path(src).stat().st_size
-    channels = 3 if size == 3 * n + HEADER_BYTES else 1
-    if size != n * channels + HEADER_BYTES:
-        raise FormatError(src, f"file has {size} bytes, expected {n + HEADER_BYTES} for header + {dims} voxels")
+    channels = channels_for(size - HEADER_BYTES, n)
+    if not channels:
+        raise FormatError(src, f"file has {size} bytes, expected {n + HEADER_BYTES} for header + {dims} voxels "
+                               f"(or {3 * n + HEADER_BYTES} in RGB)")
     with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
         fin.seek(HEADER_BYTES)
-        _copy_stream(fin, fout, math.prod(dims) * channels)
+        _copy_stream(fin, fout, n * channels)
     return dims
 
 

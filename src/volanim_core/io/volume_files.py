@@ -110,8 +110,9 @@ def slice_files(folder: str | Path) -> list[Path]:
     return files
 
 
-def read_slice(path: Path, *, colour: bool = False, expect=None) -> np.ndarray:
-    """One slice image as ``[x, y]`` (``[x, y, 3]`` with ``colour``; grey images then repeat in R, G, B).
+def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.ndarray:
+    """One slice image as ``[x, y]``, or ``[x, y, 3]`` with ``colour`` (grey images then repeat in
+    R, G, B). ``colour=None`` keeps the image as it is: ``[x, y, 3]`` for a colour image, else ``[x, y]``.
 
     ``expect`` is the first slice's ``(X, Y)``: every slice must have it.
     """
@@ -121,7 +122,10 @@ def read_slice(path: Path, *, colour: bool = False, expect=None) -> np.ndarray:
         img = np.asarray(skio.imread(path))
     except Exception as exc:  # imageio/PIL raise many types
         raise FormatError(path, f"cannot read image: {exc}") from exc
-    if img.ndim == 3 and img.shape[2] in (3, 4):
+    is_rgb = img.ndim == 3 and img.shape[2] in (3, 4)
+    if colour is None:
+        colour = is_rgb
+    if is_rgb:
         img = img[..., :3] if colour else to_grey(img)
     elif img.ndim == 2 and colour:
         img = np.repeat(img[..., None], 3, axis=2)
@@ -134,27 +138,16 @@ def read_slice(path: Path, *, colour: bool = False, expect=None) -> np.ndarray:
     return img
 
 
-def folder_is_colour(files: list[Path]) -> bool:
-    """Whether the first slice of a folder is a colour image (the slices of one scan agree)."""
-    from skimage import io as skio
-
-    try:
-        img = skio.imread(files[0])
-    except Exception as exc:  # imageio/PIL raise many types
-        raise FormatError(files[0], f"cannot read image: {exc}") from exc
-    return np.ndim(img) == 3 and np.shape(img)[2] in (3, 4)
-
-
 def read_image_folder(folder: str | Path, *, colour: bool = False) -> np.ndarray:
     """Stack a folder of 2-D slice images along z (combineToGrayVolume).
 
     Files are taken in natural order (``s2`` before ``s10``). Image rows are y,
     columns x. Colour images become grey (luminance) unless ``colour``, which keeps
-    them as ``[x, y, z, 3]`` (a folder of grey images stays ``[x, y, z]``).
+    them as ``[x, y, z, 3]`` (a folder whose first slice is grey stays ``[x, y, z]``).
     """
     files = slice_files(folder)
-    colour = colour and folder_is_colour(files)
-    first = read_slice(files[0], colour=colour)
+    first = read_slice(files[0], colour=None if colour else False)  # the first slice says what the scan is
+    colour = first.ndim == 3
     slices = [first] + [read_slice(f, colour=colour, expect=first.shape[:2]) for f in files[1:]]
     return np.stack(slices, axis=2)
 

@@ -91,14 +91,14 @@ class FilesController(Controller):
             params = dialog.parameters()
         params = dict(params)
         spacing = tuple(float(v) for v in params.pop("spacing", None) or loaded["spacing"])
-        vol = loaded["volume"]
+        vol, grey = loaded["volume"], loaded["grey"]
 
         def done(r):
             r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
             self._apply_prepared(r, path=path, spacing=spacing, dims=dims)
 
         return self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
-            vol, skeleton_path=skeleton_path, progress=progress, cancel=cancel, **params), done)
+            vol, skeleton_path=skeleton_path, grey=grey, progress=progress, cancel=cancel, **params), done)
 
     def open_volume_dialog(self) -> None:
         self.window.session.when_saved_or_discarded(self._ask_volume, "opening another volume")

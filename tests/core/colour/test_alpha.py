@@ -56,3 +56,14 @@ def test_alpha_map_files_round_trip_and_errors_name_the_line(tmp_path):
     (tmp_path / "c.alpha").write_text("0 1.5\n")
     with pytest.raises(FormatError, match=r"c\.alpha:1: alpha is between 0 and 1"):
         read_alpha_map(tmp_path / "c.alpha")
+
+
+def test_merge_clears_the_indices_asked_for_and_refuses_ones_past_the_palette():
+    from volanim_core.colour.alpha import black_indices
+
+    palette = np.array([[9, 9, 9], [0, 0, 0], [200, 10, 10]], np.uint8)
+    assert black_indices(palette).tolist() == [1]
+    tf = merge_maps(palette, (np.array([0.0]), np.array([0.7])), black_indices(palette))
+    assert tf.rgba[:, 3] == pytest.approx([0.7, 0.0, 0.7])
+    with pytest.raises(ValueError, match=r"indices to clear must be 0\.\.2"):
+        merge_maps(palette, (np.array([0.0]), np.array([0.7])), [3])
