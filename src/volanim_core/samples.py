@@ -2,6 +2,7 @@
 
     mannequin()  (160, 100, 300) uint8  layered humanoid + BoneSkeleton + part labels
     mannequin_colour()  (160, 100, 300, 3) uint8  the same body in anatomical colours (RGB)
+    mannequin_large()  (290, 169, 940) uint8  the same body at half-size Visible Human scale
     aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
     frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
                                          with a two-bone principal-axis chain
@@ -23,13 +24,14 @@ import numpy as np
 
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
-NAMES = ("mannequin", "mannequin-colour", "aliascube", "frog")
+NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog")
 #: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence.
 FILE_SAMPLES = ("walk",)
 
 # Tissue values: distinct so sampled reconstruction shows the interior moving.
 SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
 MANNEQUIN_SHAPE = (160, 100, 300)
+LARGE_SHAPE = (290, 169, 940)  # the thesis's half-size Visible Human
 
 
 @dataclass
@@ -123,17 +125,56 @@ def mannequin() -> Sample:
     Skin, fat, striped muscle (stripes across each limb, so they move with it)
     and bone rods inside the limbs; a skull and brain in the head.
     """
-    shape = MANNEQUIN_SHAPE
-    bones = mannequin_bones()
+    return _mannequin(np.ones(3), "mannequin")
+
+
+def mannequin_large() -> Sample:
+    """The mannequin at the thesis's half-size Visible Human scale, 290 x 169 x 940 voxels (46 M).
+
+    The same body sampled on a finer grid (1.81 x 1.69 x 3.13 voxels per mannequin
+    voxel), not an enlarged copy: surfaces stay smooth and every tissue layer is
+    thicker in voxels, as in a higher-resolution scan. Its bones are the
+    mannequin's, scaled.
+    """
+    return _mannequin(np.array(LARGE_SHAPE, float) / MANNEQUIN_SHAPE, "mannequin-large")
+
+
+def part_connectivity(sample: Sample, min_thinness: float = 0.5):
+    """The sample's skeleton (thinness >= ``min_thinness``) with every point attached to the bone
+    of the body part it lies in (the ground truth, not a guess): a ready ``.connect``."""
+    from volanim_core.rig.connectivity import Connectivity
+    from volanim_core.rig.pose import root_bones
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    skel = skeletonize(sample.mask, min_thinness=min_thinness)
+    x, y, z = skel.points.astype(int).T
+    bone = sample.part[x, y, z].astype(int) - 1
+    conn = Connectivity(root_bones(sample.bones), skel.points, skel.dt, skel.thinness, bone, skel.metric,
+                        thinness_threshold=min_thinness)
+    return conn.grouped()
+
+
+def _scaled(p, scale) -> tuple[float, ...]:
+    """A mannequin-voxel position on a grid ``scale`` times finer (voxel centres stay centres)."""
+    return tuple(float(v) for v in (np.asarray(p, float) + 0.5) * scale - 0.5)
+
+
+def _mannequin(scale: np.ndarray, name: str) -> Sample:
+    shape = tuple(int(round(n * f)) for n, f in zip(MANNEQUIN_SHAPE, scale))
+    small = mannequin_bones()
+    bones = small if (scale == 1).all() else \
+        BoneSkeleton({k: _scaled(v, scale) for k, v in small.joints.items()}, small.bones)
     vol = np.zeros(shape, np.uint8, order="F")
     part = np.zeros(shape, np.uint8, order="F")
     best = np.full(shape, -np.inf, np.float32, order="F")
-    for k, (name, a, b, ra, rb, squash, rod) in enumerate(_mannequin_parts(bones)):
+    for k, (label, a, b, ra, rb, squash, rod) in enumerate(_mannequin_parts(small)):
         a, b = np.asarray(a, float), np.asarray(b, float)
         r = max(ra, rb)
-        lo = np.maximum(np.floor(np.minimum(a, b) - r - 1), 0).astype(int)
-        hi = np.minimum(np.ceil(np.maximum(a, b) + r + 1), np.array(shape) - 1).astype(int)
-        x, y, z = np.meshgrid(*(np.arange(lo[i], hi[i] + 1, dtype=np.float64) for i in range(3)), indexing="ij")
+        lo = np.maximum(np.floor((np.minimum(a, b) - r - 0.5) * scale - 0.5), 0).astype(int)
+        hi = np.minimum(np.ceil((np.maximum(a, b) + r + 1.5) * scale - 0.5), np.array(shape) - 1).astype(int)
+        # the part is built in mannequin-voxel units at this grid's voxel centres
+        x, y, z = np.meshgrid(*((np.arange(lo[i], hi[i] + 1, dtype=np.float64) + 0.5) / scale[i] - 0.5
+                                for i in range(3)), indexing="ij")
         ab = b - a
         length = float(np.linalg.norm(ab))
         t = np.clip(((x - a[0]) * ab[0] + (y - a[1]) * ab[1] + (z - a[2]) * ab[2]) / length**2, 0, 1)
@@ -147,12 +188,12 @@ def mannequin() -> Sample:
         tissue = np.where(depth < 1.5, SKIN, np.where(depth < 4, FAT, np.where(stripe, MUSCLE_A, MUSCLE_B)))
         if rod:
             tissue = np.where(d < rod, BONE, tissue)
-        if name == "HEAD" and k == 2:
+        if label == "HEAD" and k == 2:
             tissue = np.where(depth < 1.5, SKIN, np.where(depth < 4, SKULL, np.where(stripe, BRAIN, BRAIN + 12)))
         best[sl] = np.where(win, depth, best[sl])
         vol[sl] = np.where(win, tissue, vol[sl])
-        part[sl] = np.where(win, bones.index(name) + 1, part[sl])
-    return Sample("mannequin", vol, bones, part)
+        part[sl] = np.where(win, bones.index(label) + 1, part[sl])
+    return Sample(name, vol, bones, part)
 
 
 #: sRGB of each mannequin tissue: skin, fat, two muscle stripes, bone, skull, brain (two stripes).
@@ -255,8 +296,9 @@ def _deepest_near(mask: np.ndarray, target, radius: float = 60.0, step: int = 4)
 
 
 def load(name: str) -> Sample:
-    """A demo dataset by name: 'mannequin', 'mannequin-colour', 'aliascube' or 'frog'."""
-    makers = {"mannequin": mannequin, "mannequin-colour": mannequin_colour, "aliascube": aliascube, "frog": frog}
+    """A demo dataset by name: one of :data:`NAMES`."""
+    makers = {"mannequin": mannequin, "mannequin-colour": mannequin_colour, "mannequin-large": mannequin_large,
+              "aliascube": aliascube, "frog": frog}
     if name not in makers:
         raise ValueError(f"unknown sample {name!r}; choose one of {', '.join(NAMES)}")
     return makers[name]()
@@ -288,4 +330,9 @@ def write_sample(name: str, folder: str | Path) -> list[Path]:
         written += [folder / f"{name}.bones", folder / f"{name}.connections"]
         write_bones(written[1], sample.bones)
         write_connections(written[2], sample.bones)
+    if name == "mannequin-large":  # ready to reconstruct at the thesis's scale: its Table 2.2 skeleton
+        from volanim_core.io import write_connect
+
+        written.append(folder / f"{name}.connect")
+        write_connect(written[-1], part_connectivity(sample))
     return written

@@ -78,3 +78,27 @@ def test_colour_mannequin_is_the_mannequin_in_colour():
     from volanim_core.colour.palette import unique_colours
 
     assert len(unique_colours(colour.volume)[0]) > 10_000  # grain: a palette has to be built
+
+
+def test_large_mannequin_is_the_mannequin_on_a_finer_grid(tmp_path):
+    """The thesis's half-size Visible Human scale; its .connect reconstructs the body."""
+    from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.rig.tskel import identity_tskel
+
+    small, large = samples.mannequin(), samples.mannequin_large()
+    assert large.volume.shape == (290, 169, 940)
+    _, n = ndimage.label(large.mask)
+    assert n == 1
+    assert set(np.unique(large.volume)) == set(np.unique(small.volume))  # the same tissues
+    scale = np.array(large.volume.shape) / small.volume.shape
+    ratio = large.mask.sum() / small.mask.sum()
+    assert abs(ratio / scale.prod() - 1) < 0.03  # the same body, sampled finer
+    for name, p in small.bones.joints.items():
+        assert np.allclose(large.bones.joints[name], (p + 0.5) * scale - 0.5)
+    files = samples.write_sample("mannequin-large", tmp_path)
+    conn = io.read_connect(tmp_path / "mannequin-large.connect")
+    assert [f.name for f in files][-1] == "mannequin-large.connect" and 20_000 < len(conn) < 40_000
+    x, y, z = conn.points.astype(int).T
+    assert np.array_equal(conn.bone + 1, large.part[x, y, z])  # each point on its body part's bone
+    rest = reconstruct(identity_tskel(conn), mode="binary")
+    assert rest.stats["filled"] > 0.98 * large.mask.sum()

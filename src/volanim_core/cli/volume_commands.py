@@ -274,7 +274,8 @@ def register(sub) -> None:
     p.add_argument("--range", nargs=2, type=finite_float, metavar=("LO", "HI"),
                    help="input range (default: data min max)")
 
-    p = add_command(sub, "samples", "Write a demo dataset: mannequin, aliascube, frog, the walk clip, or all.",
+    p = add_command(sub, "samples",
+                    "Write a demo dataset: mannequin (-colour, -large), aliascube, frog, the walk clip, or all.",
                     "volanim samples all -o .", _samples)
     p.add_argument("name", choices=(*samples.NAMES, *samples.FILE_SAMPLES, "all"))
     p.add_argument("-o", "--output", default=".", help="folder (default: current)")

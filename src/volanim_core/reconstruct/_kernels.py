@@ -106,12 +106,15 @@ def _sample(source, px, py, pz, weights, half):
 
 @njit(cache=True, parallel=True)
 def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric, mode,
-                plane_start, planes, row_ready, filled, visits):
+                plane_start, planes, row_lo, row_hi, filled, visits):
     """Fill output slices ``z0 <= z < z1``; see the module docstring.
 
     ``centres`` are posed centres in output-grid coordinates.
-    ``stencil`` may be uninitialised: row ``(z, y)`` is set to inf on first use,
-    tracked by ``row_ready[z, y]``.
+    ``stencil`` may be uninitialised: row ``(z, y)`` is valid (inf where no sphere
+    reached) on ``row_lo[z, y] <= x <= row_hi[z, y]``, the span of the runs that
+    touched it, grown (and set to inf) run by run; ``row_lo > row_hi`` = untouched.
+    Only those spans are written -- the rest of the grid is never touched --
+    and the sampling pass reads only them.
     ``filled[z]`` and ``visits[z]`` receive per-slice counts.
     """
     ny, nx = out.shape[1], out.shape[2]
@@ -126,22 +129,24 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                 dz = z - cz
                 dz2 = dz * dz
                 if metric == EUCLID:
-                    rem = r2 - dz2
-                    if rem < 0.0:
-                        rem = 0.0
-                    yhalf = np.sqrt(rem)
+                    # Rows (and slices) that cannot hold a voxel are skipped by a test the
+                    # oracle's sum can never beat: fl(fl(dx^2 + dy^2) + dz^2) >= fl(dy^2 + dz^2).
+                    if dz2 >= r2:
+                        continue
+                    yhalf = np.sqrt(r2 - dz2)
+                    ya = max(int(np.floor(cy - yhalf)), 0)
+                    yb = min(int(np.ceil(cy + yhalf)), ny - 1)
                 else:
                     yhalf = r / 3.0
-                ya = max(int(np.floor(cy - yhalf)) - 1, 0)
-                yb = min(int(np.ceil(cy + yhalf)) + 1, ny - 1)
+                    ya = max(int(np.floor(cy - yhalf)) - 1, 0)
+                    yb = min(int(np.ceil(cy + yhalf)) + 1, ny - 1)
                 for y in range(ya, yb + 1):
                     dy = y - cy
                     dy2 = dy * dy
                     if metric == EUCLID:
-                        rem = r2 - dy2 - dz2
-                        if rem < -1.0:
+                        if dy2 + dz2 >= r2:
                             continue
-                        xhalf = np.sqrt(max(rem, 0.0))
+                        xhalf = np.sqrt(r2 - dy2 - dz2)
                     else:
                         xhalf = r / 3.0
                     # The sqrt estimate is exact unless a run end lies within 1e-7 of a voxel
@@ -192,17 +197,32 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                             if out[z, y, x] < 65535:
                                 out[z, y, x] += 1
                         continue
-                    if mode != BINARY and not row_ready[z, y]:
-                        # first touch of this stencil row: the untouched rest of the
-                        # grid is never written (nor paged in)
-                        row_ready[z, y] = True
-                        for x in range(nx):
+                    if mode != BINARY:
+                        lo, hi = row_lo[z, y], row_hi[z, y]
+                        if lo > hi:  # first touch of this row
+                            lo, hi = xa, xa - 1
+                        for x in range(xa, lo):  # grow the span left (gaps included) ...
                             stencil[z, y, x] = np.inf
+                        for x in range(hi + 1, xb + 1):  # ... and right
+                            stencil[z, y, x] = np.inf
+                        row_lo[z, y], row_hi[z, y] = min(lo, xa), max(hi, xb)
                     if mode == BINARY:  # a union: no relaxation needed, so no stencil
                         for x in range(xa, xb + 1):
                             if out[z, y, x] == 0:
                                 n_filled += 1
                                 out[z, y, x] = values[i]
+                        continue
+                    value = values[i]
+                    if metric == EUCLID:  # branch-free: a win is a coin toss, a select is not
+                        for x in range(xa, xb + 1):
+                            ddx = x - cx
+                            d = np.float32((ddx * ddx + dy2) + dz2)
+                            old = stencil[z, y, x]
+                            win = d < old
+                            n_filled += win & (old == np.inf)
+                            stencil[z, y, x] = min(d, old)
+                            was = out[z, y, x]
+                            out[z, y, x] = value if win else was
                         continue
                     for x in range(xa, xb + 1):
                         d = np.float32(_distance(metric, x - cx, dy, dz, dy2, dz2))
@@ -211,25 +231,24 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                             if old == np.inf:
                                 n_filled += 1
                             stencil[z, y, x] = d
-                            out[z, y, x] = values[i]
+                            out[z, y, x] = value
             filled[z] = n_filled
             visits[z] = n_visits
 
 
 @njit(cache=True, parallel=True)
-def sample_rows(owner, out, z0, z1, nthreads, row_ready, minv, source, weights, half):
+def sample_rows(owner, out, z0, z1, nthreads, row_lo, row_hi, minv, source, weights, half):
     """Sampled mode's second pass: ``out[z, y, x] = source(T_b^-1 q)`` where ``owner`` holds
-    the winning bone + 1 (0 = empty). ``owner`` and ``out`` may be the same array."""
-    ny, nx = owner.shape[1], owner.shape[2]
+    the winning bone + 1 (0 = empty) on each row's span ``row_lo..row_hi`` (:func:`fill_slices`).
+    ``owner`` and ``out`` may be the same array."""
+    ny = owner.shape[1]
     for t in prange(nthreads):
         for z in range(z0 + t, z1, nthreads):
             for y in range(ny):
-                if not row_ready[z, y]:
-                    continue
                 last = -1
                 rx = ry = rz = 0.0
                 sx = sy = sz = 0.0
-                for x in range(nx):
+                for x in range(row_lo[z, y], row_hi[z, y] + 1):
                     b = np.int64(owner[z, y, x]) - 1
                     if b < 0:
                         continue

@@ -28,14 +28,15 @@ def gaussian_weights(kernel: int) -> np.ndarray:
     return w / w.sum()
 
 
-def sample_source(owner, source, minv, kernel, row_ready, nthreads, chunk, report) -> np.ndarray:
+def sample_source(owner, source, minv, kernel, spans, nthreads, chunk, report) -> np.ndarray:
     """The sampled volume ``[z, y, x]`` (``[z, y, x, 3]`` for colour) from the owner map ``owner``
-    (bone + 1 per voxel, 0 empty). ``report(done)`` is called with slices done, 0..nz."""
+    (bone + 1 per voxel, 0 empty), read on each row's span ``spans = (row_lo, row_hi)``.
+    ``report(done)`` is called with slices done, 0..nz."""
     nz = owner.shape[0]
     if np.ndim(source) == 3:
         src = np.ascontiguousarray(np.asarray(source).T)  # [z, y, x]; free for an F-ordered source
         out = owner if src.dtype == owner.dtype else np.zeros(owner.shape, src.dtype)
-        return _sample(owner, out, src, minv, kernel, row_ready, nthreads, chunk, report)
+        return _sample(owner, out, src, minv, kernel, spans, nthreads, chunk, report)
     rgb = np.zeros((*owner.shape, 3), np.uint8)
     for c in range(3):
         def part(done, c=c):
@@ -44,21 +45,21 @@ def sample_source(owner, source, minv, kernel, row_ready, nthreads, chunk, repor
         channel = np.asarray(source[..., c]).T
         if kernel == 1:  # nearest voxel: the bytes themselves
             out = np.zeros(owner.shape, np.uint8)
-            rgb[..., c] = _sample(owner, out, np.ascontiguousarray(channel), minv, kernel, row_ready, nthreads,
+            rgb[..., c] = _sample(owner, out, np.ascontiguousarray(channel), minv, kernel, spans, nthreads,
                                   chunk, part)
         else:
             out = np.zeros(owner.shape, np.float32)
             linear = np.ascontiguousarray(_LINEAR[channel])
-            _sample(owner, out, linear, minv, kernel, row_ready, nthreads, chunk, part)
+            _sample(owner, out, linear, minv, kernel, spans, nthreads, chunk, part)
             rgb[..., c] = from_linear(out / LINEAR_SCALE)
     return rgb
 
 
-def _sample(owner, out, src, minv, kernel, row_ready, nthreads, chunk, report) -> np.ndarray:
+def _sample(owner, out, src, minv, kernel, spans, nthreads, chunk, report) -> np.ndarray:
     weights = gaussian_weights(kernel) if kernel > 1 else np.ones((1, 1, 1))
     nz = owner.shape[0]
     for z0 in range(0, nz, chunk):
         z1 = min(nz, z0 + chunk)
-        K.sample_rows(owner, out, z0, z1, nthreads, row_ready, minv, src, weights, kernel // 2)
+        K.sample_rows(owner, out, z0, z1, nthreads, *spans, minv, src, weights, kernel // 2)
         report(z1)
     return out

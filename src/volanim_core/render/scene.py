@@ -27,7 +27,14 @@ import numpy as np
 from volanim_core.io.volume_files import to_grey
 from volanim_core.render.camera import Camera
 from volanim_core.render.colours import SKIN, rgb
-from volanim_core.render.transfer import LABEL_MODES, apply_labels, apply_rgba, label_colours, rgba_points
+from volanim_core.render.transfer import (
+    LABEL_MODES,
+    add_volume_uncopied,
+    apply_labels,
+    apply_rgba,
+    label_colours,
+    rgba_points,
+)
 from volanim_core.render.transfer_function import TransferFunction
 
 STYLES = ("surface", "volume")
@@ -243,8 +250,8 @@ class Renderer:
         else:
             data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
             data = data.ravel(order="F")
-        # the whole shared grid, refilled frame after frame: a new volume actor costs ~1 s to set up
-        # (bench_render), so cropping each frame to its body would be 15-30x slower than drawing it
+        # the whole shared grid, refilled frame after frame: a new volume actor costs a VTK pipeline
+        # set-up per frame, so cropping each frame to its body would be slower than drawing it
         key = (volume.shape, tuple(float(v) for v in np.asarray(origin) * s.spacing), data.dtype.str)
         if self._grid is not None and self._grid_key == key:
             from vtkmodules.util.numpy_support import numpy_to_vtk
@@ -256,8 +263,8 @@ class Renderer:
             return
         grid = pv.ImageData(dimensions=volume.shape[:3], origin=key[1], spacing=s.spacing)
         grid.point_data["v"] = data
-        actor = self.plotter.add_volume(grid, scalars="v", name="body", reset_camera=False, show_scalar_bar=False,
-                                        mapper="fixed_point" if self._cpu_caster() else "smart", render=False)
+        actor = add_volume_uncopied(self.plotter, grid, "v", name="body", reset_camera=False, show_scalar_bar=False,
+                                    mapper="fixed_point" if self._cpu_caster() else "smart", render=False)
         self._grid, self._grid_key = actor.GetMapper().GetInput(), key
         prop = actor.GetProperty()
         if volume.ndim == 4:

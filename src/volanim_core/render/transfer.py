@@ -82,6 +82,25 @@ def apply_rgba(volume_actor, opacity: float = 0.9) -> None:
     prop.SetInterpolationTypeToLinear()
 
 
+def add_volume_uncopied(plotter, grid, scalars: str, **kwargs):
+    """``plotter.add_volume(grid, ...)`` without its copy of the grid.
+
+    pyvista's ``add_volume`` runs ``cell_data_to_point_data`` on any dataset it is
+    given -- a full copy through a VTK filter, 1.8 s for the frog's posed 45 M
+    voxels, longer than the reconstruction. The actor is made on a 2^3 corner of
+    the grid (same array name, dtype and components; give ``clim`` so the colour
+    range does not come from it) and then reads the grid itself.
+    """
+    import pyvista as pv
+
+    corner = pv.ImageData(dimensions=(2, 2, 2), origin=grid.origin, spacing=grid.spacing)
+    values = np.asarray(grid.point_data[scalars])
+    corner.point_data[scalars] = values[: 8]
+    actor = plotter.add_volume(corner, scalars=scalars, **kwargs)
+    actor.GetMapper().SetInputData(grid)
+    return actor
+
+
 def binary_view(volume: np.ndarray) -> np.ndarray:
     """A binary-mode volume as labels 0/1 (one colour for every filled voxel)."""
     return (volume > 0).astype(np.uint8)

@@ -14,6 +14,10 @@ Two engines, same contract:
 
 The one-voxel zero pad closes the surface where the object touches the
 volume's border, which is right because outside counts as background.
+
+:func:`display_hull` is the hull the studio draws: the same surface, made
+from the mask averaged over f^3 blocks when the full one has too many
+triangles for software OpenGL to draw translucent at interactive rates.
 """
 
 from __future__ import annotations
@@ -64,3 +68,34 @@ def isosurface(mask, *, step: int = 1, engine: str = "vtk") -> tuple[np.ndarray,
     from volanim_core.render.surfaces import flying_edges
 
     return flying_edges(box, origin=lo)
+
+
+#: Triangles the studio draws for the translucent hull: llvmpipe spends ~140 ms a frame on the
+#: frog's full 1.5 M and ~50 ms on 250 k (bench_studio.py); the hull is context, not data.
+DISPLAY_FACES = 250_000
+
+
+def display_hull(mask, max_faces: int = DISPLAY_FACES) -> tuple[np.ndarray, np.ndarray]:
+    """The hull to draw: :func:`isosurface`, or -- when that has more than ``max_faces``
+    triangles -- the 0.5 isosurface of the mask averaged over ``f^3`` blocks, with the
+    smallest ``f`` that fits (triangles fall as ``1/f^2``). Same voxel frame; the
+    surface stays where the object's boundary is, only coarser."""
+    verts, faces = isosurface(mask)
+    f = max(2, int(np.ceil(np.sqrt(len(faces) / max_faces))))
+    while len(faces) > max_faces:
+        verts, faces = _block_isosurface(mask, f)
+        f += 1
+    return verts, faces
+
+
+def _block_isosurface(mask, f: int) -> tuple[np.ndarray, np.ndarray]:
+    from volanim_core.render.surfaces import flying_edges
+
+    box, lo = _padded_box(mask)
+    # pad to whole blocks, with a block of background all round so the coarse surface is closed
+    pad = [(f, f + (-n) % f) for n in box.shape]
+    box = np.pad(box, pad)
+    nx, ny, nz = (n // f for n in box.shape)
+    mean = box.reshape(nx, f, ny, f, nz, f).mean(axis=(1, 3, 5), dtype=np.float32)
+    origin = lo - f + (f - 1) / 2.0  # block b's centre is voxel lo - f + b f + (f - 1) / 2
+    return flying_edges(mean, origin=origin, spacing=float(f))

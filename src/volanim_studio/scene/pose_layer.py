@@ -13,7 +13,14 @@ from matplotlib.colors import ListedColormap
 
 from volanim_core.render.colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
-from volanim_core.render.transfer import apply_labels, apply_rgba, binary_view, rgba_points, volume_style
+from volanim_core.render.transfer import (
+    add_volume_uncopied,
+    apply_labels,
+    apply_rgba,
+    binary_view,
+    rgba_points,
+    volume_style,
+)
 from volanim_core.rig.pose import apply_matrices
 
 STUMP_COLOUR = "#ff3030"
@@ -125,8 +132,8 @@ class PoseLayer:
                 plotter.remove_scalar_bar()
             style = volume_style(mode, volume, n_bones) if volume.ndim == 3 else {"show_scalar_bar": False}
             labels = style.pop("categories", None)
-            self.preview_actor = plotter.add_volume(img, scalars="values", name="preview", render=False,
-                                                    reset_camera=False, **style)
+            self.preview_actor = add_volume_uncopied(plotter, img, "values", name="preview", render=False,
+                                                     reset_camera=False, **style)
             if labels is not None:
                 apply_labels(self.preview_actor, labels)
             if volume.ndim == 4:

@@ -99,3 +99,31 @@ def test_local_motion_inverts_fk_and_scaled_preview(man):
     assert np.allclose(pose_matrices(s.bones, angles, shifts), m, atol=1e-9)
     p = np.array([100.0, 50.0, 200.0, 1.0])
     assert np.allclose(p @ scaled(m, 2.0), (p @ m) * [0.5, 0.5, 0.5, 1.0])
+
+
+def test_pieces_and_where_they_broke_off_match_a_brute_force_answer():
+    """Sizes largest first (ties in scan order); the main body's centroid; each other piece's voxel
+    nearest to the main body (ties: the first in x-fastest order) -- against scipy + all pairs."""
+    from scipy import ndimage
+
+    from volanim_core.reconstruct.breakage import _components
+
+    rng = np.random.default_rng(5)
+    vol = (ndimage.gaussian_filter(rng.random((30, 24, 20)), 1.5) > 0.56).astype(np.uint8) * 3
+    vol[3:25, 10:13, 8:11] = 7  # one clear main body
+    zyx = vol.T
+    labels, n = ndimage.label(zyx > 0, structure=np.ones((3, 3, 3), bool))
+    assert n > 3
+    sizes = np.bincount(labels.ravel())[1:]
+    order = np.argsort(-sizes, kind="stable")
+    main = order[0] + 1
+    body = np.argwhere(labels == main)
+    want = [(int(sizes[order[0]]), body.mean(0)[::-1])]
+    for k in order[1:] + 1:
+        piece = np.argwhere(labels == k)  # C order of [z, y, x]: x fastest
+        d2 = ((piece[:, None, :] - body[None, :, :]) ** 2).sum(-1).min(1)
+        want.append((int(sizes[k - 1]), piece[int(np.argmin(d2))][::-1].astype(float)))
+    got = _components(vol)
+    assert [s for s, _ in got] == [s for s, _ in want]
+    for (_, a), (_, b) in zip(got, want):
+        assert np.allclose(a, b)

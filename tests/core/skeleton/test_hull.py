@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from volanim_core.io.mesh_files import write_mesh
-from volanim_core.skeleton.hull import isosurface
+from volanim_core.skeleton.hull import display_hull, isosurface
 
 
 @pytest.fixture
@@ -42,3 +42,23 @@ def test_errors_and_writer(tmp_path, cube):
     assert (tmp_path / "c.obj").stat().st_size > 0
     with pytest.raises(ValueError, match=".ply"):
         write_mesh(tmp_path / "c.xyz", v, f)
+
+
+def test_display_hull_is_the_hull_until_it_is_too_large():
+    """The studio draws a coarser surface in the same place once the full one has too many triangles."""
+    import pyvista as pv
+
+    g = np.indices((60, 50, 40)) - np.array([30, 25, 20])[:, None, None, None]
+    ball = (g**2).sum(0) < 17.3**2
+    ball[:, :, :3] = True  # touches the border: still closed
+    full = isosurface(ball)
+    same = display_hull(ball, max_faces=len(full[1]))
+    assert np.array_equal(same[0], full[0]) and np.array_equal(same[1], full[1])
+    v, f = display_hull(ball, max_faces=len(full[1]) // 5)
+    assert 0 < len(f) <= len(full[1]) // 5
+    mesh = pv.PolyData(v, np.hstack([np.full((len(f), 1), 3), f]).ravel())
+    assert mesh.is_manifold
+    r = np.linalg.norm(v - [30, 25, 20], axis=1)
+    inner = v[:, 2] > 6  # the ball's part away from the slab
+    assert np.abs(r[inner] - 17.3).max() < 1.5  # same place, within the block size
+    assert np.allclose(v.min(0), full[0].min(0), atol=1.5) and np.allclose(v.max(0), full[0].max(0), atol=1.5)
