@@ -35,9 +35,9 @@ from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
 from volanim_core.reconstruct.neighbours import (
     CUT_MIN_RADIUS,
+    cached_neighbours,
     check_neighbours,
     reorder_neighbours,
-    sphere_neighbours,
 )
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.sampling import sample_source
@@ -275,7 +275,7 @@ def reconstruct(
     threads : int, optional
         numba threads (default: all cores). The result does not depend on it.
     neighbours : (N, k) int ndarray, optional
-        :func:`sphere_neighbours` of this connectivity (computed when not
+        :func:`sphere_neighbours` of this connectivity (made once per connectivity and remembered when not
         given); lets each sphere skip voxels a larger neighbour provably wins.
         The result does not depend on it; ``neighbours=False`` turns the cut off.
     out : ndarray, optional
@@ -329,7 +329,7 @@ def reconstruct(
     row_lo = np.full((nz, ny) if relax else (1, 1), nx, np.int32)  # each row's span of valid stencil
     row_hi = np.full(row_lo.shape, -1, np.int32)
     if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
-        nbrs = sphere_neighbours(tskel, min_radius=CUT_MIN_RADIUS) if neighbours is None \
+        nbrs = cached_neighbours(tskel, min_radius=CUT_MIN_RADIUS) if neighbours is None \
             else reorder_neighbours(neighbours, order)
         plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:

@@ -10,6 +10,10 @@ pass them to every frame.
 
 from __future__ import annotations
 
+import hashlib
+import threading
+from collections import OrderedDict
+
 import numpy as np
 
 from volanim_core.reconstruct.radii import radius_squared
@@ -44,7 +48,7 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
         if len(idx) < 2:
             continue
         q = min(len(idx), 4 * k + 1)
-        _, nn = cKDTree(tskel.points[idx]).query(tskel.points[idx], k=q)
+        _, nn = cKDTree(tskel.points[idx]).query(tskel.points[idx], k=q, workers=-1)
         nn = idx[nn]  # global indices, nearest first (self included)
         ok = (r2[nn] >= r2[idx][:, None]) & (nn != idx[:, None])
         rank = np.cumsum(ok, axis=1) - 1
@@ -53,6 +57,38 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
         out[idx[rows], rank[rows, cols]] = nn[rows, cols]
     return out
 
+
+_CACHE: OrderedDict[bytes, np.ndarray] = OrderedDict()
+_CACHE_LOCK = threading.Lock()
+CACHED_CONNECTIVITIES = 4
+
+
+def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: float = CUT_MIN_RADIUS) -> np.ndarray:
+    """:func:`sphere_neighbours`, remembered for the last few connectivities (read-only result).
+
+    A caller who reconstructs frame after frame without passing lists gets them made
+    once: the key is a hash of exactly what they depend on -- the spheres of at least
+    ``min_radius`` (their indices, centres, radii and bones) and the point count -- a
+    few thousand values on the frog, so looking up costs ~1 ms against ~25 ms to make them.
+    """
+    r2 = radius_squared(tskel.dt)
+    big = np.flatnonzero(r2 >= radius_squared(np.array([float(min_radius)]))[0])
+    h = hashlib.blake2b(digest_size=16)
+    for part in (np.array([len(tskel), k], np.int64), big, np.ascontiguousarray(tskel.points[big], np.float64),
+                 r2[big], np.asarray(tskel.bone)[big].astype(np.int64)):
+        h.update(np.ascontiguousarray(part).tobytes())
+    key = h.digest()
+    with _CACHE_LOCK:
+        if key in _CACHE:
+            _CACHE.move_to_end(key)
+            return _CACHE[key]
+    lists = sphere_neighbours(tskel, k, min_radius)
+    lists.setflags(write=False)
+    with _CACHE_LOCK:
+        _CACHE[key] = lists
+        while len(_CACHE) > CACHED_CONNECTIVITIES:
+            _CACHE.popitem(last=False)
+    return lists
 
 
 def check_neighbours(neighbours, n: int) -> None:

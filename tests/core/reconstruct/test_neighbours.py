@@ -23,3 +23,22 @@ def test_only_spheres_the_kernel_clips_get_lists_and_those_lists_are_larger_same
     assert (t.bone[j] == t.bone[i]).all() and (r2[j] >= r2[i]).all() and (j != i).all()
     every = sphere_neighbours(t, min_radius=0.0)  # every sphere, as the lists used to be made
     assert (every[small] >= 0).any()
+
+
+def test_lists_are_made_once_per_connectivity_and_remade_when_what_they_depend_on_changes(rng):
+    from volanim_core.reconstruct.neighbours import cached_neighbours
+
+    t = random_tskel(rng, n=600, size=60, nbones=3)
+    t.dt[:] = rng.uniform(1.0, 12.0, len(t.dt))
+    first = cached_neighbours(t)
+    assert np.array_equal(first, sphere_neighbours(t)) and not first.flags.writeable
+    assert cached_neighbours(t) is first  # a second frame of the same connectivity: no work
+    big = np.flatnonzero(radius_squared(t.dt) >= CUT_MIN_RADIUS**2)
+    t.dt[big[0]] += 0.5  # a clipped sphere's radius changed: new lists
+    second = cached_neighbours(t)
+    assert second is not first and np.array_equal(second, sphere_neighbours(t))
+    small = np.flatnonzero(radius_squared(t.dt) < CUT_MIN_RADIUS**2)
+    t.dt[small[0]] *= 0.9  # a sphere the kernel never clips: the same lists hold
+    assert cached_neighbours(t) is second
+    t.bone[big[1]] = (t.bone[big[1]] + 1) % 3  # re-attached to another bone: new lists
+    assert np.array_equal(cached_neighbours(t), sphere_neighbours(t))
