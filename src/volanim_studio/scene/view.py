@@ -28,7 +28,7 @@ from .overlays import CubeOverlay, LassoOverlay
 from .pose_layer import PoseLayer, bone_lines
 from .projection import CLICK_SLOP, nearest_in_radius, project, segment_distance_2d
 
-LOD_POINTS = 50_000  # drawn while the thinness slider is dragged (software GL renders ~5x fewer per second)
+LOD_POINTS = 30_000  # drawn while the thinness slider is held: with the hull, a frame in ~50 ms of software GL
 PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
 
 
