@@ -30,6 +30,24 @@ def test_thinness_slider_shows_the_prefix(window):
     assert f"{window.scene.shown_points} of {len(skel)} points shown" == panel.count_label.text()
 
 
+def test_a_change_draws_one_frame_and_an_idle_window_draws_none(qtbot, window):
+    """Software GL spends 0.1-0.6 s on a frame: the studio drew each slider step three times
+    (pyvistaqt's 5 Hz timer, plotter.render(), then the widget's paint) and redrew while idle."""
+    renders = []
+    window.plotter.ren_win.AddObserver("StartEvent", lambda *_: renders.append(1))
+    qtbot.wait(300)  # anything pending from loading is drawn
+    renders.clear()
+    qtbot.wait(700)  # idle: the old timer drew ~3 frames here
+    assert renders == []
+    panel = window.display_panel
+    for step in (300, 500, 700):
+        panel.thinness_slider.setValue(step)
+        qtbot.waitUntil(lambda: len(renders) >= 1, timeout=5000)
+        qtbot.wait(250)
+        assert len(renders) == 1, f"{len(renders)} renders for one slider step"
+        renders.clear()
+
+
 def test_two_clicks_make_a_bone_between_exactly_those_points(qtbot, window):
     qtbot.keyClick(window, Qt.Key_B)
     assert window.mode == Mode.BONES
