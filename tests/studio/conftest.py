@@ -50,6 +50,23 @@ def clickable_point(window, near_voxel) -> int:
 JOB_TIMEOUT_MS = 600_000
 
 
+@pytest.fixture(autouse=True)
+def widgets_deleted_in_their_own_test():
+    """Destroy the test's closed widgets before the next test starts.
+
+    pytest-qt closes a test's widgets with ``deleteLater``, which Qt runs at the next
+    event loop: the next test's window start-up (``waitUntil`` in ``window``). Two CI
+    runs crashed exactly there, with the old window's GL widget and render window being
+    torn down while the new one made its first frames. Deleting them here -- after
+    pytest-qt closed them, still inside this test's teardown -- keeps the two apart.
+    """
+    yield
+    from PySide6.QtCore import QCoreApplication, QEvent
+
+    if QCoreApplication.instance() is not None:
+        QCoreApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def compiled_kernels():
     """Compile every numba kernel before any GUI test waits on one.
