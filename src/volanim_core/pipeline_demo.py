@@ -33,7 +33,6 @@ from volanim_core.io import (
 from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import reconstruct
-from volanim_core.reconstruct.neighbours import sphere_neighbours
 from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
@@ -116,12 +115,11 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     write_trans(folder / "arm.trans", trans)
     posed = connect_to_tskel(conn, trans)
     write_tskel(folder / "arm.tskel", posed)
-    nbrs = sphere_neighbours(posed)
-    r = reconstruct(posed, mode="sampled", source=s.volume, neighbours=nbrs, progress=TextProgress("    reconstruct"))
+    r = reconstruct(posed, mode="sampled", source=s.volume, progress=TextProgress("    reconstruct"))
     out["posed"] = folder / "arm-sampled.vti"
     write_volume(out["posed"], r.volume, origin=r.origin)
     hot = reconstruct(posed, mode="hotspot")
-    boned = reconstruct(posed, mode="bone", neighbours=nbrs)
+    boned = reconstruct(posed, mode="bone")
     write_volume(folder / "arm-bone.vti", boned.volume, origin=boned.origin)
     _say(f"[5] {bone} turned {angles} deg: sampled reconstruction {r.stats['filled']} voxels in "
          f"{r.stats['seconds']:.3f} s (overdraw {r.stats['overdraw']:.1f}), hotspot max {hot.stats['hotspot_max']}, "
@@ -150,11 +148,9 @@ def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
     _say(f"[6] {clip.name}: {motion.frames} frames at {motion.fps:.4g} fps retargeted onto {len(r.mapping)} bones "
          f"(up {r.up}, facing {r.forward}) in {time.perf_counter() - t:.2f} s; {len(numbers)} frames -> "
          f"{folder.name}/walk.NNNN.trans, .tskel")
-    nbrs = None
     for n, m in zip(numbers, mats):
         tskel = connect_to_tskel(conn, Trans(root_bones(s.bones), m))
-        nbrs = sphere_neighbours(tskel) if nbrs is None else nbrs  # pose-independent: once
-        rec = reconstruct(tskel, mode="sampled", source=s.volume, neighbours=nbrs)
+        rec = reconstruct(tskel, mode="sampled", source=s.volume)  # neighbour lists made once, then remembered
         path = frame_path(folder, "walk", n, "-sampled.vti")
         write_volume(path, rec.volume, origin=rec.origin)
         _say(f"    frame {n:4d}: {rec.stats['filled']} voxels, origin {rec.origin}, {rec.stats['seconds']:.3f} s "

@@ -1,11 +1,13 @@
 """Same-bone neighbour lists: which larger spheres may clip each sphere (the overdraw cut).
 
     connectivity --sphere_neighbours (cKDTree per bone)--> (N, k) indices, -1 padded
-    reconstruct() --reorder_neighbours--> the same lists after it grouped points by bone
+    reconstruct() --cached_neighbours--> the lists of the last few connectivities, remembered
+                  --reorder_neighbours--> lists a caller passed, after it grouped points by bone
 
 Same-bone neighbours keep their distances under any pose (a bone moves
-rigidly), so the lists depend only on the connectivity: compute them once and
-pass them to every frame.
+rigidly), so the lists depend only on the connectivity. ``reconstruct()``
+remembers them (:func:`cached_neighbours`): callers pass nothing, and every
+frame of a clip, every studio preview and the rest frame share one set.
 """
 
 from __future__ import annotations
@@ -29,8 +31,7 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
 
     ``(N, k)`` int32, -1 where there are fewer. Same-bone neighbours keep their
     distances under any pose (a bone moves rigidly), so this depends only on
-    the connectivity: compute it once and pass it to :func:`reconstruct` for
-    every frame (the studio does).
+    the connectivity: :func:`reconstruct` remembers it (:func:`cached_neighbours`).
 
     Only spheres of at least ``min_radius`` get lists: the kernel clips no smaller
     sphere (its rows are too short to gain), and their larger neighbours are large
@@ -41,10 +42,9 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
 
     n = len(tskel)
     out = np.full((n, k), -1, np.int32)
-    r2 = radius_squared(tskel.dt)
-    big = r2 >= radius_squared(np.array([float(min_radius)]))[0]
+    r2, big = _clipped(tskel, min_radius)
     for b in np.unique(tskel.bone[big]):
-        idx = np.flatnonzero((tskel.bone == b) & big)
+        idx = big[tskel.bone[big] == b]
         if len(idx) < 2:
             continue
         q = min(len(idx), 4 * k + 1)
@@ -56,6 +56,12 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
         rows, cols = np.nonzero(keep)
         out[idx[rows], rank[rows, cols]] = nn[rows, cols]
     return out
+
+
+def _clipped(tskel: Connectivity, min_radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Every sphere's squared radius, and the indices of those the kernel clips (radius >= ``min_radius``)."""
+    r2 = radius_squared(tskel.dt)
+    return r2, np.flatnonzero(r2 >= radius_squared(np.array([float(min_radius)]))[0])
 
 
 _CACHE: OrderedDict[bytes, np.ndarray] = OrderedDict()
@@ -70,9 +76,10 @@ def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     once: the key is a hash of exactly what they depend on -- the spheres of at least
     ``min_radius`` (their indices, centres, radii and bones) and the point count -- a
     few thousand values on the frog, so looking up costs ~1 ms against ~25 ms to make them.
+    A pose is not part of it (same-bone distances survive any pose), so every frame of a
+    clip, the studio's live and full previews and the rest frame share one set.
     """
-    r2 = radius_squared(tskel.dt)
-    big = np.flatnonzero(r2 >= radius_squared(np.array([float(min_radius)]))[0])
+    r2, big = _clipped(tskel, min_radius)
     h = hashlib.blake2b(digest_size=16)
     for part in (np.array([len(tskel), k], np.int64), big, np.ascontiguousarray(tskel.points[big], np.float64),
                  r2[big], np.asarray(tskel.bone)[big].astype(np.int64)):

@@ -48,7 +48,6 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     """One :class:`FrameVerdict` per frame of ``matrices`` (``(F, B, 4, 4)``); ``frames`` numbers them."""
     from scipy.spatial import cKDTree
 
-    from volanim_core.reconstruct.neighbours import sphere_neighbours
 
     frames = list(range(len(matrices))) if frames is None else [int(f) for f in frames]
     report = Reporter(progress, cancel)
@@ -57,7 +56,6 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     misplaced = misplaced_points(rest)
     names = list(joints or {})
     near = cKDTree(np.array([joints[n] for n in names], np.float64)) if names else None
-    nbrs = sphere_neighbours(coarse_tskel(rest, factor))  # pose-independent: once for the clip
     out = []
     for n, (frame, mats) in enumerate(zip(frames, matrices)):
         report(n, len(frames))
@@ -67,7 +65,7 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
         if len(gaps) and near is not None:
             _, k = near.query(where)
             worst = names[int(np.bincount(k, weights=gaps, minlength=len(names)).argmax())]
-        sizes = components(reconstruct(coarse_tskel(posed, factor), mode="bone", neighbours=nbrs, padding=1).volume)
+        sizes = components(reconstruct(coarse_tskel(posed, factor), mode="bone", padding=1).volume)
         behind = stumps(posed, joints or {}, misplaced)
         out.append(FrameVerdict(frame, len(sizes), int(sum(sizes[1:])) * factor ** 3, len(gaps),
                                 float(gaps.sum()), worst or (behind[0].joint if behind else ""),

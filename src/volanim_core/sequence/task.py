@@ -39,25 +39,12 @@ class Payload:
 
 
 _INSTALLED: Payload | None = None
-_NEIGHBOURS: dict = {}  # (id(payload), dt_scale) -> sphere_neighbours
 
 
 def install(payload: Payload) -> None:
     """A local pool worker's initializer: keep the payload for every task it runs."""
     global _INSTALLED
     _INSTALLED = payload
-    _NEIGHBOURS.clear()
-
-
-def _neighbours(p: Payload, spec: FrameSpec, tskel):
-    from volanim_core.reconstruct.neighbours import sphere_neighbours
-
-    key = (id(p), np.asarray(spec.dt_scale, np.float64).tobytes())
-    if key not in _NEIGHBOURS:
-        if len(_NEIGHBOURS) > 4:  # a melt has new radii every frame: keep only the recent ones
-            _NEIGHBOURS.clear()
-        _NEIGHBOURS[key] = sphere_neighbours(tskel)
-    return _NEIGHBOURS[key]
 
 
 def occupied(zyx: np.ndarray, edge: int = 64) -> tuple[slice, slice, slice]:
@@ -101,7 +88,7 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
     t0 = time.perf_counter()
     tskel = spec.tskel(p.conn)
     r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
-                    bounds=p.bounds, neighbours=_neighbours(p, spec, tskel), threads=p.threads)
+                    bounds=p.bounds, threads=p.threads)  # neighbour lists: remembered per connectivity
     volume = r.volume
     if spec.crumble:
         from .effects import fall

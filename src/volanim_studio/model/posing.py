@@ -24,22 +24,20 @@ class PoseState:
         self.doc = doc
         self.angles: dict[tuple[str, str], np.ndarray] = {}
         self.shifts: dict[tuple[str, str], np.ndarray] = {}
-        self._neighbours = None  # (thinness, neighbour lists) of the current attachments
         self._rest_parts = None  # (key, preview.RestParts) of the current attachments
         self.rest_version = 0  # counts attachment changes: a report made before one must not be kept
-        doc.events.attachments.connect(self._forget_neighbours)
+        doc.events.attachments.connect(self._forget_rest_parts)
 
-    def _forget_neighbours(self, **_) -> None:
-        self._neighbours = None
+    def _forget_rest_parts(self, **_) -> None:
         self._rest_parts = None
         self.rest_version += 1
 
-    def _statics_key(self, tskel: Tskel) -> tuple:
+    def _rest_key(self, tskel: Tskel) -> tuple:
         return (self.doc.thinness, len(tskel))
 
     def rest_parts(self, tskel: Tskel):
         """The kept :class:`~volanim_studio.model.preview.RestParts` of this frame's attachments, or None."""
-        if self._rest_parts is not None and self._rest_parts[0] == self._statics_key(tskel):
+        if self._rest_parts is not None and self._rest_parts[0] == self._rest_key(tskel):
             return self._rest_parts[1]
         return None
 
@@ -47,22 +45,7 @@ class PoseState:
         """Keep a finished report's rest parts, unless the attachments changed since it was asked for
         (``version`` is :attr:`rest_version` then): a worker's result may arrive after an edit."""
         if parts is not None and version == self.rest_version:
-            self._rest_parts = (self._statics_key(tskel), parts)
-
-    def neighbours(self, tskel: Tskel, *, compute: bool = True) -> np.ndarray | None:
-        """``sphere_neighbours`` of :meth:`tskel`'s frame, cached: it depends on the attachments
-        and the slider, not on the pose, so live previews must not recompute it (0.7 s on the frog).
-
-        With ``compute=False`` a missing cache gives None (the caller computes it off the GUI thread).
-        """
-        from volanim_core.reconstruct.neighbours import sphere_neighbours
-
-        key = self._statics_key(tskel)
-        if self._neighbours is None or self._neighbours[0] != key:
-            if not compute:
-                return None
-            self._neighbours = (key, sphere_neighbours(tskel))
-        return self._neighbours[1]
+            self._rest_parts = (self._rest_key(tskel), parts)
 
     def _key(self, bone: int) -> tuple[str, str]:
         b = self.doc.bones.bones[bone]

@@ -46,28 +46,24 @@ class Preview:
 
 
 def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,
-                 factor: int = 1, joints=None, posed_joints=None, report: bool = False, neighbours=None,
+                 factor: int = 1, joints=None, posed_joints=None, report: bool = False,
                  rest_parts: RestParts | None = None, progress=None, cancel=None) -> Preview:
     """Reconstruct the frame (and, when asked, the breakage report at full resolution).
 
-    ``neighbours``: the frame's ``sphere_neighbours`` if the caller has them (computed when None).
     ``rest_parts``: a previous report's :class:`RestParts` of the same attachments (made when None;
     the result carries them either way).
     """
     if not len(tskel):
         raise ValueError("no attached points to reconstruct: connect points to bones first")
-    from volanim_core.reconstruct.neighbours import sphere_neighbours
-
-    nbrs = sphere_neighbours(tskel) if neighbours is None else neighbours  # pose-independent: shared below
-    r = reconstruct(coarse_tskel(tskel, factor), mode=mode, source=source, kernel=kernel, neighbours=nbrs,
+    # neighbour lists: reconstruct() remembers them per connectivity (pose-independent)
+    r = reconstruct(coarse_tskel(tskel, factor), mode=mode, source=source, kernel=kernel,
                     padding=max(1, padding // factor), progress=progress, cancel=cancel)
     out = Preview(r, factor, mode)
     if report:  # three more reconstructions: each checks ``cancel`` between its chunks
-        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", neighbours=nbrs,
-                                                                              cancel=cancel)
+        posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", cancel=cancel)
         if rest_parts is None:
-            rest_parts = RestParts(reconstruct(identity_tskel(tskel.connectivity), mode="bone", neighbours=nbrs,
-                                               cancel=cancel), touching_pairs(tskel))
+            rest_parts = RestParts(reconstruct(identity_tskel(tskel.connectivity), mode="bone", cancel=cancel),
+                                   touching_pairs(tskel))
         out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone,
                                      rest_bone=rest_parts.rest_bone, pairs=rest_parts.pairs, cancel=cancel)
         out.rest_parts = rest_parts

@@ -108,7 +108,7 @@ class PreviewController(Controller):
         mode = mode if mode in ("binary", "bone") else "bone"
         try:
             tskel = self.doc.pose.tskel()
-            p = make_preview(tskel, mode=mode, factor=2, padding=2, neighbours=self.doc.pose.neighbours(tskel))
+            p = make_preview(tskel, mode=mode, factor=2, padding=2)
         except ValueError as exc:
             self.doc.message(str(exc))
             return
@@ -135,7 +135,6 @@ class PreviewController(Controller):
         joints = dict(self.doc.bones.joints)
         posed = self.doc.pose.posed_joints()
         source = self.doc.volume if settings["mode"] == "sampled" else None
-        nbrs = self.doc.pose.neighbours(tskel, compute=False)  # None: the worker computes them
         rest, version = self.doc.pose.rest_parts(tskel), self.doc.pose.rest_version  # None: the worker makes them
 
         def done(p) -> None:
@@ -143,7 +142,7 @@ class PreviewController(Controller):
             self.doc.set_preview(p)
 
         worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
-            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report, neighbours=nbrs,
+            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report,
             rest_parts=rest, progress=progress, cancel=cancel), done)
         worker.is_preview = True
         return worker

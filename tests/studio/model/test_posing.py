@@ -76,16 +76,22 @@ def test_preview_equals_the_core_and_reduced_preview_is_coarser(doc):
 
 
 def test_neighbour_lists_are_cached_until_the_frame_changes(doc):
-    t = doc.pose.tskel()
-    first = doc.pose.neighbours(t)
+    """The studio keeps no lists of its own: reconstruct() remembers them per connectivity."""
+    from volanim_core.reconstruct.engine import file_ordered
+    from volanim_core.reconstruct.neighbours import CUT_MIN_RADIUS, cached_neighbours
+
+    def lists():
+        return cached_neighbours(file_ordered(doc.pose.tskel())[0])
+
+    first = lists()
     doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -30, 0), merge=False)
-    assert doc.pose.neighbours(doc.pose.tskel()) is first  # a pose change keeps them
-    doc.attachments.assign([0], doc.bones.index("HEAD"))
-    assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None  # an edit drops them
-    t = doc.pose.tskel()
-    assert doc.pose.neighbours(t) is not first
+    assert lists() is first  # a pose change keeps them
+    clipped = int(np.flatnonzero(doc.pose.tskel().dt >= CUT_MIN_RADIUS)[0])
+    doc.attachments.assign([clipped], doc.bones.index("HEAD"))  # an edit of a point they hold drops them
+    second = lists()
+    assert second is not first
     doc.thinness = 0.8
-    assert doc.pose.neighbours(doc.pose.tskel(), compute=False) is None
+    assert lists() is not second
 
 
 def test_a_report_made_with_kept_rest_parts_equals_a_fresh_one_and_edits_drop_them(doc):
