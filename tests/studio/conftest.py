@@ -50,6 +50,20 @@ def clickable_point(window, near_voxel) -> int:
 JOB_TIMEOUT_MS = 600_000
 
 
+def open_project(qtbot, window, path) -> bool:
+    """Open a project and wait until it is applied (``on_opened``), and its job's thread has ended.
+
+    Waiting for ``not window.busy`` alone raced: the job's thread ends before its queued
+    "succeeded" handler -- the one that applies the project's files -- has run on the GUI
+    thread, so a busy machine saw a document without its attachments (CI, once).
+    """
+    opened = []
+    window.files.open_project(path, on_opened=opened.append)
+    qtbot.waitUntil(lambda: bool(opened), timeout=JOB_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    return opened[0]
+
+
 @pytest.fixture(autouse=True)
 def widgets_deleted_in_their_own_test():
     """Destroy the test's closed widgets before the next test starts.

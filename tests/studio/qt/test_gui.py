@@ -15,7 +15,7 @@ from paths import ASSETS
 from volanim_core import io, samples
 from volanim_studio.model.modes import Mode
 
-from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view
+from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view, open_project
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
@@ -147,8 +147,7 @@ def test_rename_in_panel_and_save_reopen_identical(qtbot, window, tmp_path):
 
     other = MainWindow()
     qtbot.addWidget(other)
-    other.files.open_project(path)
-    qtbot.waitUntil(lambda: not other.busy, timeout=JOB_TIMEOUT_MS)
+    assert open_project(qtbot, other, path)
     assert other.doc.bones == doc.bones and len(other.doc.skeleton) == len(doc.skeleton)
     other.close()
 
@@ -272,8 +271,7 @@ def save_close_reopen(qtbot, window, path):
     window.close()
     again = MainWindow()
     qtbot.addWidget(again)
-    again.files.open_project(saved)
-    qtbot.waitUntil(lambda: not again.busy, timeout=JOB_TIMEOUT_MS)
+    assert open_project(qtbot, again, saved)
     return again
 
 

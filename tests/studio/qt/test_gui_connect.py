@@ -19,7 +19,7 @@ from volanim_core.skeleton.points import Skeleton
 from volanim_studio.model.modes import Mode
 from volanim_studio.model.project import read_project
 
-from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view
+from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view, open_project
 
 pytestmark = pytest.mark.gui
 
@@ -132,8 +132,7 @@ def test_save_connect_quit_reopen_and_continue(qtbot, window, tmp_path):
 
     other = MainWindow()
     qtbot.addWidget(other)
-    other.files.open_project(path)
-    qtbot.waitUntil(lambda: not other.busy, timeout=JOB_TIMEOUT_MS)
+    assert open_project(qtbot, other, path)
     assert np.array_equal(other.doc.attachments.bone, before)
     other.close()
 

@@ -13,7 +13,7 @@ from volanim_studio.model import autosave
 from volanim_studio.model.modes import Mode
 from volanim_studio.model.project import read_project
 
-from ..conftest import JOB_TIMEOUT_MS
+from ..conftest import JOB_TIMEOUT_MS, open_project
 
 pytestmark = pytest.mark.gui
 
@@ -94,8 +94,7 @@ def test_a_new_volume_is_a_new_document_and_the_old_project_is_untouched(qtbot, 
     assert {p: p.read_bytes() for p in before} == before  # man.volanim and its files untouched
     assert window.windowTitle() == "volanim studio — box.volanim[*]"
     assert read_project(box).get("bones") is None  # (a project without bones was saved with an empty,
-    window.files.open_project(box)  # unreadable .bones file and could not be reopened)
-    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    assert open_project(qtbot, window, box)  # unreadable .bones file and could not be reopened)
     assert window.last_error is None and len(window.doc.bones) == 0 and window.doc.skeleton is not None
 
 
