@@ -1,14 +1,19 @@
 """numba kernels of the reconstruction (ReconstructEuclid, done properly).
 
-Layout: output, stencil and source are C-ordered ``[z, y, x]`` arrays (the
-transposes of our ``[x, y, z]`` volumes), so an x-run is contiguous memory.
+Layout: output and source are C-ordered ``[z, y, x]`` arrays (the transposes
+of our ``[x, y, z]`` volumes), so an x-run is contiguous memory. The stencil
+(each voxel's best distance so far) is one ``[y, x]`` slice per thread, not a
+grid: one thread fills a slice from its first sphere to its last, so the
+stencil only has to live for that slice -- it stays in cache, and the grid
+costs no memory beyond the output.
 
     slice_lists  bucket spheres by the output z-slices they overlap, keeping
                  file order inside each slice (that order is the tie-break)
     fill_slices  for each slice (threads take slices round-robin), for each of
                  its spheres, for each row y: the exact x-run of the circle;
                  per voxel: distance vs stencil, and on a win write the mode's
-                 value (sampled mode: the bone, as in bone mode)
+                 value (sampled mode: the bone, as in bone mode); the voxel
+                 loop is branch-free over a row slice, which LLVM vectorises
     sample_rows  sampled mode's second pass: each filled voxel once, the source
                  position stepped along the row (p = p_row + x * step) with the
                  winning bone's inverse -- no matrix product per voxel, and no
@@ -27,7 +32,11 @@ closer to ``c_j`` than to ``c_i``, then ``j`` covers ``q`` (|q - c_j| <
 side of the bisector plane of each such neighbour -- a half-space that clips
 each x-run in O(1). A margin (2^-20 r_i^2 + 1e-6 in squared distance) keeps
 the cut clear of float32 ties, so every voxel's owner is provably the same as
-without the cut; the oracle tests check it.
+without the cut; the oracle tests check it. Planes are written in the sphere's
+own frame (small numbers: rounding far below the margin wherever the grid
+lies) and chosen per slice: one that misses the slice's disc costs nothing
+per row, one that covers it skips the slice. Skipping a cut is always exact
+(more visits, same owners); only cutting needs the margin.
 """
 
 from __future__ import annotations
@@ -37,6 +46,7 @@ from numba import njit, prange
 
 BINARY, MOTTLED, BONE, SAMPLED, HOTSPOT = 0, 1, 2, 3, 4
 EUCLID, CHAMFER = 0, 1
+
 
 
 @njit(cache=True)
@@ -105,29 +115,43 @@ def _sample(source, px, py, pz, weights, half):
 
 
 @njit(cache=True, parallel=True)
-def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric, mode,
-                plane_start, planes, row_lo, row_hi, filled, visits):
+def fill_slices(out, scratch, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric, mode,
+                plane_start, planes, max_planes, row_lo, row_hi, filled, visits):
     """Fill output slices ``z0 <= z < z1``; see the module docstring.
 
     ``centres`` are posed centres in output-grid coordinates.
-    ``stencil`` may be uninitialised: row ``(z, y)`` is valid (inf where no sphere
-    reached) on ``row_lo[z, y] <= x <= row_hi[z, y]``, the span of the runs that
-    touched it, grown (and set to inf) run by run; ``row_lo > row_hi`` = untouched.
-    Only those spans are written -- the rest of the grid is never touched --
-    and the sampling pass reads only them.
+    ``scratch[t]`` is thread t's stencil slice ``[y, x]`` (float32, uninitialised:
+    nothing is reset between slices). While slice z is filled, its row y is valid
+    (inf where no sphere reached) on ``row_lo[z, y] <= x <= row_hi[z, y]``, the
+    span of the runs that touched it, grown (and set to inf) run by run;
+    ``row_lo > row_hi`` = untouched (the callers' initial state). Only those spans
+    of the output are written, and the sampling pass reads only them.
+    ``planes[plane_start[i]:plane_start[i + 1]]`` are sphere i's half-spaces
+    (:func:`build_halfspaces`), at most ``max_planes`` per sphere.
     ``filled[z]`` and ``visits[z]`` receive per-slice counts.
     """
     ny, nx = out.shape[1], out.shape[2]
+    relax = mode != BINARY and mode != HOTSPOT
     for t in prange(nthreads):
+        stencil = scratch[t]
+        # the planes that cut this sphere's disc in this slice: x <= cx + (ay dy + e) / -ax
+        # (right ends), x >= ... (left ends), or the whole row when ax = 0
+        cut_ay = np.empty(max_planes)
+        cut_e = np.empty(max_planes)
+        cut_inv = np.empty(max_planes)
+        cut_side = np.empty(max_planes, np.int8)
         for z in range(z0 + t, z1, nthreads):
             n_filled = 0
             n_visits = 0
+            lo_z = row_lo[z]
+            hi_z = row_hi[z]
             for k in range(offsets[z], offsets[z + 1]):
                 i = ids[k]
                 cx, cy, cz = centres[i, 0], centres[i, 1], centres[i, 2]
                 r2, r = r2s[i], radii[i]
                 dz = z - cz
                 dz2 = dz * dz
+                n_cut = 0
                 if metric == EUCLID:
                     # Rows (and slices) that cannot hold a voxel are skipped by a test the
                     # oracle's sum can never beat: fl(fl(dx^2 + dy^2) + dz^2) >= fl(dy^2 + dz^2).
@@ -136,6 +160,23 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                     yhalf = np.sqrt(r2 - dz2)
                     ya = max(int(np.floor(cy - yhalf)), 0)
                     yb = min(int(np.ceil(cy + yhalf)), ny - 1)
+                    # Voronoi half-spaces against larger neighbours, in the sphere's own frame
+                    # u = q - c: a.u + w <= 0 keeps q. A plane that keeps this slice's whole disc
+                    # (radius yhalf) is dropped here; one that cuts it all drops the slice.
+                    for h in range(plane_start[i], plane_start[i + 1]):
+                        e = planes[h, 2] * dz + planes[h, 3]  # the plane's value at the disc's centre
+                        reach = planes[h, 4] * yhalf
+                        if e + reach <= 0.0:
+                            continue
+                        if e - reach > 0.0:
+                            ya = yb + 1
+                            break
+                        ax = planes[h, 0]
+                        cut_ay[n_cut] = planes[h, 1]
+                        cut_e[n_cut] = e
+                        cut_inv[n_cut] = -1.0 / ax if ax != 0.0 else 0.0
+                        cut_side[n_cut] = 1 if ax > 0.0 else (-1 if ax < 0.0 else 0)
+                        n_cut += 1
                 else:
                     yhalf = r / 3.0
                     ya = max(int(np.floor(cy - yhalf)) - 1, 0)
@@ -169,24 +210,16 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                         xa = 0
                     if xb > nx - 1:
                         xb = nx - 1
-                    # Voronoi half-spaces against larger neighbours: a.q + b <= 0 keeps q
-                    for h in range(plane_start[i], plane_start[i + 1]):
-                        ax = planes[h, 0]
-                        bx = planes[h, 1] * y + planes[h, 2] * z + planes[h, 3]
-                        va = ax * xa + bx
-                        vb = ax * xb + bx
-                        if va <= 0.0 and vb <= 0.0:
-                            continue  # the plane does not cut this run
-                        if va > 0.0 and vb > 0.0:
-                            xa = xb + 1  # the whole run is on the neighbour's side
-                            break
-                        lim = -bx / ax  # one end is kept: cut at the plane
-                        if va > 0.0:
-                            xa = int(np.ceil(lim))
-                        else:
-                            xb = int(np.floor(lim))
-                        if xa > xb:
-                            break
+                    for h in range(n_cut):
+                        f = cut_ay[h] * dy + cut_e[h]  # the plane's value at u = (0, dy, dz)
+                        # where it crosses this row, kept within -1..nx before the integer conversion
+                        lim = max(min(cx + f * cut_inv[h], nx + 1.0), -2.0)
+                        if cut_side[h] > 0:
+                            xb = min(xb, int(np.floor(lim)))
+                        elif cut_side[h] < 0:
+                            xa = max(xa, int(np.ceil(lim)))
+                        elif f > 0.0:
+                            xa = xb + 1
                     if xa > xb:
                         continue
                     n_visits += xb - xa + 1
@@ -197,15 +230,16 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                             if out[z, y, x] < 65535:
                                 out[z, y, x] += 1
                         continue
-                    if mode != BINARY:
-                        lo, hi = row_lo[z, y], row_hi[z, y]
+                    if relax:
+                        srow = stencil[y]
+                        lo, hi = lo_z[y], hi_z[y]
                         if lo > hi:  # first touch of this row
                             lo, hi = xa, xa - 1
                         for x in range(xa, lo):  # grow the span left (gaps included) ...
-                            stencil[z, y, x] = np.inf
+                            srow[x] = np.inf
                         for x in range(hi + 1, xb + 1):  # ... and right
-                            stencil[z, y, x] = np.inf
-                        row_lo[z, y], row_hi[z, y] = min(lo, xa), max(hi, xb)
+                            srow[x] = np.inf
+                        lo_z[y], hi_z[y] = min(lo, xa), max(hi, xb)
                     if mode == BINARY:  # a union: no relaxation needed, so no stencil
                         for x in range(xa, xb + 1):
                             if out[z, y, x] == 0:
@@ -213,24 +247,29 @@ def fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                                 out[z, y, x] = values[i]
                         continue
                     value = values[i]
-                    if metric == EUCLID:  # branch-free: a win is a coin toss, a select is not
-                        for x in range(xa, xb + 1):
-                            ddx = x - cx
+                    if metric == EUCLID:
+                        # Branch-free over a row slice, x as xa + k: LLVM vectorises this (4x on long
+                        # runs). (xa - cx) + k equals x - cx exactly: centres are multiples of 2^-20
+                        # below 2^31, so every such difference fits a double's 53 bits.
+                        srun = srow[xa:xb + 1]
+                        orun = out[z, y, xa:xb + 1]
+                        x0 = xa - cx
+                        for k in range(xb - xa + 1):
+                            ddx = x0 + k
                             d = np.float32((ddx * ddx + dy2) + dz2)
-                            old = stencil[z, y, x]
+                            old = srun[k]
                             win = d < old
                             n_filled += win & (old == np.inf)
-                            stencil[z, y, x] = min(d, old)
-                            was = out[z, y, x]
-                            out[z, y, x] = value if win else was
+                            srun[k] = d if win else old
+                            orun[k] = value if win else orun[k]
                         continue
                     for x in range(xa, xb + 1):
                         d = np.float32(_distance(metric, x - cx, dy, dz, dy2, dz2))
-                        old = stencil[z, y, x]
+                        old = srow[x]
                         if d < old:
                             if old == np.inf:
                                 n_filled += 1
-                            stencil[z, y, x] = d
+                            srow[x] = d
                             out[z, y, x] = value
             filled[z] = n_filled
             visits[z] = n_visits
@@ -339,10 +378,13 @@ def count_outside(centres, r2s, radii, metric, shape, row_budget):
 
 @njit(cache=True)
 def build_halfspaces(centres, r2s, neighbours, min_r2):
-    """Bisector half-spaces ``a.q + b <= 0`` (the kept side) of each sphere against its
-    larger neighbours, with the float margin, packed: sphere i's planes are rows
-    ``start[i]:start[i + 1]`` of ``planes``. Spheres with ``r2 < min_r2`` get none:
-    for small spheres clipping each row costs more than the voxels it saves."""
+    """Bisector half-spaces of each sphere against its larger neighbours, with the float margin,
+    in the sphere's own frame ``u = q - c_i``: ``a.u + w <= 0`` keeps ``q``, where
+    ``a = 2 (c_j - c_i)`` and ``w = -|c_j - c_i|^2 - margin``, so ``a.u + w`` is
+    ``|q - c_i|^2 - |q - c_j|^2 - margin`` computed from small numbers (its rounding stays far
+    below the margin wherever the grid lies). Column 4 is ``|(a_x, a_y)|``, how fast the value
+    changes within a slice. Sphere i's planes are rows ``start[i]:start[i + 1]``; spheres with
+    ``r2 < min_r2`` get none: for small spheres clipping each row costs more than it saves."""
     n, k = neighbours.shape
     start = np.zeros(n + 1, np.int64)
     for i in range(n):
@@ -352,21 +394,23 @@ def build_halfspaces(centres, r2s, neighbours, min_r2):
                 if neighbours[i, h] >= 0:
                     c += 1
         start[i + 1] = start[i] + c
-    planes = np.empty((start[n], 4))
+    planes = np.empty((start[n], 5))
     for i in range(n):
         if start[i + 1] == start[i]:
             continue
-        ci0, ci1, ci2 = centres[i, 0], centres[i, 1], centres[i, 2]
         margin = r2s[i] * 2.0**-20 + 1e-6
         row = start[i]
         for h in range(k):
             j = neighbours[i, h]
             if j < 0:
                 continue
-            cj0, cj1, cj2 = centres[j, 0], centres[j, 1], centres[j, 2]
-            planes[row, 0] = 2.0 * (cj0 - ci0)
-            planes[row, 1] = 2.0 * (cj1 - ci1)
-            planes[row, 2] = 2.0 * (cj2 - ci2)
-            planes[row, 3] = (ci0 * ci0 + ci1 * ci1 + ci2 * ci2) - (cj0 * cj0 + cj1 * cj1 + cj2 * cj2) - margin
+            d0 = centres[j, 0] - centres[i, 0]
+            d1 = centres[j, 1] - centres[i, 1]
+            d2 = centres[j, 2] - centres[i, 2]
+            planes[row, 0] = 2.0 * d0
+            planes[row, 1] = 2.0 * d1
+            planes[row, 2] = 2.0 * d2
+            planes[row, 3] = -(d0 * d0 + d1 * d1 + d2 * d2) - margin
+            planes[row, 4] = 2.0 * np.sqrt(d0 * d0 + d1 * d1)
             row += 1
     return start, planes

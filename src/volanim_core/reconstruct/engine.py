@@ -23,7 +23,6 @@ as float32 (squared Euclidean, or integer 3-4-5 chamfer).
 from __future__ import annotations
 
 import math
-import threading
 import time
 from dataclasses import dataclass, field
 
@@ -48,6 +47,7 @@ from volanim_core.volume import Bounds
 MODES = ("binary", "mottled", "bone", "sampled", "hotspot")
 _MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT}
 SNAP = 2.0**20
+LAUNCH_SECONDS = 0.25  # aimed length of one parallel launch: the progress and cancel granularity
 CLIP_ROW_BUDGET = 4_000_000  # rows counted exactly per clipped sphere (radius ~1000); beyond, estimated
 
 
@@ -194,43 +194,6 @@ def grid_bounds(tskels: Tskel | list[Tskel], padding: int = 2, *, centres: list 
     return Bounds(tuple(int(v) for v in lo), tuple(int(v) for v in hi))
 
 
-class _Workspace(threading.local):
-    """The stencil of this thread's last call, kept for its next one.
-
-    Page faults on fresh memory are the largest cost after the kernel itself
-    on a sparse grid (the posed frog: 36 M voxels, 1.1 M filled) and they do
-    not parallelise here, so the stencil -- a temporary -- is reused between
-    calls of the same grid size (rows are re-initialised lazily by the
-    kernel, so only the small per-row span arrays are reset). One per thread: the
-    studio reconstructs on the GUI thread (live) while a worker makes the full
-    preview, and they must not write each other's scratch memory.
-    """
-
-    def __init__(self):
-        self.stencil = np.empty((0, 0, 0), np.float32)
-
-    def stencil_for(self, shape) -> np.ndarray:
-        if self.stencil.size < int(np.prod(shape)):
-            self.stencil = np.empty(int(np.prod(shape)), np.float32)
-        return self.stencil.reshape(-1)[: int(np.prod(shape))].reshape(shape)
-
-    def release(self) -> None:
-        self.stencil = np.empty((0, 0, 0), np.float32)
-
-
-_WORKSPACE = _Workspace()
-
-
-def release_workspace() -> None:
-    """Free this thread's stencil kept between calls (up to 4 bytes per output voxel)."""
-    _WORKSPACE.release()
-
-
-def workspace_nbytes() -> int:
-    """Bytes this thread's workspace holds between calls."""
-    return int(_WORKSPACE.stencil.nbytes)
-
-
 def mottled_values(n: int) -> np.ndarray:
     """One value 1..255 per sphere, neighbours in file order far apart (uint8)."""
     return (1 + (np.arange(n, dtype=np.int64) * 97) % 255).astype(np.uint8)
@@ -321,11 +284,14 @@ def reconstruct(
     out_dtype, values = _labels(mode, tskel, value)
     final_dtype = source.dtype if mode == "sampled" else out_dtype
     relax = mode not in ("hotspot", "binary")  # binary is a union and hotspot a count: no stencil
-    per_voxel = np.dtype(out_dtype).itemsize + (4 if relax else 0) + \
+    per_voxel = np.dtype(out_dtype).itemsize + \
         (np.dtype(final_dtype).itemsize if final_dtype != out_dtype else 0) + (3 if np.ndim(source) == 4 else 0)
     check_output_grid(bounds.shape, per_voxel)
+    nthreads = int(threads or numba.config.NUMBA_NUM_THREADS)
+    nthreads = max(1, min(nthreads, numba.config.NUMBA_NUM_THREADS))
     out = _output_array(out, (nz, ny, nx), out_dtype, final_dtype)
-    stencil = _WORKSPACE.stencil_for((nz, ny, nx) if relax else (1, 1, 1))  # rows set on first use
+    # one slice of stencil per thread: a slice is filled by one thread, start to end
+    scratch = np.empty((nthreads, ny, nx) if relax else (nthreads, 1, 1), np.float32)
     row_lo = np.full((nz, ny) if relax else (1, 1), nx, np.int32)  # each row's span of valid stencil
     row_hi = np.full(row_lo.shape, -1, np.int32)
     if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
@@ -333,27 +299,35 @@ def reconstruct(
             else reorder_neighbours(neighbours, order)
         plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:
-        plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 4))
-    ext = _extent(tskel)
-    zlo = np.floor(centres[:, 2] - ext).astype(np.int64) - 1
-    zhi = np.ceil(centres[:, 2] + ext).astype(np.int64) + 1
+        plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 5))
+    max_planes = max(1, int(np.diff(plane_start).max())) if len(tskel) else 1
+    if metric == K.EUCLID:  # |z - cz| < sqrt(r2): no margin needed, the kernel tests each slice exactly
+        reach = np.sqrt(r2s)
+        zlo = np.floor(centres[:, 2] - reach).astype(np.int64)
+        zhi = np.ceil(centres[:, 2] + reach).astype(np.int64)
+    else:
+        zlo = np.floor(centres[:, 2] - _extent(tskel)).astype(np.int64) - 1
+        zhi = np.ceil(centres[:, 2] + _extent(tskel)).astype(np.int64) + 1
     offsets, ids = K.slice_lists(zlo, zhi, nz)
     filled = np.zeros(nz, np.int64)
     visits = np.zeros(nz, np.int64)
 
-    nthreads = int(threads or numba.config.NUMBA_NUM_THREADS)
-    nthreads = max(1, min(nthreads, numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
     try:
-        chunk = max(nthreads * 8, nz // 8)  # few calls: each parallel launch costs
         total = 2 * nz if mode == "sampled" else nz  # sampling is a second pass: report and cancel in it too
         report(0, total)
-        for z0 in range(0, nz, chunk):
+        z0, chunk = 0, max(nthreads * 8, nz // 16)  # a first, small launch measures the pace ...
+        while z0 < nz:
             z1 = min(nz, z0 + chunk)
-            K.fill_slices(out, stencil, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric,
-                          _MODE_CODE[mode], plane_start, planes, row_lo, row_hi, filled, visits)
+            started = time.perf_counter()
+            K.fill_slices(out, scratch, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric,
+                          _MODE_CODE[mode], plane_start, planes, max_planes, row_lo, row_hi, filled, visits)
             report(z1, total)
+            # ... and the next ones last about LAUNCH_SECONDS each: progress and cancel stay that responsive,
+            # and a fast call is not cut into many launches (each ends on its slowest thread)
+            pace = (z1 - z0) / max(time.perf_counter() - started, 1e-6)
+            z0, chunk = z1, max(nthreads * 4, int(pace * LAUNCH_SECONDS))
         if mode == "sampled":
             out = sample_source(out, source, _grid_to_source(minv_rest, origin, source_origin), kernel,
                                 (row_lo, row_hi), nthreads, chunk, lambda done: report(nz + done, total))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volanim_core.reconstruct.breakage import BreakageReport, breakage_report, touching_pairs
+from volanim_core.reconstruct.breakage import BreakageReport, breakage_report, rest_voxels, touching_pairs
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.tskel import coarse_tskel, identity_tskel
@@ -19,12 +19,13 @@ from volanim_core.rig.tskel import coarse_tskel, identity_tskel
 
 @dataclass
 class RestParts:
-    """What the breakage report needs that no pose changes: the rest bone volume and the sphere pairs
-    that touch at rest (on the frog about a third of a full preview). The studio keeps them until
+    """What the breakage report needs that no pose changes: the rest bone volume, its voxels'
+    coordinates and bones, and the sphere pairs that touch at rest. The studio keeps them until
     the attachments or the slider change (:meth:`Posing.rest_parts`)."""
 
     rest_bone: Reconstruction
     pairs: tuple
+    voxels: tuple  # breakage.rest_voxels(rest_bone)
 
 
 @dataclass
@@ -62,9 +63,10 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     if report:  # three more reconstructions: each checks ``cancel`` between its chunks
         posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", cancel=cancel)
         if rest_parts is None:
-            rest_parts = RestParts(reconstruct(identity_tskel(tskel.connectivity), mode="bone", cancel=cancel),
-                                   touching_pairs(tskel))
+            rest_bone = reconstruct(identity_tskel(tskel.connectivity), mode="bone", cancel=cancel)
+            rest_parts = RestParts(rest_bone, touching_pairs(tskel), rest_voxels(rest_bone))
         out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone,
-                                     rest_bone=rest_parts.rest_bone, pairs=rest_parts.pairs, cancel=cancel)
+                                     rest_bone=rest_parts.rest_bone, pairs=rest_parts.pairs,
+                                     rest=rest_parts.voxels, cancel=cancel)
         out.rest_parts = rest_parts
     return out

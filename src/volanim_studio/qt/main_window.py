@@ -32,6 +32,7 @@ from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .files_controller import FilesController
 from .gui_gc import collect_on_gui_thread
+from .interactor import close_interactor
 from .mode_keys import LettersPastNumberFields
 from .naming_controller import NamingController
 from .pose_panel import PosePanel
@@ -334,7 +335,7 @@ class MainWindow(QMainWindow):
         self.timeline.stop()
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
         self.session.close()
-        self.plotter.close()
+        close_interactor(self.plotter)
         super().closeEvent(event)
 
 

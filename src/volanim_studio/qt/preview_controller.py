@@ -17,7 +17,6 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
-from volanim_core.reconstruct.engine import release_workspace
 
 from ..model.preview import make_preview
 from .controller import FAILED, Controller
@@ -64,10 +63,8 @@ class PreviewController(Controller):
         reconstruct_panel.joint_clicked.connect(self.jump_to_joint)
 
     def leave_pose(self) -> None:
-        """Leaving the pose stage frees the live preview's reconstruction workspace
-        (up to 4 bytes per output voxel, kept between drags for speed)."""
+        """Leaving the pose stage drops a live preview still waiting to run."""
         self._live_timer.stop()
-        release_workspace()
 
     def drag_started(self) -> None:
         self._posing_drag = True

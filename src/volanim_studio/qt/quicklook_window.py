@@ -13,6 +13,8 @@ from pathlib import Path
 from PySide6.QtWidgets import QMainWindow
 from pyvistaqt import QtInteractor
 
+from volanim_studio.qt.interactor import close_interactor
+
 
 class QuickLookWindow(QMainWindow):
     def __init__(self, path, parent=None):
@@ -26,10 +28,10 @@ class QuickLookWindow(QMainWindow):
         try:
             self.renderer, self.what = quick_look(path, plotter=self.plotter, size=(800, 600))
         except BaseException:
-            self.plotter.close()
+            close_interactor(self.plotter)
             raise
         self.statusBar().showMessage(f"{path}: {self.what}. Drag to turn, wheel to zoom.")
 
     def closeEvent(self, event) -> None:
-        self.plotter.close()
+        close_interactor(self.plotter)
         super().closeEvent(event)

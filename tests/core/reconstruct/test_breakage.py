@@ -127,3 +127,34 @@ def test_pieces_and_where_they_broke_off_match_a_brute_force_answer():
     assert [s for s, _ in got] == [s for s, _ in want]
     for (_, a), (_, b) in zip(got, want):
         assert np.allclose(a, b)
+
+
+def test_a_piece_far_from_the_main_body_is_located_where_it_is_nearest():
+    """The search box around a piece grows until it holds a main-body voxel closer than its margin:
+    a piece 30 voxels away, off-axis, still gets its nearest voxel, not the first one found."""
+    from volanim_core.reconstruct.breakage import _components
+
+    vol = np.zeros((60, 50, 40), np.uint8)
+    vol[2:20, 2:20, 2:20] = 1  # the main body
+    vol[45:50, 30:33, 25:27] = 1  # a piece far off, nearest to the body's corner (19, 19, 19)
+    vol[6, 28, 3] = 1  # and a one-voxel piece 8 beyond the body's y face
+    got = _components(vol)
+    assert [n for n, _ in got] == [18**3, 30, 1]
+    assert np.allclose(got[1][1], (45, 30, 25)) and np.allclose(got[2][1], (6, 28, 3))
+
+
+def test_rest_voxels_kept_by_the_caller_give_the_same_report(man):
+    from volanim_core.reconstruct.breakage import lost_voxels, rest_voxels
+    from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.rig.tskel import identity_tskel
+
+    s, conn = man
+    m = pose_matrices(s.bones, {"L_UPPERARM": (0, -60, 0)})
+    posed = connect_to_tskel(conn, Trans(root_bones(s.bones), m))
+    rest = reconstruct(identity_tskel(conn), mode="bone")
+    vol = reconstruct(posed, mode="bone")
+    kept = rest_voxels(rest)
+    assert len(kept[0]) == rest.stats["filled"] and kept[1].min() >= 0
+    a, b = lost_voxels(rest, vol, posed.matrices), lost_voxels(rest, vol, posed.matrices, kept)
+    assert len(a) > 0 and np.array_equal(np.sort(a, axis=0), np.sort(b, axis=0))
+

@@ -111,6 +111,39 @@ def test_overdraw_cut_changes_nothing_but_visits(rng, mode, monkeypatch):
     assert cut.stats["visits"] < full.stats["visits"]
 
 
+def test_overdraw_cut_on_large_rotated_spheres_changes_nothing_but_visits(rng):
+    """Spheres as large as the cut's minimum radius and larger, on rotated bones: the planes are
+    chosen slice by slice (dropped where they miss the disc, the slice skipped where one covers it)."""
+    from volanim_core.reconstruct.neighbours import CUT_MIN_RADIUS
+
+    source = rng.integers(1, 256, (60, 60, 60)).astype(np.uint8)
+    for case in range(3):
+        t = random_tskel(rng, n=120, size=60, nbones=2, quarter_turns=case == 0)
+        t = Tskel(t.bones, t.matrices, t.points, np.sqrt(rng.integers(int(CUT_MIN_RADIUS**2) - 20, 200, len(t))),
+                  None, t.bone)
+        cut = reconstruct(t, mode="bone", source=source)
+        full = reconstruct(t, mode="bone", source=source, neighbours=False)
+        assert np.array_equal(cut.volume, full.volume) and cut.stats["filled"] == full.stats["filled"]
+        assert cut.stats["visits"] < full.stats["visits"]
+    want, _, ties = naive.reconstruct(t, cut.bounds, mode="bone", source=source)
+    assert (cut.volume == want)[~ties].all()
+
+
+def test_a_plane_along_y_or_z_cuts_rows_or_whole_slices_exactly():
+    """Neighbours straight above (z), beside (y) and ahead (x): a bisector parallel to the rows
+    cuts whole rows, one parallel to the slices cuts whole slices, one across the rows cuts runs."""
+    bone = [RootBone((0, 0, 0), (1, 0, 0))]
+    pts = [[20, 20, 20], [20, 20, 27], [20, 27, 20], [27, 20, 20], [13, 20, 20]]
+    t = Tskel(bone, np.eye(4)[None], pts, [11.0, 13.0, 13.0, 13.0, 12.0], None, [0] * 5)
+    b = Bounds((0, 0, 0), (40, 40, 40))
+    cut = reconstruct(t, mode="mottled", bounds=b)
+    full = reconstruct(t, mode="mottled", bounds=b, neighbours=False)
+    assert np.array_equal(cut.volume, full.volume)
+    assert cut.stats["visits"] < full.stats["visits"]
+    want, _, ties = naive.reconstruct(t, b, mode="mottled")
+    assert (cut.volume == want)[~ties].all()
+
+
 # spec: docs/formats.md#reconstruction
 def test_ties_go_to_the_first_sphere_in_file_order():
     # two equal spheres, centres 2 apart: the mid-plane voxels are equidistant
@@ -196,6 +229,22 @@ def test_bad_arguments():
         reconstruct(t, mode="sampled", source=np.zeros((2, 2, 2)), kernel=4)
 
 
+def test_a_fast_call_is_one_launch_after_the_first_and_a_slow_one_reports_often(monkeypatch):
+    """Launches are sized to last LAUNCH_SECONDS after a small first one: few for a fast call (each
+    launch waits for its slowest thread), many -- progress and cancel -- for a slow one."""
+    from volanim_core.reconstruct import engine as rec
+
+    t = Tskel([RootBone((0, 0, 0), (0, 0, 300))], np.eye(4)[None], [[5, 5, z] for z in range(0, 300, 2)],
+              [3.0] * 150, None, [0] * 150)
+    calls = []
+    reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d))
+    assert len(calls) <= 3  # 0, the first launch, the rest
+    monkeypatch.setattr(rec, "LAUNCH_SECONDS", 0.0)
+    calls.clear()
+    r = reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d), threads=2)
+    assert len(calls) > 10 and calls == sorted(calls) and calls[-1] == r.volume.shape[2]
+
+
 def test_progress_and_cancel():
     t = random_tskel(np.random.default_rng(1), n=200, size=30)
     seen = []
@@ -252,8 +301,11 @@ def test_neighbours_refer_to_the_callers_order(rng, monkeypatch):
     assert np.array_equal(cut.volume, plain.volume)
 
 
-def test_cancel_is_checked_while_sampling_not_only_while_filling():
+def test_cancel_is_checked_while_sampling_not_only_while_filling(monkeypatch):
     """The sampled pass used to run in one uninterruptible call after the last progress report."""
+    from volanim_core.reconstruct import engine as rec
+
+    monkeypatch.setattr(rec, "LAUNCH_SECONDS", 0.0)  # launches as short as on a volume that takes minutes
     mask = np.zeros((20, 20, 40), bool)
     mask[5:15, 5:15, 2:38] = True
     pts = np.argwhere(mask)
@@ -274,18 +326,21 @@ def test_cancel_is_checked_while_sampling_not_only_while_filling():
                     cancel=lambda: len(calls) and calls[-1][0] > nz)
 
 
+@pytest.mark.parametrize("threads", [1, 2])
 @pytest.mark.parametrize("mode", ["bone", "mottled", "sampled"])
-def test_runs_in_one_row_in_any_order_over_a_used_workspace(mode):
-    """Each row's stencil is valid on the span of the runs that touched it; a run landing right,
-    then left, then in the gap must see inf there, never the previous call's distances."""
-    bounds = Bounds((0, 0, 0), (39, 4, 4))
-    big = Tskel([RootBone((0, 2, 2), (39, 2, 2))], np.eye(4)[None], [[20, 2, 2]], [30.0], None, [0])
-    reconstruct(big, mode="bone", bounds=bounds)  # leaves small distances all over the kept stencil
+def test_runs_in_one_row_in_any_order_over_a_stencil_slice_an_earlier_slice_used(mode, threads):
+    """A thread's stencil is one slice, reused slice after slice and never reset: each row is valid
+    only on the span of the runs that touched it in this slice. Runs landing right, then left,
+    then in the gap must see inf there, never the small distances an earlier slice left."""
+    bounds = Bounds((0, 0, 0), (39, 4, 11))
+    bone = [RootBone((0, 2, 2), (39, 2, 2))]
     xs = [20, 34, 5, 12, 27]  # middle, far right, far left, then both gaps
-    t = Tskel([RootBone((0, 2, 2), (39, 2, 2))], np.eye(4)[None], [[x, 2, 2] for x in xs], [1.5] * len(xs), None,
-              [0] * len(xs))
-    source = np.arange(40 * 5 * 5, dtype=np.uint16).reshape(40, 5, 5)
-    r = reconstruct(t, mode=mode, source=source, bounds=bounds)
-    want, _, _ = naive.reconstruct(t, bounds, mode=mode, source=source)
+    # first a big sphere over the whole row in slices 0..5, then small ones in slices 7..9
+    pts = [[20, 2, 2]] + [[x, 2, 8] for x in xs]
+    t = Tskel(bone, np.eye(4)[None], pts, [4.0] + [1.5] * len(xs), None, [0] * len(pts))
+    source = np.arange(40 * 5 * 12, dtype=np.uint16).reshape(40, 5, 12)
+    r = reconstruct(t, mode=mode, source=source, bounds=bounds, threads=threads)
+    want, best, _ = naive.reconstruct(t, bounds, mode=mode, source=source)
     assert np.array_equal(r.volume, want)
-    assert r.stats["filled"] == 19 * len(xs)  # centre, 6 faces, 12 edges (sqrt 2 < 1.5)
+    assert r.stats["filled"] == np.isfinite(best).sum()
+    assert (want[:, :, 7:10] > 0).sum() == 19 * len(xs)  # centre, 6 faces, 12 edges (sqrt 2 < 1.5)

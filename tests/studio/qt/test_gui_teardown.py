@@ -21,3 +21,27 @@ def test_a_window_is_opened_and_left_to_pytest_qt(qtbot):
 def test_the_previous_window_is_gone_before_this_test_runs_an_event_loop():
     # no event loop has run since the previous test: only its own teardown can have deleted it
     assert DESTROYED == ["window"]
+
+
+def _surface_wrappers() -> list:
+    import gc
+
+    from PySide6.QtGui import QSurface
+
+    return [o for o in gc.get_objects() if type(o) is QSurface]
+
+
+def test_a_closed_window_leaves_no_wrapper_of_its_gl_surface(qtbot):
+    """QSurface is not a QObject: PySide cannot see Qt delete it, and a wrapper kept past the widget
+    handed a later QMenu at the same address back to Python as a QSurface (a CI run's error)."""
+    from volanim_studio.qt.main_window import MainWindow
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitExposed(w)
+    w.plotter.render()
+    qtbot.wait(50)
+    assert _surface_wrappers(), "the interactor wraps its surface once drawn (else this test tests nothing)"
+    w.close()
+    assert _surface_wrappers() == []
