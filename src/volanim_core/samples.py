@@ -128,25 +128,26 @@ def mannequin() -> Sample:
     return _mannequin(np.ones(3), "mannequin")
 
 
-def mannequin_large() -> Sample:
+def mannequin_large(progress=None) -> Sample:
     """The mannequin at the thesis's half-size Visible Human scale, 290 x 169 x 940 voxels (46 M).
 
     The same body sampled on a finer grid (1.81 x 1.69 x 3.13 voxels per mannequin
     voxel), not an enlarged copy: surfaces stay smooth and every tissue layer is
     thicker in voxels, as in a higher-resolution scan. Its bones are the
-    mannequin's, scaled.
+    mannequin's, scaled. ``progress(done, total)`` counts body parts (~2 s in all).
     """
-    return _mannequin(np.array(LARGE_SHAPE, float) / MANNEQUIN_SHAPE, "mannequin-large")
+    return _mannequin(np.array(LARGE_SHAPE, float) / MANNEQUIN_SHAPE, "mannequin-large", progress)
 
 
-def part_connectivity(sample: Sample, min_thinness: float = 0.5):
+def part_connectivity(sample: Sample, min_thinness: float = 0.5, progress=None):
     """The sample's skeleton (thinness >= ``min_thinness``) with every point attached to the bone
-    of the body part it lies in (the ground truth, not a guess): a ready ``.connect``."""
+    of the body part it lies in (the ground truth, not a guess): a ready ``.connect``.
+    ``progress`` is the skeletonization's."""
     from volanim_core.rig.connectivity import Connectivity
     from volanim_core.rig.pose import root_bones
     from volanim_core.skeleton.skeletonize import skeletonize
 
-    skel = skeletonize(sample.mask, min_thinness=min_thinness)
+    skel = skeletonize(sample.mask, min_thinness=min_thinness, progress=progress)
     x, y, z = skel.points.astype(int).T
     bone = sample.part[x, y, z].astype(int) - 1
     conn = Connectivity(root_bones(sample.bones), skel.points, skel.dt, skel.thinness, bone, skel.metric,
@@ -159,7 +160,7 @@ def _scaled(p, scale) -> tuple[float, ...]:
     return tuple(float(v) for v in (np.asarray(p, float) + 0.5) * scale - 0.5)
 
 
-def _mannequin(scale: np.ndarray, name: str) -> Sample:
+def _mannequin(scale: np.ndarray, name: str, progress=None) -> Sample:
     shape = tuple(int(round(n * f)) for n, f in zip(MANNEQUIN_SHAPE, scale))
     small = mannequin_bones()
     bones = small if (scale == 1).all() else \
@@ -167,7 +168,8 @@ def _mannequin(scale: np.ndarray, name: str) -> Sample:
     vol = np.zeros(shape, np.uint8, order="F")
     part = np.zeros(shape, np.uint8, order="F")
     best = np.full(shape, -np.inf, np.float32, order="F")
-    for k, (label, a, b, ra, rb, squash, rod) in enumerate(_mannequin_parts(small)):
+    parts = _mannequin_parts(small)
+    for k, (label, a, b, ra, rb, squash, rod) in enumerate(parts):
         a, b = np.asarray(a, float), np.asarray(b, float)
         r = max(ra, rb)
         lo = np.maximum(np.floor((np.minimum(a, b) - r - 0.5) * scale - 0.5), 0).astype(int)
@@ -193,6 +195,8 @@ def _mannequin(scale: np.ndarray, name: str) -> Sample:
         best[sl] = np.where(win, depth, best[sl])
         vol[sl] = np.where(win, tissue, vol[sl])
         part[sl] = np.where(win, bones.index(label) + 1, part[sl])
+        if progress is not None:
+            progress(k + 1, len(parts))
     return Sample(name, vol, bones, part)
 
 
@@ -309,9 +313,10 @@ def walk_clip() -> Path:
     return Path(__file__).resolve().parent / "sample_data" / "walk.bvh"
 
 
-def write_sample(name: str, folder: str | Path) -> list[Path]:
+def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``), or for
-    ``walk`` the clip ``walk.bvh`` and its licence."""
+    ``walk`` the clip ``walk.bvh`` and its licence. ``progress(done, total)`` is reported for
+    ``mannequin-large`` (its body, then the skeleton of its ``.connect``: ~10 s on 2 cores)."""
     from volanim_core.io import write_bones, write_connections, write_raw
     from volanim_core.io._atomic import atomic_write_bytes
 
@@ -323,7 +328,9 @@ def write_sample(name: str, folder: str | Path) -> list[Path]:
         for src, dst in zip((clip, clip.with_name(f"{clip.name}.LICENSE")), written):
             atomic_write_bytes(dst, src.read_bytes())
         return written
-    sample = load(name)
+    report = progress or (lambda done, total: None)
+    # mannequin-large: the body is the first 20 %, its .connect's skeleton the rest
+    sample = mannequin_large(lambda d, t: report(20 * d // t, 100)) if name == "mannequin-large" else load(name)
     written = [folder / f"{name}.VOL"]
     write_raw(written[0], sample.volume)
     if sample.bones is not None:
@@ -334,5 +341,7 @@ def write_sample(name: str, folder: str | Path) -> list[Path]:
         from volanim_core.io import write_connect
 
         written.append(folder / f"{name}.connect")
-        write_connect(written[-1], part_connectivity(sample))
+        conn = part_connectivity(sample, progress=lambda d, t: report(20 + 80 * d // max(t, 1), 100))
+        write_connect(written[-1], conn)
+        report(100, 100)
     return written

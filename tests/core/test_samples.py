@@ -95,7 +95,9 @@ def test_large_mannequin_is_the_mannequin_on_a_finer_grid(tmp_path):
     assert abs(ratio / scale.prod() - 1) < 0.03  # the same body, sampled finer
     for name, p in small.bones.joints.items():
         assert np.allclose(large.bones.joints[name], (p + 0.5) * scale - 0.5)
-    files = samples.write_sample("mannequin-large", tmp_path)
+    calls = []
+    files = samples.write_sample("mannequin-large", tmp_path, progress=lambda d, t: calls.append(d / t))
+    assert calls == sorted(calls) and calls[-1] == 1.0 and len(set(calls)) > 10  # ~10 s: a bar that moves
     conn = io.read_connect(tmp_path / "mannequin-large.connect")
     assert [f.name for f in files][-1] == "mannequin-large.connect" and 20_000 < len(conn) < 40_000
     x, y, z = conn.points.astype(int).T

@@ -53,9 +53,9 @@ JOB_TIMEOUT_MS = 600_000
 def open_project(qtbot, window, path) -> bool:
     """Open a project and wait until it is applied (``on_opened``), and its job's thread has ended.
 
-    Waiting for ``not window.busy`` alone raced: the job's thread ends before its queued
-    "succeeded" handler -- the one that applies the project's files -- has run on the GUI
-    thread, so a busy machine saw a document without its attachments (CI, once).
+    ``on_opened`` is the controller's own completion callback. (``not window.busy`` used to come
+    one event too early -- the project's files were applied by a second handler -- which a busy CI
+    machine saw once; ``test_a_project_reads_as_done_only_once_it_is_applied`` pins the fix.)
     """
     opened = []
     window.files.open_project(path, on_opened=opened.append)

@@ -13,6 +13,7 @@ from volanim_core.io import add_header, float_to_uint8, histogram_file, read_vol
 from .. import samples, volume
 from ..io._text import parse_int, read_records
 from ..io.raw_volumes import raw_layout
+from ..progress import TextProgress
 from ._common import (
     add_command,
     add_dims,
@@ -174,7 +175,10 @@ def _float2uchar(args):
 
 def _samples(args):
     for name in (*samples.NAMES, *samples.FILE_SAMPLES) if args.name == "all" else [args.name]:
-        for path in samples.write_sample(name, args.output):
+        bar = TextProgress(f"making {name}")
+        written = samples.write_sample(name, args.output, progress=bar)
+        bar.close()
+        for path in written:
             print(f"wrote {path}")
 
 

@@ -48,7 +48,6 @@ BINARY, MOTTLED, BONE, SAMPLED, HOTSPOT = 0, 1, 2, 3, 4
 EUCLID, CHAMFER = 0, 1
 
 
-
 @njit(cache=True)
 def slice_lists(zlo, zhi, nz):
     """Spheres per z-slice: ``(offsets[nz + 1], ids)``, file order within a slice."""

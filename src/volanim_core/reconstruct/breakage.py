@@ -179,7 +179,6 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     the frog) or a distance transform (1.1 s).
     """
     import cc3d
-    from scipy.spatial import cKDTree
 
     zyx = np.ascontiguousarray(np.asarray(volume).T)  # cc3d numbers pieces in memory order: make it x-fastest
     labels, n = cc3d.connected_components(zyx, connectivity=26, binary_image=True, return_N=True)
@@ -193,20 +192,22 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     for k in order[1:] + 1:
         box = stats["bounding_boxes"][k]
         voxels = np.argwhere(labels[box] == k) + [s.start for s in box]  # x-fastest order
-        d = _distance_to_label(labels, main, box, voxels, cKDTree)
+        d = _distance_to_label(labels, main, box, voxels)
         out.append((int(sizes[k - 1]), voxels[int(np.argmin(d))][::-1].astype(np.float64)))
     return out
 
 
-def _distance_to_label(labels: np.ndarray, label: int, box, voxels: np.ndarray, tree_class) -> np.ndarray:
+def _distance_to_label(labels: np.ndarray, label: int, box, voxels: np.ndarray) -> np.ndarray:
     """Each of ``voxels`` (inside the slices ``box``) to its nearest voxel labelled ``label``."""
+    from scipy.spatial import cKDTree
+
     margin = 4
     while True:
         grown = tuple(slice(max(s.start - margin, 0), min(s.stop + margin, n)) for s, n in zip(box, labels.shape))
         near = np.argwhere(labels[grown] == label) + [s.start for s in grown]
         whole = all(g.start == 0 and g.stop == n for g, n in zip(grown, labels.shape))
         if len(near):
-            d, _ = tree_class(near).query(voxels)
+            d, _ = cKDTree(near).query(voxels)
             if d.min() <= margin or whole:
                 return d
             margin = int(np.ceil(d.min()))
@@ -283,33 +284,49 @@ def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, 
     return (p[i[open_]] + p[j[open_]]) / 2.0, gap[open_]
 
 
+@dataclass
+class RestParts:
+    """What the report needs that no pose changes, made once per connectivity: the rest frame's
+    bone volume, its voxels' rest coordinates and bones (:func:`rest_voxels`), and the sphere
+    pairs that touch at rest (:func:`touching_pairs`). The studio keeps them between previews."""
+
+    rest_bone: Reconstruction
+    voxels: tuple[np.ndarray, np.ndarray]
+    pairs: tuple
+
+    @classmethod
+    def of(cls, conn: Connectivity, cancel=None) -> RestParts:
+        rest = identity_tskel(conn)
+        rest_bone = reconstruct(rest, mode="bone", cancel=cancel)
+        return cls(rest_bone, rest_voxels(rest_bone), touching_pairs(rest))
+
+
 def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: dict[str, np.ndarray], *,
-                    posed: Reconstruction | None = None, rest_bone: Reconstruction | None = None,
-                    pairs=None, rest=None, top: int = 5, cancel=None) -> BreakageReport:
+                    posed: Reconstruction | None = None, rest: RestParts | None = None,
+                    top: int = 5, cancel=None) -> BreakageReport:
     """The breakage report of one posed frame.
 
     Parameters
     ----------
     tskel : the posed frame
     joints, posed_joints : joint name -> rest / posed position
-    posed, rest_bone : reconstructions already made (bone or any mode; rest in bone mode), reused
-    pairs : :func:`touching_pairs` of the frame's points, when the caller keeps them (pose-independent)
-    rest : :func:`rest_voxels` of ``rest_bone``, when the caller keeps them (pose-independent)
+    posed : the frame's reconstruction, already made (bone or any mode), reused
+    rest : :class:`RestParts` of the frame's connectivity, when the caller keeps them (made when None)
     cancel : callable, optional
         ``cancel() -> True`` raises :class:`~volanim_core.errors.Cancelled` between phases.
     """
     check = Reporter(None, cancel)
     if posed is None:
         posed = reconstruct(tskel, mode="bone", cancel=cancel)
-    if rest_bone is None:
-        rest_bone = reconstruct(identity_tskel(tskel.connectivity), mode="bone", cancel=cancel)
+    if rest is None:
+        rest = RestParts.of(tskel.connectivity, cancel)
     hot = reconstruct(tskel, mode="hotspot", bounds=posed.bounds, cancel=cancel)
     check(0, 1)
-    lost = lost_voxels(rest_bone, posed, tskel.matrices, rest)
-    where, gaps = cracks(tskel, pairs=pairs)
+    lost = lost_voxels(rest.rest_bone, posed, tskel.matrices, rest.voxels)
+    where, gaps = cracks(tskel, pairs=rest.pairs)
     check(0, 1)
     parts = _components(posed.volume)
-    report = BreakageReport([n for n, _ in parts], int(posed.stats["filled"]), int(rest_bone.stats["filled"]),
+    report = BreakageReport([n for n, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
                             cracks=len(gaps), stumps=stumps(tskel, joints))
     names = list(joints)

@@ -301,13 +301,10 @@ def reconstruct(
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 5))
     max_planes = max(1, int(np.diff(plane_start).max())) if len(tskel) else 1
-    if metric == K.EUCLID:  # |z - cz| < sqrt(r2): no margin needed, the kernel tests each slice exactly
-        reach = np.sqrt(r2s)
-        zlo = np.floor(centres[:, 2] - reach).astype(np.int64)
-        zhi = np.ceil(centres[:, 2] + reach).astype(np.int64)
-    else:
-        zlo = np.floor(centres[:, 2] - _extent(tskel)).astype(np.int64) - 1
-        zhi = np.ceil(centres[:, 2] + _extent(tskel)).astype(np.int64) + 1
+    # Euclid: |z - cz| < sqrt(r2), no margin needed (the kernel tests each slice exactly); 345: a margin of 1
+    reach, margin = (np.sqrt(r2s), 0) if metric == K.EUCLID else (_extent(tskel), 1)
+    zlo = np.floor(centres[:, 2] - reach).astype(np.int64) - margin
+    zhi = np.ceil(centres[:, 2] + reach).astype(np.int64) + margin
     offsets, ids = K.slice_lists(zlo, zhi, nz)
     filled = np.zeros(nz, np.int64)
     visits = np.zeros(nz, np.int64)

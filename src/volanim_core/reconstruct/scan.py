@@ -48,7 +48,6 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     """One :class:`FrameVerdict` per frame of ``matrices`` (``(F, B, 4, 4)``); ``frames`` numbers them."""
     from scipy.spatial import cKDTree
 
-
     frames = list(range(len(matrices))) if frames is None else [int(f) for f in frames]
     report = Reporter(progress, cancel)
     rest = identity_tskel(conn)

@@ -24,7 +24,7 @@ class PoseState:
         self.doc = doc
         self.angles: dict[tuple[str, str], np.ndarray] = {}
         self.shifts: dict[tuple[str, str], np.ndarray] = {}
-        self._rest_parts = None  # (key, preview.RestParts) of the current attachments
+        self._rest_parts = None  # (key, breakage.RestParts) of the current attachments
         self.rest_version = 0  # counts attachment changes: a report made before one must not be kept
         doc.events.attachments.connect(self._forget_rest_parts)
 
@@ -36,7 +36,7 @@ class PoseState:
         return (self.doc.thinness, len(tskel))
 
     def rest_parts(self, tskel: Tskel):
-        """The kept :class:`~volanim_studio.model.preview.RestParts` of this frame's attachments, or None."""
+        """The kept :class:`~volanim_core.reconstruct.breakage.RestParts` of this frame's attachments, or None."""
         if self._rest_parts is not None and self._rest_parts[0] == self._rest_key(tskel):
             return self._rest_parts[1]
         return None

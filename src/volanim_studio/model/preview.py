@@ -11,21 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volanim_core.reconstruct.breakage import BreakageReport, breakage_report, rest_voxels, touching_pairs
+from volanim_core.reconstruct.breakage import BreakageReport, RestParts, breakage_report
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
 from volanim_core.rig.connectivity import Tskel
-from volanim_core.rig.tskel import coarse_tskel, identity_tskel
-
-
-@dataclass
-class RestParts:
-    """What the breakage report needs that no pose changes: the rest bone volume, its voxels'
-    coordinates and bones, and the sphere pairs that touch at rest. The studio keeps them until
-    the attachments or the slider change (:meth:`Posing.rest_parts`)."""
-
-    rest_bone: Reconstruction
-    pairs: tuple
-    voxels: tuple  # breakage.rest_voxels(rest_bone)
+from volanim_core.rig.tskel import coarse_tskel
 
 
 @dataclass
@@ -51,8 +40,8 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
                  rest_parts: RestParts | None = None, progress=None, cancel=None) -> Preview:
     """Reconstruct the frame (and, when asked, the breakage report at full resolution).
 
-    ``rest_parts``: a previous report's :class:`RestParts` of the same attachments (made when None;
-    the result carries them either way).
+    ``rest_parts``: a previous report's :class:`~volanim_core.reconstruct.breakage.RestParts` of the
+    same attachments (made when None; the result carries them either way).
     """
     if not len(tskel):
         raise ValueError("no attached points to reconstruct: connect points to bones first")
@@ -63,10 +52,8 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     if report:  # three more reconstructions: each checks ``cancel`` between its chunks
         posed_bone = r if (mode == "bone" and factor == 1) else reconstruct(tskel, mode="bone", cancel=cancel)
         if rest_parts is None:
-            rest_bone = reconstruct(identity_tskel(tskel.connectivity), mode="bone", cancel=cancel)
-            rest_parts = RestParts(rest_bone, touching_pairs(tskel), rest_voxels(rest_bone))
-        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone,
-                                     rest_bone=rest_parts.rest_bone, pairs=rest_parts.pairs,
-                                     rest=rest_parts.voxels, cancel=cancel)
+            rest_parts = RestParts.of(tskel.connectivity, cancel)
+        out.report = breakage_report(tskel, joints or {}, posed_joints or {}, posed=posed_bone, rest=rest_parts,
+                                     cancel=cancel)
         out.rest_parts = rest_parts
     return out

@@ -71,16 +71,21 @@ class FilesController(Controller):
         self.doc.set_hull(*result["hull"])
         self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
 
-    def load_demo(self, name: str, *, skeleton_path=None) -> Worker:
+    def load_demo(self, name: str, *, skeleton_path=None, then: Callable[[], None] | None = None) -> Worker:
+        """Prepare a demo dataset in a worker; ``then()`` runs right after it is applied (see :meth:`open_project`)."""
         def done(r):
             self._apply_prepared(r, spacing=r["spacing"])
             self.doc.demo_name = name
+            if then is not None:
+                then()
 
         return self.jobs.run(f"Preparing the {name} demo", lambda progress, cancel: tasks.load_demo(
             name, skeleton_path=skeleton_path, progress=progress, cancel=cancel), done)
 
-    def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None) -> Worker | None:
-        """Read a volume; ask for the threshold (unless ``params``); segment it in a worker."""
+    def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None,
+                    then: Callable[[], None] | None = None) -> Worker | None:
+        """Read a volume; ask for the threshold (unless ``params``); segment it in a worker;
+        ``then()`` runs right after it is applied."""
         loaded = self.attempt("Open volume", lambda: tasks.load_volume_file(str(path), dims))
         if loaded is FAILED:
             return None
@@ -96,6 +101,8 @@ class FilesController(Controller):
         def done(r):
             r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
             self._apply_prepared(r, path=path, spacing=spacing, dims=dims)
+            if then is not None:
+                then()
 
         return self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
             vol, skeleton_path=skeleton_path, grey=grey, progress=progress, cancel=cancel, **params), done)
@@ -141,7 +148,7 @@ class FilesController(Controller):
             done(False)
             return None
 
-        def rest(_=None, reset=False):
+        def rest(reset=False):
             warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path, reset=reset))
             if warnings is FAILED:
                 done(False)
@@ -157,14 +164,16 @@ class FilesController(Controller):
         worker = None
         if data.get("volume"):
             worker = self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
-                                      skeleton_path=data.get("mskel"))
+                                      skeleton_path=data.get("mskel"), then=rest)
             if worker is None:
                 done(False)
                 return None
         elif data.get("demo"):
-            worker = self.load_demo(data["demo"], skeleton_path=data.get("mskel"))
+            worker = self.load_demo(data["demo"], skeleton_path=data.get("mskel"), then=rest)
         if worker is not None:
-            worker.succeeded.connect(rest)
+            # the rest is applied by the job's own completion handler, not by a second connection to
+            # `succeeded`: that would run as a separate event after the job reads as done ("not busy"),
+            # and anything acting in between (a key press, a test) would see a half-opened project
             worker.failed.connect(lambda *_: done(False))
             worker.was_cancelled.connect(lambda: done(False))
             return worker

@@ -152,6 +152,38 @@ def test_rename_in_panel_and_save_reopen_identical(qtbot, window, tmp_path):
     other.close()
 
 
+def test_a_project_reads_as_done_only_once_it_is_applied(qtbot, window, tmp_path):
+    """Between two events of the application there must never be a window that is no longer busy
+    while its project is still unapplied: the project's files were applied by a second slot on the
+    job's `succeeded`, a separate event after the one that ended the job (a busy CI saw it)."""
+    from PySide6.QtCore import QCoreApplication, QEvent, QObject
+
+    from volanim_studio.qt.main_window import MainWindow
+
+    window.doc.bone_edits.add_bone(np.array(J["L_HIP"]), np.array(J["L_KNEE"]))
+    path = window.files.save_project(path=tmp_path / "s.volanim")
+    other = MainWindow()
+    qtbot.addWidget(other)
+    opened, between = [], []
+
+    class Watch(QObject):
+        def eventFilter(self, obj, event):  # noqa: N802 (Qt name)
+            if event.type() == QEvent.MetaCall and not other.busy and not opened:
+                between.append(len(other.doc.bones))
+            return False
+
+    watch = Watch()
+    QCoreApplication.instance().installEventFilter(watch)
+    try:
+        assert other.files.open_project(path, on_opened=opened.append) is not None
+        qtbot.waitUntil(lambda: bool(opened) and not other.busy, timeout=JOB_TIMEOUT_MS)
+    finally:
+        QCoreApplication.instance().removeEventFilter(watch)
+    assert opened == [True] and other.doc.bones == window.doc.bones
+    assert between == [], "an event ran while the job read as done but its project was not applied"
+    other.close()
+
+
 def test_malformed_file_shows_error_dialog_and_keeps_document(qtbot, window, tmp_path):
     window.doc.bone_edits.add_bone(np.array(J["L_HIP"]), np.array(J["L_KNEE"]))
     before = window.doc.bones

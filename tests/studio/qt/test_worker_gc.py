@@ -41,7 +41,10 @@ def test_a_worker_that_allocates_does_not_collect_the_gui_threads_garbage(qtbot,
 
     window.jobs.run("Allocating", allocate, lambda n: None)
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
-    assert _Cycle.freed_on == []  # not by the worker
+    gui = threading.main_thread().name
+    # not by the worker; the GUI thread's own collector may already have freed it while this test
+    # waited (its timer runs whenever generation 0 fills -- a slow job gave it time: one local run)
+    assert set(_Cycle.freed_on) <= {gui}
     keep = [[] for _ in range(2 * gc.get_threshold()[0])]  # the GUI thread fills generation 0
     qtbot.waitUntil(lambda: bool(_Cycle.freed_on), timeout=10_000)  # and its collector timer frees the cycle
-    assert _Cycle.freed_on == [threading.main_thread().name] and len(keep)
+    assert _Cycle.freed_on == [gui] and len(keep)
