@@ -82,6 +82,29 @@ def apply_rgba(volume_actor, opacity: float = 0.9) -> None:
     prop.SetInterpolationTypeToLinear()
 
 
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "software rasterizer", "swr ")
+
+
+def gl_renderer(render_window) -> str:
+    """The OpenGL renderer string of a VTK render window ('' until its context exists)."""
+    for line in (render_window.ReportCapabilities() or "").splitlines():
+        if "renderer string" in line.lower():
+            return line.split(":", 1)[1].strip()
+    return ""
+
+
+def software_gl(renderer: str) -> bool:
+    """Whether an OpenGL renderer string (:func:`gl_renderer`) names a software rasteriser
+    (Mesa's llvmpipe and kin).
+
+    There VTK's fixed-point CPU ray caster draws a posed reconstruction as fast as the smart
+    mapper's shader or faster -- the frog's bone preview at 1200x800: 0.37 s against 0.86 s, its
+    sampled preview 0.85 against 0.87 s -- while on a GPU the shader is far faster.
+    """
+    name = renderer.lower() + " "
+    return any(soft in name for soft in SOFTWARE_RENDERERS)
+
+
 def add_volume_uncopied(plotter, grid, scalars: str, **kwargs):
     """``plotter.add_volume(grid, ...)`` without its copy of the grid.
 

@@ -3,6 +3,7 @@
     volume, mask, spacing ......... what was loaded (or None)
     skeleton (Skeleton) ........... the cloud, sorted by decreasing thinness
     hull (vertices, faces) ........ isosurface, drawn translucent and not pickable
+    hull_lod ...................... a coarser one, drawn while a slider is held
     thinness ...................... the slider: points with thinness >= it are shown
     bones (BoneSkeleton) .......... named joints, bones in root order  [undoable: bone_edits]
     attachments ................... the bone of every skeleton point  [undoable]
@@ -53,6 +54,7 @@ class Document:
         self.skeleton: Skeleton | None = None
         self.mskel_path: str | None = None
         self.hull: tuple[np.ndarray, np.ndarray] | None = None
+        self.hull_lod: tuple[np.ndarray, np.ndarray] | None = None  # drawn while a slider is held
         self._thinness = 0.0
         self.bones = BoneSkeleton()
         self.bones_path: str | None = None
@@ -105,8 +107,11 @@ class Document:
         self.events.thinness.emit(value=self._thinness)
         self.events.attachments.emit(indices=None)
 
-    def set_hull(self, vertices, faces) -> None:
+    def set_hull(self, vertices, faces, lod=None) -> None:
+        """The hull to draw, and ``lod``: a coarser ``(vertices, faces)`` of it for frames drawn
+        while a slider is held (None: the hull is light enough as it is)."""
         self.hull = None if vertices is None else (np.asarray(vertices), np.asarray(faces))
+        self.hull_lod = None if vertices is None or lod is None else (np.asarray(lod[0]), np.asarray(lod[1]))
         self.events.hull.emit()
 
     @property

@@ -68,7 +68,7 @@ class FilesController(Controller):
         self.doc.set_volume(result["volume"], result["mask"], spacing=spacing or result.get("spacing", (1, 1, 1)),
                             path=path, segmentation=result["segmentation"], dims=dims)
         self.doc.set_skeleton(result["skeleton"], result.get("skeleton_path"))
-        self.doc.set_hull(*result["hull"])
+        self.doc.set_hull(*result["hull"], lod=result.get("hull_lod"))
         self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
 
     def load_demo(self, name: str, *, skeleton_path=None, then: Callable[[], None] | None = None) -> Worker:

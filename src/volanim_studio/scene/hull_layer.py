@@ -16,6 +16,7 @@ class HullLayer:
     def __init__(self, view):
         self.view = view
         self.actor = None
+        self._meshes = None  # (full, coarse) once a hull exists; coarse is full when it has no LOD
         view.doc.events.volume.connect(self._on_hull_changed)
         view.doc.events.hull.connect(self._on_hull_changed)
         for name in ("hull_visible", "hull_opacity", "clip_axis", "clip_position"):
@@ -29,21 +30,37 @@ class HullLayer:
         if view.doc.hull is None:
             view.render()
             return
-        verts, faces = view.doc.hull
-        cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
-        mesh = pv.PolyData(view.world(verts).astype(np.float32), cells)
         volume = view.doc.volume
-        colour = volume is not None and volume.ndim == 4 and len(verts)
-        if colour:  # a colour scan's hull shows the colours of its surface voxels
-            mesh.point_data["rgb"] = filled_voxel_values(volume, np.asarray(verts, np.float64))
+        colour = volume is not None and volume.ndim == 4 and len(view.doc.hull[0])
+        mesh = self._mesh(*view.doc.hull, colour)
+        lod = mesh if view.doc.hull_lod is None else self._mesh(*view.doc.hull_lod, colour)
+        self._meshes = (mesh, lod)
         # not pickable: a click must reach the skeleton points inside it
         self.actor = view.plotter.add_mesh(
-            mesh, color=None if colour else HULL_COLOUR, scalars="rgb" if colour else None, rgb=bool(colour),
+            lod if view.dragging else mesh, color=None if colour else HULL_COLOUR,
+            scalars="rgb" if colour else None, rgb=bool(colour),
             opacity=view.settings.hull_opacity, pickable=False, smooth_shading=True, name="hull", render=False,
             reset_camera=False)
         self._apply_state()
         view.apply_stage()
         view.front_view()
+
+    def _mesh(self, verts, faces, colour: bool) -> pv.PolyData:
+        view = self.view
+        cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
+        mesh = pv.PolyData(view.world(verts).astype(np.float32), cells)
+        if colour:  # a colour scan's hull shows the colours of its surface voxels
+            mesh.point_data["rgb"] = filled_voxel_values(view.doc.volume, np.asarray(verts, np.float64))
+        return mesh
+
+    def set_dragging(self, on: bool) -> None:
+        """The coarse hull while a slider is held, the full one after (same actor, clip and opacity)."""
+        if self.actor is not None:
+            self.actor.GetMapper().SetInputData(self._meshes[1] if on else self._meshes[0])
+
+    @property
+    def drawn_faces(self) -> int:
+        return 0 if self.actor is None else int(self.actor.GetMapper().GetInput().GetNumberOfCells())
 
     def _apply_state(self) -> None:
         if self.actor is None:

@@ -18,7 +18,9 @@ from volanim_core.render.transfer import (
     apply_labels,
     apply_rgba,
     binary_view,
+    gl_renderer,
     rgba_points,
+    software_gl,
     volume_style,
 )
 from volanim_core.rig.pose import apply_matrices
@@ -41,6 +43,7 @@ class PoseLayer:
         self.view = view
         self.preview_actor = None
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
+        self._mapper = None  # the volume mapper for full previews, chosen once the GL context exists
         view.doc.events.pose.connect(self.on_pose_changed)
         view.doc.events.preview.connect(self.on_report)
         view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
@@ -133,7 +136,7 @@ class PoseLayer:
             style = volume_style(mode, volume, n_bones) if volume.ndim == 3 else {"show_scalar_bar": False}
             labels = style.pop("categories", None)
             self.preview_actor = add_volume_uncopied(plotter, img, "values", name="preview", render=False,
-                                                     reset_camera=False, **style)
+                                                     reset_camera=False, mapper=self.volume_mapper(), **style)
             if labels is not None:
                 apply_labels(self.preview_actor, labels)
             if volume.ndim == 4:
@@ -153,6 +156,17 @@ class PoseLayer:
                              n_colors=256 if labels is None else len(labels) + 1, show_scalar_bar=False,
                              name="slices", render=False, reset_camera=False)
         view.render()
+
+    def volume_mapper(self) -> str:
+        """pyvista's name of the mapper full previews use: the CPU ray caster on software OpenGL
+        (2.3x faster there on label volumes, as fast on grey ones), VTK's smart mapper on a GPU."""
+        if self._mapper is None:
+            ren_win = self.view.plotter.ren_win
+            renderer = gl_renderer(ren_win) if ren_win is not None else ""
+            if not renderer:
+                return "smart"  # no GL context yet (never drawn): decide on a later preview
+            self._mapper = "fixed_point" if software_gl(renderer) else "smart"
+        return self._mapper
 
     def show_surface(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
         """A live preview: the reconstruction's surface coloured by label (software GL draws a

@@ -280,8 +280,9 @@ class SceneView:
         self._update_cloud()
 
     def set_dragging(self, on: bool) -> None:
-        """While the slider is held draw at most LOD_POINTS; the full prefix on release."""
+        """While the slider is held draw at most LOD_POINTS and the coarse hull; everything on release."""
         self.dragging = bool(on)
+        self.hull.set_dragging(self.dragging)
         self._update_cloud()
 
     def _drawn(self) -> tuple[np.ndarray, np.ndarray]:

@@ -155,6 +155,7 @@ def test_rest_voxels_kept_by_the_caller_give_the_same_report(man):
     vol = reconstruct(posed, mode="bone")
     kept = rest_voxels(rest)
     assert len(kept[0]) == rest.stats["filled"] and kept[1].min() >= 0
+    assert (np.diff(kept[1]) >= 0).all()  # grouped by bone: moved a slice per bone
     a, b = lost_voxels(rest, vol, posed.matrices), lost_voxels(rest, vol, posed.matrices, kept)
     assert len(a) > 0 and np.array_equal(np.sort(a, axis=0), np.sort(b, axis=0))
 

@@ -291,3 +291,35 @@ def test_hotspot_gets_a_heat_colour_bar_and_labels_do_not():
     bar = pictures["hotspot"][H // 5: 3 * H // 5, int(W * 0.89): int(W * 0.91)]
     assert (bar[..., 0] > 200).mean() > 0.5 and bar[..., 2].mean() < bar[..., 0].mean()  # warm colours
     assert not lit(pictures["bone"][:, int(W * 0.89):].astype(np.uint8)).any()  # no bar for labels
+
+
+
+@pytest.mark.parametrize("renderer, software", [
+    ("llvmpipe (LLVM 15.0.6, 256 bits)", True),
+    ("softpipe", True),
+    ("Software Rasterizer", True),
+    ("NVIDIA GeForce RTX 3060/PCIe/SSE2", False),
+    ("Mesa Intel(R) UHD Graphics 620 (KBL GT2)", False),
+    ("AMD Radeon Pro 5500M OpenGL Engine", False),
+])
+def test_software_gl_reads_the_renderer_string(renderer, software):
+    from volanim_core.render.transfer import software_gl
+
+    assert software_gl(renderer) is software
+
+
+def test_the_renderer_string_comes_from_a_drawn_window():
+    import pyvista as pv
+
+    from volanim_core.render.transfer import gl_renderer
+
+    p = pv.Plotter(off_screen=True, window_size=(64, 64))
+    try:
+        assert gl_renderer(p.ren_win) == ""  # no context before the first picture
+        p.add_mesh(pv.Sphere())
+        p.show(auto_close=False)
+        report = p.ren_win.ReportCapabilities()
+        line = next(x for x in report.splitlines() if "renderer string" in x.lower())
+        assert gl_renderer(p.ren_win) == line.split(":", 1)[1].strip() != ""
+    finally:
+        p.close()

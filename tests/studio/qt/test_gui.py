@@ -30,6 +30,25 @@ def test_thinness_slider_shows_the_prefix(window):
     assert f"{window.scene.shown_points} of {len(skel)} points shown" == panel.count_label.text()
 
 
+def test_a_held_slider_draws_fewer_points_and_a_coarser_hull(window, monkeypatch):
+    """While the thinness slider is held: a spread subset of the points and the coarse hull
+    (software GL spends most of such a frame on them); on release, everything again."""
+    from volanim_core.skeleton.hull import LOD_FACES
+    from volanim_studio.scene import view
+
+    monkeypatch.setattr(view, "LOD_POINTS", 1000)  # the mannequin shows ~3 k points: make the LOD bite
+    panel, scene, doc = window.display_panel, window.scene, window.doc
+    full_faces = len(doc.hull[1])
+    assert full_faces > LOD_FACES and doc.hull_lod is not None and len(doc.hull_lod[1]) <= LOD_FACES
+    panel.thinness_slider.setValue(0)
+    assert scene.shown_points == doc.visible_count > 1000 and scene.hull.drawn_faces == full_faces
+    panel.thinness_slider.sliderPressed.emit()
+    panel.thinness_slider.setValue(100)
+    assert scene.shown_points == min(1000, doc.visible_count) and scene.hull.drawn_faces == len(doc.hull_lod[1])
+    panel.thinness_slider.sliderReleased.emit()
+    assert scene.shown_points == doc.visible_count and scene.hull.drawn_faces == full_faces
+
+
 def test_a_change_draws_one_frame_and_an_idle_window_draws_none(qtbot, window):
     """Software GL spends 0.1-0.6 s on a frame: the studio drew each slider step three times
     (pyvistaqt's 5 Hz timer, plotter.render(), then the widget's paint) and redrew while idle."""

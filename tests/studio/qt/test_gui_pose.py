@@ -10,6 +10,7 @@ from PySide6.QtWidgets import QPushButton
 from paths import ASSETS
 from volanim_core import samples
 from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.render.transfer import gl_renderer, software_gl
 from volanim_studio.model.modes import Mode
 
 from ..conftest import JOB_TIMEOUT_MS, front_view
@@ -54,7 +55,12 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     text = w.reconstruct_panel.report.text()
     assert "healthy: one piece" in text and "cracks" in text and "hotspot" in text
     assert w.reconstruct_panel.joints.count() == len(p.report.joints) + len(p.report.pieces)
-    assert w.scene.pose_layer.preview_actor is not None and w.scene.pose_layer.preview_actor.GetVisibility()
+    actor = w.scene.pose_layer.preview_actor
+    assert actor is not None and actor.GetVisibility()
+    # the CPU ray caster on software OpenGL (this machine: llvmpipe under Xvfb), the smart mapper on a GPU
+    assert gl_renderer(w.plotter.ren_win)  # drawn: its context exists
+    cpu = actor.GetMapper().IsA("vtkFixedPointVolumeRayCastMapper")
+    assert cpu == software_gl(gl_renderer(w.plotter.ren_win))
     # one undo step for the whole drag
     qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
     assert w.doc.pose.is_rest
