@@ -3,7 +3,7 @@
     compile_kernels()
         skeletonize (euclid, 345) --> auto_connect (path) --> reconstruct
         (every mode x metric, sampled with kernel 1 and 3, and a colour source) --> palette
-        orderings --> breakage report --> a crumble's heap
+        orderings --> breakage report (+ detached pieces) --> a crumble's heap
 
 The kernels are ``@njit(cache=True)``: the machine code lands in the package's
 ``__pycache__`` and later processes load it in well under a second. A fresh
@@ -35,7 +35,7 @@ def compile_kernels(progress=None) -> float:
     ``progress(done, total)`` is called after each step (for a message or a bar).
     """
     from volanim_core.colour.sort import sort_palette
-    from volanim_core.reconstruct.breakage import breakage_report
+    from volanim_core.reconstruct.breakage import breakage_report, components
     from volanim_core.reconstruct.engine import MODES, reconstruct
     from volanim_core.rig.attach import auto_connect
     from volanim_core.rig.bones import Bone, BoneSkeleton
@@ -71,6 +71,9 @@ def compile_kernels(progress=None) -> float:
     sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "path")  # all moves
     sort_palette(np.arange(12, dtype=np.uint8).repeat(3).reshape(-1, 3), "cluster-seeds")
     breakage_report(tskel, dict(bones.joints), dict(bones.joints))
+    two = np.zeros((6, 6, 6), np.uint8)
+    two[1, 1, 1] = two[4, 4, 4] = 1
+    components(two)  # a report's detached pieces: where each is nearest the main body
     fall(np.pad(source, ((8, 8), (8, 8), (0, 8))), 1.0)  # a crumble's heap (room for it around the bar)
     _report(progress, total, total)
     return time.perf_counter() - t0

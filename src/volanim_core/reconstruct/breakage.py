@@ -182,7 +182,9 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     import cc3d
 
     zyx = np.ascontiguousarray(np.asarray(volume).T)  # cc3d numbers pieces in memory order: make it x-fastest
-    labels, n = cc3d.connected_components(zyx, connectivity=26, binary_image=True, return_N=True)
+    # uint32 whatever the size (cc3d would pick uint16 for small grids): one numba type for the passes below
+    labels, n = cc3d.connected_components(zyx, connectivity=26, binary_image=True, return_N=True,
+                                          out_dtype=np.uint32)
     if n == 0:
         return []
     counts, sums = _label_stats(labels, n)
