@@ -72,6 +72,22 @@ def best_of(fn, repeats: int = 5) -> float:
     return min(times)
 
 
+def interleaved(fns: dict, rounds: int = 15) -> dict:
+    """Median seconds of each of ``fns`` (name -> no-argument callable), called in turn round after
+    round in this one process: the shared machine's speed drifts by 2x between minutes, so a ratio
+    of two cases timed minutes apart (or in separate processes) is noise; taken round by round,
+    both cases see the same machine. Each is called once first (compilation, caches)."""
+    for fn in fns.values():
+        fn()
+    times = {name: [] for name in fns}
+    for _ in range(rounds):
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - t0)
+    return {name: statistics.median(ts) for name, ts in times.items()}
+
+
 def table(rows: list[list], header: list[str]) -> str:
     """A plain-text table, or a Markdown one when ``VOLANIM_BENCH_MARKDOWN`` is set (``make docs``
     puts the benchmarks' own tables into the README)."""
