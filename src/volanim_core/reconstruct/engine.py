@@ -32,6 +32,7 @@ import numpy as np
 from volanim_core.limits import MAX_COORD, available_bytes, human_bytes, max_voxels
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
+from volanim_core.reconstruct._clipped import count_outside
 from volanim_core.reconstruct.neighbours import (
     CUT_MIN_RADIUS,
     cached_neighbours,
@@ -331,7 +332,7 @@ def reconstruct(
     finally:
         numba.set_num_threads(previous)
 
-    clipped, estimated = K.count_outside(centres, r2s, radii, metric, (nz, ny, nx), CLIP_ROW_BUDGET) \
+    clipped, estimated = count_outside(centres, r2s, radii, metric, (nz, ny, nx), CLIP_ROW_BUDGET) \
         if len(tskel) else (0.0, False)
     stats = _stats(len(tskel), filled, visits, int(round(clipped)), out if mode == "hotspot" else None)
     stats["clipped_estimated"] = bool(estimated)
