@@ -245,17 +245,16 @@ def _piece_voxels(labels, counts, skip):
         start[k + 1] = start[k] + (counts[k] if k != skip else 0)
     fill = start.copy()
     out = np.empty((start[n + 1], 3), np.int64)
-    nz, ny, nx = labels.shape
-    for z in range(nz):
-        for y in range(ny):
-            row = labels[z, y]
-            for x in range(nx):
-                k = row[x]
-                if k == 0 or k == skip:
-                    continue
-                f = fill[k]
-                out[f, 0], out[f, 1], out[f, 2] = z, y, x
-                fill[k] = f + 1
+    _, ny, nx = labels.shape
+    flat = labels.ravel()  # a view for a C-contiguous grid (numba copies any other)
+    for i in range(flat.size):
+        k = flat[i]
+        if k == 0 or k == skip:
+            continue
+        f = fill[k]
+        out[f, 0], rest = divmod(i, ny * nx)  # coordinates only for the voxels kept
+        out[f, 1], out[f, 2] = divmod(rest, nx)
+        fill[k] = f + 1
     return start, out
 
 

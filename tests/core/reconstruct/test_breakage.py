@@ -159,3 +159,18 @@ def test_rest_voxels_kept_by_the_caller_give_the_same_report(man):
     a, b = lost_voxels(rest, vol, posed.matrices), lost_voxels(rest, vol, posed.matrices, kept)
     assert len(a) > 0 and np.array_equal(np.sort(a, axis=0), np.sort(b, axis=0))
 
+
+
+def test_rest_voxels_of_a_volume_in_any_memory_order():
+    """A Reconstruction built by hand may hold an x-slowest (C-ordered [x, y, z]) array: the same
+    voxels, grouped by bone, in x-fastest order within each."""
+    from volanim_core.reconstruct.breakage import rest_voxels
+    from volanim_core.reconstruct.engine import Reconstruction
+
+    vol = np.zeros((5, 4, 3), np.uint8)
+    vol[1, 2, 0] = 2
+    vol[4, 0, 2] = 1
+    vol[0, 3, 1] = 2
+    for v in (vol, np.asfortranarray(vol)):
+        points, bone = rest_voxels(Reconstruction(v, (10, 20, 30)))
+        assert points.tolist() == [[14, 20, 32], [11, 22, 30], [10, 23, 31]] and bone.tolist() == [0, 1, 1]
