@@ -13,7 +13,7 @@ from volanim_core import samples
 from volanim_core.io import read_mskel, read_volume_grid
 from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter
-from volanim_core.skeleton.hull import LOD_FACES, display_hull
+from volanim_core.skeleton.hull import display_hulls
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 from volanim_core.volume import fill_cavities, threshold
 
@@ -46,10 +46,9 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     else:
         skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, progress=sub, cancel=cancel)
     report(80, 100)
-    verts, faces = display_hull(mask)
-    lod = display_hull(mask, LOD_FACES) if len(faces) > LOD_FACES else None  # drawn while a slider is held
+    hull, lod = display_hulls(mask)  # lod: drawn while a slider is held
     report(100, 100)
-    return {"volume": volume, "mask": mask, "skeleton": skel, "hull": (verts, faces), "hull_lod": lod,
+    return {"volume": volume, "mask": mask, "skeleton": skel, "hull": hull, "hull_lod": lod,
             "skeleton_path": skeleton_path,
             "segmentation": {"lo": lo, "hi": hi, "fill": fill, "metric": metric, "min_thinness": min_thinness}}
 

@@ -78,17 +78,28 @@ DISPLAY_FACES = 250_000
 LOD_FACES = 30_000
 
 
-def display_hull(mask, max_faces: int = DISPLAY_FACES) -> tuple[np.ndarray, np.ndarray]:
+def display_hull(mask, max_faces: int = DISPLAY_FACES, surface=None) -> tuple[np.ndarray, np.ndarray]:
     """The hull to draw: :func:`isosurface`, or -- when that has more than ``max_faces``
     triangles -- the 0.5 isosurface of the mask averaged over ``f^3`` blocks, with the
     smallest ``f`` that fits (triangles fall as ``1/f^2``). Same voxel frame; the
-    surface stays where the object's boundary is, only coarser."""
-    verts, faces = isosurface(mask)
+    surface stays where the object's boundary is, only coarser. ``surface``: the mask's
+    :func:`isosurface`, when the caller has it already."""
+    verts, faces = isosurface(mask) if surface is None else surface
     f = max(2, int(np.ceil(np.sqrt(len(faces) / max_faces))))
     while len(faces) > max_faces:
         verts, faces = _block_isosurface(mask, f)
         f += 1
     return verts, faces
+
+
+def display_hulls(mask) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray] | None]:
+    """The studio's hull (:func:`display_hull`) and its level of detail for frames drawn while a
+    slider is held (at most ``LOD_FACES`` triangles; None when the hull has no more), from one
+    isosurface of the mask."""
+    surface = isosurface(mask)
+    hull = display_hull(mask, DISPLAY_FACES, surface)
+    lod = display_hull(mask, LOD_FACES, surface) if len(hull[1]) > LOD_FACES else None
+    return hull, lod
 
 
 def _block_isosurface(mask, f: int) -> tuple[np.ndarray, np.ndarray]:

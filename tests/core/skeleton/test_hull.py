@@ -62,3 +62,17 @@ def test_display_hull_is_the_hull_until_it_is_too_large():
     inner = v[:, 2] > 6  # the ball's part away from the slab
     assert np.abs(r[inner] - 17.3).max() < 1.5  # same place, within the block size
     assert np.allclose(v.min(0), full[0].min(0), atol=1.5) and np.allclose(v.max(0), full[0].max(0), atol=1.5)
+
+
+def test_display_hulls_give_a_level_of_detail_only_for_a_heavy_hull():
+    from volanim_core.skeleton import hull
+
+    g = np.indices((60, 50, 40)) - np.array([30, 25, 20])[:, None, None, None]
+    ball = (g**2).sum(0) < 17.3**2
+    (v, f), lod = hull.display_hulls(ball)
+    assert len(f) < hull.LOD_FACES and lod is None  # ~14 k triangles: light enough to drag with
+    big = np.kron(ball, np.ones((2, 2, 2), bool))  # 4x the triangles
+    (v, f), lod = hull.display_hulls(big)
+    assert len(f) == len(isosurface(big)[1]) > hull.LOD_FACES
+    assert lod is not None and 0 < len(lod[1]) <= hull.LOD_FACES
+    assert np.allclose(lod[0].min(0), v.min(0), atol=3.0) and np.allclose(lod[0].max(0), v.max(0), atol=3.0)
