@@ -35,6 +35,16 @@ class Reporter:
             self._progress(done, total)
 
 
+def stage(progress: ProgressFn | None, start: int, stop: int, total: int = 100) -> ProgressFn:
+    """One stage's ``progress(done, of)`` drawn on ``start..stop`` of a whole job's ``total``: a job
+    of several stages shows one bar that only moves forward. ``progress`` may be a
+    :class:`Reporter` (its cancel check then runs at each of the stage's steps) or None."""
+    def report(done: int, of: int) -> None:
+        if progress is not None:
+            progress(start + (stop - start) * done // max(of, 1), total)
+    return report
+
+
 class TextProgress:
     """A one-line progress bar on stderr (redrawn at most 10 times a second)."""
 

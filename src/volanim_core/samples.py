@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.progress import stage
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
 NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog")
@@ -328,9 +329,8 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         for src, dst in zip((clip, clip.with_name(f"{clip.name}.LICENSE")), written):
             atomic_write_bytes(dst, src.read_bytes())
         return written
-    report = progress or (lambda done, total: None)
     # mannequin-large: the body is the first 20 %, its .connect's skeleton the rest
-    sample = mannequin_large(lambda d, t: report(20 * d // t, 100)) if name == "mannequin-large" else load(name)
+    sample = mannequin_large(stage(progress, 0, 20)) if name == "mannequin-large" else load(name)
     written = [folder / f"{name}.VOL"]
     write_raw(written[0], sample.volume)
     if sample.bones is not None:
@@ -341,7 +341,5 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         from volanim_core.io import write_connect
 
         written.append(folder / f"{name}.connect")
-        conn = part_connectivity(sample, progress=lambda d, t: report(20 + 80 * d // max(t, 1), 100))
-        write_connect(written[-1], conn)
-        report(100, 100)
+        write_connect(written[-1], part_connectivity(sample, progress=stage(progress, 20, 100)))
     return written

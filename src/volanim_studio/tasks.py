@@ -12,7 +12,7 @@ import numpy as np
 from volanim_core import samples
 from volanim_core.io import read_mskel, read_volume_grid
 from volanim_core.io.volume_files import is_colour, to_grey
-from volanim_core.progress import Reporter
+from volanim_core.progress import Reporter, stage
 from volanim_core.skeleton.hull import display_hulls
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 from volanim_core.volume import fill_cavities, threshold
@@ -38,13 +38,11 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
         raise ValueError(f"no voxel lies in the threshold range {lo}..{hi if hi is not None else 'max'}")
     report(10, 100)
 
-    def sub(done, total):  # skeletonize's progress mapped onto 10..80 %
-        report(10 + int(70 * done / max(total, 1)), 100)
-
     if skeleton_path:
         skel = read_mskel(skeleton_path)
     else:
-        skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, progress=sub, cancel=cancel)
+        skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, progress=stage(report, 10, 80),
+                           cancel=cancel)
     report(80, 100)
     hull, lod = display_hulls(mask)  # lod: drawn while a slider is held
     report(100, 100)

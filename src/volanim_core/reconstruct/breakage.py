@@ -291,7 +291,7 @@ def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
     order within a bone. Pose-independent, so a caller reporting on many poses makes them once."""
     zyx = np.asarray(rest_bone.volume).T  # C-contiguous for a reconstruction
     counts, _ = _label_stats(zyx, int(zyx.max()) if zyx.size else 0)
-    start, voxels = _piece_voxels(zyx, counts, 0)  # two passes, no grid-sized temporaries
+    _, voxels = _piece_voxels(zyx, counts, 0)  # two passes, no grid-sized temporaries
     bone = np.repeat(np.arange(len(counts) - 1), counts[1:])
     return voxels[:, ::-1] + np.asarray(rest_bone.origin), bone
 

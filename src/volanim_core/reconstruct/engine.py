@@ -271,9 +271,10 @@ def reconstruct(
         check_neighbours(neighbours, len(tskel))
     tskel, order = file_ordered(tskel)
     posed = posed_centres(tskel)
-    check_reach(posed, _extent(tskel), " once posed")
-    if bounds is None:
+    if bounds is None:  # grid_bounds checks the posed reach itself
         bounds = grid_bounds(tskel, padding, centres=[posed]) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
+    else:
+        check_reach(posed, _extent(tskel), " once posed")
     if min(bounds.shape) < 1:
         raise ValueError(f"empty output bounds {bounds.lo}..{bounds.hi}: each upper bound must be >= its lower bound")
     origin = np.asarray(bounds.lo, np.float64)
