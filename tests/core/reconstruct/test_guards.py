@@ -100,3 +100,12 @@ def test_skeletonize_refuses_a_nan_minimum_thinness():
     with pytest.raises(ValueError, match="min_thinness is NaN"):
         skeletonize(ball, min_thinness=float("nan"))
     assert len(skeletonize(ball, min_thinness=-np.inf)) == int(ball.sum())
+
+
+@pytest.mark.parametrize("bounds", [None, Bounds((0, 0, 0), (9, 9, 9))])
+def test_a_pose_that_carries_a_sphere_out_of_reach_is_refused_with_or_without_bounds(bounds):
+    """The posed reach is checked once a call: by grid_bounds when it makes the bounds, by the call
+    itself when the caller gives them."""
+    far = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1e300, 0, 0, 1]]
+    with pytest.raises(ValueError, match="once posed .* reaches"):
+        reconstruct(frame([[5, 5, 5]], [2.0], far), bounds=bounds)
