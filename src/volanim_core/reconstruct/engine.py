@@ -64,8 +64,8 @@ class Reconstruction:
     origin : (3,) ints
         Voxel ``[0, 0, 0]`` of ``volume`` is voxel ``origin`` of the rest frame.
     stats : dict
-        ``spheres``, ``filled`` (voxels), ``visits`` (sphere-voxel visits),
-        ``overdraw`` (visits / filled), ``clipped`` (sphere voxels outside
+        ``spheres``, ``filled`` (voxels), ``visits`` (voxels the spheres
+        examined: the kernel's work), ``overdraw`` (visits / filled), ``clipped`` (sphere voxels outside
         given bounds), ``seconds``; hotspot adds ``hotspot_max`` and
         ``hotspot_mean`` (over covered voxels).
     """
