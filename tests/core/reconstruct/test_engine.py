@@ -129,6 +129,30 @@ def test_overdraw_cut_on_large_rotated_spheres_changes_nothing_but_visits(rng):
     assert (cut.volume == want)[~ties].all()
 
 
+def test_visits_are_the_voxels_examined_and_filled_the_voxels_won():
+    """A small sphere sweeps the x-box of each slice's disc (every voxel strictly within the disc's
+    half-width of the centre) on the rows that cross the disc: ``visits`` counts those voxels, corners
+    outside the sphere included (the kernel's work), while ``filled`` counts only the voxels won."""
+    bone = [RootBone((0, 0, 0), (1, 0, 0))]
+    c, r2 = np.array([10.3, 10.6, 10.2]), 7.0
+    m = np.eye(4)
+    m[3, :3] = c - 10  # a centre off the voxels, so the boxes hold corners outside the sphere
+    t = Tskel(bone, m[None], [[10, 10, 10]], [np.sqrt(r2)], None, [0])
+    b = Bounds((0, 0, 0), (20, 20, 20))
+    r = reconstruct(t, mode="bone", bounds=b)
+    x = np.arange(21.0)
+    examined = 0
+    for z in x:
+        for y in x:
+            rest = r2 - (z - c[2]) ** 2  # the slice disc's squared half-width
+            if (y - c[1]) ** 2 + (z - c[2]) ** 2 < r2:
+                examined += int(((x - c[0]) ** 2 < rest).sum())
+    inside = ((x[:, None, None] - c[0]) ** 2 + (x[None, :, None] - c[1]) ** 2
+              + (x[None, None, :] - c[2]) ** 2 < r2).sum()
+    assert r.stats["filled"] == inside == (r.volume > 0).sum()
+    assert r.stats["visits"] == examined > inside
+
+
 def test_a_plane_along_y_or_z_cuts_rows_or_whole_slices_exactly():
     """Neighbours straight above (z), beside (y) and ahead (x): a bisector parallel to the rows
     cuts whole rows, one parallel to the slices cuts whole slices, one across the rows cuts runs."""
