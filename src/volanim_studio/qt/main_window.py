@@ -85,7 +85,8 @@ class MainWindow(QMainWindow):
         self.resize(1400, 900)
         # Frames are drawn when the model changes (SceneView.render), not on pyvistaqt's 5 Hz timer:
         # with software GL each unasked frame of a large cloud costs 0.2-0.6 s of the GUI thread.
-        # No multisampling: 8x MSAA costs software GL ~30 % a frame; FXAA smooths edges for ~1 ms.
+        # No multisampling: 8x MSAA costs software GL ~30 % a frame. FXAA smooths edges instead (~16 ms
+        # of a frame with the hull at 1200x800 on software GL; the scene drops it while a slider is held).
         self.plotter = QtInteractor(self, auto_update=False, multi_samples=0)
         self.plotter.enable_anti_aliasing("fxaa")
         self.setCentralWidget(self.plotter.interactor if hasattr(self.plotter, "interactor") else self.plotter)

@@ -31,8 +31,8 @@ def test_thinness_slider_shows_the_prefix(window):
 
 
 def test_a_held_slider_draws_fewer_points_and_a_coarser_hull(window, monkeypatch):
-    """While the thinness slider is held: a spread subset of the points and the coarse hull
-    (software GL spends most of such a frame on them); on release, everything again."""
+    """While the thinness slider is held: a spread subset of the points, the coarse hull and no FXAA
+    pass (software GL spends most of such a frame on them); on release, everything again."""
     from volanim_core.skeleton.hull import LOD_FACES
     from volanim_studio.scene import view
 
@@ -42,11 +42,15 @@ def test_a_held_slider_draws_fewer_points_and_a_coarser_hull(window, monkeypatch
     assert full_faces > LOD_FACES and doc.hull_lod is not None and len(doc.hull_lod[1]) <= LOD_FACES
     panel.thinness_slider.setValue(0)
     assert scene.shown_points == doc.visible_count > 1000 and scene.hull.drawn_faces == full_faces
+    renderer = window.plotter.renderer
+    assert renderer.GetUseFXAA()
     panel.thinness_slider.sliderPressed.emit()
     panel.thinness_slider.setValue(100)
     assert scene.shown_points == min(1000, doc.visible_count) and scene.hull.drawn_faces == len(doc.hull_lod[1])
+    assert not renderer.GetUseFXAA()
     panel.thinness_slider.sliderReleased.emit()
     assert scene.shown_points == doc.visible_count and scene.hull.drawn_faces == full_faces
+    assert renderer.GetUseFXAA()
 
 
 def test_a_change_draws_one_frame_and_an_idle_window_draws_none(qtbot, window):
