@@ -1,9 +1,10 @@
 """A sequence on disk: an OME-Zarr time series plus an append-only manifest of finished frames.
 
     OUT.zarr/zarr.json            group; attributes "ome" (NGFF 0.5 multiscales: t, z, y, x) and "volanim"
-    OUT.zarr/0/                   the array (T, Z, Y, X); 64^3 chunks inside shards (1, Z, Y, X): one shard
+    OUT.zarr/0/                   the array (T, Z, Y, X); 128^3 chunks inside shards (1, Z, Y, X): one shard
                                   per frame, so no two tasks ever write the same shard (concurrent writes
-                                  into one shard silently lose data); all-zero chunks are not stored
+                                  into one shard silently lose data); chunks outside the box a frame's
+                                  body reaches are never written (a walk's shared grid is mostly empty)
     OUT.zarr/volanim-plan.json    what was asked (the plan's key), written once, atomically
     OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes, stats
 
@@ -32,9 +33,18 @@ def frame_checksum(part_zyx: np.ndarray, region=None) -> str:
     return h.hexdigest()
 
 
-def chunk_shape(shape_zyx, edge: int = 64) -> tuple[int, int, int]:
+# 128, not 64: zarr spends ~0.4 ms per chunk written, whatever its size -- a frog frame's 168 chunks
+# of 64^3 cost 4x its 21 of 128^3 (measured: 78 vs 34 ms a frame), for 7 % more bytes on disk
+CHUNK_EDGE = 128
+# Every chunk of the box a task writes is stored, zeros included: zarr's check for an all-zero
+# chunk (write_empty_chunks=False) took more than half of a frame's write (np.array_equal per
+# chunk), and the box is already the part of the grid a body reaches, so few of its chunks are empty.
+WRITE_CONFIG = {"write_empty_chunks": True}
+
+
+def chunk_shape(shape_zyx, edge: int = CHUNK_EDGE) -> tuple[int, int, int]:
     """Bricks of ``edge`` voxels (fewer along a shorter axis): a posed body fills a small part of a
-    sequence's shared grid, and bricks it does not touch are all zero, so they are never written."""
+    sequence's shared grid, and bricks it does not reach are never written."""
     return tuple(int(max(1, min(n, edge))) for n in shape_zyx)
 
 
@@ -65,7 +75,7 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     # a shard holds whole chunks: round it up (past the array's edge), still exactly one per frame
     shard = tuple(-(-n // c) * c for n, c in zip((z, y, x), chunks))
     root.create_array("0", shape=(n_frames, z, y, x), dtype=dtype, chunks=(1, *chunks), shards=(1, *shard),
-                      fill_value=0, dimension_names=("t", "z", "y", "x"), config={"write_empty_chunks": False})
+                      fill_value=0, dimension_names=("t", "z", "y", "x"), config=WRITE_CONFIG)
     atomic_write_text(path / PLAN_FILE, json.dumps(plan, indent=1))
     (path / FRAMES_FILE).write_bytes(b"")
 
@@ -110,7 +120,8 @@ def open_frames(path: str | Path, mode: str = "r"):
     """The ``(T, Z, Y, X)`` zarr array of a sequence."""
     import zarr
 
-    return zarr.open_array(str(Path(path) / "0"), mode=mode)
+    array = zarr.open_array(str(Path(path) / "0"), mode=mode)
+    return array if mode == "r" else array.with_config(WRITE_CONFIG)  # runtime config: not kept in the store
 
 
 def read_frame(path: str | Path, index: int) -> np.ndarray:

@@ -12,7 +12,9 @@ so each worker computes them once per DT scale and keeps them.
 
 from __future__ import annotations
 
+import os
 import resource
+import socket
 import time
 from dataclasses import dataclass
 
@@ -22,7 +24,7 @@ from volanim_core.rig.connectivity import Connectivity
 from volanim_core.volume import Bounds
 
 from .frames import FrameSpec
-from .store import frame_checksum, open_frames
+from .store import CHUNK_EDGE, frame_checksum, open_frames
 
 
 @dataclass
@@ -47,7 +49,7 @@ def install(payload: Payload) -> None:
     _INSTALLED = payload
 
 
-def occupied(zyx: np.ndarray, edge: int = 64) -> tuple[slice, slice, slice]:
+def occupied(zyx: np.ndarray, edge: int = CHUNK_EDGE) -> tuple[slice, slice, slice]:
     """The ``[z, y, x]`` slices holding every filled voxel of a frame, widened to whole
     ``edge``-voxel chunks (outside them the frame is zero)."""
     out = []
@@ -58,6 +60,14 @@ def occupied(zyx: np.ndarray, edge: int = 64) -> tuple[slice, slice, slice]:
         lo, hi = int(filled[0]) // edge * edge, int(filled[-1]) + 1
         out.append(slice(lo, hi))
     return tuple(out)
+
+
+def reach_box(tskel, shared: Bounds) -> Bounds:
+    """The part of the shared grid a frame's spheres can fill: their bounding box (no padding)."""
+    from volanim_core.reconstruct.engine import grid_bounds
+
+    own = grid_bounds(tskel, 0)
+    return Bounds(tuple(map(max, own.lo, shared.lo)), tuple(map(min, own.hi, shared.hi)))
 
 
 def frame_file(pattern: str, number: int) -> str:
@@ -87,27 +97,35 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
         raise RuntimeError("reconstruct_frame: no payload (the pool's initializer did not run)")
     t0 = time.perf_counter()
     tskel = spec.tskel(p.conn)
+    # A pose is reconstructed in the box its spheres reach, not the whole shared grid: a voxel's value
+    # depends only on the spheres that cover it, so the box is the shared grid's frame cut out (the
+    # walk's grid is 5x its body's box). A crumble's heap falls to the floor: it needs the whole grid.
+    box = p.bounds if spec.crumble else reach_box(tskel, p.bounds)
     r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
-                    bounds=p.bounds, threads=p.threads)  # neighbour lists: remembered per connectivity
-    volume = r.volume
+                    bounds=box, threads=p.threads)  # neighbour lists: remembered per connectivity
+    zyx = r.volume.T  # the engine's own [z, y, x] array: C-contiguous, no copy
     if spec.crumble:
         from .effects import fall
 
-        volume = fall(volume, spec.crumble, spec.down)
-    zyx = np.ascontiguousarray(volume.T)
-    region = occupied(zyx)
-    part = zyx[region]
+        zyx = np.ascontiguousarray(fall(r.volume, spec.crumble, spec.down).T)
+        region = occupied(zyx)
+        part = zyx[region]
+    else:
+        region = tuple(slice(lo - s, hi - s + 1) for lo, hi, s in zip(box.lo[::-1], box.hi[::-1], p.bounds.lo[::-1]))
+        part = zyx
     # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
     # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)
     open_frames(p.store, "r+")[(index, *region)] = part
     if p.every_frame_as:
         from volanim_core import io
 
-        io.write_output(frame_file(p.every_frame_as, spec.number), volume, origin=r.origin)
+        whole = np.zeros(p.bounds.shape[::-1], part.dtype)  # per-frame files line up too: the shared grid
+        whole[region] = part
+        io.write_output(frame_file(p.every_frame_as, spec.number), whole.T, origin=p.bounds.lo)
     s = r.stats
     return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
             "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),
             "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
             "dt_scale": round(float(np.mean(spec.dt_scale)), 6), "crumble": spec.crumble,
-            "seconds": round(time.perf_counter() - t0, 4),
+            "seconds": round(time.perf_counter() - t0, 4), "worker": f"{socket.gethostname()}:{os.getpid()}",
             "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
