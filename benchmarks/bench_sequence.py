@@ -143,7 +143,8 @@ def main() -> None:
                          f"{two['fps']:.2f} / {two['steady']:.2f}", f"{dask['fps']:.2f} / {dask['steady']:.2f}",
                          f"{two['steady'] / one['steady']:.2f}", f"{100 * overhead:+.0f} %",
                          f"{max(two['peak'], dask['peak']) / 2**20:.0f}", f"{two['size'] / 2**20:.1f}"])
-            large = (case, one, two)
+            if make is large_case:
+                large = (case, one, two)
     print("\nsequence, sampled mode, 2 cores; frames/s as whole run (with worker start-up) / steady state "
           "(once every worker has made its first frame)")
     print(f"best of {ROUNDS} interleaved rounds each; this machine's own 2-vs-1 throughput on pure CPU work "

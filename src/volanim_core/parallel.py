@@ -19,6 +19,7 @@ import os
 import sys
 from concurrent.futures import Future
 from contextlib import contextmanager
+from functools import cache
 
 
 @contextmanager
@@ -59,6 +60,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
             pool.shutdown(wait=True, cancel_futures=True)
 
 
+@cache  # once per process
 def keep_freed_memory() -> None:
     """Let this process's malloc keep freed memory for the next frame, as glibc does by default.
 
@@ -83,9 +85,6 @@ def keep_freed_memory() -> None:
     libc.mallopt(m_trim_threshold, 64 << 20)
 
 
-_TUNED = False
-
-
 def _start_worker(install, payload) -> None:
     """A local pool worker's initializer."""
     keep_freed_memory()
@@ -94,10 +93,7 @@ def _start_worker(install, payload) -> None:
 
 def _on_dask_worker(task, *args):
     """A task on a Dask worker (the first one there tunes malloc for the rest)."""
-    global _TUNED
-    if not _TUNED:
-        keep_freed_memory()
-        _TUNED = True
+    keep_freed_memory()
     return task(*args)
 
 

@@ -43,15 +43,32 @@ class SequenceReport:
     workers: str = ""
 
 
-def shared_bounds(conn: Connectivity, frames: list[FrameSpec], padding: int = 2) -> Bounds:
+def shared_bounds(conn: Connectivity, frames: list[FrameSpec], padding: int = 2,
+                  boxes: list[Bounds] | None = None) -> Bounds:
     """One output grid holding every frame (the old ``tskelbounds`` over all of them), and room
-    on the floor for a crumble's heap."""
-    bounds = grid_bounds([f.tskel(conn) for f in frames], padding)
+    on the floor for a crumble's heap. ``boxes``: the frames' :func:`frame_boxes`, when made already."""
+    boxes = frame_boxes(conn, frames) if boxes is None else boxes
+    # the union of the unpadded boxes, padded: exactly grid_bounds(every frame, padding)
+    bounds = Bounds(tuple(min(b.lo[a] for b in boxes) - padding for a in range(3)),
+                    tuple(max(b.hi[a] for b in boxes) + padding for a in range(3)))
     crumbles = [f for f in frames if f.crumble]
     if crumbles:
         room = heap_room(conn, crumbles[0], padding)
         bounds = Bounds(tuple(map(min, bounds.lo, room.lo)), tuple(map(max, bounds.hi, room.hi)))
     return bounds
+
+
+def frame_boxes(conn: Connectivity, frames: list[FrameSpec]) -> list[Bounds]:
+    """Each frame's posed spheres' bounding box, unpadded: the part of the grid the frame can fill."""
+    return [grid_bounds(f.tskel(conn), 0) for f in frames]
+
+
+def frame_grids(frames: list[FrameSpec], boxes: list[Bounds], bounds: Bounds) -> list[Bounds]:
+    """The grid each frame is reconstructed in: its box inside the shared grid (a voxel's value depends
+    only on the spheres covering it, so that is the shared grid's frame cut out; a walk's grid is 5x
+    its body's box), or the whole grid for a crumble, whose heap falls to the floor."""
+    return [bounds if f.crumble else Bounds(tuple(map(max, b.lo, bounds.lo)), tuple(map(min, b.hi, bounds.hi)))
+            for f, b in zip(frames, boxes)]
 
 
 def heap_room(conn: Connectivity, spec: FrameSpec, padding: int) -> Bounds:
@@ -87,7 +104,8 @@ def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int
 
 
 def check_memory(bounds: Bounds, dtype: np.dtype, workers: int, source) -> int:
-    """Bytes one frame needs; refuse (ValueError) when ``workers`` of them cannot fit, saying how large."""
+    """Bytes the frame grid ``bounds`` needs (give the largest); refuse (ValueError) when ``workers`` of
+    them cannot fit, saying how large."""
     voxels = int(np.prod(bounds.shape, dtype=np.int64))
     per_frame = voxels * (2 * dtype.itemsize + 4)  # output + stencil (float32) + the copy written out
     check_output_grid(bounds.shape, 2 * dtype.itemsize + 4)  # the voxel limit, and one frame at all
@@ -132,11 +150,13 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                          "render it with the palette's transfer function ('volanim alpha merge', render --tf)")
     t0 = time.perf_counter()
     out = Path(out)
-    bounds = shared_bounds(conn, frames, padding)
+    boxes = frame_boxes(conn, frames)  # each frame posed once, here
+    bounds = shared_bounds(conn, frames, padding, boxes)
+    grids = frame_grids(frames, boxes, bounds)
     dtype = output_dtype(mode, len(conn.bones), None if source is None else source.dtype)
     n_workers = workers or 1
     if scheduler is None:
-        check_memory(bounds, dtype, n_workers, source)
+        check_memory(max(grids, key=lambda g: np.prod(g.shape, dtype=np.int64)), dtype, n_workers, source)
     key = plan_key(conn, frames, mode, kernel, padding, source)
     plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
             "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
@@ -168,7 +188,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
         while queue or pending:  # two frames per worker in flight: frames finish about in order
             while queue and len(pending) < 2 * max(running, 1):
                 i = queue.pop(0)
-                pending.add(submit(i, frames[i]))
+                pending.add(submit(i, frames[i], grids[i]))
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:
                 rec = fut.result()

@@ -3,7 +3,7 @@
     Payload (connectivity, source, mode, shared bounds, store path)
         --local pool: handed to each worker process once (initializer)
         --Dask: scattered to every worker once, passed to each task as a future
-    reconstruct_frame(payload, index, spec) --> writes shard ``index`` of the zarr store
+    reconstruct_frame(payload, index, spec, grid) --> writes shard ``index`` of the zarr store
         (+ the optional per-frame file) --> returns statistics, never the voxels
 
 Neighbour lists depend on the connectivity and the radii, not on the pose,
@@ -62,14 +62,6 @@ def occupied(zyx: np.ndarray, edge: int = CHUNK_EDGE) -> tuple[slice, slice, sli
     return tuple(out)
 
 
-def reach_box(tskel, shared: Bounds) -> Bounds:
-    """The part of the shared grid a frame's spheres can fill: their bounding box (no padding)."""
-    from volanim_core.reconstruct.engine import grid_bounds
-
-    own = grid_bounds(tskel, 0)
-    return Bounds(tuple(map(max, own.lo, shared.lo)), tuple(map(min, own.hi, shared.hi)))
-
-
 def frame_file(pattern: str, number: int) -> str:
     """``DIR/NAME.%04d.vti`` with the frame number filled in."""
     return pattern % number
@@ -88,8 +80,9 @@ def check_frame_pattern(pattern: str) -> None:
         raise ValueError(f"--every-frame-as {pattern!r} must end in .vti, .nrrd or .vol/.VOL")
 
 
-def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> dict:
-    """Reconstruct ``spec`` into frame ``index`` of the store; returns its statistics."""
+def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid: Bounds) -> dict:
+    """Reconstruct ``spec`` in ``grid`` (its part of the shared grid: ``run.frame_grids``) into frame
+    ``index`` of the store; returns its statistics."""
     from volanim_core.reconstruct.engine import reconstruct
 
     p = payload if payload is not None else _INSTALLED
@@ -97,12 +90,8 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
         raise RuntimeError("reconstruct_frame: no payload (the pool's initializer did not run)")
     t0 = time.perf_counter()
     tskel = spec.tskel(p.conn)
-    # A pose is reconstructed in the box its spheres reach, not the whole shared grid: a voxel's value
-    # depends only on the spheres that cover it, so the box is the shared grid's frame cut out (the
-    # walk's grid is 5x its body's box). A crumble's heap falls to the floor: it needs the whole grid.
-    box = p.bounds if spec.crumble else reach_box(tskel, p.bounds)
     r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
-                    bounds=box, threads=p.threads)  # neighbour lists: remembered per connectivity
+                    bounds=grid, threads=p.threads)  # neighbour lists: remembered per connectivity
     zyx = r.volume.T  # the engine's own [z, y, x] array: C-contiguous, no copy
     if spec.crumble:
         from .effects import fall
@@ -111,7 +100,7 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec) -> d
         region = occupied(zyx)
         part = zyx[region]
     else:
-        region = tuple(slice(lo - s, hi - s + 1) for lo, hi, s in zip(box.lo[::-1], box.hi[::-1], p.bounds.lo[::-1]))
+        region = tuple(slice(lo - o, hi - o + 1) for lo, hi, o in zip(grid.lo[::-1], grid.hi[::-1], p.bounds.lo[::-1]))
         part = zyx
     # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
     # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)

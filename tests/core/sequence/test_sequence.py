@@ -22,7 +22,7 @@ from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
 from volanim_core.sequence.effects import melt
 from volanim_core.sequence.frames import frames_from_files
-from volanim_core.sequence.run import run_sequence, shared_bounds
+from volanim_core.sequence.run import frame_boxes, frame_grids, run_sequence, shared_bounds
 
 CONNECT = ASSETS / "mannequin.0.50.connect"
 
@@ -80,6 +80,19 @@ def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_gri
     assert [a["name"] for a in ms["axes"]] == ["t", "z", "y", "x"] and ms["datasets"][0]["path"] == "0"
     translation = ms["datasets"][0]["coordinateTransformations"][1]["translation"]
     assert translation == [0.0, *map(float, bounds.lo[::-1])]
+
+
+def test_a_run_that_cannot_fit_says_how_large_its_largest_frame_is(tmp_path, conn, walk):
+    """A frame is reconstructed in its own box of the shared grid, so that box (not the walk's whole
+    grid) is what each worker needs; the refusal comes before anything is written."""
+    bounds = shared_bounds(conn, walk)
+    grids = frame_grids(walk, frame_boxes(conn, walk), bounds)
+    largest = max(grids, key=lambda g: np.prod(g.shape))
+    assert all(np.all(np.greater_equal(g.lo, bounds.lo)) and np.all(np.less_equal(g.hi, bounds.hi)) for g in grids)
+    assert np.prod(largest.shape) < np.prod(bounds.shape)  # the body's box is smaller than the walk's grid
+    with pytest.raises(ValueError, match=rf"each frame needs .* \(grid {'x'.join(map(str, largest.shape))} = "):
+        run_sequence(conn, walk, tmp_path / "s.zarr", mode="bone", workers=10**6)
+    assert not (tmp_path / "s.zarr").exists()
 
 
 # spec: docs/formats.md#zarr
