@@ -120,16 +120,17 @@ def main(argv=None) -> int:
     p.add_argument("names", nargs="*", help=f"regions (default all): commands {' '.join(SCRIPTS)}")
     p.add_argument("--check", action="store_true", help="report regions that differ; write nothing")
     args = p.parse_args(argv)
-    text = README.read_text(encoding="utf-8")
-    names = args.names or list(regions(text))
-    stale = []
+    names = args.names or list(regions(README.read_text(encoding="utf-8")))
+    bodies = {}
     for name in names:
         print(f"make docs: {name} ...", end=" ", flush=True)
         t0 = time.perf_counter()
-        body = generate(name)
+        bodies[name] = generate(name)
         print(f"{time.perf_counter() - t0:.0f} s", flush=True)
-        if regions(text).get(name) != body:
-            stale.append(name)
+    # read again now: the benchmarks take minutes, and prose edited meanwhile must not be lost
+    text = README.read_text(encoding="utf-8")
+    stale = [name for name, body in bodies.items() if regions(text).get(name) != body]
+    for name, body in bodies.items():
         text = replace_region(text, name, body)
     if args.check:
         if stale:

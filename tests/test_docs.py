@@ -68,3 +68,27 @@ def test_the_readme_commands_table_is_what_make_docs_writes():
     new = update.replace_region(text, "commands", "| a |\n")
     assert update.regions(new)["commands"] == "| a |\n" and update.regions(new)["thesis_tables"] == \
         regions["thesis_tables"]
+
+
+def test_make_docs_keeps_prose_edited_while_the_benchmarks_ran(tmp_path, monkeypatch):
+    """The benchmarks take minutes; make docs read the README before them and wrote that text back
+    with the new tables, losing any edit made meanwhile."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("update_readme", REPO / "docs" / "update_readme.py")
+    update = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(update)
+    readme = tmp_path / "README.md"
+    readme.write_text("intro\n<!-- make docs: commands -->\nold\n<!-- end: commands -->\n", encoding="utf-8")
+    monkeypatch.setattr(update, "README", readme)
+    real = update.generate
+
+    def generate_while_someone_edits(name):
+        body = real(name)
+        readme.write_text(readme.read_text(encoding="utf-8").replace("intro", "intro, edited"), encoding="utf-8")
+        return body
+
+    monkeypatch.setattr(update, "generate", generate_while_someone_edits)
+    assert update.main(["commands"]) == 0
+    text = readme.read_text(encoding="utf-8")
+    assert text.startswith("intro, edited\n") and update.regions(text)["commands"] == update.commands_table()

@@ -1,7 +1,9 @@
 """Where many independent tasks run: this process, a local process pool, or a Dask cluster.
 
-    with executor(task, payload, install, workers=N, scheduler=None) as (submit, label, n):
+    with executor(task, payload, install, workers=N, scheduler=None) as (submit, label, in_flight):
         futures = [submit(*args) for args in work]      # task(payload, *args) runs somewhere
+        # keep ``in_flight`` submitted and not yet collected: 2 per worker (one running, one queued so no
+        # worker waits on the driver), 1 in this process (a task runs when it is submitted)
 
 One function serves frames of a sequence and frames of a render. The payload
 (what every task needs: a connectivity, a source volume, render settings) is
@@ -24,7 +26,7 @@ from functools import cache
 
 @contextmanager
 def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolate: bool = False):
-    """``(submit(*args) -> Future, description, worker count)``; see the module docstring.
+    """``(submit(*args) -> Future, description, tasks to keep in flight)``; see the module docstring.
 
     ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
     ``isolate``: never run tasks in this process, even with one worker (the studio: an OpenGL
@@ -38,7 +40,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
             shared = client.scatter(payload, broadcast=True, hash=False)  # shipped to each worker once
             ex = client.get_executor(pure=False)
             n = len(client.scheduler_info().get("workers", {}))
-            yield (lambda *args: ex.submit(_on_dask_worker, task, shared, *args)), f"Dask, {n} workers", n
+            yield (lambda *args: ex.submit(_on_dask_worker, task, shared, *args)), f"Dask, {n} workers", 2 * max(n, 1)
         finally:
             if client is not scheduler:
                 client.close()
@@ -55,7 +57,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
                              initargs=(install, payload)) as pool:
         try:
             label = f"{workers} local worker{'s' if workers > 1 else ''}"
-            yield (lambda *args: pool.submit(task, None, *args)), label, workers
+            yield (lambda *args: pool.submit(task, None, *args)), label, 2 * workers
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
 

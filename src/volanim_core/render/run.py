@@ -289,10 +289,10 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
 def _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate) -> str:
     """Draw ``todo`` anywhere; the driver writes each picture as it arrives. Returns where it ran."""
     with executor(render_task, job, install, workers=min(workers, len(todo)), scheduler=scheduler,
-                  isolate=isolate) as (submit, label, running):
+                  isolate=isolate) as (submit, label, in_flight):
         pending, queue = set(), list(todo)
-        while queue or pending:  # two frames per worker in flight: pictures arrive about in order
-            while queue and len(pending) < 2 * max(running, 1):
+        while queue or pending:  # pictures arrive about in order
+            while queue and len(pending) < in_flight:
                 pending.add(submit(queue.pop(0)))
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:

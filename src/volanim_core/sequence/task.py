@@ -5,6 +5,7 @@
         --Dask: scattered to every worker once, passed to each task as a future
     reconstruct_frame(payload, index, spec, grid) --> writes shard ``index`` of the zarr store
         (+ the optional per-frame file) --> returns statistics, never the voxels
+    reconstruct_frames(payload, [(index, spec, grid), ...]) --> several short frames as one task
 
 Neighbour lists depend on the connectivity and the radii, not on the pose,
 so each worker computes them once per DT scale and keeps them.
@@ -104,7 +105,12 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
         part = zyx
     # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
     # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)
-    open_frames(p.store, "r+")[(index, *region)] = part
+    import zarr
+
+    # zarr encodes chunks on as many threads as it may: give it the worker's cores, not the others' (its
+    # default took 1.4 cores for a large frame's write; two workers then slowed each other by 10 %)
+    with zarr.config.set({"async.concurrency": p.threads}):
+        open_frames(p.store, "r+")[(index, *region)] = part
     if p.every_frame_as:
         from volanim_core import io
 
@@ -116,5 +122,12 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
             "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),
             "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
             "dt_scale": round(float(np.mean(spec.dt_scale)), 6), "crumble": spec.crumble,
-            "seconds": round(time.perf_counter() - t0, 4), "worker": f"{socket.gethostname()}:{os.getpid()}",
+            "seconds": round(time.perf_counter() - t0, 4), "finished": round(time.time(), 4),
+            "worker": f"{socket.gethostname()}:{os.getpid()}",
             "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
+
+
+def reconstruct_frames(payload: Payload | None, work: list[tuple[int, FrameSpec, Bounds]]) -> list[dict]:
+    """Several frames as one task, in order: a Dask task costs milliseconds of scheduling on the
+    workers' own cores, as much as a small frame's reconstruction (``run.frames_per_task``)."""
+    return [reconstruct_frame(payload, index, spec, grid) for index, spec, grid in work]

@@ -68,12 +68,14 @@ class PreviewController(Controller):
 
     def drag_started(self) -> None:
         self._posing_drag = True
+        self.scene.hold_fxaa(True)
         worker = self.jobs.worker
         if worker is not None and getattr(worker, "is_preview", False):
             worker.cancel()  # a newer pose is coming
 
     def drag_finished(self) -> None:
         self._posing_drag = False
+        self.scene.hold_fxaa(False)
         if self.in_pose_mode() and len(self.doc.attachments.bone) and (self.doc.attachments.bone >= 0).any():
             self.preview()
 

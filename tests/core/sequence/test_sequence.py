@@ -22,7 +22,14 @@ from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
 from volanim_core.sequence.effects import melt
 from volanim_core.sequence.frames import frames_from_files
-from volanim_core.sequence.run import frame_boxes, frame_grids, run_sequence, shared_bounds
+from volanim_core.sequence.run import (
+    DASK_TASK_SECONDS,
+    frame_boxes,
+    frame_grids,
+    frames_per_task,
+    run_sequence,
+    shared_bounds,
+)
 
 CONNECT = ASSETS / "mannequin.0.50.connect"
 
@@ -42,21 +49,48 @@ def frames_of(path) -> list[np.ndarray]:
     return [np.asarray(f) for f in store.open_frames(path)[:]]
 
 
-def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_path, conn, walk):
-    from distributed import Client, LocalCluster
+def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_path, conn):
+    """24 short frames: Dask gets them several to a task once the first are timed (a task costs the
+    workers milliseconds of scheduling), and that changes nothing in the frames."""
+    from distributed import Client, LocalCluster, get_task_stream
 
+    walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))
     one = run_sequence(conn, walk, tmp_path / "one.zarr", mode="bone", workers=1)
     two = run_sequence(conn, walk, tmp_path / "two.zarr", mode="bone", workers=2)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster, Client(cluster) as client:
-        dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client)
+        with get_task_stream(client) as tasks:
+            dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client)
         ran_on = {w["host"] for w in client.scheduler_info()["workers"].values()}
     assert ran_on == {"127.0.0.1"} and dask.workers == "Dask, 2 workers"
+    assert 4 < len(tasks.data) < 24  # the first four alone, then batches
     a, b, c = (frames_of(tmp_path / f"{n}.zarr") for n in ("one", "two", "dask"))
-    assert len(a) == 6 and all(np.array_equal(x, y) and np.array_equal(x, z) for x, y, z in zip(a, b, c))
+    assert len(a) == 24 and all(np.array_equal(x, y) and np.array_equal(x, z) for x, y, z in zip(a, b, c))
     assert [r["sha256"] for r in one.records] == [r["sha256"] for r in dask.records]
-    assert len({r["sha256"] for r in two.records}) == 6  # the frames differ from each other
+    assert [r["index"] for r in dask.records] == list(range(24))
+    assert len({r["sha256"] for r in two.records}) == 24  # the frames differ from each other
     assert all(r["filled"] > 0 and "peak_rss" in r for r in dask.records)
+
+
+def test_one_worker_reports_each_frame_before_making_the_next(tmp_path, conn, walk):
+    """In this process a task runs when submitted: keeping two in flight made two frames before the
+    first was reported (progress came in pairs, and a kill lost a finished frame)."""
+    made_when_reported = []
+
+    def on_frame(rec, done, total):
+        made_when_reported.append(sum(bool(np.any(f)) for f in frames_of(tmp_path / "s.zarr")))
+
+    run_sequence(conn, walk[:3], tmp_path / "s.zarr", mode="binary", workers=1, on_frame=on_frame)
+    assert made_when_reported == [1, 2, 3]
+
+
+def test_frames_per_task_makes_tasks_of_the_length_asked_from_the_frames_timed_so_far():
+    assert frames_per_task([], DASK_TASK_SECONDS) == 1  # nothing timed yet
+    assert frames_per_task([0.03] * 5, 0.0) == 1  # a local pool: a task costs microseconds
+    assert frames_per_task([0.03] * 5, 0.25) == 8
+    assert frames_per_task([0.001] * 5, 0.25) == 16  # at most 16: progress and a kill's loss stay small
+    assert frames_per_task([0.6, 0.7], 0.25) == 1
+    assert frames_per_task([1.0] * 40 + [0.05] * 32, 0.25) == 5  # the recent frames (a crumble slows down)
 
 
 def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_grid(tmp_path, conn, walk):

@@ -40,6 +40,22 @@ def drag(qtbot, window, axis: int, values) -> None:
     slider.sliderReleased.emit()
 
 
+def test_a_held_pose_slider_draws_without_fxaa_and_the_release_with_it(qtbot, posed_window):
+    """FXAA is a full-window pass (~16 ms of software GL at 1200x800): a pose drag's live preview
+    draws without it, and the frame after release has it again."""
+    w = posed_window
+    renderer = w.plotter.renderer
+    w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
+    assert renderer.GetUseFXAA()
+    slider = w.pose_panel.sliders[1]
+    slider.sliderPressed.emit()
+    slider.setValue(-20)
+    assert not renderer.GetUseFXAA()
+    slider.sliderReleased.emit()
+    assert renderer.GetUseFXAA()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+
+
 def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     w = posed_window
     w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
