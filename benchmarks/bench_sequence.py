@@ -92,12 +92,25 @@ def run(case, folder: Path, **where) -> dict:
 
     name, conn, frames, source = case
     out = folder / "s.zarr"
+    before = _helper_cpu()
     rep = run_sequence(conn, frames, out, mode="sampled", source=source, force=True, **where)
+    helpers = _helper_cpu() - before
     size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
     shutil.rmtree(out)
     return {"fps": len(frames) / rep.seconds, "steady": steady_rate(rep.records),
             "peak": max(r["peak_rss"] for r in rep.records), "size": size,
-            "voxels": int(np.prod(rep.bounds.shape)), "seconds": rep.seconds}
+            "voxels": int(np.prod(rep.bounds.shape)), "seconds": rep.seconds, "helpers": helpers / rep.seconds}
+
+
+def _helper_cpu() -> float:
+    """CPU seconds of this process's threads other than the main one: with a LocalCluster, its
+    scheduler, nannies and client (one event loop thread) -- Dask's own work on the workers' cores."""
+    import threading
+
+    import psutil
+
+    main = threading.main_thread().native_id
+    return sum(t.user_time + t.system_time for t in psutil.Process().threads() if t.id != main)
 
 
 def _spin(n: int) -> float:
@@ -153,6 +166,7 @@ def main() -> None:
                          f"{one['fps']:.2f} / {one['steady']:.2f}",
                          f"{two['fps']:.2f} / {two['steady']:.2f}", f"{dask['fps']:.2f} / {dask['steady']:.2f}",
                          f"{two['steady'] / one['steady']:.2f}", f"{100 * overhead:+.0f} %",
+                         f"{100 * dask['helpers']:.0f} %",
                          f"{max(two['peak'], dask['peak']) / 2**20:.0f}", f"{two['size'] / 2**20:.1f}"])
             if make is large_case:
                 large = (case, one, two)
@@ -161,8 +175,11 @@ def main() -> None:
     print(f"best of {ROUNDS} interleaved rounds each; this machine's own 2-vs-1 throughput on pure CPU work "
           f"(same run, best of 5): {machine_scaling():.2f}x")
     print(table(rows, ["dataset", "frames", "grid M voxels", "1 worker f/s", "2 local workers f/s",
-                       "Dask 2 workers f/s", "2 vs 1 steady (>= 1.8)", "Dask vs pool (<= 10 %)", "peak MB/worker",
-                       "store MB"]))
+                       "Dask 2 workers f/s", "2 vs 1 steady (>= 1.8)", "Dask vs pool (<= 10 %)",
+                       "scheduler + nannies + client CPU", "peak MB/worker", "store MB"]))
+    print("scheduler + nannies + client CPU: this process's threads but the main one (the LocalCluster's event loop) "
+          "during the Dask run, "
+          "in % of one core -- taken from the two cores the workers run on (on a cluster it is another machine's)")
 
     # 100 frames at Visible-Human half scale: mannequin-large is that scale, so its measured cost per
     # frame on one worker is the cost; N workers make ceil(100 / N) frames each, at the 2-worker efficiency
