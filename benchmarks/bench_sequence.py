@@ -186,7 +186,7 @@ def main() -> None:
     # measured here (128 workers for 100 frames: one frame's time, not a 128th of a frame)
     case, one, two = large
     per = 1 / one["steady"]
-    efficiency = two["steady"] / one["steady"] / 2
+    efficiency = min(1.0, two["steady"] / one["steady"] / 2)  # above 1 is this VM's noise, not a promise
     ext = [[str(w), f"{per:.2f}", _duration(-(-100 // w) * per / (efficiency if w > 1 else 1)),
             f"{two['peak'] / 2**30:.1f}"] for w in (1, 2, 8, 32, 128)]
     print(f"\n100 frames at Visible-Human half scale ({case[0]}: {len(case[1]):,} spheres, a "
