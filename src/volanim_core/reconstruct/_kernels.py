@@ -85,6 +85,19 @@ def _distance(metric, dx, dy, dz, dy2, dz2):
     return 3.0 * a + b + c
 
 
+@njit(cache=True)
+def spheres_fit(centres, extents, limit):
+    """True when every sphere (centre +- extent, the extent not negative) is finite and lies within
+    ``limit`` voxels of the origin: the frame checks' fast path, one pass (on the frog the NumPy checks
+    took 4 ms of a 65 ms call); only when it fails do the callers find the point and say what is wrong."""
+    for i in range(centres.shape[0]):
+        e = extents[i]
+        reach = max(abs(centres[i, 0]), abs(centres[i, 1]), abs(centres[i, 2])) + e
+        if not (e >= 0.0 and reach <= limit):  # NaN fails both
+            return False
+    return True
+
+
 @njit(cache=True, inline="always")
 def _inside(metric, dx, dy, dz, dy2, dz2, r2, r):
     """The oracle's predicate: squared distance < r2 (Euclid) or chamfer distance < r."""

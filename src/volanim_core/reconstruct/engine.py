@@ -105,7 +105,9 @@ def check_matrices(tskel: Tskel) -> np.ndarray:
 def check_frame(tskel: Tskel) -> None:
     """Refuse points a reconstruction cannot place: NaN/infinite values, negative radii,
     and spheres that reach beyond ``MAX_COORD`` voxels."""
-    pts, dt = np.asarray(tskel.points, np.float64), np.asarray(tskel.dt, np.float64)
+    pts, dt = np.ascontiguousarray(tskel.points, np.float64), np.ascontiguousarray(tskel.dt, np.float64)
+    if K.spheres_fit(pts, dt, MAX_COORD):
+        return
     finite = np.isfinite(pts)
     bad = ~(finite[:, 0] & finite[:, 1] & finite[:, 2]) | ~np.isfinite(dt) | (dt < 0)
     if bad.any():
@@ -116,7 +118,8 @@ def check_frame(tskel: Tskel) -> None:
 
 def check_reach(centres: np.ndarray, extents: np.ndarray, where: str) -> None:
     """Every sphere (centre +- extent) must lie within ``MAX_COORD`` voxels of the origin."""
-    if not len(centres):
+    if not len(centres) or K.spheres_fit(np.ascontiguousarray(centres, np.float64),
+                                         np.ascontiguousarray(extents, np.float64), MAX_COORD):
         return
     a = np.abs(centres)
     reach = np.maximum(np.maximum(a[:, 0], a[:, 1]), a[:, 2]) + extents  # not .max(axis=1): 20x slower on (N, 3)
