@@ -195,8 +195,9 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                 pending.add(submit([(i, frames[i], grids[i]) for i in batch]))
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for fut in finished:
-                for rec in fut.result():
-                    store.record(out, rec)
+                recs = fut.result()
+                store.record(out, *recs)  # one fsync a task, not one a frame
+                for rec in recs:
                     records[rec["index"]] = rec
                     seconds.append(rec["seconds"])
                     if on_frame is not None:

@@ -8,10 +8,10 @@
     OUT.zarr/volanim-plan.json    what was asked (the plan's key), written once, atomically
     OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes, stats
 
-A frame is appended to the manifest only after its shard is written, by the
-one process that runs the sequence, in one ``write`` + ``fsync``; a killed run
-leaves at most a torn last line, which reading ignores. So a rerun skips
-exactly the frames that were complete and redoes the rest.
+A task's frames are appended to the manifest only after their shards are
+written, by the one process that runs the sequence, in one ``write`` +
+``fsync``; a killed run leaves at most a torn last line, which reading
+ignores. So a rerun skips exactly the frames that were complete and redoes the rest.
 """
 
 from __future__ import annotations
@@ -105,9 +105,9 @@ def finished(path: str | Path) -> dict[int, dict]:
     return out
 
 
-def record(path: str | Path, rec: dict) -> None:
-    """Append one finished frame: one write, then fsync (called by the driver only)."""
-    line = (json.dumps(rec, separators=(",", ":")) + "\n").encode()
+def record(path: str | Path, *recs: dict) -> None:
+    """Append finished frames (a task's): one write, then one fsync (called by the driver only)."""
+    line = b"".join((json.dumps(rec, separators=(",", ":")) + "\n").encode() for rec in recs)
     fd = os.open(Path(path) / FRAMES_FILE, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
     try:
         os.write(fd, line)

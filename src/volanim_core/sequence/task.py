@@ -100,8 +100,9 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
         zyx = np.ascontiguousarray(fall(r.volume, spec.crumble, spec.down).T)
         region = occupied(zyx)
         part = zyx[region]
-    else:
-        region = tuple(slice(lo - o, hi - o + 1) for lo, hi, o in zip(grid.lo[::-1], grid.hi[::-1], p.bounds.lo[::-1]))
+    else:  # the frame's grid, placed in the shared grid
+        placed = Bounds(tuple(np.subtract(grid.lo, p.bounds.lo)), tuple(np.subtract(grid.hi, p.bounds.lo)))
+        region = placed.slices()[::-1]
         part = zyx
     # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
     # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)
