@@ -60,9 +60,10 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     return out
 
 
-def _clipped(tskel: Connectivity, min_radius: float) -> tuple[np.ndarray, np.ndarray]:
-    """Every sphere's squared radius, and the indices of those the kernel clips (radius >= ``min_radius``)."""
-    r2 = radius_squared(tskel.dt)
+def _clipped(tskel: Connectivity, min_radius: float, r2: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every sphere's squared radius (``r2`` when the caller has it), and the indices of those the
+    kernel clips (radius >= ``min_radius``)."""
+    r2 = radius_squared(tskel.dt) if r2 is None else r2
     return r2, np.flatnonzero(r2 >= radius_squared(np.array([float(min_radius)]))[0])
 
 
@@ -71,7 +72,8 @@ _CACHE_LOCK = threading.Lock()
 CACHED_CONNECTIVITIES = 4
 
 
-def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: float = CUT_MIN_RADIUS) -> np.ndarray:
+def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: float = CUT_MIN_RADIUS, *,
+                      r2: np.ndarray | None = None) -> np.ndarray:
     """:func:`sphere_neighbours`, remembered for the last few connectivities (read-only result).
 
     A caller who reconstructs frame after frame without passing lists gets them made
@@ -80,8 +82,9 @@ def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     few thousand values on the frog, so looking up costs ~1 ms against ~25 ms to make them.
     A pose is not part of it (same-bone distances survive any pose), so every frame of a
     clip, the studio's live and full previews and the rest frame share one set.
+    ``r2``: the spheres' :func:`radius_squared`, when the caller has them.
     """
-    r2, big = _clipped(tskel, min_radius)
+    r2, big = _clipped(tskel, min_radius, r2)
     h = hashlib.blake2b(digest_size=16)
     for part in (np.array([len(tskel), k], np.int64), big, np.ascontiguousarray(tskel.points[big], np.float64),
                  r2[big], np.asarray(tskel.bone)[big].astype(np.int64)):

@@ -64,6 +64,22 @@ def test_kernel_equals_oracle_on_random_cases(rng, metric, mode):
             assert r.stats["hotspot_max"] == want.max()
 
 
+@pytest.mark.parametrize("mode", ["bone", "sampled"])
+def test_grids_a_few_voxels_wide_and_spheres_at_their_edges_equal_the_oracle(rng, mode):
+    """A small sphere's rows are swept in whole vectors of 4 voxels, shifted left at the grid's right
+    edge and left as they are where the grid is narrower than that: every case must match the oracle."""
+    source = rng.integers(1, 256, (14, 14, 14)).astype(np.uint8)
+    for width in range(1, 10):
+        t = random_tskel(rng, n=40, identity=True)
+        b = grid_bounds(t, padding=0)
+        for x0 in (b.lo[0], b.hi[0] - width + 1, (b.lo[0] + b.hi[0]) // 2):  # the left edge, the right, between
+            bounds = Bounds((x0, b.lo[1], b.lo[2]), (x0 + width - 1, b.hi[1], b.hi[2]))
+            r = reconstruct(t, mode=mode, source=source, bounds=bounds)
+            want, best, ties = naive.reconstruct(t, bounds, mode=mode, source=source)
+            assert ((r.volume == want) | ties).all(), (width, x0)
+            assert r.stats["filled"] == np.isfinite(best).sum()
+
+
 # spec: docs/formats.md#reconstruction
 @pytest.mark.parametrize("kernel", [3, 5])
 def test_smoothed_sampling_equals_oracle(rng, kernel):
@@ -83,6 +99,21 @@ def test_one_and_two_threads_bit_identical(rng, mode):
     a = reconstruct(t, mode=mode, source=source, threads=1)
     b = reconstruct(t, mode=mode, source=source, threads=2)
     assert np.array_equal(a.volume, b.volume) and a.stats["filled"] == b.stats["filled"]
+
+
+@pytest.mark.parametrize("metric", ["euclid", "345"])
+@pytest.mark.parametrize("mode", MODES)
+def test_a_previous_result_passed_as_out_gives_what_a_fresh_array_gives(rng, mode, metric):
+    """The kernel reads a voxel's stencil only where the output is still 0, so ``out=`` must come back
+    zeroed: a previous frame's volume (same grid, other owners) must leave no trace in the next."""
+    source = rng.integers(1, 256, (20, 20, 20)).astype(np.uint8)
+    a, b = random_tskel(rng, n=300, size=20, metric=metric), random_tskel(rng, n=300, size=20, metric=metric)
+    bounds = Bounds((-8, -8, -8), (28, 28, 28))
+    first = reconstruct(a, mode=mode, source=source, bounds=bounds)
+    fresh = reconstruct(b, mode=mode, source=source, bounds=bounds)
+    reused = reconstruct(b, mode=mode, source=source, bounds=bounds, out=first.volume)
+    assert np.shares_memory(reused.volume, first.volume)  # the array was reused, not replaced
+    assert np.array_equal(reused.volume, fresh.volume) and reused.stats["filled"] == fresh.stats["filled"]
 
 
 def test_in_memory_order_reconstructs_like_the_written_file(tmp_path, rng):
@@ -353,9 +384,9 @@ def test_cancel_is_checked_while_sampling_not_only_while_filling(monkeypatch):
 @pytest.mark.parametrize("threads", [1, 2])
 @pytest.mark.parametrize("mode", ["bone", "mottled", "sampled"])
 def test_runs_in_one_row_in_any_order_over_a_stencil_slice_an_earlier_slice_used(mode, threads):
-    """A thread's stencil is one slice, reused slice after slice and never reset: each row is valid
-    only on the span of the runs that touched it in this slice. Runs landing right, then left,
-    then in the gap must see inf there, never the small distances an earlier slice left."""
+    """A thread's stencil is one slice, reused slice after slice and never reset: a voxel's stencil
+    counts only once a sphere of this slice has won it. Runs landing right, then left, then in
+    the gaps must win every voxel, never lose to the small distances an earlier slice left."""
     bounds = Bounds((0, 0, 0), (39, 4, 11))
     bone = [RootBone((0, 2, 2), (39, 2, 2))]
     xs = [20, 34, 5, 12, 27]  # middle, far right, far left, then both gaps
