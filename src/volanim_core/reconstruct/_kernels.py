@@ -165,7 +165,8 @@ def _sample(source, px, py, pz, weights, half):
 def _rows_in_box(stencil, out, z, ya, yb, cx, cy, dz2, r2, yhalf, value, lo_z, hi_z):
     """A sphere without planes on slice z (Euclid, a relaxing mode): every row over the x-box of the
     slice's disc, with the oracle's predicate per voxel -- no square root, rounding or end-point
-    checks per row (the box is at most 4/pi wider than the runs). Returns the voxels it examined.
+    checks per row (the box is at most 4/pi wider than the runs). Returns the box's voxels (the
+    sphere's work; the sweep's round-up to whole vectors is not counted).
     It counts nothing per voxel: a sum in the voxel loop costs 16 % of the frog's kernel (rows of
     ~9 voxels run in the loop's scalar remainder), so a slice's filled voxels are counted once at
     its end (:func:`fill_slices`) and its visits are the box's voxels, counted per row.

@@ -9,13 +9,13 @@ The hint never faults and changes no result.
 
 from __future__ import annotations
 
-from llvmlite import binding, ir
+from llvmlite import ir
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-# the intrinsic's name carries the pointer type: typed pointers (LLVM < 15) or opaque ones
-_NAME = "llvm.prefetch.p0" if binding.llvm_version_info >= (15,) else "llvm.prefetch.p0i8"
+# the typed-pointer name (LLVM 14, numba 0.59); LLVM with opaque pointers renames it itself (checked on 22)
+_NAME = "llvm.prefetch.p0i8"
 
 
 def _codegen(context, builder, signature, args):
