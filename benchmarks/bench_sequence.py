@@ -13,12 +13,17 @@ are behind every worker) to the moment the first worker finished its last, each 
 the part of its own time inside that window (``steady_rate``). A real sequence is 100-1000
 frames, so the steady state is what it runs at.
 
+The ratios (2 workers vs 1, Dask vs the pool) are medians of each round's own ratio: the two runs
+of a round are seconds apart, in alternating order, while this shared VM's speed drifts by 2x
+over minutes -- the ratio of each side's best round compares two unrelated lucky minutes.
+
     .venv/bin/python benchmarks/bench_sequence.py [FRAMES]    # FRAMES: the same count for every dataset
 """
 
 from __future__ import annotations
 
 import shutil
+import statistics
 import sys
 import tempfile
 import time
@@ -67,7 +72,8 @@ def large_case(n: int):
 
 
 CASES = ((mannequin_case, 48), (frog_case, 24), (large_case, 16))  # frames: a few seconds a run
-ROUNDS = 3
+ROUNDS = 5  # of the 2-worker pool and Dask, back to back (the 1-worker run: the first ONE_WORKER_ROUNDS)
+ONE_WORKER_ROUNDS = 3
 
 
 def steady_rate(records: list[dict]) -> float:
@@ -156,27 +162,38 @@ def main() -> None:
         folder = Path(tmp)
         for make, n in CASES:
             case = make(count or n)
-            # this VM's neighbours take whole cores for seconds at a time: interleave the three, ROUNDS times,
-            # and keep each one's best round
-            tries = [(run(case, folder, workers=1), run(case, folder, workers=2), run(case, folder, scheduler=client))
-                     for _ in range(ROUNDS)]
-            one, two, dask = (max((t[k] for t in tries), key=lambda r: r["steady"]) for k in range(3))
-            overhead = two["steady"] / dask["steady"] - 1  # extra time per frame on Dask
+            # This VM's neighbours take whole cores for seconds at a time, so the pool and Dask run back to
+            # back, in alternating order, round after round: each ratio compares two runs a few seconds
+            # apart, and the table gives the median ratio (best-of-N of each side compares two lucky
+            # minutes instead). The frames/s columns are each side's best round.
+            tries = []
+            for k in range(ROUNDS):
+                one = run(case, folder, workers=1) if k < ONE_WORKER_ROUNDS else None
+                pair = [("two", {"workers": 2}), ("dask", {"scheduler": client})]
+                got = {name: run(case, folder, **where) for name, where in (pair if k % 2 == 0 else pair[::-1])}
+                tries.append({"one": one, **got})
+            best = {k: max((t[k] for t in tries if t[k]), key=lambda r: r["steady"]) for k in ("one", "two", "dask")}
+            one, two, dask = best["one"], best["two"], best["dask"]
+            speedup = statistics.median(t["two"]["steady"] / t["one"]["steady"] for t in tries if t["one"])
+            overheads = [t["two"]["steady"] / t["dask"]["steady"] - 1 for t in tries]  # extra time per frame
             rows.append([case[0], f"{len(case[2])}", f"{one['voxels'] / 1e6:.0f}",
                          f"{one['fps']:.2f} / {one['steady']:.2f}",
                          f"{two['fps']:.2f} / {two['steady']:.2f}", f"{dask['fps']:.2f} / {dask['steady']:.2f}",
-                         f"{two['steady'] / one['steady']:.2f}", f"{100 * overhead:+.0f} %",
-                         f"{100 * dask['helpers']:.0f} %",
+                         f"{speedup:.2f}", f"{100 * statistics.median(overheads):+.0f} %",
+                         " ".join(f"{100 * o:+.0f}" for o in overheads),
+                         f"{100 * statistics.median(t['dask']['helpers'] for t in tries):.0f} %",
                          f"{max(two['peak'], dask['peak']) / 2**20:.0f}", f"{two['size'] / 2**20:.1f}"])
             if make is large_case:
-                large = (case, one, two)
+                large = (case, one, two, speedup)
     print("\nsequence, sampled mode, 2 cores; frames/s as whole run (with worker start-up) / steady state "
           "(while every worker runs, after its first frame)")
-    print(f"best of {ROUNDS} interleaved rounds each; this machine's own 2-vs-1 throughput on pure CPU work "
+    print(f"f/s: each one's best of {ROUNDS} rounds ({ONE_WORKER_ROUNDS} for 1 worker); ratios: the median of the "
+          f"rounds' own ratios (runs seconds apart); this machine's own 2-vs-1 throughput on pure CPU work "
           f"(same run, best of 5): {machine_scaling():.2f}x")
     print(table(rows, ["dataset", "frames", "grid M voxels", "1 worker f/s", "2 local workers f/s",
                        "Dask 2 workers f/s", "2 vs 1 steady (>= 1.8)", "Dask vs pool (<= 10 %)",
-                       "scheduler + nannies + client CPU", "peak MB/worker", "store MB"]))
+                       "Dask vs pool, each round %", "scheduler + nannies + client CPU", "peak MB/worker",
+                       "store MB"]))
     print("scheduler + nannies + client CPU: this process's threads but the main one (the LocalCluster's event loop) "
           "during the Dask run, "
           "in % of one core -- taken from the two cores the workers run on (on a cluster it is another machine's)")
@@ -184,9 +201,9 @@ def main() -> None:
     # 100 frames at Visible-Human half scale: mannequin-large is that scale, so its measured cost per
     # frame on one worker is the cost; N workers make ceil(100 / N) frames each, at the 2-worker efficiency
     # measured here (128 workers for 100 frames: one frame's time, not a 128th of a frame)
-    case, one, two = large
+    case, one, two, speedup = large
     per = 1 / one["steady"]
-    efficiency = min(1.0, two["steady"] / one["steady"] / 2)  # above 1 is this VM's noise, not a promise
+    efficiency = min(1.0, speedup / 2)  # above 1 is this VM's noise, not a promise
     ext = [[str(w), f"{per:.2f}", _duration(-(-100 // w) * per / (efficiency if w > 1 else 1)),
             f"{two['peak'] / 2**30:.1f}"] for w in (1, 2, 8, 32, 128)]
     print(f"\n100 frames at Visible-Human half scale ({case[0]}: {len(case[1]):,} spheres, a "
