@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from volanim_core.progress import Reporter
+from volanim_core.reconstruct import _labels as L
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
 from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
@@ -169,25 +170,21 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     piece's voxel nearest to the largest one -- the place of the break (ties: the
     first in x-fastest order).
 
-    Works on the ``[z, y, x]`` view, which is C-contiguous for a reconstruction: its flat
-    order is the volume's x-fastest order, so nothing of grid size is copied to get it
-    (the frog's posed grid is 45 M voxels). cc3d labels it (the same labels as
-    ``scipy.ndimage.label``, in half the time); :func:`_label_stats` measures every piece in one
-    more pass (cc3d's own statistics take 8x as long: every piece's centroid and box). The
-    nearest voxels come from one KD-tree of the main body's boundary voxels, which holds the
-    nearest main voxel of any voxel outside (:func:`_boundary_voxels`), made once for all the
-    pieces -- not a box search per piece (0.4 s for the frog's 250 pieces), a distance transform
-    (1.1 s) or the boundary found with array operations over the grid (0.45 s).
+    Works on the ``[z, y, x]`` view, which is C-contiguous for a reconstruction (the frog's
+    posed grid is 45 M voxels: nothing of grid size is copied), and on its x-runs
+    (:mod:`._labels`: labelled, measured and searched run by run, with the GIL released so the
+    studio's window keeps drawing while its worker makes the report). The nearest voxels come
+    from one KD-tree of the main body's boundary voxels, which holds the nearest main voxel of
+    any voxel outside, made once for all the pieces -- not a box search per piece (0.4 s for the
+    frog's 250 pieces), a distance transform (1.1 s) or the boundary found with array operations
+    over the grid (0.45 s).
     """
-    import cc3d
-
-    zyx = np.ascontiguousarray(np.asarray(volume).T)  # cc3d numbers pieces in memory order: make it x-fastest
-    # uint32 whatever the size (cc3d would pick uint16 for small grids): one numba type for the passes below
-    labels, n = cc3d.connected_components(zyx, connectivity=26, binary_image=True, return_N=True,
-                                          out_dtype=np.uint32)
+    zyx = np.ascontiguousarray(np.asarray(volume).T)
+    ny = zyx.shape[1]
+    first, x0, x1, piece, n = L.label_runs(zyx)
     if n == 0:
         return []
-    counts, sums = _label_stats(labels, n)
+    counts, sums = L.piece_stats(first, x0, x1, piece, n, ny)
     sizes = counts[1:]
     order = np.argsort(-sizes, kind="stable")
     main = int(order[0]) + 1
@@ -196,11 +193,11 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
         return out
     from scipy.spatial import cKDTree
 
-    start, pieces = _piece_voxels(labels, counts, main)  # every other piece's voxels, in one pass
+    start, pieces = L.piece_voxels(first, x0, x1, piece, counts, main, ny)  # every other piece's voxels
     # a KD-tree's query slows with the distance searched (a piece reaching 90 voxels away: 0.3 s), so each
     # piece asks within a reach grown until one of its voxels is nearer: every voxel at the piece's least
     # distance is then found, so the first of them in x-fastest order is exact
-    tree = cKDTree(_boundary_voxels(labels, main), balanced_tree=False, compact_nodes=False)
+    tree = cKDTree(L.boundary_voxels(zyx, first, x0, x1, piece, main), balanced_tree=False, compact_nodes=False)
     for k in order[1:] + 1:
         voxels = pieces[start[k]:start[k + 1]]  # x-fastest order
         reach = 8.0
@@ -213,10 +210,10 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _label_stats(labels, n):
-    """Per label 0..n of a ``[z, y, x]`` grid: its voxel count and the sum of its voxels' ``(z, y, x)``
-    (float64); label 0 (empty) is not measured."""
+    """Per label 0..n of a ``[z, y, x]`` grid (here: a rest volume's bones): its voxel count and the
+    sum of its voxels' ``(z, y, x)`` (float64); label 0 (empty) is not measured."""
     counts = np.zeros(n + 1, np.int64)
     sums = np.zeros((n + 1, 3))
     nz, ny, nx = labels.shape
@@ -234,17 +231,14 @@ def _label_stats(labels, n):
     return counts, sums
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _piece_voxels(labels, counts, skip):
     """The ``(z, y, x)`` of every voxel of each label but 0 and ``skip`` (0: none more), grouped by
     label (label k's rows ``start[k]:start[k + 1]``), in scan order within each; ``counts`` from
     :func:`_label_stats`."""
-    n = len(counts) - 1
-    start = np.zeros(n + 2, np.int64)
-    for k in range(1, n + 1):
-        start[k + 1] = start[k] + (counts[k] if k != skip else 0)
+    start = L.group_starts(counts, skip)
     fill = start.copy()
-    out = np.empty((start[n + 1], 3), np.int64)
+    out = np.empty((start[-1], 3), np.int64)
     _, ny, nx = labels.shape
     flat = labels.ravel()  # a view for a C-contiguous grid (numba copies any other)
     for i in range(flat.size):
@@ -256,32 +250,6 @@ def _piece_voxels(labels, counts, skip):
         out[f, 1], out[f, 2] = divmod(rest, nx)
         fill[k] = f + 1
     return start, out
-
-
-@njit(cache=True)
-def _boundary_voxels(labels, label):
-    """``(z, y, x)`` of the voxels labelled ``label`` with a 6-neighbour in the grid that is not.
-
-    The voxel of a body nearest to any voxel outside it is one of these: were it inside, its
-    neighbour one step towards the outside voxel (along the largest difference) would be closer."""
-    nz, ny, nx = labels.shape
-    out = np.empty((1024, 3), np.int64)
-    f = 0
-    for z in range(nz):
-        for y in range(ny):
-            for x in range(nx):
-                if labels[z, y, x] != label:
-                    continue
-                if (x > 0 and labels[z, y, x - 1] != label) or (x < nx - 1 and labels[z, y, x + 1] != label) or \
-                        (y > 0 and labels[z, y - 1, x] != label) or (y < ny - 1 and labels[z, y + 1, x] != label) or \
-                        (z > 0 and labels[z - 1, y, x] != label) or (z < nz - 1 and labels[z + 1, y, x] != label):
-                    if f == len(out):
-                        grown = np.empty((2 * f, 3), np.int64)
-                        grown[:f] = out
-                        out = grown
-                    out[f, 0], out[f, 1], out[f, 2] = z, y, x
-                    f += 1
-    return out[:f]
 
 
 def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
