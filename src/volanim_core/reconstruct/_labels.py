@@ -3,6 +3,7 @@
     runs(zyx)                          -> every row's runs of non-zero voxels
     label_runs(zyx)                    -> the runs, each run's piece (1..n), n
     piece_stats(...)                   -> each piece's voxel count and coordinate sums
+    group_starts(counts, skip)         -> where each piece's rows start in piece_voxels' output
     piece_voxels(..., skip)            -> every voxel of each piece but ``skip``, grouped by piece
     boundary_voxels(zyx, ..., piece)   -> the piece's voxels with an empty 6-neighbour in the grid
 

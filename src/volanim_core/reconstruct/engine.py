@@ -312,16 +312,13 @@ def reconstruct(
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 5))
     max_planes = max(1, int(np.diff(plane_start).max())) if len(tskel) else 1
-    if metric == K.EUCLID:
-        # the slices with |z - cz| < r + 1e-7: the kernel tests each exactly, and one farther out has
-        # dz^2 > r2 by far more than rounding (listing two more a sphere, as floor/ceil of cz -+ r did,
-        # cost the frog 275 k sphere-slice visits that only loaded the sphere to skip it)
-        reach = np.sqrt(r2s) + 1e-7
-        zlo = np.floor(centres[:, 2] - reach).astype(np.int64) + 1
-        zhi = np.ceil(centres[:, 2] + reach).astype(np.int64) - 1
-    else:  # 345: a margin of 1
-        zlo = np.floor(centres[:, 2] - _extent(tskel)).astype(np.int64) - 1
-        zhi = np.ceil(centres[:, 2] + _extent(tskel)).astype(np.int64) + 1
+    # Euclid: the slices with |z - cz| < r + 1e-7 (one slice in from floor/ceil at each end): the kernel
+    # tests each exactly, and one farther out has dz^2 > r2 by far more than rounding (listing two more a
+    # sphere, as floor/ceil of cz -+ r did, cost the frog 275 k sphere-slice visits that only loaded the
+    # sphere to skip it). 345: a margin of 1 beyond floor/ceil.
+    reach, inward = (np.sqrt(r2s) + 1e-7, 1) if metric == K.EUCLID else (_extent(tskel), -1)
+    zlo = np.floor(centres[:, 2] - reach).astype(np.int64) + inward
+    zhi = np.ceil(centres[:, 2] + reach).astype(np.int64) - inward
     offsets, ids = K.slice_lists(zlo, zhi, nz)
     filled = np.zeros(nz, np.int64)
     visits = np.zeros(nz, np.int64)
