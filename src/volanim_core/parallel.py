@@ -35,7 +35,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
     if scheduler is not None:
         from distributed import Client
 
-        client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+        client = scheduler if isinstance(scheduler, Client) else connect(scheduler)
         try:
             shared = client.scatter(payload, broadcast=True, hash=False)  # shipped to each worker once
             ex = client.get_executor(pure=False)
@@ -60,6 +60,17 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
             yield (lambda *args: pool.submit(task, None, *args)), label, 2 * workers
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+def connect(address: str):
+    """A ``distributed.Client`` of the scheduler at ``address``; one not reached (within Dask's
+    ``distributed.comm.timeouts.connect``, 30 s by default) is a ConnectionError that names it."""
+    from distributed import Client
+
+    try:
+        return Client(address)
+    except OSError as exc:  # distributed's "Timed out trying to connect to ... after 30 s"
+        raise ConnectionError(f"cannot reach the Dask scheduler at {address}: {exc}") from exc
 
 
 @cache  # once per process

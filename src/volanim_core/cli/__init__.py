@@ -74,9 +74,10 @@ def _input_files(args) -> list[str]:
 
 
 def describe(exc: BaseException, args) -> str:
-    """One line for the user: FormatErrors and OSErrors name their file; other refusals get the input's name."""
+    """One line for the user: FormatErrors and OSErrors name their file; other refusals get the input's name
+    (but a connection's failure is the network's, not an input's: it names what it could not reach)."""
     text = str(exc) or type(exc).__name__
-    if isinstance(exc, FormatError):
+    if isinstance(exc, (FormatError, ConnectionError)):
         return text
     if isinstance(exc, OSError) and exc.filename:
         return f"{exc.filename}: {exc.strerror or text}"

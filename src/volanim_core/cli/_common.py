@@ -128,6 +128,17 @@ def bounds_arg(values) -> Bounds:
     return Bounds(tuple(values[:3]), tuple(values[3:]))
 
 
+def local_workers(args) -> int | None:
+    """``--workers`` (default: every core), or None with ``--scheduler``: then the wait to reach it (up to
+    Dask's connect timeout, 30 s by default) is announced first, as nothing else is printed meanwhile."""
+    if args.scheduler:
+        print(f"connecting to the Dask scheduler at {args.scheduler} ...", file=sys.stderr, flush=True)
+        return None
+    from volanim_core.parallel import default_workers
+
+    return default_workers() if args.workers is None else args.workers
+
+
 class FrameProgress:
     """``frame done/total  N frames/s  ETA m:ss`` on one stderr line (sequence, render).
 

@@ -5,7 +5,16 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._common import FrameProgress, add_command, ascii_int, checked_by, finite_float, positive_float, positive_int
+from ._common import (
+    FrameProgress,
+    add_command,
+    ascii_int,
+    checked_by,
+    finite_float,
+    local_workers,
+    positive_float,
+    positive_int,
+)
 
 EXAMPLE = (
     "volanim render walk.zarr -o walk.mp4   # the sequence's mode picks the colours",
@@ -37,7 +46,6 @@ class CutAction(argparse.Action):
 
 def _render(args):
     from volanim_core import io
-    from volanim_core.parallel import default_workers
     from volanim_core.render.camera import named_view
     from volanim_core.render.run import open_inputs, render
     from volanim_core.render.scene import RenderSettings, transfer_of
@@ -61,7 +69,7 @@ def _render(args):
     if args.save_tf:
         io.write_transfer_function(args.save_tf, transfer_of(settings))
         print(f"wrote {args.save_tf} (the {'--tf' if args.tf else preset + ' preset'}'s transfer function)")
-    workers = None if args.scheduler else (default_workers() if args.workers is None else args.workers)
+    workers = local_workers(args)
     rep = render(inputs, settings, args.output, fps=args.fps, workers=workers or 1, scheduler=args.scheduler,
                  force=args.force, keep_frames=args.keep_frames, dims=args.dims, on_frame=FrameProgress())
     print(file=sys.stderr)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ._common import FrameProgress, add_command, ascii_int, checked_by, positive_float, positive_int
+from ._common import FrameProgress, add_command, ascii_int, checked_by, local_workers, positive_float, positive_int
 
 EXAMPLE = (
     "volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr",
@@ -19,7 +19,6 @@ EXAMPLE = (
 def _sequence(args):
     from volanim_core.io import read_bones, read_connect, read_volume_grid
     from volanim_core.motion.retarget import read_mapping
-    from volanim_core.parallel import default_workers
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
     from volanim_core.sequence.run import run_sequence
@@ -38,7 +37,7 @@ def _sequence(args):
     if args.source:
         source, origin, _ = read_volume_grid(args.source, dims=args.dims)
         source_origin = tuple(int(round(v)) for v in origin)
-    workers = None if args.scheduler else (default_workers() if args.workers is None else args.workers)
+    workers = local_workers(args)
     rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_origin=source_origin,
                        kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
                        workers=workers, scheduler=args.scheduler, force=args.force,

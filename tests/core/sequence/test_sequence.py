@@ -216,3 +216,24 @@ def test_bad_options_are_argument_errors_naming_the_option(tmp_path, capsys, opt
               str(tmp_path / "x.zarr"), *option])
     assert exc.value.code == 2 and f"argument {option[0].split('=')[0]}" in capsys.readouterr().err
     assert not (tmp_path / "x.zarr").exists()
+
+
+def test_a_scheduler_that_cannot_be_reached_is_named_and_announced(tmp_path, capsys):
+    """The wait for a Dask scheduler (30 s by default) is announced before it starts, and its failure names
+    the scheduler, not the input files (it used to read "CONNECT, BONES: Timed out trying to connect ...")."""
+    import socket
+
+    import dask
+
+    with socket.socket() as s:  # a free port on the loopback interface: nothing listens there
+        s.bind(("127.0.0.1", 0))
+        address = f"tcp://127.0.0.1:{s.getsockname()[1]}"
+    args = ["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "--frames", "0:20:10",
+            "--mode", "bone", "--scheduler", address, "-o", str(tmp_path / "w.zarr")]
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        assert main(args) == 2
+    err = capsys.readouterr().err
+    assert f"connecting to the Dask scheduler at {address}" in err
+    error = err.strip().splitlines()[-1]
+    assert error.startswith(f"volanim sequence: error: cannot reach the Dask scheduler at {address}"), error
+    assert CONNECT.name not in error
