@@ -107,14 +107,17 @@ def _check_demo(text: str, out) -> None:
                   "[8] render: 34 frames"):
         assert stage in text, stage
     source = io.read_volume(out / "mannequin.VOL")
-    rest, _, _ = io.read_volume_grid(out / "rest-sampled.vti")
-    posed, origin, _ = io.read_volume_grid(out / "arm-sampled.vti")
+    rest = io.read_scan(out / "rest-sampled.vti").data
+    posed, placed, _ = io.read_scan(out / "arm-sampled.vti")
+    origin = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
     assert set(np.unique(posed)) <= set(np.unique(source))  # sampled values come from the source
     assert (rest > 0).sum() > 0.99 * (source > 0).sum()
     assert origin[0] < 13  # the raised arm reaches further out than the rest pose
     assert len(list((out / "walk").glob("walk.*.tskel"))) == 8
-    first, o0, _ = io.read_volume_grid(out / "walk" / "walk.0000-sampled.vti")
-    _, o1, _ = io.read_volume_grid(out / "walk" / "walk.0532-sampled.vti")
+    first, placed, _ = io.read_scan(out / "walk" / "walk.0000-sampled.vti")
+    o0 = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
+    _, placed, _ = io.read_scan(out / "walk" / "walk.0532-sampled.vti")
+    o1 = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
     assert abs(int((first > 0).sum()) - int((rest > 0).sum())) < 0.1 * (rest > 0).sum()  # same body, posed
     assert o1[1] < o0[1] - 100  # the mannequin walked forward (-y) across the clip
     from volanim_core.sequence import store

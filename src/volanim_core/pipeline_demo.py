@@ -105,7 +105,7 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     write_tskel(folder / "rest.tskel", rest)
     r = reconstruct(rest, mode="sampled", source=s.volume, progress=TextProgress("    reconstruct"))
     out["rest"] = folder / "rest-sampled.vti"
-    write_volume(out["rest"], r.volume, origin=r.origin)
+    write_volume(out["rest"], r.volume, r.geometry)
     loss = 100.0 * (int(s.mask.sum()) - r.stats["filled"]) / s.mask.sum()
     _say(f"[4] identity reconstruction: {r.stats['filled']} voxels ({loss:.2f} % loss from the object), "
          f"{r.stats['seconds']:.3f} s -> {out['rest'].name}")
@@ -117,10 +117,10 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
     write_tskel(folder / "arm.tskel", posed)
     r = reconstruct(posed, mode="sampled", source=s.volume, progress=TextProgress("    reconstruct"))
     out["posed"] = folder / "arm-sampled.vti"
-    write_volume(out["posed"], r.volume, origin=r.origin)
+    write_volume(out["posed"], r.volume, r.geometry)
     hot = reconstruct(posed, mode="hotspot")
     boned = reconstruct(posed, mode="bone")
-    write_volume(folder / "arm-bone.vti", boned.volume, origin=boned.origin)
+    write_volume(folder / "arm-bone.vti", boned.volume, boned.geometry)
     _say(f"[5] {bone} turned {angles} deg: sampled reconstruction {r.stats['filled']} voxels in "
          f"{r.stats['seconds']:.3f} s (overdraw {r.stats['overdraw']:.1f}), hotspot max {hot.stats['hotspot_max']}, "
          f"origin {r.origin} -> {out['posed'].name}, arm-bone.vti")
@@ -152,7 +152,7 @@ def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
         tskel = connect_to_tskel(conn, Trans(root_bones(s.bones), m))
         rec = reconstruct(tskel, mode="sampled", source=s.volume)  # neighbour lists made once, then remembered
         path = frame_path(folder, "walk", n, "-sampled.vti")
-        write_volume(path, rec.volume, origin=rec.origin)
+        write_volume(path, rec.volume, rec.geometry)
         _say(f"    frame {n:4d}: {rec.stats['filled']} voxels, origin {rec.origin}, {rec.stats['seconds']:.3f} s "
              f"-> {folder.name}/{path.name}")
     return written, r

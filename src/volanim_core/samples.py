@@ -26,13 +26,17 @@ from volanim_core.progress import stage
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
 NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog")
-#: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence.
-FILE_SAMPLES = ("walk",)
+#: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence;
+#: ``mannequin-ct`` writes the mannequin as a CT scan arrives, a DICOM series (:func:`write_mannequin_ct`).
+FILE_SAMPLES = ("walk", "mannequin-ct")
 
 # Tissue values: distinct so sampled reconstruction shows the interior moving.
 SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
 MANNEQUIN_SHAPE = (160, 100, 300)
 LARGE_SHAPE = (290, 169, 940)  # the thesis's half-size Visible Human
+CT_SPACING, CT_ORIGIN = (0.7, 0.7, 2.5), (-56.0, -35.0, -1150.0)  # a CT's voxels (mm), somewhere in a scanner
+#: Hounsfield units a CT of the mannequin's tissues would read (air: -1000).
+CT_HU = {SKIN: 30, FAT: -100, MUSCLE_A: 45, MUSCLE_B: 60, BONE: 700, SKULL: 900, BRAIN: 35}
 
 
 @dataclass
@@ -314,6 +318,34 @@ def walk_clip() -> Path:
     return Path(__file__).resolve().parent / "sample_data" / "walk.bvh"
 
 
+def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
+    """The mannequin as a CT series arrives: ``mannequin-ct/`` (DICOM, one file a slice, Hounsfield
+    units stored with intercept -1024, 0.7 x 0.7 x 2.5 mm voxels at :data:`CT_ORIGIN`) and
+    ``mannequin-ct.bones``: its bones in the voxels of the 0.7 mm cubes ``skeletonize`` makes of it.
+
+    The body is the mannequin's voxels taken as 1 mm cubes, sampled (nearest) onto the CT's grid.
+    """
+    from volanim_core.geometry import Geometry
+    from volanim_core.io import write_bones
+    from volanim_core.io.medical_files import write_dicom_series
+    from volanim_core.volume import resample
+
+    folder = Path(folder)
+    s = mannequin()
+    table = np.full(256, -1000, np.int16)
+    for value, hu in CT_HU.items():
+        table[value] = hu
+    hu = table[s.volume]
+    ct, geometry = resample(hu, Geometry(origin=CT_ORIGIN), CT_SPACING, order=0, progress=stage(progress, 0, 30))
+    files = write_dicom_series(folder / "mannequin-ct", ct, geometry, description="mannequin CT (volanim sample)")
+    cube = CT_SPACING[0]  # skeletonize's default voxel: the smallest spacing
+    bones = BoneSkeleton({n: np.round(np.asarray(p) / cube, 3) for n, p in s.bones.joints.items()}, list(s.bones.bones))
+    write_bones(folder / "mannequin-ct.bones", bones)
+    if progress is not None:
+        progress(1, 1)
+    return [folder / "mannequin-ct", folder / "mannequin-ct.bones"] if files else []
+
+
 def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``), or for
     ``walk`` the clip ``walk.bvh`` and its licence. ``progress(done, total)`` is reported for
@@ -323,6 +355,8 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
+    if name == "mannequin-ct":
+        return write_mannequin_ct(folder, progress)
     if name == "walk":
         clip = walk_clip()
         written = [folder / clip.name, folder / f"{clip.name}.LICENSE"]

@@ -15,10 +15,16 @@ reverse            ReverseData                      255 - v
 remap              remapVolume                      256-entry lookup table
 fit_pow2           FitVolume                        pad up to powers of two
 float_to_uint8     float2uchar                      (in volanim_core.io)
+segment            (segmentation)                   threshold + optional cavity fill
+resample           (halving the Visible Human)      new voxel size, geometry kept
 =================  ==============================  ==========================
 
 Bounds are inclusive voxel index ranges ``(lo, hi)`` with ``lo, hi`` 3-tuples,
-as the old tools printed them.
+as the old tools printed them. The functions take and return arrays; where a
+tool moves voxels (crop, flip, fit_pow2, resample) the caller updates the
+volume's :class:`~volanim_core.geometry.Geometry` with the matching method
+(``shifted``, ``flipped``, ``with_spacing``), so every voxel stays where it is
+in physical space.
 """
 
 from __future__ import annotations
@@ -28,11 +34,13 @@ from typing import NamedTuple
 import numpy as np
 from scipy import ndimage
 
+from .geometry import Geometry
 from .io.volume_files import float_to_uint8
+from .progress import Reporter
 
 __all__ = [
-    "Bounds", "box_fill", "crop", "fill_cavities", "fit_pow2", "flip", "float_to_uint8",
-    "histogram", "remap", "reverse", "super_diff", "threshold", "tight_bounds",
+    "Bounds", "box_fill", "crop", "fill_cavities", "fit_pow2", "flip", "float_to_uint8", "histogram",
+    "isotropic_mask", "remap", "resample", "reverse", "segment", "super_diff", "threshold", "tight_bounds",
 ]
 
 
@@ -218,3 +226,77 @@ def fit_pow2(vol: np.ndarray, *, center: bool = False) -> tuple[np.ndarray, tupl
     lo = tuple(-o for o in offset)
     hi = tuple(lo_ + t - 1 for lo_, t in zip(lo, target))
     return crop(vol, Bounds(lo, hi)), offset
+
+
+def segment(vol: np.ndarray, lo: float = 1, hi: float | None = None, *, fill: bool = False) -> np.ndarray:
+    """The object mask (bool): ``lo <= v <= hi`` (default: every non-zero voxel), enclosed cavities
+    filled when ``fill``. NaN voxels are background. The CLI's and the studio's one segmentation."""
+    mask = threshold(vol, lo, hi).view(bool)
+    return fill_cavities(mask) if fill else mask
+
+
+def resampled_shape(shape, spacing, new_spacing) -> tuple[int, int, int]:
+    """The grid covering the same extent (first to last voxel centre) at ``new_spacing``."""
+    return tuple(int(np.floor((n - 1) * s / t + 1e-9)) + 1 for n, s, t in zip(shape, spacing, new_spacing))
+
+
+def resample(vol: np.ndarray, geometry: Geometry, spacing, *, order: int = 1, threshold_at: float | None = None,
+             progress=None, cancel=None) -> tuple[np.ndarray, Geometry]:
+    """The volume on a grid of voxel size ``spacing`` (3 numbers, or one for cubes): ``(volume, geometry)``.
+
+    Voxel ``[0, 0, 0]``'s centre and the axes stay where they are; the grid covers the same extent.
+    ``order`` 0 is nearest (labels), 1 linear (intensities). ``threshold_at``: return the bool mask
+    ``resampled > threshold_at`` instead, made a slab at a time (a mask resampled linearly and
+    thresholded at 0.5 is smoother than nearest, without a float copy of the whole output).
+    """
+    from scipy import ndimage
+
+    vol = _check3d(vol)
+    new = np.broadcast_to(np.asarray(spacing, np.float64), (3,))
+    if not np.all(np.isfinite(new)) or np.any(new <= 0):
+        raise ValueError(f"the new voxel size must be positive, got {spacing!r}")
+    if order not in (0, 1, 3):
+        raise ValueError(f"order must be 0 (nearest), 1 (linear) or 3 (cubic), got {order}")
+    shape = resampled_shape(vol.shape, geometry.spacing, new)
+    _check_grid_size(shape, 1 if threshold_at is not None else vol.dtype.itemsize)
+    step = new / np.asarray(geometry.spacing)
+    src = vol.view(np.uint8) if vol.dtype == bool else vol  # ndimage takes no bool
+    out = np.empty(shape, bool if threshold_at is not None else vol.dtype, order="F")
+    report = Reporter(progress, cancel)
+    slab = max(1, int(2**24 // max(1, shape[0] * shape[1])))
+    for z0 in range(0, shape[2], slab):
+        z1 = min(shape[2], z0 + slab)
+        part = ndimage.affine_transform(src, step, offset=(0.0, 0.0, z0 * step[2]), output_shape=(*shape[:2], z1 - z0),
+                                        order=order, mode="nearest", prefilter=order > 1,
+                                        output=np.float32 if threshold_at is not None else src.dtype)
+        out[:, :, z0:z1] = part > threshold_at if threshold_at is not None else part.view(out.dtype)
+        report(z1, shape[2])
+    return out, geometry.with_spacing(tuple(new))
+
+
+def isotropic_mask(mask: np.ndarray, geometry: Geometry, voxel_size: float | None = None, *,
+                   progress=None, cancel=None) -> tuple[np.ndarray, Geometry]:
+    """A mask on cubic voxels of ``voxel_size`` (default: the smallest spacing), ``(mask, geometry)``;
+    returned as it is when its voxels are cubes of that size already.
+
+    Distances, thinness, sphere radii and bone rotations are all taken in voxels, so the skeleton
+    is made on cubes: then a sphere is a sphere in the body and a rotation keeps its shape.
+    """
+    size = float(min(geometry.spacing) if voxel_size is None else voxel_size)
+    if geometry.is_isotropic and abs(geometry.spacing[0] - size) <= 1e-6 * size:
+        return mask, geometry
+    return resample(mask, geometry, size, order=1, threshold_at=0.5, progress=progress, cancel=cancel)
+
+
+def _check_grid_size(shape, itemsize: int) -> None:
+    from .limits import available_bytes, human_bytes, max_voxels
+
+    voxels = int(np.prod(shape, dtype=np.float64))
+    shown = "x".join(str(n) for n in shape)
+    if voxels > max_voxels():
+        raise ValueError(f"the resampled grid would be {shown} = {voxels:,} voxels, over the limit of "
+                         f"{max_voxels():,}: choose a larger voxel size")
+    free = available_bytes()
+    if free is not None and voxels * itemsize > free:
+        raise ValueError(f"the resampled grid would be {shown} voxels, {human_bytes(voxels * itemsize)}, more than "
+                         f"the {human_bytes(free)} of memory available: choose a larger voxel size")

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from volanim_core import samples
-from volanim_core.io import read_mskel, read_volume_grid
+from volanim_core.io import read_mskel, read_scan
 from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter, stage
 from volanim_core.skeleton.hull import display_hulls
@@ -54,8 +54,10 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
 def load_volume_file(path: str, dims=None) -> dict:
     """Read any supported volume (fast; the heavy part is :func:`prepare_volume`). A colour volume
     stays in colour (``volume``); ``grey`` is what its threshold is chosen on."""
-    data, origin, spacing = read_volume_grid(path, dims=dims, colour=True)
-    return {"volume": data, "grey": to_grey(data) if is_colour(data) else data, "spacing": spacing, "path": path}
+    scan = read_scan(path, dims=dims, colour=True)
+    data = scan.data
+    return {"volume": data, "grey": to_grey(data) if is_colour(data) else data, "spacing": scan.geometry.spacing,
+            "path": path, "geometry": scan.geometry, "segments": scan.segments}
 
 
 def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> dict:

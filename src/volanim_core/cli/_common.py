@@ -9,7 +9,8 @@ import sys
 import time
 from pathlib import Path
 
-from volanim_core.io import read_volume, write_output
+from volanim_core.geometry import IDENTITY
+from volanim_core.io import read_scan, write_output
 from volanim_core.io._text import is_number
 from volanim_core.volume import Bounds
 
@@ -32,21 +33,27 @@ def add_command(sub, name: str, help: str, example: str | tuple[str, ...], func)
 
 
 def add_volume_in(p: argparse.ArgumentParser, name: str = "volume", help: str = "input volume") -> None:
-    p.add_argument(name, help=f"{help} (.vol with --dims or NAME.XxYxZ.vol, .VOL, .vti, .nrrd, .nii, .mha, "
-                   "or a folder of slices)")
+    p.add_argument(name, help=f"{help} (.vol with --dims or NAME.XxYxZ.vol, .VOL, .vti, .nrrd/.nhdr, .nii(.gz), "
+                   ".mha/.mhd, .mgz, a 3-D .tif, a DICOM folder or file, or a folder of slices)")
 
 
 def add_dims(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    p.add_argument("--series", help="the DICOM series to read from a folder holding several (its UID or number)")
+
+
+def load_scan(path: str, args, *, colour: bool = False):
+    """The volume and its geometry (:func:`io.read_scan`) with the command's ``--dims`` and ``--series``."""
+    return read_scan(path, dims=getattr(args, "dims", None), series=getattr(args, "series", None), colour=colour)
 
 
 def load(path: str, args) -> object:
-    return read_volume(path, dims=getattr(args, "dims", None))
+    return load_scan(path, args).data
 
 
-def save(path: str, vol, **kw) -> Path:
+def save(path: str, vol, geometry=IDENTITY) -> Path:
     """Write a volume and say where (:func:`io.write_output`: a headerless ``.vol`` is named by its size)."""
-    path, note = write_output(path, vol, **kw)
+    path, note = write_output(path, vol, geometry)
     if note:
         print(f"note: {note}")
     print(f"wrote {path} ({vol.shape[0]}x{vol.shape[1]}x{vol.shape[2]}, {vol.dtype}{' RGB' if vol.ndim == 4 else ''})")
@@ -96,18 +103,22 @@ def positive_int(text: str) -> int:
 
 AXIS_OPTIONS = ("--down", "--up", "--forward")  # options whose value is a signed axis such as -z
 _SIGNED_AXIS = re.compile(r"-[xyz]", re.IGNORECASE)
+RANGE_OPTIONS = ("--threshold", "--range")  # LO[:HI]: a CT's body starts at -300 Hounsfield units
+_NEGATIVE_RANGE = re.compile(r"-[0-9.][0-9.eE+-]*(?::[0-9.eE+-]*)?")
 
 
 def join_dash_values(argv: list[str]) -> list[str]:
-    """``--opt -inf`` -> ``--opt=-inf`` and ``--down -z`` -> ``--down=-z``: argparse takes a value
-    that starts with a dash for an option and refuses it. A signed axis is joined only after the
-    options that take one, so no short option elsewhere is swallowed."""
+    """``--opt -inf`` -> ``--opt=-inf``, ``--down -z`` -> ``--down=-z`` and ``--threshold -300:3000`` ->
+    ``--threshold=-300:3000``: argparse takes a value that starts with a dash for an option and refuses
+    it. A signed axis or a range is joined only after the options that take one, so no short option
+    elsewhere is swallowed."""
     out: list[str] = []
     for token in argv:
         prev = out[-1] if out else ""
         joinable = prev.startswith("--") and "=" not in prev and (
             (_INFINITY.fullmatch(token) and token.startswith("-"))
-            or (prev in AXIS_OPTIONS and _SIGNED_AXIS.fullmatch(token)))
+            or (prev in AXIS_OPTIONS and _SIGNED_AXIS.fullmatch(token))
+            or (prev in RANGE_OPTIONS and _NEGATIVE_RANGE.fullmatch(token)))
         if joinable:
             out[-1] = f"{prev}={token}"
         else:

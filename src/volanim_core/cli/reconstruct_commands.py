@@ -11,9 +11,9 @@ from volanim_core.io import (
     read_bones,
     read_connect,
     read_mskel,
+    read_scan,
     read_trans,
     read_tskel,
-    read_volume_grid,
     write_connect,
     write_output,
     write_trans,
@@ -21,6 +21,7 @@ from volanim_core.io import (
 )
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
+from volanim_core.reconstruct.source_space import check_source_overlap, source_geometry_for
 from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
@@ -99,17 +100,21 @@ def _check_output(path: str) -> None:
 def _reconstruct(args):
     _check_output(args.output)
     t = read_tskel(args.tskel)
-    source, source_origin = None, (0, 0, 0)
+    source, source_geometry = None, None
     if args.source:
-        source, origin, _ = read_volume_grid(args.source, dims=args.dims, colour=True)
-        source_origin = tuple(int(round(v)) for v in origin)
+        source, source_geometry, _ = read_scan(args.source, dims=args.dims, colour=True)
+        t.geometry, note = source_geometry_for(t.geometry, source_geometry)
+        if note:
+            print(f"note: {note}")
+        if args.mode == "sampled":
+            check_source_overlap(t, source.shape, source_geometry)
     elif args.mode == "sampled":
         raise ValueError("sampled mode needs --source VOLUME")
     bounds = bounds_arg(args.bounds) if args.bounds else None
     bar = TextProgress("reconstruct")
-    r = reconstruct(t, mode=args.mode, source=source, source_origin=source_origin, kernel=args.kernel,
+    r = reconstruct(t, mode=args.mode, source=source, source_geometry=source_geometry, kernel=args.kernel,
                     bounds=bounds, padding=args.padding, threads=args.threads, progress=bar)
-    output, note = write_output(args.output, r.volume, origin=r.origin)
+    output, note = write_output(args.output, r.volume, r.geometry)
     if note:
         print(f"note: {note}")
     s = r.stats

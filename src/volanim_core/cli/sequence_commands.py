@@ -17,7 +17,7 @@ EXAMPLE = (
 
 
 def _sequence(args):
-    from volanim_core.io import read_bones, read_connect, read_volume_grid
+    from volanim_core.io import read_bones, read_connect, read_scan
     from volanim_core.motion.retarget import read_mapping
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
@@ -33,12 +33,18 @@ def _sequence(args):
         frames += teleport(conn, frames, args.teleport, down=args.down)
     elif args.crumble:
         frames += crumble(frames, args.crumble, down=args.down)
-    source, source_origin = None, (0, 0, 0)
+    source, source_geometry = None, None
     if args.source:
-        source, origin, _ = read_volume_grid(args.source, dims=args.dims)
-        source_origin = tuple(int(round(v)) for v in origin)
+        from volanim_core.reconstruct.source_space import check_source_overlap, source_geometry_for
+
+        source, source_geometry, _ = read_scan(args.source, dims=args.dims)
+        conn.geometry, note = source_geometry_for(conn.geometry, source_geometry)
+        if note:
+            print(f"note: {note}")
+        if args.mode == "sampled":
+            check_source_overlap(conn, source.shape, source_geometry)
     workers = local_workers(args)
-    rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_origin=source_origin,
+    rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_geometry=source_geometry,
                        kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
                        workers=workers, scheduler=args.scheduler, force=args.force,
                        threads_per_worker=args.threads_per_worker, on_frame=FrameProgress())

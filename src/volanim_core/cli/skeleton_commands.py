@@ -6,34 +6,44 @@ import time
 
 import numpy as np
 
-from volanim_core.io import write_mskel
+from volanim_core.io import read_scan, write_mskel
 from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
 from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
 from .. import volume
-from ._common import add_command, add_dims, add_volume_in, ascii_float, ascii_int, load, parse_range
+from ._common import add_command, add_dims, add_volume_in, ascii_float, ascii_int, load, parse_range, positive_float
 
 
 def segment(vol: np.ndarray, threshold, fill: bool) -> np.ndarray:
     """The object mask: ``threshold`` band (default: non-zero), cavities filled if asked."""
     lo, hi = threshold if threshold else (1, None)
-    mask = volume.threshold(vol, lo, hi).view(bool)
-    return volume.fill_cavities(mask) if fill else mask
+    return volume.segment(vol, lo, hi, fill=fill)
 
 
 def _skeletonize(args):
-    vol = load(args.volume, args)
-    mask = segment(vol, args.threshold, args.fill_cavities)
+    scan = read_scan(args.volume, dims=args.dims, series=args.series)
+    mask = segment(scan.data, args.threshold, args.fill_cavities)
+    mask, geometry = _cubic(mask, scan.geometry, args.voxel_size)
     bar = TextProgress("skeletonize")
     t0 = time.perf_counter()
-    skel = skeletonize(mask, metric=args.metric, min_thinness=args.min_thinness, progress=bar)
+    skel = skeletonize(mask, metric=args.metric, min_thinness=args.min_thinness, geometry=geometry, progress=bar)
     elapsed = time.perf_counter() - t0
     write_mskel(args.output, skel)
     lo, hi = (skel.thinness.min(), skel.thinness.max()) if len(skel) else (float("nan"),) * 2
     print(f"{len(skel)} points from {int(mask.sum())} object voxels, thinness {lo:.3f} .. {hi:.3f}, "
           f"dt up to {skel.dt.max() if len(skel) else 0:.2f} ({args.metric}), {elapsed:.2f} s -> {args.output}")
+
+
+def _cubic(mask: np.ndarray, geometry, voxel_size):
+    """The mask on cubic voxels (:func:`volume.isotropic_mask`), saying so when it resampled."""
+    cubes, cubic = volume.isotropic_mask(mask, geometry, voxel_size, progress=TextProgress("resample"))
+    if cubes is not mask:
+        old = " x ".join(f"{v:g}" for v in geometry.spacing)
+        print(f"resampled {old} mm voxels to {cubic.spacing[0]:g} mm cubes: "
+              f"{'x'.join(map(str, mask.shape))} -> {'x'.join(map(str, cubes.shape))} voxels")
+    return cubes, cubic
 
 
 def _isosurface(args):
@@ -63,6 +73,9 @@ def register(sub) -> None:
     p.add_argument("--metric", choices=("euclid", "345"), default="euclid", help="distance metric (default euclid)")
     p.add_argument("--min-thinness", type=ascii_float, default=DEFAULT_MIN_THINNESS,
                    help=f"keep points with thinness >= this (default {DEFAULT_MIN_THINNESS}; -inf keeps all)")
+    p.add_argument("--voxel-size", type=positive_float, metavar="MM",
+                   help="skeletonize on cubes of this size (default: the scan's smallest spacing); a scan whose "
+                        "voxels are not cubes is resampled, so spheres stay spheres in the body")
     p.add_argument("-o", "--output", required=True, help="output .mskel")
 
     p = add_command(sub, "isosurface", "Isosurface hull of the object as a mesh (.ply, .vtp, .obj, .stl).",

@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.io import add_header, float_to_uint8, histogram_file, read_volume, remove_header
+from volanim_core.geometry import axis_codes
+from volanim_core.io import add_header, float_to_uint8, histogram_file, remove_header
+from volanim_core.io.volume_files import finite_range, non_finite_count
 
 from .. import samples, volume
 from ..io._text import parse_int, read_records
@@ -22,36 +24,50 @@ from ._common import (
     bounds_arg,
     finite_float,
     load,
+    load_scan,
     parse_range,
+    positive_float,
     save,
 )
 
 
 def _info(args):
-    vol = read_volume(args.volume, dims=args.dims, colour=True)
+    scan = load_scan(args.volume, args, colour=True)
+    vol = scan.data
     kind = f"{vol.dtype} RGB" if vol.ndim == 4 else str(vol.dtype)
     if vol.ndim == 4:  # values and bounds of a colour volume: of its brightest channel
         vol = vol.max(axis=3)
-    b = volume.tight_bounds(vol)
+    bad = non_finite_count(vol)
+    with np.errstate(invalid="ignore"):
+        b = volume.tight_bounds(vol)
+    g = scan.geometry
+    found = finite_range(vol)
     print(f"{args.volume}: {vol.shape[0]} x {vol.shape[1]} x {vol.shape[2]} voxels, {kind}")
-    print(f"values {vol.min()} .. {vol.max()}, non-zero {int(np.count_nonzero(vol))}")
+    print(f"spacing {' x '.join(f'{v:g}' for v in g.spacing)} mm, origin ({', '.join(f'{v:g}' for v in g.origin)}) "
+          f"mm, axes {axis_codes(g.matrix)} (direction {' '.join(f'{v:g}' for v in g.direction)})")
+    values = f"values {found[0]:g} .. {found[1]:g}" if found else "values: none finite"
+    print(f"{values}, non-zero {int(np.count_nonzero(np.nan_to_num(vol, nan=0.0)))}"
+          + (f", {bad} NaN or infinite (background)" if bad else ""))
     print(f"tight bounds (inclusive x0 y0 z0 x1 y1 z1): {b if b else 'none (all zero)'}")
+    if scan.segments:
+        print("segments: " + ", ".join(f"{v} {name}" for v, name in sorted(scan.segments.items())))
 
 
 def _convert(args):
-    vol = read_volume(args.input, dims=args.dims, colour=not args.grey)  # colour stays colour unless asked
-    if args.rescale:
-        vol = float_to_uint8(vol)
-    save(args.output, vol)
+    scan = load_scan(args.input, args, colour=not args.grey)  # colour stays colour unless asked
+    vol = float_to_uint8(scan.data) if args.rescale else scan.data
+    save(args.output, vol, scan.geometry)
 
 
 def _threshold(args):
     lo, hi = args.range
-    save(args.output, volume.threshold(load(args.input, args), lo, hi, value=args.value))
+    scan = load_scan(args.input, args)
+    save(args.output, volume.threshold(scan.data, lo, hi, value=args.value), scan.geometry)
 
 
 def _fill(args):
-    vol = load(args.input, args)
+    scan = load_scan(args.input, args)
+    vol = scan.data
     if not args.cavities and args.box is None:
         raise ValueError("nothing to do: give --cavities and/or --box x0 y0 z0 x1 y1 z1")
     if args.cavities:
@@ -60,11 +76,12 @@ def _fill(args):
         print(f"filled {np.count_nonzero(vol) - before} cavity voxels")
     if args.box is not None:
         vol = volume.box_fill(vol, bounds_arg(args.box), args.value)
-    save(args.output, vol)
+    save(args.output, vol, scan.geometry)
 
 
 def _crop(args):
-    vol = load(args.input, args)
+    scan = load_scan(args.input, args)
+    vol = scan.data
     if args.bounds:
         b = bounds_arg(args.bounds)
     else:
@@ -73,8 +90,10 @@ def _crop(args):
             raise ValueError(f"{args.input}: the volume is all zero, there is nothing to crop to")
     if args.pad:
         b = volume.Bounds(tuple(v - args.pad for v in b.lo), tuple(v + args.pad for v in b.hi))
-    print(f"crop bounds: {b}  (origin of the output in the input: {b.lo})")
-    save(args.output, volume.crop(vol, b))
+    geometry = scan.geometry.shifted(b.lo)
+    print(f"crop bounds: {b}  (origin of the output in the input: {b.lo}; at "
+          f"({', '.join(f'{v:g}' for v in geometry.origin)}) mm)")
+    save(args.output, volume.crop(vol, b), geometry)
 
 
 def _tightbounds(args):
@@ -83,7 +102,13 @@ def _tightbounds(args):
 
 
 def _flip(args):
-    save(args.output, volume.flip(load(args.input, args), args.axis))
+    """Mirror the voxels; the geometry is flipped with them, so the scan stays where it is in space
+    unless ``--mirror`` asks for a mirrored body (the old tool's only meaning)."""
+    scan = load_scan(args.input, args)
+    axis = "xyz".index(args.axis)
+    keep = args.mirror or scan.geometry.is_identity  # a volume placed nowhere has nowhere to stay
+    geometry = scan.geometry if keep else scan.geometry.flipped(axis, scan.data.shape[axis])
+    save(args.output, volume.flip(scan.data, args.axis), geometry)
 
 
 def _count(args):
@@ -100,16 +125,18 @@ def _count(args):
 
 
 def _diff(args):
-    out = volume.super_diff(load(args.first, args), load(args.second, args))
+    first = load_scan(args.first, args)
+    out = volume.super_diff(first.data, load(args.second, args))
     counts = np.bincount(out.ravel(), minlength=201)
     for label, code in volume.SUPER_DIFF_CODES.items():
         print(f"{code:3d} {label:12s} {int(counts[code])}")
     if args.output:
-        save(args.output, out)
+        save(args.output, out, first.geometry)
 
 
 def _reverse(args):
-    save(args.output, volume.reverse(load(args.input, args)))
+    scan = load_scan(args.input, args)
+    save(args.output, volume.reverse(scan.data), scan.geometry)
 
 
 def read_remap_table(path: str) -> np.ndarray:
@@ -149,7 +176,8 @@ def _remap(args):
         table = np.arange(256)
         for a, b in args.pairs:
             table[a] = b
-    save(args.output, volume.remap(load(args.input, args), table))
+    scan = load_scan(args.input, args)
+    save(args.output, volume.remap(scan.data, table), scan.geometry)
 
 
 def _addheader(args):
@@ -163,14 +191,38 @@ def _rmheader(args):
 
 
 def _fitpow2(args):
-    out, offset = volume.fit_pow2(load(args.input, args), center=args.center)
+    scan = load_scan(args.input, args)
+    out, offset = volume.fit_pow2(scan.data, center=args.center)
     print(f"old voxel (0,0,0) is at {offset} in the output")
-    save(args.output, out)
+    save(args.output, out, scan.geometry.shifted(np.negative(offset)))
 
 
 def _float2uchar(args):
     lo, hi = args.range if args.range else (None, None)
-    save(args.output, float_to_uint8(load(args.input, args), lo, hi))
+    scan = load_scan(args.input, args)
+    bad = non_finite_count(scan.data)
+    if bad:
+        print(f"note: {bad} NaN or infinite voxels are background (0)")
+    save(args.output, float_to_uint8(scan.data, lo, hi), scan.geometry)
+
+
+def _resample(args):
+    scan = load_scan(args.input, args)
+    g = scan.geometry
+    if args.spacing:
+        spacing = args.spacing if len(args.spacing) == 3 else args.spacing * 3
+    elif args.factor:
+        spacing = [s * args.factor for s in g.spacing]
+    elif args.size:
+        spacing = [s * (n - 1) / max(m - 1, 1) for s, n, m in zip(g.spacing, scan.data.shape, args.size)]
+    else:
+        spacing = [min(g.spacing)] * 3
+    order = 0 if args.labels else 1
+    vol, geometry = volume.resample(scan.data, g, spacing, order=order, progress=TextProgress("resample"))
+    print(f"{'x'.join(map(str, scan.data.shape))} voxels of {' x '.join(f'{v:g}' for v in g.spacing)} mm -> "
+          f"{'x'.join(map(str, vol.shape))} of {' x '.join(f'{v:g}' for v in geometry.spacing)} mm "
+          f"({'nearest' if order == 0 else 'linear'})")
+    save(args.output, vol, geometry)
 
 
 def _samples(args):
@@ -190,7 +242,8 @@ def _io(p, output=True):
 
 
 def register(sub) -> None:
-    p = add_command(sub, "info", "Print a volume's size, value range and tight bounds.",
+    p = add_command(sub, "info", "Print a volume's size, geometry (spacing, origin, axes), value range, "
+                    "NaN count and tight bounds.",
                     "volanim info frog.VOL", _info)
     add_volume_in(p)
     add_dims(p)
@@ -226,10 +279,12 @@ def register(sub) -> None:
     _io(p, output=False)
     p.add_argument("--level", type=finite_float, default=0, help="count voxels above this value (default 0)")
 
-    p = add_command(sub, "flip", "Mirror a volume along an axis.",
+    p = add_command(sub, "flip", "Reverse a volume's voxels along an axis; the geometry follows, so in a viewer that "
+                    "places scans (3D Slicer, napari) it stays where it was; --mirror mirrors the body itself.",
                     "volanim flip mannequin.VOL mirrored.VOL --axis x", _flip)
     _io(p)
     p.add_argument("--axis", choices=("x", "y", "z"), required=True)
+    p.add_argument("--mirror", action="store_true", help="keep the geometry: the body is mirrored in space")
 
     p = add_command(sub, "count", "Histogram of voxel values; streams raw files (Count).",
                     "volanim count frog.VOL", _count)
@@ -277,6 +332,18 @@ def register(sub) -> None:
     _io(p)
     p.add_argument("--range", nargs=2, type=finite_float, metavar=("LO", "HI"),
                    help="input range (default: data min max)")
+
+    p = add_command(sub, "resample", "Resample to another voxel size, geometry kept: linear for intensities, "
+                    "nearest (--labels) for labels and masks.",
+                    ("volanim resample frog.VOL frog-half.nrrd --factor 2 --labels",
+                     "volanim resample mannequin.VOL mannequin-coarse.nrrd --spacing 2   # 2 mm cubes"), _resample)
+    _io(p)
+    how = p.add_mutually_exclusive_group()
+    how.add_argument("--spacing", nargs="+", type=positive_float, metavar="MM",
+                     help="new voxel size: one number (cubes) or three (default: the smallest spacing, as cubes)")
+    how.add_argument("--factor", type=positive_float, help="voxel size times this (2 halves each dimension)")
+    how.add_argument("--size", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="new dimensions")
+    p.add_argument("--labels", action="store_true", help="nearest voxel (labels, masks) instead of linear")
 
     p = add_command(sub, "samples",
                     "Write a demo dataset: mannequin (-colour, -large), aliascube, frog, the walk clip, or all.",

@@ -28,10 +28,11 @@ from .raw_volumes import (
 from .render_files import read_camera, read_transfer_function, write_camera, write_transfer_function
 from .skeleton_files import read_mskel, read_skel, write_mskel, write_skel
 from .volume_files import (
+    Scan,
     float_to_uint8,
     read_image_folder,
+    read_scan,
     read_volume,
-    read_volume_grid,
     saturate_for_raw,
     write_output,
     write_volume,
@@ -59,7 +60,8 @@ __all__ = [
     "read_trans",
     "read_tskel",
     "read_volume",
-    "read_volume_grid",
+    "read_scan",
+    "Scan",
     "remove_header",
     "saturate_for_raw",
     "write_output",

@@ -34,6 +34,7 @@ class TextRecords:
     records: list[tuple[int, list[str]]]
     header: dict[str, str] = field(default_factory=dict)
     first_comment: str | None = None
+    header_lines: dict[str, int] = field(default_factory=dict)  # where each header comment stands
 
     def error(self, line: int | None, message: str) -> FormatError:
         return FormatError(self.path, message, line)
@@ -63,6 +64,7 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
     text = text.removeprefix("\ufeff")
     records: list[tuple[int, list[str]]] = []
     header: dict[str, str] = {}
+    header_lines: dict[str, int] = {}
     first_comment = None
     for number, line in enumerate(text.splitlines(), start=1):
         hash_at = line.find("#")
@@ -73,11 +75,12 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
             m = _HEADER.match(comment.strip())
             if m:
                 header[m.group(1).strip().lower()] = m.group(2)
+                header_lines[m.group(1).strip().lower()] = number
             line = line[:hash_at]
         tokens = line.split()
         if tokens:
             records.append((number, tokens))
-    result = TextRecords(str(path), records, header, first_comment)
+    result = TextRecords(str(path), records, header, first_comment, header_lines)
     if not records and not allow_empty:
         raise result.error(None, "the file is empty, expected at least one data line")
     return result
@@ -124,6 +127,19 @@ def parse_metric(rec: TextRecords) -> str:
     if metric in ("345", "3-4-5", "chamfer"):
         return "345"
     raise rec.error(None, f"unknown '# metric: {metric}', expected 'euclid' or '345'")
+
+
+def parse_geometry(rec: TextRecords):
+    """The ``# geometry:`` header (docs/formats.md, "Physical space"); the identity when there is none."""
+    from volanim_core.geometry import IDENTITY, Geometry
+
+    text = rec.header.get("geometry")
+    if text is None:
+        return IDENTITY
+    try:
+        return Geometry.parse(text)
+    except ValueError as exc:
+        raise rec.error(rec.header_lines.get("geometry"), f"bad '# geometry:' header: {exc}") from None
 
 
 def fmt_float(value: float) -> str:

@@ -15,7 +15,7 @@ from volanim_core.rig.connectivity import Connectivity, RootBone, Trans, Tskel
 
 from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
-from ._text import TextRecords, fmt_float, parse_float, parse_metric, read_records
+from ._text import TextRecords, fmt_float, parse_float, parse_geometry, parse_metric, read_records
 
 ROOT_SYNTAX = "'Root: x y z :: x y z [NAME]'"
 
@@ -114,7 +114,8 @@ def read_connect(path: str | Path) -> Connectivity:
     threshold = rec.header.get("thinness")
     if threshold is not None:
         threshold = parse_float(rec, None, threshold, "'# thinness:' header")
-    return Connectivity(bones, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), threshold)
+    return Connectivity(bones, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), threshold,
+                        parse_geometry(rec))
 
 
 def read_trans(path: str | Path) -> Trans:
@@ -126,7 +127,7 @@ def read_trans(path: str | Path) -> Trans:
 def read_tskel(path: str | Path) -> Tskel:
     """Read a ``.tskel`` file: per bone ``Root:``, 4 matrix rows, then points."""
     rec, bones, mats, arr, owner = _read_rooted(path, matrices=True, points=True)
-    return Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec))
+    return Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), parse_geometry(rec))
 
 
 def _format_matrix(m: np.ndarray) -> list[str]:
@@ -146,6 +147,10 @@ def _bone_blocks(bones, bone_index, points, dt, thinness, matrices=None) -> list
     return lines
 
 
+def _geometry_header(geometry) -> list[str]:
+    return [] if geometry.is_identity else [f"# geometry: {geometry.header_value()}"]
+
+
 def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | None = None) -> None:
     """Write a ``.connect`` file atomically.
 
@@ -160,6 +165,7 @@ def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | Non
     if th is not None:
         lines.append(f"# thinness: {th:.2f}" if round(th, 2) == th else f"# thinness: {fmt_float(th)}")
     lines.append(f"# metric: {conn.metric}")
+    lines += _geometry_header(conn.geometry)
     lines += _bone_blocks(conn.bones, conn.bone[keep], conn.points[keep], conn.dt[keep], conn.thinness[keep])
     atomic_write_text(path, "\n".join(lines) + "\n")
 
@@ -175,7 +181,7 @@ def write_trans(path: str | Path, trans: Trans) -> None:
 
 def write_tskel(path: str | Path, tskel: Tskel) -> None:
     """Write a ``.tskel`` file atomically, points grouped under their bone."""
-    lines = ["# volanim tskel 1", f"# metric: {tskel.metric}"]
+    lines = ["# volanim tskel 1", f"# metric: {tskel.metric}", *_geometry_header(tskel.geometry)]
     lines += _bone_blocks(tskel.bones, tskel.bone, tskel.points, tskel.dt, tskel.thinness, tskel.matrices)
     atomic_write_text(path, "\n".join(lines) + "\n")
 

@@ -10,23 +10,26 @@ from volanim_core.skeleton.points import Skeleton
 
 from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
-from ._text import parse_metric, read_records
+from ._text import parse_geometry, parse_metric, read_records
 
 
-def _header(kind: str, metric: str) -> list[str]:
-    return [f"# volanim {kind} 1", f"# metric: {metric}"]
+def _header(kind: str, skel: Skeleton) -> list[str]:
+    lines = [f"# volanim {kind} 1", f"# metric: {skel.metric}"]
+    if not skel.geometry.is_identity:
+        lines.append(f"# geometry: {skel.geometry.header_value()}")
+    return lines
 
 
 def read_skel(path: str | Path) -> Skeleton:
     """Read a ``.skel`` file (``x y z dt`` a line) into a Skeleton (thinness NaN)."""
     rec = read_records(path)
     arr = parse_point_rows(rec, rec.records, (4,), "x y z dt")
-    return Skeleton(arr[:, :3].astype(np.int32), arr[:, 3], None, parse_metric(rec))
+    return Skeleton(arr[:, :3].astype(np.int32), arr[:, 3], None, parse_metric(rec), parse_geometry(rec))
 
 
 def write_skel(path: str | Path, skel: Skeleton) -> None:
     """Write ``x y z dt`` lines atomically."""
-    lines = _header("skel", skel.metric) + format_point_rows(skel.points, skel.dt)
+    lines = _header("skel", skel) + format_point_rows(skel.points, skel.dt)
     atomic_write_text(path, "\n".join(lines) + "\n")
 
 
@@ -38,7 +41,7 @@ def read_mskel(path: str | Path) -> Skeleton:
     """
     rec = read_records(path)
     arr = parse_point_rows(rec, rec.records, (5,), "x y z dt thinness")
-    skel = Skeleton(arr[:, :3].astype(np.int32), arr[:, 3], arr[:, 4], parse_metric(rec))
+    skel = Skeleton(arr[:, :3].astype(np.int32), arr[:, 3], arr[:, 4], parse_metric(rec), parse_geometry(rec))
     return skel if skel.is_sorted() else skel.sorted()
 
 
@@ -47,5 +50,5 @@ def write_mskel(path: str | Path, skel: Skeleton) -> None:
     if np.isnan(skel.thinness).any():
         raise ValueError("a .mskel needs a thinness for every point")
     skel = skel if skel.is_sorted() else skel.sorted()
-    lines = _header("mskel", skel.metric) + format_point_rows(skel.points, skel.dt, skel.thinness)
+    lines = _header("mskel", skel) + format_point_rows(skel.points, skel.dt, skel.thinness)
     atomic_write_text(path, "\n".join(lines) + "\n")

@@ -1,9 +1,18 @@
-"""Every volume format behind two calls: :func:`read_volume` and :func:`write_volume`.
+"""Every volume format behind two calls: :func:`read_scan` (voxels and :class:`Geometry`) and
+:func:`write_volume`; :func:`read_volume` when only the voxels matter.
 
-    .vol/.VOL           raw_volumes (ours)
-    .vti .mha .mhd .nii .nii.gz               VTK readers through pyvista (lazy import)
-    .nrrd                                     nrrd_files (ours: VTK's reader mangles 3-D scalars)
-    folder of 2-D images                      scikit-image, stacked along z
+    .vol/.VOL                      raw_volumes (ours; no geometry: the identity)
+    .vti .vtk                      VTK readers through pyvista (lazy import)
+    .nrrd .nhdr .seg.nrrd          nrrd_files (ours: guarded, every encoding, segment names)
+    .mha .mhd                      metaimage_files (ours: VTK drops the direction)
+    .nii .nii.gz .mgh .mgz         nibabel          } medical_files
+    DICOM folder or file           pydicom          }
+    .tif/.tiff (one 3-D file)      tifffile         }
+    folder of 2-D images           scikit-image, stacked along z
+
+Geometry is LPS millimetres (:mod:`volanim_core.geometry`); every writer but ``.vol``/``.VOL``
+keeps it. Float data keep NaN and infinity as they are; :func:`float_to_uint8` (rescaling) and
+every tool treat them as background.
 
 Colour (RGB) volumes are ``vol[x, y, z, channel]`` uint8 arrays: RGB slice images,
 3- or 4-component ``.vti``, an RGB NRRD and a raw ``.vol``/``.VOL`` of 3 bytes a voxel.
@@ -18,20 +27,38 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
 from volanim_core.errors import FormatError
+from volanim_core.geometry import IDENTITY, Geometry
 
 from . import raw_volumes
 from ._atomic import atomic_vtk_save
+from .metaimage_files import read_metaimage, write_metaimage
 from .nrrd_files import read_nrrd, write_nrrd
 from .vtk_headers import check_claims
 
-VTK_SUFFIXES = (".vti", ".mha", ".mhd", ".nii", ".nii.gz", ".vtk")
-NRRD_SUFFIXES = (".nrrd",)
+VTK_SUFFIXES = (".vti", ".vtk")
+NRRD_SUFFIXES = (".nrrd", ".nhdr")
+META_SUFFIXES = (".mha", ".mhd")
+NIBABEL_SUFFIXES = (".nii", ".nii.gz", ".mgh", ".mgz")
+DICOM_SUFFIXES = (".dcm", ".dicom", ".ima")
+TIFF_SUFFIXES = (".tif", ".tiff")
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm")
-WRITE_SUFFIXES = (".vol", ".VOL", ".vti", ".nrrd")
+READ_SUFFIXES = (".vol", ".VOL", *VTK_SUFFIXES, *NRRD_SUFFIXES, *META_SUFFIXES, *NIBABEL_SUFFIXES,
+                 *DICOM_SUFFIXES, *TIFF_SUFFIXES)
+WRITE_SUFFIXES = (".vol", ".VOL", ".vti", ".nrrd", ".nii", ".nii.gz", ".mha")
+
+
+class Scan(NamedTuple):
+    """A volume as read: its voxels ``data[x, y, z]`` (``[x, y, z, 3]`` colour), where they are
+    (``geometry``) and, for a segmentation, the names of its labels (``segments``: value -> name)."""
+
+    data: np.ndarray
+    geometry: Geometry
+    segments: dict
 
 
 def _suffix(path: Path) -> str:
@@ -39,18 +66,49 @@ def _suffix(path: Path) -> str:
     return ".nii.gz" if name.endswith(".nii.gz") else path.suffix.lower()
 
 
+def finite_range(vol: np.ndarray) -> tuple[float, float] | None:
+    """``(min, max)`` over the finite values (NaN and infinity are background); None if there are none."""
+    vol = np.asarray(vol)
+    if vol.dtype.kind != "f":
+        return (float(vol.min()), float(vol.max())) if vol.size else None
+    lo, hi = np.inf, -np.inf
+    for z in range(vol.shape[-1] if vol.ndim else 0):  # a slice at a time: no volume-sized mask
+        s = vol[..., z]
+        s = s[np.isfinite(s)]
+        if s.size:
+            lo, hi = min(lo, float(s.min())), max(hi, float(s.max()))
+    return (lo, hi) if lo <= hi else None
+
+
+def non_finite_count(vol: np.ndarray) -> int:
+    """How many voxels are NaN or infinite (0 for integer data)."""
+    vol = np.asarray(vol)
+    if vol.dtype.kind not in "fc":
+        return 0
+    return int(sum(int(np.count_nonzero(~np.isfinite(vol[..., z]))) for z in range(vol.shape[-1])))
+
+
 def float_to_uint8(vol: np.ndarray, lo: float | None = None, hi: float | None = None) -> np.ndarray:
     """Map ``[lo, hi]`` linearly onto 0..255 and clip (float2uchar).
 
-    ``lo``/``hi`` default to the data's minimum and maximum.
+    ``lo``/``hi`` default to the data's finite minimum and maximum; NaN and infinite voxels are
+    background (0), not part of the range.
     """
     vol = np.asarray(vol)
-    lo = float(np.min(vol)) if lo is None else float(lo)
-    hi = float(np.max(vol)) if hi is None else float(hi)
+    if lo is None or hi is None:
+        found = finite_range(vol) or (0.0, 0.0)
+        lo = found[0] if lo is None else float(lo)
+        hi = found[1] if hi is None else float(hi)
+    lo, hi = float(lo), float(hi)
     if hi <= lo:
-        return np.zeros(vol.shape, np.uint8) if vol.size == 0 or hi < lo else (vol > lo).astype(np.uint8) * 255
-    out = (np.asarray(vol, np.float64) - lo) * (255.0 / (hi - lo))
-    return np.clip(np.rint(out), 0, 255).astype(np.uint8)
+        if vol.size == 0 or hi < lo:
+            return np.zeros(vol.shape, np.uint8)
+        with np.errstate(invalid="ignore"):
+            return ((vol > lo) & np.isfinite(vol)).astype(np.uint8) * 255
+    with np.errstate(invalid="ignore", over="ignore"):
+        out = (np.asarray(vol, np.float64) - lo) * (255.0 / (hi - lo))
+        out[~np.isfinite(out)] = 0  # NaN, +-inf: background
+        return np.clip(np.rint(out), 0, 255).astype(np.uint8)
 
 
 LUMA = np.array([0.2125, 0.7154, 0.0721])  # Rec. 709, as skimage.color.rgb2gray
@@ -85,15 +143,19 @@ def _read_vtk(path: Path):
         raise FormatError(path, "expected a 3-D image with point scalars")
     if tuple(img.dimensions) != tuple(claimed):
         raise FormatError(path, f"VTK read a {img.dimensions} grid, the header says {claimed}")
+    try:
+        geometry = Geometry(tuple(img.spacing), tuple(img.origin), tuple(np.asarray(img.direction_matrix).ravel()))
+    except ValueError as exc:
+        raise FormatError(path, f"bad geometry: {exc}") from None
     scalars = np.asarray(img.point_data.active_scalars)
     if scalars.ndim > 1 and scalars.shape[1] in (3, 4) and scalars.dtype == np.uint8:  # RGB(A): drop alpha
         nx, ny, nz = img.dimensions
         data = scalars[:, :3].reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
-        return data, tuple(img.origin), tuple(img.spacing)
+        return data, geometry
     if scalars.ndim > 1:  # other vector data: take the first component
         scalars = scalars[:, 0]
     data = scalars.reshape(img.dimensions, order="F")
-    return data, tuple(img.origin), tuple(img.spacing)
+    return data, geometry
 
 
 def _natural_key(name: str):
@@ -152,60 +214,83 @@ def read_image_folder(folder: str | Path, *, colour: bool = False) -> np.ndarray
     return np.stack(slices, axis=2)
 
 
-def read_volume_grid(path: str | Path, *, dims=None, rescale: bool = False, colour: bool = False):
-    """Read any supported volume: ``(data[x, y, z], origin, spacing)``.
+def read_scan(path: str | Path, *, dims=None, rescale: bool = False, colour: bool = False,
+              series: str | None = None) -> Scan:
+    """Read any supported volume with its geometry: a :class:`Scan` ``(data, geometry, segments)``.
 
     Parameters
     ----------
     path : str or Path
-        A file, or a folder of slice images.
+        A file, a folder of DICOM files, or a folder of slice images.
     dims : (3,) ints, optional
         Dimensions of a headerless ``.vol``.
     rescale : bool
-        Map non-uint8 data onto 0..255 (min..max). Off by default: data keep
-        their type unless the user asks.
+        Map non-uint8 data onto 0..255 (finite min..max; NaN and infinity become 0). Off by
+        default: data keep their type unless the user asks.
     colour : bool
         Return a colour volume as ``data[x, y, z, channel]`` (uint8 RGB); without it
         colour is read as grey (luminance).
+    series : str, optional
+        The DICOM series to read from a folder holding several (its UID or number).
     """
     path = Path(path)
     try:
-        data, origin, spacing = _read_any(path, dims, colour)
+        data, geometry, segments = _read_any(path, dims, colour, series)
     except OSError as exc:  # permissions, a file that vanished, disk errors: one error type, the file named
         raise FormatError(getattr(exc, "filename", None) or path, f"cannot read: {exc.strerror or exc}") from exc
     if is_colour(data) and not colour:
         data = np.asfortranarray(to_grey(data))
     if rescale and data.dtype != np.uint8:
         data = float_to_uint8(data)
-    return data, origin, spacing
+    return Scan(data, geometry, segments)
 
 
-def _read_any(path: Path, dims, colour: bool):
+def _read_any(path: Path, dims, colour: bool, series):
+    from . import medical_files
+
     if path.is_dir():
-        data, origin, spacing = read_image_folder(path, colour=colour), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
-    elif not path.exists():
+        if medical_files.is_dicom_folder(path):
+            return (*medical_files.read_dicom(path, series=series), {})
+        return read_image_folder(path, colour=colour), IDENTITY, {}
+    if not path.exists():
         raise FormatError(path, "no such file or folder")
-    elif path.suffix.lower() == ".vol":
-        data, origin, spacing = raw_volumes.read_raw(path, dims), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)
-    elif _suffix(path) in NRRD_SUFFIXES:
-        data, origin, spacing = read_nrrd(path)
-    elif _suffix(path) in VTK_SUFFIXES:
-        data, origin, spacing = _read_vtk(path)
-    else:
-        raise FormatError(path, f"unknown volume format {path.suffix!r}; expected .vol, .VOL, "
-                          + ", ".join(VTK_SUFFIXES + NRRD_SUFFIXES) + " or a folder of slice images")
-    return data, origin, spacing
+    suffix = _suffix(path)
+    if suffix == ".vol":
+        return raw_volumes.read_raw(path, dims), IDENTITY, {}
+    if suffix in NRRD_SUFFIXES:
+        return read_nrrd(path)
+    if suffix in META_SUFFIXES:
+        return (*read_metaimage(path), {})
+    if suffix in NIBABEL_SUFFIXES:
+        return (*medical_files.read_nibabel(path), {})
+    if suffix in TIFF_SUFFIXES:
+        return (*medical_files.read_tiff_stack(path), {})
+    if suffix in VTK_SUFFIXES:
+        return (*_read_vtk(path), {})
+    if suffix in DICOM_SUFFIXES or _is_dicom_file(path):
+        return (*medical_files.read_dicom(path, series=series), {})
+    raise FormatError(path, f"unknown volume format {path.suffix!r}; expected "
+                      + ", ".join(READ_SUFFIXES) + ", a DICOM folder or a folder of slice images")
+
+
+def _is_dicom_file(path: Path) -> bool:
+    try:
+        with path.open("rb") as fh:
+            return fh.read(132)[128:132] == b"DICM"
+    except OSError:
+        return False
 
 
 def read_volume(path: str | Path, *, dims=None, rescale: bool = False, colour: bool = False) -> np.ndarray:
     """Read any supported volume as an array indexed ``[x, y, z]`` (``[x, y, z, 3]`` for colour with ``colour``)."""
-    return read_volume_grid(path, dims=dims, rescale=rescale, colour=colour)[0]
+    return read_scan(path, dims=dims, rescale=rescale, colour=colour).data
 
 
-def _write_vti(path: Path, vol: np.ndarray, origin, spacing) -> None:
+def _write_vti(path: Path, vol: np.ndarray, geometry: Geometry) -> None:
     import pyvista as pv
 
-    img = pv.ImageData(dimensions=vol.shape[:3], origin=origin, spacing=spacing)
+    img = pv.ImageData(dimensions=vol.shape[:3], origin=geometry.origin, spacing=geometry.spacing)
+    img.direction_matrix = geometry.matrix
     if is_colour(vol):  # one RGB tuple per point, x fastest
         img.point_data["rgb"] = np.ascontiguousarray(vol.transpose(2, 1, 0, 3)).reshape(-1, 3)
     else:
@@ -227,35 +312,65 @@ def saturate_for_raw(path: str | Path, vol: np.ndarray) -> tuple[np.ndarray, str
     return np.minimum(vol, 255).astype(np.uint8), note
 
 
-def write_output(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0),
-                 spacing=(1.0, 1.0, 1.0)) -> tuple[Path, str | None]:
+def write_output(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY) -> tuple[Path, str | None]:
     """Write a result where the user asked, with what raw formats need: counts above 255 saturate
-    (:func:`saturate_for_raw`) and a headerless ``.vol`` is named ``NAME.XxYxZ.vol``
-    (:func:`raw_volumes.raw_name_for`). Returns the path written and a note for the user, or None.
+    (:func:`saturate_for_raw`), a headerless ``.vol`` is named ``NAME.XxYxZ.vol``
+    (:func:`raw_volumes.raw_name_for`), and a geometry ``.vol``/``.VOL`` cannot hold is said.
+    Returns the path written and a note for the user, or None.
 
-    Every command and the studio write their results through this, so none forgets either rule.
+    Every command and the studio write their results through this, so none forgets these rules.
     """
     vol, note = saturate_for_raw(path, np.asarray(vol))
     path = raw_volumes.raw_name_for(path, vol.shape[:3])
-    write_volume(path, vol, origin=origin, spacing=spacing)
+    write_volume(path, vol, geometry)
+    if path.suffix.lower() == ".vol" and not geometry.is_identity:
+        lost = f"{path.name} holds no geometry ({geometry.describe()}): write .nrrd, .nii, .mha or .vti to keep it"
+        note = f"{note}; {lost}" if note else lost
     return path, note
 
 
-def write_volume(path: str | Path, vol: np.ndarray, *, origin=(0.0, 0.0, 0.0), spacing=(1.0, 1.0, 1.0)) -> None:
-    """Write a volume as ``.vol``, ``.VOL``, ``.vti`` or ``.nrrd``, atomically.
+def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY) -> None:
+    """Write a volume as ``.vol``, ``.VOL``, ``.vti``, ``.nrrd``, ``.nii``/``.nii.gz`` or ``.mha``, atomically.
 
-    ``.vol``/``.VOL`` hold uint8 only and no origin: callers print the origin.
+    ``.vol``/``.VOL`` hold uint8 only and no geometry: :func:`write_output` says so.
     """
     path = Path(path)
     vol = np.asarray(vol)
     if vol.ndim != 3 and not is_colour(vol):
         raise ValueError(f"a volume must be 3-D (or 3-D with 3 colour channels), got shape {vol.shape}")
+    if not isinstance(geometry, Geometry):
+        raise TypeError(f"geometry must be a Geometry, got {type(geometry).__name__}")
     suffix = _suffix(path)
     if suffix == ".vol":
         raw_volumes.write_raw(path, vol)
     elif suffix == ".vti":
-        _write_vti(path, vol, origin, spacing)
+        _write_vti(path, vol, geometry)
     elif suffix == ".nrrd":
-        write_nrrd(path, vol, origin, spacing)
+        write_nrrd(path, vol, geometry)
+    elif suffix == ".mha":
+        write_metaimage(path, vol, geometry)
+    elif suffix in (".nii", ".nii.gz"):
+        _write_nifti(path, vol, geometry)
     else:
         raise ValueError(f"cannot write {path.name}: choose one of {', '.join(WRITE_SUFFIXES)}")
+
+
+def _write_nifti(path: Path, vol: np.ndarray, geometry: Geometry) -> None:
+    """NIfTI-1 through nibabel, qform and sform both set (scanner space), atomically."""
+    import nibabel as nib
+
+    from ._atomic import atomic_open
+
+    if is_colour(vol):
+        raise ValueError(f"cannot write a colour volume to {path.name}: NIfTI colour is not supported; use .nrrd")
+    affine = np.diag([-1.0, -1.0, 1.0, 1.0]) @ geometry.affine  # LPS -> RAS
+    img = nib.Nifti1Image(np.asarray(vol), affine)
+    img.set_qform(affine, code=1)
+    img.set_sform(affine, code=1)
+    data = img.to_bytes()
+    if path.name.lower().endswith(".gz"):
+        import gzip
+
+        data = gzip.compress(data, compresslevel=6)
+    with atomic_open(path, "wb") as fh:
+        fh.write(data)

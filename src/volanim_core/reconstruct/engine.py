@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.limits import MAX_COORD, available_bytes, human_bytes, max_voxels
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
@@ -63,6 +64,9 @@ class Reconstruction:
         with more bones) or the source's dtype (sampled).
     origin : (3,) ints
         Voxel ``[0, 0, 0]`` of ``volume`` is voxel ``origin`` of the rest frame.
+    geometry : Geometry
+        Where ``volume``'s voxels are in physical space: the frame's geometry shifted to ``origin``
+        (what a writer records, so the posed frame overlays the scan it came from).
     stats : dict
         ``spheres``, ``filled`` (voxels), ``visits`` (voxels the spheres
         examined: the kernel's work), ``overdraw`` (visits / filled), ``clipped`` (sphere voxels outside
@@ -73,6 +77,7 @@ class Reconstruction:
     volume: np.ndarray
     origin: tuple[int, int, int]
     stats: dict = field(default_factory=dict)
+    geometry: Geometry = IDENTITY
 
     @property
     def bounds(self) -> Bounds:
@@ -213,7 +218,7 @@ def reconstruct(
     *,
     mode: str = "binary",
     source: np.ndarray | None = None,
-    source_origin=(0, 0, 0),
+    source_geometry: Geometry | None = None,
     kernel: int = 1,
     bounds: Bounds | None = None,
     padding: int = 2,
@@ -234,8 +239,10 @@ def reconstruct(
     source : (X, Y, Z) ndarray indexed ``[x, y, z]``, required for 'sampled'
         The rest-pose volume; positions outside it read 0. A colour source
         ``(X, Y, Z, 3)`` uint8 gives a colour result (:mod:`.sampling`).
-    source_origin : 3 ints
-        Rest-frame voxel of ``source[0, 0, 0]`` (non-zero for a cropped source).
+    source_geometry : Geometry, optional
+        Where the source's voxels are: each output voxel samples the source at the same physical
+        point as its rest position in the frame's grid (``tskel.geometry``). None: the source is
+        on the frame's own grid. :func:`check_source_overlap` refuses a source the frame misses.
     kernel : {1, 3, 5}
         Sampled mode: nearest voxel (1) or a Gaussian-weighted average over
         a 3^3 / 5^3 neighbourhood (anti-aliasing; leave 1 for label volumes).
@@ -340,7 +347,8 @@ def reconstruct(
             pace = (z1 - z0) / max(time.perf_counter() - started, 1e-6)
             z0, chunk = z1, max(nthreads * 4, int(pace * LAUNCH_SECONDS))
         if mode == "sampled":
-            out = sample_source(out, source, _grid_to_source(minv_rest, origin, source_origin), kernel,
+            to_source = np.eye(4) if source_geometry is None else tskel.geometry.index_map(source_geometry)
+            out = sample_source(out, source, _grid_to_source(minv_rest, origin, to_source), kernel,
                                 (row_lo, row_hi), nthreads, chunk, lambda done: report(nz + done, total))
     finally:
         numba.set_num_threads(previous)
@@ -353,7 +361,7 @@ def reconstruct(
     stats["clipped_estimated"] = bool(estimated)
     stats["seconds"] = time.perf_counter() - t0
     volume = out.transpose(2, 1, 0, 3) if out.ndim == 4 else out.T  # [x, y, z] view: no copy
-    return Reconstruction(volume, tuple(int(v) for v in bounds.lo), stats)
+    return Reconstruction(volume, tuple(int(v) for v in bounds.lo), stats, tskel.geometry.shifted(bounds.lo))
 
 
 def _check_arguments(mode, kernel, source, value) -> None:
@@ -413,13 +421,12 @@ def _output_array(out, shape_zyx, out_dtype, final_dtype) -> np.ndarray:
     return np.zeros(shape_zyx, out_dtype)
 
 
-def _grid_to_source(minv_rest: np.ndarray, origin: np.ndarray, source_origin) -> np.ndarray:
-    """Per bone: output-grid coordinates -> source-array coordinates (shift in, invert, shift out)."""
+def _grid_to_source(minv_rest: np.ndarray, origin: np.ndarray, to_source: np.ndarray) -> np.ndarray:
+    """Per bone: output-grid coordinates -> source-array coordinates (shift in, invert, then the
+    frame's grid -> the source's grid, :meth:`Geometry.index_map`)."""
     shift_in = np.eye(4)
     shift_in[3, :3] = origin
-    shift_out = np.eye(4)
-    shift_out[3, :3] = -np.asarray(source_origin, np.float64)
-    return np.ascontiguousarray(shift_in @ minv_rest @ shift_out)
+    return np.ascontiguousarray(shift_in @ minv_rest @ to_source)
 
 
 def _stats(spheres: int, filled: np.ndarray, visits: np.ndarray, clipped: int, hotspot=None) -> dict:

@@ -58,7 +58,8 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     out = []
     for n, (frame, mats) in enumerate(zip(frames, matrices)):
         report(n, len(frames))
-        posed = Tskel(conn.bones, np.asarray(mats), conn.points, conn.dt, conn.thinness, conn.bone, conn.metric)
+        posed = Tskel(conn.bones, np.asarray(mats), conn.points, conn.dt, conn.thinness, conn.bone, conn.metric,
+                      conn.geometry)
         where, gaps = cracks(posed, pairs=pairs)
         worst = ""
         if len(gaps) and near is not None:

@@ -121,9 +121,11 @@ def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
 
 
 def _read(path, dims=None):
-    from volanim_core.io import read_volume_grid
+    from volanim_core.io import read_scan
 
-    return read_volume_grid(path, dims=dims, colour=True)  # a colour volume is drawn in its colours
+    scan = read_scan(path, dims=dims, colour=True)  # a colour volume is drawn in its colours
+    g = scan.geometry  # frames are drawn in voxels: the origin in voxels of the frame's own spacing
+    return scan.data, tuple(np.asarray(g.origin) / np.asarray(g.spacing)), g.spacing
 
 
 @dataclass

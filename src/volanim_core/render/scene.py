@@ -225,6 +225,9 @@ class Renderer:
             self.plotter.add_text(f"frame {number}", position="upper_right", font_size=12, name="frame",
                                   color=_contrast(s.background), render=False)
         s.camera.apply(self.plotter.camera)  # adding actors must not have moved it
+        # near and far planes from what is in view now: a camera placed far from the body (a long walk's
+        # shared grid, a large scan) otherwise keeps planes that cut the whole body away (black frames)
+        self.plotter.renderer.ResetCameraClippingRange()
 
     def close(self) -> None:
         self.plotter.close()

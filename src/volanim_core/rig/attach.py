@@ -59,7 +59,7 @@ def connect_nearest(skeleton: Skeleton, bones: BoneSkeleton) -> Connectivity:
     """A connectivity attaching every skeleton point to its nearest bone."""
     bone = attach_nearest_bone(skeleton.points, bones)
     conn = Connectivity(root_bones(bones), skeleton.points, skeleton.dt, skeleton.thinness, bone,
-                        skeleton.metric)
+                        skeleton.metric, geometry=skeleton.geometry)
     return conn.grouped()
 
 

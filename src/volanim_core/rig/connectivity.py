@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.limits import voxel_points
 from volanim_core.skeleton.points import check_metric
 
@@ -78,6 +79,7 @@ class Connectivity:
     bone: np.ndarray
     metric: str = "euclid"
     thinness_threshold: float | None = None
+    geometry: Geometry = IDENTITY  # the voxel grid of the coordinates (volanim_core.geometry)
 
     def __post_init__(self):
         self.points, self.dt, self.thinness, self.bone = _points_fields(
@@ -104,7 +106,7 @@ class Connectivity:
     def take(self, order: np.ndarray) -> Connectivity:
         """A copy holding the points in ``order`` (a permutation or a subset)."""
         return Connectivity(self.bones, self.points[order], self.dt[order], self.thinness[order],
-                            self.bone[order], self.metric, self.thinness_threshold)
+                            self.bone[order], self.metric, self.thinness_threshold, self.geometry)
 
     def is_grouped(self) -> bool:
         """Whether points are grouped by bone in root order, as files list them."""
@@ -143,12 +145,13 @@ class Trans:
 class Tskel(Connectivity):
     """Contents of a ``.tskel`` file: a connectivity plus one matrix per bone (root order).
 
-    ``Tskel(bones, matrices, points, dt, thinness, bone, metric)``; a matrix maps
-    rest voxel coordinates to posed ones, ``[x y z 1] @ M``.
+    ``Tskel(bones, matrices, points, dt, thinness, bone, metric, geometry)``; a matrix maps
+    rest voxel coordinates to posed ones, ``[x y z 1] @ M``, both in the voxels of ``geometry``.
     """
 
-    def __init__(self, bones, matrices, points, dt, thinness, bone, metric: str = "euclid"):
-        super().__init__(bones, points, dt, thinness, bone, metric)
+    def __init__(self, bones, matrices, points, dt, thinness, bone, metric: str = "euclid",
+                 geometry: Geometry = IDENTITY):
+        super().__init__(bones, points, dt, thinness, bone, metric, None, geometry)
         self.matrices = _check_matrices(matrices, len(self.bones))
 
     def __eq__(self, other) -> bool:
@@ -159,8 +162,9 @@ class Tskel(Connectivity):
 
     def take(self, order: np.ndarray) -> Tskel:
         return Tskel(self.bones, self.matrices, self.points[order], self.dt[order], self.thinness[order],
-                     self.bone[order], self.metric)
+                     self.bone[order], self.metric, self.geometry)
 
     @property
     def connectivity(self) -> Connectivity:
-        return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric)
+        return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
+                            geometry=self.geometry)

@@ -31,13 +31,14 @@ def _coords(b) -> str:
 def connect_to_tskel(conn: Connectivity, trans: Trans) -> Tskel:
     """One frame ready to reconstruct: the connectivity with the frame's matrices."""
     check_root_order(conn.bones, trans.bones)
-    return Tskel(conn.bones, trans.matrices, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric)
+    return Tskel(conn.bones, trans.matrices, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric,
+                 conn.geometry)
 
 
 def identity_tskel(conn: Connectivity) -> Tskel:
     """The rest frame: every matrix the identity (reconstructs the original shape)."""
     mats = np.tile(np.eye(4), (len(conn.bones), 1, 1))
-    return Tskel(conn.bones, mats, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric)
+    return Tskel(conn.bones, mats, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric, conn.geometry)
 
 
 def coarse_tskel(tskel: Tskel, factor: int) -> Tskel:
@@ -48,7 +49,7 @@ def coarse_tskel(tskel: Tskel, factor: int) -> Tskel:
     from volanim_core.rig.pose import scaled
 
     return Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
-                 tskel.bone, tskel.metric)
+                 tskel.bone, tskel.metric, tskel.geometry.with_spacing(np.multiply(tskel.geometry.spacing, factor)))
 
 
 def sort_tskel(tskel: Tskel) -> Tskel:

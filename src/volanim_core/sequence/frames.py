@@ -34,7 +34,7 @@ class FrameSpec:
     def tskel(self, conn: Connectivity) -> Tskel:
         plain = np.isscalar(self.dt_scale) and self.dt_scale == 1.0
         dt = conn.dt if plain else conn.dt * np.asarray(self.dt_scale, np.float64)
-        return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric)
+        return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric, conn.geometry)
 
     def key(self) -> bytes:
         """Everything that decides this frame's voxels besides the connectivity (for plan keys)."""

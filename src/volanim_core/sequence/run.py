@@ -89,7 +89,8 @@ def heap_room(conn: Connectivity, spec: FrameSpec, padding: int) -> Bounds:
     return Bounds(tuple(lo), tuple(hi))
 
 
-def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int, padding: int, source) -> str:
+def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int, padding: int, source,
+             source_geometry=None) -> str:
     """What the store's content depends on; a rerun with another key must not resume."""
     h = hashlib.blake2b(digest_size=16)
     for a in (conn.points, conn.dt, conn.bone, *[np.asarray(b.proximal + b.distal) for b in conn.bones]):
@@ -97,6 +98,10 @@ def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int
     for f in frames:
         h.update(f.key())
     h.update(f"{mode}|{kernel}|{padding}|{conn.metric}".encode())
+    if not conn.geometry.is_identity:  # keys of stores made before geometry was recorded stay the same
+        h.update(conn.geometry.header_value().encode())
+    if source_geometry is not None and not source_geometry.is_identity:
+        h.update(source_geometry.header_value().encode())
     if source is not None:
         h.update(str((source.shape, source.dtype.str)).encode())
         h.update(np.ascontiguousarray(source).data)
@@ -122,12 +127,14 @@ def check_memory(bounds: Bounds, dtype: np.dtype, workers: int, source) -> int:
 
 
 def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str = "binary", source=None,
-                 source_origin=(0, 0, 0), kernel: int = 1, padding: int = 2, fps: float = 24.0,
+                 source_geometry=None, kernel: int = 1, padding: int = 2, fps: float = 24.0,
                  every_frame_as: str | None = None, workers: int | None = None, scheduler=None,
                  force: bool = False, replace_other: bool = False, threads_per_worker: int = 1,
                  on_frame=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
+    ``source_geometry``: where the source's voxels are (:func:`reconstruct`); the store records the
+    frames' geometry (``conn.geometry`` at the shared grid's origin) in physical units.
     ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
     ``on_frame(record, done, total)`` after each finished frame (progress).
     ``replace_other``: a store of another sequence at ``out`` is replaced instead of refused (a
@@ -157,7 +164,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
     n_workers = workers or 1
     if scheduler is None:
         check_memory(max(grids, key=lambda g: np.prod(g.shape, dtype=np.int64)), dtype, n_workers, source)
-    key = plan_key(conn, frames, mode, kernel, padding, source)
+    key = plan_key(conn, frames, mode, kernel, padding, source, source_geometry)
     plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
             "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
     old = store.read_plan(out) if out.exists() else None
@@ -172,12 +179,13 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
             raise ValueError(f"{out} holds another sequence (different frames, connectivity, mode or source); "
                              "pass --force to replace it, or choose another -o")
         rest = plan["rest_filled"] = _rest_filled(conn)  # once per store: a resumed run does not redo it
-        store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps)
+        store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps,
+                     geometry=conn.geometry.shifted(bounds.lo))
         done = {}
     if every_frame_as:
         Path(every_frame_as).parent.mkdir(parents=True, exist_ok=True)
     todo = [i for i in range(len(frames)) if i not in done]
-    payload = Payload(conn, mode, kernel, bounds, str(out.resolve()), source, tuple(source_origin), every_frame_as,
+    payload = Payload(conn, mode, kernel, bounds, str(out.resolve()), source, source_geometry, every_frame_as,
                       threads_per_worker)
     records = dict(done)
     total = len(frames)

@@ -49,28 +49,39 @@ def chunk_shape(shape_zyx, edge: int = CHUNK_EDGE) -> tuple[int, int, int]:
 
 
 def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: dict, *, fps: float = 24.0,
-           spacing=(1.0, 1.0, 1.0)):
-    """A new, empty sequence store (an existing one at ``path`` is replaced)."""
+           geometry=None):
+    """A new, empty sequence store (an existing one at ``path`` is replaced).
+
+    ``origin_xyz``: the grid's voxel ``[0, 0, 0]`` in the frames' voxel indices; ``geometry``: where it
+    is in physical space (default: the identity shifted to ``origin_xyz``). OME-Zarr's ``scale`` and
+    ``translation`` are physical (millimetres), so napari and 3D Slicer overlay a frame on its scan;
+    OME-Zarr has no rotation, so a scan with tilted axes has its full geometry in volanim's attributes.
+    """
     import zarr
 
+    from volanim_core.geometry import Geometry
     from volanim_core.io._atomic import atomic_write_text
 
     path = Path(path)
     dtype = np.dtype(dtype)
     z, y, x = (int(v) for v in shape_zyx)
     ox, oy, oz = (float(v) for v in origin_xyz)
-    sx, sy, sz = (float(v) for v in spacing)
+    if geometry is None:
+        geometry = Geometry(origin=(ox, oy, oz))
+    sx, sy, sz = geometry.spacing
+    px, py, pz = geometry.origin
     ome = {"version": "0.5", "multiscales": [{
         "name": path.stem,
-        "axes": [{"name": "t", "type": "time", "unit": "second"}, {"name": "z", "type": "space"},
-                 {"name": "y", "type": "space"}, {"name": "x", "type": "space"}],
+        "axes": [{"name": "t", "type": "time", "unit": "second"}, {"name": "z", "type": "space", "unit": "millimeter"},
+                 {"name": "y", "type": "space", "unit": "millimeter"},
+                 {"name": "x", "type": "space", "unit": "millimeter"}],
         "datasets": [{"path": "0", "coordinateTransformations": [
             {"type": "scale", "scale": [1.0 / fps, sz, sy, sx]},
-            {"type": "translation", "translation": [0.0, oz * sz, oy * sy, ox * sx]}]}],
+            {"type": "translation", "translation": [0.0, pz, py, px]}]}],
     }]}
     root = zarr.open_group(str(path), mode="w", zarr_format=3)
     root.attrs.update({"ome": ome, "volanim": {"origin_xyz": [ox, oy, oz], "mode": plan.get("mode"),
-                                               "frames": plan.get("numbers")}})
+                                               "frames": plan.get("numbers"), "geometry": geometry.header_value()}})
     chunks = chunk_shape((z, y, x))
     # a shard holds whole chunks: round it up (past the array's edge), still exactly one per frame
     shard = tuple(-(-n // c) * c for n, c in zip((z, y, x), chunks))
@@ -127,6 +138,18 @@ def open_frames(path: str | Path, mode: str = "r"):
 def read_frame(path: str | Path, index: int) -> np.ndarray:
     """Frame ``index`` as a ``[x, y, z]`` volume (like every volanim volume)."""
     return np.asarray(open_frames(path)[index]).T
+
+
+def geometry(path: str | Path):
+    """Where the store's voxel ``[0, 0, 0]`` is in physical space (the identity shifted to its origin for a
+    store made before geometry was recorded)."""
+    import zarr
+
+    from volanim_core.geometry import Geometry
+
+    attrs = zarr.open_group(str(path), mode="r").attrs["volanim"]
+    text = attrs.get("geometry")
+    return Geometry.parse(text) if text else Geometry(origin=tuple(float(v) for v in attrs["origin_xyz"]))
 
 
 def origin(path: str | Path) -> tuple[int, int, int]:

@@ -36,7 +36,7 @@ class Payload:
     bounds: Bounds
     store: str
     source: np.ndarray | None = None
-    source_origin: tuple = (0, 0, 0)
+    source_geometry: object = None  # a Geometry, or None: the source is on the frames' grid
     every_frame_as: str | None = None  # "DIR/NAME.%04d.vti" (or .nrrd, .vol, .VOL)
     threads: int = 1  # numba threads per task: N workers x 1 thread use N cores without oversubscription
 
@@ -91,7 +91,7 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
         raise RuntimeError("reconstruct_frame: no payload (the pool's initializer did not run)")
     t0 = time.perf_counter()
     tskel = spec.tskel(p.conn)
-    r = reconstruct(tskel, mode=p.mode, source=p.source, source_origin=p.source_origin, kernel=p.kernel,
+    r = reconstruct(tskel, mode=p.mode, source=p.source, source_geometry=p.source_geometry, kernel=p.kernel,
                     bounds=grid, threads=p.threads)  # neighbour lists: remembered per connectivity
     zyx = r.volume.T  # the engine's own [z, y, x] array: C-contiguous, no copy
     if spec.crumble:
@@ -117,7 +117,7 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
 
         whole = np.zeros(p.bounds.shape[::-1], part.dtype)  # per-frame files line up too: the shared grid
         whole[region] = part
-        io.write_output(frame_file(p.every_frame_as, spec.number), whole.T, origin=p.bounds.lo)
+        io.write_output(frame_file(p.every_frame_as, spec.number), whole.T, p.conn.geometry.shifted(p.bounds.lo))
     s = r.stats
     return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
             "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.limits import voxel_points
 
 METRICS = ("euclid", "345")
@@ -35,12 +36,17 @@ class Skeleton:
     thinness : (N,) ndarray of float64
         Thinness of each point; NaN when unknown (a ``.skel`` file).
     metric : {'euclid', '345'}
+    geometry : Geometry
+        Where the voxel grid of ``points`` is in physical space (the identity for a file
+        that records none); ``dt`` is in its voxels, which are cubes (``spacing`` isotropic)
+        whenever the skeleton was made by :func:`~volanim_core.skeleton.skeletonize`.
     """
 
     points: np.ndarray
     dt: np.ndarray
     thinness: np.ndarray
     metric: str = "euclid"
+    geometry: Geometry = IDENTITY
 
     def __post_init__(self):
         self.points = voxel_points(self.points)
@@ -67,7 +73,7 @@ class Skeleton:
         """A copy sorted by decreasing thinness (stable; NaN last)."""
         key = np.where(np.isnan(self.thinness), -np.inf, self.thinness)
         order = np.argsort(-key, kind="stable")
-        return Skeleton(self.points[order], self.dt[order], self.thinness[order], self.metric)
+        return Skeleton(self.points[order], self.dt[order], self.thinness[order], self.metric, self.geometry)
 
     def is_sorted(self) -> bool:
         key = np.where(np.isnan(self.thinness), -np.inf, self.thinness)
@@ -81,4 +87,4 @@ class Skeleton:
     def at(self, thinness: float) -> Skeleton:
         """The skeleton at ``thinness``: the points with thinness >= it."""
         n = self.count_at(thinness)
-        return Skeleton(self.points[:n], self.dt[:n], self.thinness[:n], self.metric)
+        return Skeleton(self.points[:n], self.dt[:n], self.thinness[:n], self.metric, self.geometry)

@@ -22,6 +22,7 @@ import os
 import numpy as np
 
 from volanim_core.errors import Cancelled
+from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.skeleton._kernels import chamfer345, thinness_chunk
 from volanim_core.skeleton.points import Skeleton, check_metric
@@ -78,6 +79,7 @@ def skeletonize(
     *,
     metric: str = "euclid",
     min_thinness: float = DEFAULT_MIN_THINNESS,
+    geometry: Geometry = IDENTITY,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
 ) -> Skeleton:
@@ -95,6 +97,10 @@ def skeletonize(
     metric : {'euclid', '345'}
     min_thinness : float
         Keep points with thinness >= this; ``-np.inf`` keeps all object voxels.
+    geometry : Geometry
+        Where the mask's voxels are (recorded in the skeleton, and so in its ``.mskel``). Its
+        voxels must be cubes: resample an anisotropic scan first
+        (:func:`volanim_core.volume.isotropic_mask`), else radii would be ellipsoids in the body.
     progress : callable(done, total), optional
     cancel : callable() -> bool, optional
         Polled between chunks; True raises :class:`~volanim_core.errors.Cancelled`.
@@ -114,6 +120,10 @@ def skeletonize(
     ([4, 4, 4], 4.0)
     """
     check_metric(metric)
+    if not geometry.is_isotropic:
+        raise ValueError(f"the voxels are not cubes ({' x '.join(f'{v:g}' for v in geometry.spacing)} mm): "
+                         "resample to cubic voxels first (volanim_core.volume.isotropic_mask; on the command "
+                         "line, skeletonize does it, --voxel-size sets the size)")
     if min_thinness != min_thinness:  # NaN would silently keep nothing
         raise ValueError("min_thinness is NaN; give a number (or -inf to keep every object voxel)")
     m = _as_mask(mask)
@@ -153,7 +163,7 @@ def skeletonize(
     dts, ths = np.concatenate(dt_parts), np.concatenate(th_parts)
     order = np.argsort(-ths, kind="stable")
     report(100, 100)
-    return Skeleton(points[order], dts[order], ths[order], metric)
+    return Skeleton(points[order], dts[order], ths[order], metric, geometry)
 
 
 __all__ = ["DEFAULT_MIN_THINNESS", "Cancelled", "distance_transform", "skeletonize"]

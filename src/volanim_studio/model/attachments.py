@@ -150,7 +150,7 @@ class Attachments:
         keep = self.bone >= 0
         roots = [RootBone(*doc.bones.segment(i), b.label) for i, b in enumerate(doc.bones.bones)]
         conn = Connectivity(roots, s.points[keep], s.dt[keep], s.thinness[keep], self.bone[keep], s.metric,
-                            thinness)
+                            thinness, s.geometry)
         return conn.grouped()
 
     def save(self, path, thinness: float | None = None) -> int:
@@ -180,7 +180,8 @@ class Attachments:
         remap = self._match_bones(conn, name)
         if doc.skeleton is None or not len(doc.skeleton):
             th = conn.thinness if not np.isnan(conn.thinness).all() else np.zeros(len(conn))
-            doc.set_skeleton(Skeleton(conn.points, conn.dt, np.nan_to_num(th), conn.metric), path=None)
+            doc.set_skeleton(Skeleton(conn.points, conn.dt, np.nan_to_num(th), conn.metric, conn.geometry),
+                             path=None)
         s = doc.skeleton
         index = {tuple(p): i for i, p in enumerate(s.points.tolist())}
         found = np.array([index.get(tuple(p), -1) for p in conn.points.tolist()], np.int64)
@@ -191,10 +192,11 @@ class Attachments:
             fill = conn.thinness_threshold if conn.thinness_threshold is not None else 0.0
             th = np.where(np.isnan(conn.thinness[missing]), fill, conn.thinness[missing])
             merged = Skeleton(np.vstack([s.points, conn.points[missing]]), np.r_[s.dt, conn.dt[missing]],
-                              np.r_[s.thinness, th], s.metric)
+                              np.r_[s.thinness, th], s.metric, s.geometry)
             old_bone = np.r_[self.bone, np.full(int(missing.sum()), UNATTACHED, np.int32)]
             order = np.argsort(-merged.thinness, kind="stable")
-            doc.set_skeleton(Skeleton(merged.points[order], merged.dt[order], merged.thinness[order], s.metric),
+            doc.set_skeleton(Skeleton(merged.points[order], merged.dt[order], merged.thinness[order], s.metric,
+                                      s.geometry),
                              path=doc.mskel_path, keep_attachments=old_bone[order])
             doc.undo.clear()  # the cloud changed under the history
             s = doc.skeleton

@@ -125,7 +125,7 @@ class PoseState:
         t = self.doc.thinness if thinness is None else thinness
         keep = ~(conn.thinness < t)
         return Tskel(conn.bones, self.matrices(), conn.points[keep], conn.dt[keep], conn.thinness[keep],
-                     conn.bone[keep], conn.metric)
+                     conn.bone[keep], conn.metric, conn.geometry)
 
     def save_tskel(self, path) -> int:
         t = self.tskel()

@@ -7,6 +7,7 @@ import pytest
 
 from volanim_core import io
 from volanim_core.errors import FormatError
+from volanim_core.geometry import Geometry
 from volanim_core.io import raw_volumes
 
 
@@ -105,10 +106,10 @@ def test_header_add_remove_streaming_round_trip(tmp_path, vol, monkeypatch):
 @pytest.mark.parametrize("suffix", [".vti", ".nrrd"])
 def test_vtk_format_round_trip(tmp_path, vol, suffix):
     path = tmp_path / f"a{suffix}"
-    io.write_volume(path, vol, origin=(1.0, 2.0, 3.0), spacing=(1.0, 1.0, 1.5))
-    data, origin, spacing = io.read_volume_grid(path)
+    io.write_volume(path, vol, Geometry(origin=(1.0, 2.0, 3.0), spacing=(1.0, 1.0, 1.5)))
+    data, geometry, _ = io.read_scan(path)
     assert np.array_equal(data, vol)
-    assert np.allclose(origin, (1, 2, 3)) and np.allclose(spacing, (1, 1, 1.5))
+    assert np.allclose(geometry.origin, (1, 2, 3)) and np.allclose(geometry.spacing, (1, 1, 1.5))
 
 
 # spec: docs/formats.md#other-volumes

@@ -9,6 +9,7 @@ from scipy.spatial.transform import Rotation
 import naive
 from volanim_core import samples
 from volanim_core.errors import Cancelled
+from volanim_core.geometry import Geometry
 from volanim_core.reconstruct.engine import grid_bounds, reconstruct
 from volanim_core.rig.connectivity import RootBone, Tskel
 from volanim_core.skeleton.skeletonize import skeletonize
@@ -314,7 +315,8 @@ def test_cropped_source_with_origin(rng):
     t = random_tskel(rng)
     b = grid_bounds(t)
     full = reconstruct(t, mode="sampled", source=src, bounds=b)
-    crop = reconstruct(t, mode="sampled", source=src[2:, 3:, 1:], source_origin=(2, 3, 1), bounds=b)
+    crop = reconstruct(t, mode="sampled", source=src[2:, 3:, 1:],
+                       source_geometry=Geometry(origin=(2, 3, 1)), bounds=b)
     # every voxel sampled from inside the crop agrees; outside the crop reads 0
     differ = full.volume != crop.volume
     assert (crop.volume[differ] == 0).all()

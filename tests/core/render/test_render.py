@@ -13,6 +13,7 @@ import pytest
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
+from volanim_core.geometry import Geometry
 from volanim_core.render.camera import Camera, named_view
 from volanim_core.render.run import frame_path, open_inputs, render
 from volanim_core.render.scene import Renderer, RenderSettings
@@ -138,7 +139,7 @@ def test_a_rerun_draws_only_the_missing_pictures_and_other_settings_redraw(tmp_p
 
 # spec: docs/formats.md#tf
 def test_one_volume_file_to_a_png_with_a_transfer_function_and_a_saved_camera(tmp_path, capsys):
-    io.write_volume(tmp_path / "b.vti", ball(radius=15, value=200), origin=(5, 5, 5))
+    io.write_volume(tmp_path / "b.vti", ball(radius=15, value=200), Geometry(origin=(5, 5, 5)))
     tf = TransferFunction([0, 100, 255], [[0, 0, 0, 0], [1, 0, 0, 0.2], [1, 0, 0, 1]])
     io.write_transfer_function(tmp_path / "red.tf", tf)
     args = ["render", str(tmp_path / "b.vti"), "-o", str(tmp_path / "b.png"), "--style", "volume", "--tf",

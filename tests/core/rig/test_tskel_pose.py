@@ -91,7 +91,8 @@ def test_cli_pose_to_reconstruct_chain(tmp_path, capsys):
                  "--loss", "-o", str(tmp_path / "arm.vti")]) == 0
     out = capsys.readouterr().out
     assert "voxels filled" in out and "voxel loss against the identity frame" in out
-    data, origin, _ = io.read_volume_grid(tmp_path / "arm.vti")
+    data, placed, _ = io.read_scan(tmp_path / "arm.vti")
+    origin = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
     assert origin[0] < 13 and data.max() == 250  # the arm moved outward; bone values carried
     assert main(["reconstruct", str(tmp_path / "rest.tskel"), "--mode", "hotspot", "--bounds", "0", "0", "0",
                  "100", "99", "299", "-o", str(tmp_path / "hot.VOL")]) == 0

@@ -165,7 +165,8 @@ def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tm
     assert main(args) == 0
     text = capsys.readouterr().out
     assert "loss %" in text and "wrote" in text and "2 made, 0 already complete" in text
-    vol, origin, _ = io.read_volume_grid(tmp_path / "f" / "w.0020.nrrd")
+    vol, placed, _ = io.read_scan(tmp_path / "f" / "w.0020.nrrd")
+    origin = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
     assert np.array_equal(vol, store.read_frame(out, 1)) and tuple(int(v) for v in origin) == store.origin(out)
     assert main(args) == 0 and "0 made, 2 already complete" in capsys.readouterr().out
     assert main(args[:-4] + ["-o", str(out), "--padding", "5"]) == 2

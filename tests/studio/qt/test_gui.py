@@ -13,6 +13,7 @@ from PySide6.QtCore import Qt
 
 from paths import ASSETS
 from volanim_core import io, samples
+from volanim_core.geometry import Geometry
 from volanim_studio.model.modes import Mode
 
 from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view, open_project
@@ -411,7 +412,7 @@ def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(q
 
     vol = np.zeros((20, 16, 12), np.uint8, order="F")
     vol[4:15, 3:12, 2:10] = 200
-    write_volume(tmp_path / "posed.vti", vol, origin=(5, 6, 7))
+    write_volume(tmp_path / "posed.vti", vol, Geometry(origin=(5, 6, 7)))
     verts, faces = isosurface(vol > 0)
     write_mesh(tmp_path / "hull.ply", verts, faces)
     points_before = len(window.doc.skeleton)

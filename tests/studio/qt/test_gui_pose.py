@@ -165,7 +165,9 @@ def test_compare_export_and_slices(qtbot, posed_window, tmp_path):
     assert w.previews.export_preview(tmp_path / "posed.vti")
     from volanim_core import io
 
-    data, origin, _ = io.read_volume_grid(tmp_path / "posed.vti")
+    data, placed, _ = io.read_scan(tmp_path / "posed.vti")
+
+    origin = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
     assert np.array_equal(data, w.doc.preview.reconstruction.volume)
     assert tuple(origin) == tuple(float(v) for v in w.doc.preview.origin_voxels)
     # a headerless .vol is named by its size, as the command line names it
