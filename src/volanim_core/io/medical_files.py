@@ -102,34 +102,39 @@ def _mgh_bytes(path: Path) -> bytes:
 # --- DICOM ------------------------------------------------------------------------------------
 
 def _read_dicom_header(f: Path):
+    """A file's dataset with its large elements (the pixels) left on disk until they are used, or None
+    for a file that is not DICOM: one read of each file serves grouping, sorting and the pixels."""
     import pydicom
     from pydicom.errors import InvalidDicomError
 
     try:
-        return pydicom.dcmread(str(f), stop_before_pixels=True)
+        return pydicom.dcmread(str(f), defer_size=4096)
     except (InvalidDicomError, OSError, EOFError, ValueError, TypeError, AttributeError, KeyError):
         return None
 
 
-def dicom_series(folder: str | Path) -> dict[str, list[Path]]:
-    """The DICOM files of a folder by SeriesInstanceUID (files that are not DICOM images are skipped)."""
-    folder = Path(folder)
-    series: dict[str, list[Path]] = {}
+def _series_datasets(folder: Path) -> dict[str, list[tuple[Path, object]]]:
+    series: dict[str, list[tuple[Path, object]]] = {}
     for f in sorted(p for p in folder.iterdir() if p.is_file()):
         ds = _read_dicom_header(f)
         if ds is None or "Rows" not in ds:  # not DICOM, or no image (a report, a DICOMDIR)
             continue
-        series.setdefault(str(ds.get("SeriesInstanceUID", "")), []).append(f)
+        series.setdefault(str(ds.get("SeriesInstanceUID", "")), []).append((f, ds))
     return series
 
 
-def describe_series(series: dict[str, list[Path]]) -> list[str]:
-    """One line a series: ``N. UID  description  (files)``, for the choice the user makes."""
+def dicom_series(folder: str | Path) -> dict[str, list[Path]]:
+    """The DICOM files of a folder by SeriesInstanceUID (files that are not DICOM images are skipped)."""
+    return {uid: [f for f, _ in found] for uid, found in _series_datasets(Path(folder)).items()}
+
+
+def describe_series(series: dict[str, list]) -> list[str]:
+    """One line a series: ``N. UID  modality description  (files)``, for the choice the user makes."""
     lines = []
-    for k, (uid, files) in enumerate(series.items(), start=1):
-        ds = _read_dicom_header(files[0])
-        text = " ".join(str(ds.get(t, "")) for t in ("Modality", "SeriesDescription") if ds is not None).strip()
-        lines.append(f"{k}. {uid or '(no UID)'}  {text or '(no description)'}  ({len(files)} files)")
+    for k, (uid, found) in enumerate(series.items(), start=1):
+        ds = found[0][1]
+        text = " ".join(str(ds.get(t, "")) for t in ("Modality", "SeriesDescription")).strip()
+        lines.append(f"{k}. {uid or '(no UID)'}  {text or '(no description)'}  ({len(found)} files)")
     return lines
 
 
@@ -155,21 +160,20 @@ def read_dicom(path: str | Path, *, series: str | None = None):
     path = Path(path)
     if path.is_file():
         return _read_multiframe(path)
-    found = dicom_series(path)
+    found = _series_datasets(path)
     if not found:
         raise FormatError(path, "holds no DICOM image files")
     if series is None and len(found) > 1:
         raise FormatError(path, f"holds {len(found)} DICOM series; choose one with --series UID or its number:\n  "
                           + "\n  ".join(describe_series(found)))
     if series is None:
-        files = next(iter(found.values()))
+        headers = next(iter(found.values()))
     elif series in found:
-        files = found[series]
+        headers = found[series]
     elif series.isdigit() and 1 <= int(series) <= len(found):
-        files = list(found.values())[int(series) - 1]
+        headers = list(found.values())[int(series) - 1]
     else:
         raise FormatError(path, f"has no series {series!r}; it has:\n  " + "\n  ".join(describe_series(found)))
-    headers = [(f, _read_dicom_header(f)) for f in files]
     if len(headers) == 1 and int(headers[0][1].get("NumberOfFrames", 1) or 1) > 1:
         return _read_multiframe(headers[0][0])
     return _read_slices(path, headers)
@@ -216,7 +220,26 @@ def _rescale(path: Path, slices: np.ndarray, slopes, intercepts) -> np.ndarray:
     return out
 
 
+_PLAIN_SYNTAXES = ("1.2.840.10008.1.2", "1.2.840.10008.1.2.1")  # implicit / explicit VR little endian
+
+
 def _pixels(f: Path, ds) -> np.ndarray:
+    """One frame's pixels ``[rows, columns]``. Uncompressed little-endian grey slices, what most series
+    are, are viewed straight from their bytes (pydicom's general decoder spent half of a CT series'
+    read deciding that); everything else goes through pydicom."""
+    syntax = str(getattr(getattr(ds, "file_meta", None), "TransferSyntaxUID", ""))
+    alloc, stored = int(ds.get("BitsAllocated", 0)), int(ds.get("BitsStored", 0) or 0)
+    if syntax in _PLAIN_SYNTAXES and int(ds.get("SamplesPerPixel", 1)) == 1 and alloc in (8, 16, 32) \
+            and 0 < stored <= alloc and int(ds.get("NumberOfFrames", 1) or 1) == 1:
+        rows, cols = int(ds.Rows), int(ds.Columns)
+        data = ds.PixelData
+        if len(data) >= rows * cols * alloc // 8:
+            signed = int(ds.get("PixelRepresentation", 0)) == 1
+            img = np.frombuffer(data, f"<{'i' if signed else 'u'}{alloc // 8}", count=rows * cols).reshape(rows, cols)
+            if stored < alloc:  # the bits above BitsStored are not the pixel's: sign-extend or clear them
+                shift = alloc - stored
+                img = (img << shift) >> shift
+            return img
     try:
         return ds.pixel_array
     except Exception as exc:  # missing decoder plugins, bad data: name the file and the syntax
@@ -226,8 +249,6 @@ def _pixels(f: Path, ds) -> np.ndarray:
 
 
 def _read_slices(folder: Path, headers):
-    import pydicom
-
     f0, ds0 = headers[0]
     row, col = _orientation(f0, ds0.get("ImageOrientationPatient"))
     normal = np.cross(row, col)
@@ -259,9 +280,8 @@ def _read_slices(folder: Path, headers):
     first = None
     slopes, intercepts = [], []
     for z, k in enumerate(order):
-        f = headers[k][0]
-        ds = pydicom.dcmread(str(f))
-        img = _pixels(f, ds)
+        f, ds = headers[k]
+        img = _pixels(f, ds)  # its deferred pixels are read now
         if img.ndim != 2:
             raise FormatError(f, f"holds {img.shape} pixels; a series of grey slices was expected")
         if first is None:

@@ -315,3 +315,20 @@ def test_nan_voxels_are_background_not_a_black_volume(tmp_path, capsys):
     assert main(["convert", str(tmp_path / "mri.nii"), str(tmp_path / "mri.nrrd"), "--rescale"]) == 0
     out = io.read_volume(tmp_path / "mri.nrrd")
     assert out.max() == 255 and out[0, 0, 0] == 0 and np.count_nonzero(out) > 0.9 * out.size
+
+
+@pytest.mark.parametrize("signed", [0, 1])
+def test_12_bit_pixels_read_like_pydicom(tmp_path, signed):
+    """Our fast path for plain slices against pydicom's decoder: 12 of 16 bits, high bits set."""
+    hu = synthetic_ct((8, 6, 3))
+    write_ct_series(tmp_path / "ct", hu, shuffle=False)
+    for f in sorted((tmp_path / "ct").iterdir()):
+        ds = pydicom.dcmread(f)
+        raw = np.frombuffer(ds.PixelData, "<u2").copy()
+        ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 12, 11, signed
+        ds.PixelData = (raw | 0xF000).astype("<u2").tobytes()  # garbage above bit 11
+        ds.save_as(f)
+    scan = io.read_scan(tmp_path / "ct")
+    for z, f in enumerate(sorted((tmp_path / "ct").iterdir())):
+        ds = pydicom.dcmread(f)
+        assert np.array_equal(scan.data[:, :, z], ds.pixel_array.T.astype(np.int32) + int(ds.RescaleIntercept))

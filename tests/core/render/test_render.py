@@ -47,6 +47,22 @@ def test_a_sphere_covers_its_projected_disc(style):
     assert np.sqrt(pixels / np.pi) == pytest.approx(expected, rel=0.04)
 
 
+@pytest.mark.parametrize("view", ["three-quarter", "front"])
+@pytest.mark.parametrize("at", [(230, 20, 10), (0, 540, 300)])
+def test_a_body_in_a_corner_of_a_large_sequence_grid_is_drawn_not_clipped(view, at):
+    """The clipping range was never reset after the camera was placed: a body in a corner of a long
+    walk's shared grid (300 x 600 x 400 voxels) came out black or cut (0 pixels before the fix)."""
+    body = np.zeros((60, 60, 60), np.uint8)
+    body[10:50, 10:50, 10:50] = 1
+    r = Renderer(RenderSettings(named_view(view, (0, 0, 0), (300, 600, 400)), preset="binary", size=(160, 120)))
+    try:
+        pixels = lit(r.render(body, at)).sum()
+    finally:
+        r.close()
+    # the cube's silhouette seen from ~1000 units: at least 60 pixels in either view
+    assert pixels >= 60
+
+
 def test_a_parallel_camera_draws_true_size_and_the_cut_shows_the_inside():
     shell = ball(radius=20, value=1)
     shell[ball(radius=12) > 0] = 2  # label 2 inside label 1
