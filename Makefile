@@ -61,6 +61,7 @@ bench: install-test system-deps
 	xvfb-run -a $(PY) benchmarks/bench_studio.py
 	xvfb-run -a $(PY) benchmarks/bench_motion.py
 	$(PY) benchmarks/bench_colour.py
+	$(PY) benchmarks/bench_scans.py
 
 # The README's generated tables (volume tools, every benchmark's figures): about 15 minutes on 2 cores.
 docs: install-test system-deps
