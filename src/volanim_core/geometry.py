@@ -20,13 +20,20 @@ geometry: unit spacing, origin 0, axes as they are.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Geometry", "IDENTITY"]
+__all__ = ["Geometry", "IDENTITY", "axis_codes", "mm"]
 
 _ORTHO_TOLERANCE = 1e-4
+_ASCII_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")  # as io._text.NUMBER
+
+
+def mm(values, sep: str = " x ") -> str:
+    """Numbers as people read them (``0.7 x 0.7 x 2.5``): spacings, origins, in messages."""
+    return sep.join(f"{float(v):g}" for v in values)
 
 
 def _triple(values, what: str) -> tuple[float, float, float]:
@@ -177,10 +184,7 @@ class Geometry:
             if key not in want or key in found:
                 raise ValueError(f"expected 'spacing', 'origin' or 'direction' (each once), got {words[i]!r}")
             values = words[i + 1:i + 1 + want[key]]
-            try:
-                numbers = [float(v) for v in values]
-            except ValueError:
-                numbers = []
+            numbers = [float(v) for v in values if _ASCII_NUMBER.fullmatch(v)]  # no "nan", "1_0", "１"
             if len(numbers) != want[key]:
                 raise ValueError(f"'{key}' takes {want[key]} numbers, got {' '.join(values)!r}")
             found[key] = numbers
@@ -192,9 +196,7 @@ class Geometry:
 
     def describe(self) -> str:
         """One line for people: ``spacing 0.5 x 0.5 x 2 mm, origin (-40, -25, -900) mm[, axes ...]``."""
-        s = " x ".join(f"{v:g}" for v in self.spacing)
-        o = ", ".join(f"{v:g}" for v in self.origin)
-        text = f"spacing {s} mm, origin ({o}) mm"
+        text = f"spacing {mm(self.spacing)} mm, origin ({mm(self.origin, ', ')}) mm"
         if self.direction != IDENTITY.direction:
             text += f", axes {axis_codes(self.matrix)}"
         return text

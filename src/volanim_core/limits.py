@@ -94,6 +94,21 @@ def checked_grid(path: str | Path, dims, itemsize: int = 1, *, line: int | None 
     return sizes
 
 
+def check_allocation(shape, bytes_per_voxel: int, what: str, advice: str) -> None:
+    """Refuse (ValueError) a grid the caller is about to make when it is over the voxel limit or the
+    memory free, stating its size; ``what`` names it ("the output grid"), ``advice`` says what to change."""
+    voxels = math.prod(int(n) for n in shape)
+    nbytes = voxels * bytes_per_voxel
+    shown = "x".join(str(int(n)) for n in shape)
+    if voxels > max_voxels():
+        raise ValueError(f"{what} would be {shown} = {voxels:,} voxels ({human_bytes(nbytes)}); the limit "
+                         f"is {max_voxels():,} voxels: {advice}")
+    free = available_bytes()
+    if free is not None and nbytes > free:
+        raise ValueError(f"{what} would be {shown} voxels, {human_bytes(nbytes)}, but only "
+                         f"{human_bytes(free)} of memory is available: {advice}")
+
+
 def voxel_points(points) -> np.ndarray:
     """``(N, 3)`` int32 voxel coordinates; NaN, fractions and magnitudes over ``MAX_COORD`` are a
     ValueError naming the point (a plain int32 cast wraps 3e9 to -2147483648)."""

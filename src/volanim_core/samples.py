@@ -337,13 +337,13 @@ def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
         table[value] = hu
     hu = table[s.volume]
     ct, geometry = resample(hu, Geometry(origin=CT_ORIGIN), CT_SPACING, order=0, progress=stage(progress, 0, 30))
-    files = write_dicom_series(folder / "mannequin-ct", ct, geometry, description="mannequin CT (volanim sample)")
+    write_dicom_series(folder / "mannequin-ct", ct, geometry, description="mannequin CT (volanim sample)")
     cube = CT_SPACING[0]  # skeletonize's default voxel: the smallest spacing
     bones = BoneSkeleton({n: np.round(np.asarray(p) / cube, 3) for n, p in s.bones.joints.items()}, list(s.bones.bones))
     write_bones(folder / "mannequin-ct.bones", bones)
     if progress is not None:
         progress(1, 1)
-    return [folder / "mannequin-ct", folder / "mannequin-ct.bones"] if files else []
+    return [folder / "mannequin-ct", folder / "mannequin-ct.bones"]
 
 
 def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:

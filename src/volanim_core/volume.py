@@ -36,6 +36,7 @@ from scipy import ndimage
 
 from .geometry import Geometry
 from .io.volume_files import float_to_uint8
+from .limits import check_allocation
 from .progress import Reporter
 
 __all__ = [
@@ -258,7 +259,8 @@ def resample(vol: np.ndarray, geometry: Geometry, spacing, *, order: int = 1, th
     if order not in (0, 1, 3):
         raise ValueError(f"order must be 0 (nearest), 1 (linear) or 3 (cubic), got {order}")
     shape = resampled_shape(vol.shape, geometry.spacing, new)
-    _check_grid_size(shape, 1 if threshold_at is not None else vol.dtype.itemsize)
+    check_allocation(shape, 1 if threshold_at is not None else vol.dtype.itemsize, "the resampled grid",
+                     "choose a larger voxel size")
     step = new / np.asarray(geometry.spacing)
     src = vol.view(np.uint8) if vol.dtype == bool else vol  # ndimage takes no bool
     out = np.empty(shape, bool if threshold_at is not None else vol.dtype, order="F")
@@ -287,16 +289,3 @@ def isotropic_mask(mask: np.ndarray, geometry: Geometry, voxel_size: float | Non
         return mask, geometry
     return resample(mask, geometry, size, order=1, threshold_at=0.5, progress=progress, cancel=cancel)
 
-
-def _check_grid_size(shape, itemsize: int) -> None:
-    from .limits import available_bytes, human_bytes, max_voxels
-
-    voxels = int(np.prod(shape, dtype=np.float64))
-    shown = "x".join(str(n) for n in shape)
-    if voxels > max_voxels():
-        raise ValueError(f"the resampled grid would be {shown} = {voxels:,} voxels, over the limit of "
-                         f"{max_voxels():,}: choose a larger voxel size")
-    free = available_bytes()
-    if free is not None and voxels * itemsize > free:
-        raise ValueError(f"the resampled grid would be {shown} voxels, {human_bytes(voxels * itemsize)}, more than "
-                         f"the {human_bytes(free)} of memory available: choose a larger voxel size")

@@ -15,7 +15,7 @@ from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter, stage
 from volanim_core.skeleton.hull import display_hulls
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
-from volanim_core.volume import fill_cavities, threshold
+from volanim_core.volume import segment
 
 
 def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: bool, metric: str = "euclid",
@@ -31,9 +31,7 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     report(0, 100)
     if grey is None:  # a colour scan is segmented on its luminance
         grey = to_grey(volume) if is_colour(volume) else volume
-    mask = threshold(grey, lo, hi).view(bool)
-    if fill:
-        mask = fill_cavities(mask)
+    mask = segment(grey, lo, hi, fill=fill)  # the command line's own segmentation
     if not mask.any():
         raise ValueError(f"no voxel lies in the threshold range {lo}..{hi if hi is not None else 'max'}")
     report(10, 100)

@@ -47,6 +47,25 @@ def load_scan(path: str, args, *, colour: bool = False):
     return read_scan(path, dims=getattr(args, "dims", None), series=getattr(args, "series", None), colour=colour)
 
 
+def load_source(args, frame, *, colour: bool = False):
+    """``--source``: the volume a frame (a ``Tskel`` or ``Connectivity``) samples and its geometry, or
+    ``(None, None)``. Settles the frame's grid against the source (``frame.geometry``; a note when it
+    had to assume one) and refuses a sampled frame that misses the source (reconstruct, sequence)."""
+    from volanim_core.reconstruct.source_space import check_source_overlap, source_geometry_for
+
+    if not args.source:
+        if args.mode == "sampled":
+            raise ValueError("sampled mode needs --source VOLUME")
+        return None, None
+    source, geometry, _ = load_scan(args.source, args, colour=colour)
+    frame.geometry, note = source_geometry_for(frame.geometry, geometry)
+    if note:
+        print(f"note: {note}")
+    if args.mode == "sampled":
+        check_source_overlap(frame, source.shape, geometry)
+    return source, geometry
+
+
 def load(path: str, args) -> object:
     return load_scan(path, args).data
 

@@ -11,7 +11,6 @@ from volanim_core.io import (
     read_bones,
     read_connect,
     read_mskel,
-    read_scan,
     read_trans,
     read_tskel,
     write_connect,
@@ -21,13 +20,12 @@ from volanim_core.io import (
 )
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
-from volanim_core.reconstruct.source_space import check_source_overlap, source_geometry_for
 from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
 from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
 
-from ._common import add_command, ascii_int, bounds_arg, finite_float
+from ._common import add_command, add_dims, ascii_int, bounds_arg, finite_float, load_source
 
 
 def _connect(args):
@@ -100,16 +98,7 @@ def _check_output(path: str) -> None:
 def _reconstruct(args):
     _check_output(args.output)
     t = read_tskel(args.tskel)
-    source, source_geometry = None, None
-    if args.source:
-        source, source_geometry, _ = read_scan(args.source, dims=args.dims, colour=True)
-        t.geometry, note = source_geometry_for(t.geometry, source_geometry)
-        if note:
-            print(f"note: {note}")
-        if args.mode == "sampled":
-            check_source_overlap(t, source.shape, source_geometry)
-    elif args.mode == "sampled":
-        raise ValueError("sampled mode needs --source VOLUME")
+    source, source_geometry = load_source(args, t, colour=True)
     bounds = bounds_arg(args.bounds) if args.bounds else None
     bar = TextProgress("reconstruct")
     r = reconstruct(t, mode=args.mode, source=source, source_geometry=source_geometry, kernel=args.kernel,
@@ -185,7 +174,7 @@ def register(sub) -> None:
                     _reconstruct)
     p.add_argument("tskel")
     p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
-    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    add_dims(p)  # --dims for a headerless .vol source, --series for a DICOM folder of several
     p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     group = p.add_mutually_exclusive_group()

@@ -4,7 +4,17 @@ from __future__ import annotations
 
 import sys
 
-from ._common import FrameProgress, add_command, ascii_int, checked_by, local_workers, positive_float, positive_int
+from ._common import (
+    FrameProgress,
+    add_command,
+    add_dims,
+    ascii_int,
+    checked_by,
+    load_source,
+    local_workers,
+    positive_float,
+    positive_int,
+)
 
 EXAMPLE = (
     "volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr",
@@ -17,7 +27,7 @@ EXAMPLE = (
 
 
 def _sequence(args):
-    from volanim_core.io import read_bones, read_connect, read_scan
+    from volanim_core.io import read_bones, read_connect
     from volanim_core.motion.retarget import read_mapping
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
@@ -33,16 +43,7 @@ def _sequence(args):
         frames += teleport(conn, frames, args.teleport, down=args.down)
     elif args.crumble:
         frames += crumble(frames, args.crumble, down=args.down)
-    source, source_geometry = None, None
-    if args.source:
-        from volanim_core.reconstruct.source_space import check_source_overlap, source_geometry_for
-
-        source, source_geometry, _ = read_scan(args.source, dims=args.dims)
-        conn.geometry, note = source_geometry_for(conn.geometry, source_geometry)
-        if note:
-            print(f"note: {note}")
-        if args.mode == "sampled":
-            check_source_overlap(conn, source.shape, source_geometry)
+    source, source_geometry = load_source(args, conn)
     workers = local_workers(args)
     rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_geometry=source_geometry,
                        kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
@@ -76,7 +77,7 @@ def register(sub) -> None:
     p.add_argument("connect", help="the .connect every frame uses")
     p.add_argument("frames", nargs="+", help=".trans or .tskel files (numbered NAME.0000.trans ...), or one .bvh")
     p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
-    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
+    add_dims(p)  # --dims for a headerless .vol source, --series for a DICOM folder of several
     p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     p.add_argument("--padding", type=ascii_int, default=2, help="voxels around every frame's spheres (default 2)")

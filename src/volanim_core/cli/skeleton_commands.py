@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 
+from volanim_core.geometry import mm
 from volanim_core.io import read_scan, write_mskel
 from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
@@ -40,8 +41,7 @@ def _cubic(mask: np.ndarray, geometry, voxel_size):
     """The mask on cubic voxels (:func:`volume.isotropic_mask`), saying so when it resampled."""
     cubes, cubic = volume.isotropic_mask(mask, geometry, voxel_size, progress=TextProgress("resample"))
     if cubes is not mask:
-        old = " x ".join(f"{v:g}" for v in geometry.spacing)
-        print(f"resampled {old} mm voxels to {cubic.spacing[0]:g} mm cubes: "
+        print(f"resampled {mm(geometry.spacing)} mm voxels to {cubic.spacing[0]:g} mm cubes: "
               f"{'x'.join(map(str, mask.shape))} -> {'x'.join(map(str, cubes.shape))} voxels")
     return cubes, cubic
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.geometry import axis_codes
+from volanim_core.geometry import axis_codes, mm
 from volanim_core.io import add_header, float_to_uint8, histogram_file, remove_header
 from volanim_core.io.volume_files import finite_range, non_finite_count
 
@@ -43,10 +43,11 @@ def _info(args):
     g = scan.geometry
     found = finite_range(vol)
     print(f"{args.volume}: {vol.shape[0]} x {vol.shape[1]} x {vol.shape[2]} voxels, {kind}")
-    print(f"spacing {' x '.join(f'{v:g}' for v in g.spacing)} mm, origin ({', '.join(f'{v:g}' for v in g.origin)}) "
-          f"mm, axes {axis_codes(g.matrix)} (direction {' '.join(f'{v:g}' for v in g.direction)})")
+    print(f"spacing {mm(g.spacing)} mm, origin ({mm(g.origin, ', ')}) mm, axes {axis_codes(g.matrix)} "
+          f"(direction {mm(g.direction, ' ')})")
     values = f"values {found[0]:g} .. {found[1]:g}" if found else "values: none finite"
-    print(f"{values}, non-zero {int(np.count_nonzero(np.nan_to_num(vol, nan=0.0)))}"
+    # NaN and infinity count as non-zero to NumPy; they are background here
+    print(f"{values}, non-zero {int(np.count_nonzero(vol)) - bad}"
           + (f", {bad} NaN or infinite (background)" if bad else ""))
     print(f"tight bounds (inclusive x0 y0 z0 x1 y1 z1): {b if b else 'none (all zero)'}")
     if scan.segments:
@@ -91,8 +92,7 @@ def _crop(args):
     if args.pad:
         b = volume.Bounds(tuple(v - args.pad for v in b.lo), tuple(v + args.pad for v in b.hi))
     geometry = scan.geometry.shifted(b.lo)
-    print(f"crop bounds: {b}  (origin of the output in the input: {b.lo}; at "
-          f"({', '.join(f'{v:g}' for v in geometry.origin)}) mm)")
+    print(f"crop bounds: {b}  (origin of the output in the input: {b.lo}; at ({mm(geometry.origin, ', ')}) mm)")
     save(args.output, volume.crop(vol, b), geometry)
 
 
@@ -219,9 +219,8 @@ def _resample(args):
         spacing = [min(g.spacing)] * 3
     order = 0 if args.labels else 1
     vol, geometry = volume.resample(scan.data, g, spacing, order=order, progress=TextProgress("resample"))
-    print(f"{'x'.join(map(str, scan.data.shape))} voxels of {' x '.join(f'{v:g}' for v in g.spacing)} mm -> "
-          f"{'x'.join(map(str, vol.shape))} of {' x '.join(f'{v:g}' for v in geometry.spacing)} mm "
-          f"({'nearest' if order == 0 else 'linear'})")
+    print(f"{'x'.join(map(str, scan.data.shape))} voxels of {mm(g.spacing)} mm -> "
+          f"{'x'.join(map(str, vol.shape))} of {mm(geometry.spacing)} mm ({'nearest' if order == 0 else 'linear'})")
     save(args.output, vol, geometry)
 
 

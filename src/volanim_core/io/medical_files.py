@@ -53,8 +53,8 @@ def read_nibabel(path: str | Path):
     """NIfTI-1/2 or MGH/MGZ through nibabel: ``(data[x, y, z], Geometry)``.
 
     The orientation is nibabel's ``affine`` (the sform when its code is set, else the qform);
-    scaled data (``scl_slope``/``scl_inter``) come back scaled, as float, unless the scaling is
-    the identity.
+    ``scl_slope``/``scl_inter`` are applied as DICOM's rescale is (:func:`_rescale`): a CT stored
+    with intercept -1024 comes back as int16 Hounsfield units, whichever format it came in.
     """
     import nibabel as nib
 
@@ -73,14 +73,14 @@ def read_nibabel(path: str | Path):
         raise FormatError(path, f"nibabel could not read it: {exc}") from None
     shape = _squeeze3(path, img.shape)
     checked_grid(path, shape, np.dtype(img.get_data_dtype()).itemsize, what="its dimensions")
+    proxy = img.dataobj
     try:
-        data = np.asanyarray(img.dataobj)
+        raw = np.asarray(proxy.get_unscaled())
     except Exception as exc:
         raise FormatError(path, f"its voxels cannot be read: {exc}") from None
-    data = np.asfortranarray(data.reshape(shape, order="F"))
-    if data.dtype == np.float64 and img.get_data_dtype().kind != "f":  # scaled integers: float32 keeps them
-        data = data.astype(np.float32, order="F")
-    return data, _geometry_from_ras(path, img.affine)
+    raw = np.asfortranarray(raw.reshape(shape, order="F"))
+    slope, inter = float(proxy.slope), float(proxy.inter)  # nibabel gives 1 and 0 where the file sets none
+    return _rescale(raw, [slope] * shape[2], [inter] * shape[2]), _geometry_from_ras(path, img.affine)
 
 
 def _mgh_bytes(path: Path) -> bytes:
@@ -101,7 +101,7 @@ def _mgh_bytes(path: Path) -> bytes:
 
 # --- DICOM ------------------------------------------------------------------------------------
 
-def _read_dicom_header(f: Path):
+def _read_deferred(f: Path):
     """A file's dataset with its large elements (the pixels) left on disk until they are used, or None
     for a file that is not DICOM: one read of each file serves grouping, sorting and the pixels."""
     import pydicom
@@ -116,16 +116,11 @@ def _read_dicom_header(f: Path):
 def _series_datasets(folder: Path) -> dict[str, list[tuple[Path, object]]]:
     series: dict[str, list[tuple[Path, object]]] = {}
     for f in sorted(p for p in folder.iterdir() if p.is_file()):
-        ds = _read_dicom_header(f)
+        ds = _read_deferred(f)
         if ds is None or "Rows" not in ds:  # not DICOM, or no image (a report, a DICOMDIR)
             continue
         series.setdefault(str(ds.get("SeriesInstanceUID", "")), []).append((f, ds))
     return series
-
-
-def dicom_series(folder: str | Path) -> dict[str, list[Path]]:
-    """The DICOM files of a folder by SeriesInstanceUID (files that are not DICOM images are skipped)."""
-    return {uid: [f for f, _ in found] for uid, found in _series_datasets(Path(folder)).items()}
 
 
 def describe_series(series: dict[str, list]) -> list[str]:
@@ -138,17 +133,18 @@ def describe_series(series: dict[str, list]) -> list[str]:
     return lines
 
 
+def is_dicom_file(path: Path) -> bool:
+    """Whether a file is DICOM Part 10: the 'DICM' mark after its 128-byte preamble."""
+    try:
+        with path.open("rb") as fh:
+            return fh.read(132)[128:132] == b"DICM"
+    except OSError:
+        return False
+
+
 def is_dicom_folder(folder: Path) -> bool:
-    """Whether a folder holds DICOM files (a look at its first few files, by their 'DICM' preamble)."""
-    for f in sorted(p for p in folder.iterdir() if p.is_file())[:8]:
-        try:
-            with f.open("rb") as fh:
-                head = fh.read(132)
-        except OSError:
-            continue
-        if head[128:132] == b"DICM":
-            return True
-    return False
+    """Whether a folder holds DICOM files (a look at its first few files)."""
+    return any(is_dicom_file(f) for f in sorted(p for p in folder.iterdir() if p.is_file())[:8])
 
 
 def read_dicom(path: str | Path, *, series: str | None = None):
@@ -201,8 +197,10 @@ def _pixel_spacing(path: Path, ps) -> tuple[float, float]:
     return dx, dy
 
 
-def _rescale(path: Path, slices: np.ndarray, slopes, intercepts) -> np.ndarray:
-    """Apply RescaleSlope/RescaleIntercept (per slice): integers stay integers where they can."""
+def _rescale(slices: np.ndarray, slopes, intercepts) -> np.ndarray:
+    """Apply a slope and intercept per slice (DICOM's RescaleSlope/RescaleIntercept, NIfTI's scl_*):
+    integers stay integers where they fit (a CT in int16 Hounsfield units), else float32 (float64
+    data stay float64)."""
     slopes, intercepts = np.asarray(slopes, np.float64), np.asarray(intercepts, np.float64)
     if np.all(slopes == 1) and np.all(intercepts == 0):
         return slices
@@ -214,10 +212,24 @@ def _rescale(path: Path, slices: np.ndarray, slopes, intercepts) -> np.ndarray:
                 out = slices.astype(dtype, order="F")
                 out += intercepts.astype(dtype)[None, None, :]
                 return out
-    out = slices.astype(np.float32, order="F")
-    out *= slopes.astype(np.float32)[None, None, :]
-    out += intercepts.astype(np.float32)[None, None, :]
+    dtype = np.result_type(slices.dtype, np.float32) if slices.dtype.kind == "f" else np.float32
+    out = slices.astype(dtype, order="F")
+    out *= slopes.astype(dtype)[None, None, :]
+    out += intercepts.astype(dtype)[None, None, :]
     return out
+
+
+def _uneven_step(steps: np.ndarray) -> int | None:
+    """The index of the step that breaks an even stack of slices (a missing, duplicate or stray
+    slice), or None when every step is the median within 1 % (0.01 mm at least)."""
+    if not len(steps):
+        return None
+    if np.any(steps <= 1e-6):
+        return int(np.argmin(steps))
+    median = float(np.median(steps))
+    if np.ptp(steps) > max(0.01, 0.01 * median):
+        return int(np.argmax(np.abs(steps - median)))
+    return None
 
 
 _PLAIN_SYNTAXES = ("1.2.840.10008.1.2", "1.2.840.10008.1.2.1")  # implicit / explicit VR little endian
@@ -267,8 +279,8 @@ def _read_slices(folder: Path, headers):
     order = np.argsort(places, kind="stable")
     positions = np.asarray(places)[order]
     steps = np.diff(positions)
-    if len(steps) and (np.any(steps <= 1e-6) or np.ptp(steps) > max(0.01, 0.01 * float(np.median(steps)))):
-        where = int(np.argmax(np.abs(steps - np.median(steps)))) if np.any(steps > 1e-6) else int(np.argmin(steps))
+    where = _uneven_step(steps)
+    if where is not None:
         a, b = headers[order[where]][0].name, headers[order[where + 1]][0].name
         raise FormatError(folder, f"its slices are not evenly spaced along the slice normal (step {steps[where]:.4g} "
                                   f"mm between {a} and {b}, median {np.median(steps):.4g} mm): a missing or "
@@ -292,7 +304,7 @@ def _read_slices(folder: Path, headers):
     dx, dy = _pixel_spacing(f0, ds0.get("PixelSpacing") or ds0.get("ImagerPixelSpacing"))
     origin = np.asarray(headers[order[0]][1].ImagePositionPatient, np.float64)
     direction = np.column_stack([row, col, normal])
-    return _rescale(folder, first, slopes, intercepts), Geometry((dx, dy, dz), tuple(origin),
+    return _rescale(first, slopes, intercepts), Geometry((dx, dy, dz), tuple(origin),
                                                                  tuple(direction.reshape(-1)))
 
 
@@ -321,6 +333,12 @@ def _read_multiframe(path: Path):
     if iop is None and per_frame:
         iop = item(per_frame[0], "PlaneOrientationSequence", "ImageOrientationPatient")
     ps = ds.get("PixelSpacing") or item(shared, "PixelMeasuresSequence", "PixelSpacing")
+    if int(ds.get("SamplesPerPixel", 1)) != 1:
+        raise FormatError(path, f"holds colour pixels ({ds.get('PhotometricInterpretation')}); volanim reads grey "
+                                "DICOM images and series")
+    alone = frames == 1 and iop is None and "ImagePositionPatient" not in ds
+    if alone:  # one image placed nowhere (a secondary capture): ITK's default, the identity at 0
+        iop, ds.ImagePositionPatient = [1, 0, 0, 0, 1, 0], [0, 0, 0]
     row, col = _orientation(path, iop)
     normal = np.cross(row, col)
     dx, dy = _pixel_spacing(path, ps)
@@ -340,13 +358,15 @@ def _read_multiframe(path: Path):
     along = positions @ normal
     order = np.argsort(along, kind="stable")
     steps = np.diff(along[order])
-    if len(steps) and (np.any(steps <= 1e-6) or np.ptp(steps) > max(0.01, 0.01 * float(np.median(steps)))):
-        raise FormatError(path, "its frames are not evenly spaced along the frame normal")
+    where = _uneven_step(steps)
+    if where is not None:
+        raise FormatError(path, f"its frames are not evenly spaced along the frame normal (step {steps[where]:.4g} "
+                                f"mm after frame {int(order[where])}, median {np.median(steps):.4g} mm)")
     dz = float(np.median(steps)) if len(steps) else float(ds.get("SliceThickness", 1.0) or 1.0)
     vol = np.asfortranarray(pixels[order].transpose(2, 1, 0))
     slope = float(ds.get("RescaleSlope", 1) or 1) * float(ds.get("DoseGridScaling", 1) or 1)
     intercept = float(ds.get("RescaleIntercept", 0) or 0)
-    vol = _rescale(path, vol, [slope] * frames, [intercept] * frames)
+    vol = _rescale(vol, [slope] * frames, [intercept] * frames)
     direction = np.column_stack([row, col, normal])
     return vol, Geometry((dx, dy, dz), tuple(positions[order[0]]), tuple(direction.reshape(-1)))
 

@@ -23,29 +23,12 @@ from volanim_core.geometry import IDENTITY, Geometry
 
 from ._atomic import atomic_open
 from ._inflate import inflate_capped
-from .vtk_headers import check_claims
+from .vtk_headers import check_claims, metaimage_header
 
 _MET_DTYPES = {"MET_CHAR": "i1", "MET_UCHAR": "u1", "MET_SHORT": "i2", "MET_USHORT": "u2", "MET_INT": "i4",
                "MET_UINT": "u4", "MET_LONG": "i4", "MET_ULONG": "u4", "MET_LONG_LONG": "i8",
                "MET_ULONG_LONG": "u8", "MET_FLOAT": "f4", "MET_DOUBLE": "f8"}
 _WRITE = {v: k for k, v in reversed(list(_MET_DTYPES.items()))}
-
-
-def _header(path: Path) -> tuple[dict, int]:
-    fields, offset = {}, 0
-    with path.open("rb") as fh:
-        for raw in iter(lambda: fh.readline(1 << 16), b""):
-            offset += len(raw)
-            line = raw.decode("latin-1").strip()
-            if not line:
-                continue
-            key, _, value = line.partition("=")
-            fields[key.strip().lower()] = value.strip()
-            if key.strip().lower() == "elementdatafile":
-                return fields, offset
-            if offset > 1 << 20:
-                break
-    raise FormatError(path, "the MetaImage header has no ElementDataFile line")
 
 
 def _floats(path: Path, fields: dict, keys: tuple[str, ...], n: int, default):
@@ -65,7 +48,7 @@ def read_metaimage(path: str | Path):
     """Read a 3-D ``.mha``/``.mhd``: ``(data[x, y, z] (or [x, y, z, 3] for RGB), Geometry)``."""
     path = Path(path)
     dims = check_claims(path, path.suffix.lower())  # sizes against the file and memory, before anything
-    fields, end = _header(path)
+    fields, end = metaimage_header(path)
     dtype = np.dtype(_MET_DTYPES[fields["elementtype"].upper()])
     msb = fields.get("binarydatabyteordermsb", fields.get("elementbyteordermsb", "false"))
     if msb.lower() == "true":

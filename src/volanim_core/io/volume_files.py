@@ -267,18 +267,10 @@ def _read_any(path: Path, dims, colour: bool, series):
         return (*medical_files.read_tiff_stack(path), {})
     if suffix in VTK_SUFFIXES:
         return (*_read_vtk(path), {})
-    if suffix in DICOM_SUFFIXES or _is_dicom_file(path):
+    if suffix in DICOM_SUFFIXES or medical_files.is_dicom_file(path):
         return (*medical_files.read_dicom(path, series=series), {})
     raise FormatError(path, f"unknown volume format {path.suffix!r}; expected "
                       + ", ".join(READ_SUFFIXES) + ", a DICOM folder or a folder of slice images")
-
-
-def _is_dicom_file(path: Path) -> bool:
-    try:
-        with path.open("rb") as fh:
-            return fh.read(132)[128:132] == b"DICM"
-    except OSError:
-        return False
 
 
 def read_volume(path: str | Path, *, dims=None, rescale: bool = False, colour: bool = False) -> np.ndarray:

@@ -75,11 +75,11 @@ def _vti(path: Path) -> tuple[int, int, int]:
     return dims
 
 
-def _metaimage(path: Path) -> tuple[int, int, int]:
-    head = _head(path)
-    fields, end = {}, None
-    offset = 0
-    for raw in head.splitlines(keepends=True):
+def metaimage_header(path: Path) -> tuple[dict[str, str], int]:
+    """A MetaImage header's ``Key = Value`` fields (keys lower-case) and the offset of its first data
+    byte (the end of the ElementDataFile line), from the file's first MB."""
+    fields, offset = {}, 0
+    for raw in _head(path).splitlines(keepends=True):
         offset += len(raw)
         line = raw.decode("latin-1").strip()
         if not line:
@@ -89,10 +89,12 @@ def _metaimage(path: Path) -> tuple[int, int, int]:
             raise FormatError(path, f"expected 'Key = Value' in the MetaImage header, got {line[:60]!r}")
         fields[key.strip().lower()] = value.strip()
         if key.strip().lower() == "elementdatafile":
-            end = offset
-            break
-    if end is None:
-        raise FormatError(path, "the MetaImage header has no ElementDataFile line (is the file truncated?)")
+            return fields, offset
+    raise FormatError(path, "the MetaImage header has no ElementDataFile line (is the file truncated?)")
+
+
+def _metaimage(path: Path) -> tuple[int, int, int]:
+    fields, end = metaimage_header(path)
     sizes = fields.get("dimsize", "").split()
     if fields.get("ndims", "3").strip() != "3" or len(sizes) != 3:
         raise FormatError(path, f"expected a 3-D MetaImage, got NDims {fields.get('ndims')!r}, "

@@ -22,7 +22,6 @@ as float32 (squared Euclidean, or integer 3-4-5 chamfer).
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
@@ -30,7 +29,7 @@ import numba
 import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
-from volanim_core.limits import MAX_COORD, available_bytes, human_bytes, max_voxels
+from volanim_core.limits import MAX_COORD, check_allocation
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
 from volanim_core.reconstruct._clipped import count_outside
@@ -137,16 +136,7 @@ def check_reach(centres: np.ndarray, extents: np.ndarray, where: str) -> None:
 
 def check_output_grid(shape, bytes_per_voxel: int) -> None:
     """Refuse an output grid that cannot be allocated, stating its size."""
-    voxels = math.prod(int(n) for n in shape)
-    nbytes = voxels * bytes_per_voxel
-    shown = "x".join(str(int(n)) for n in shape)
-    if voxels > max_voxels():
-        raise ValueError(f"the output grid would be {shown} = {voxels:,} voxels ({human_bytes(nbytes)}); the limit "
-                         f"is {max_voxels():,} voxels: give smaller --bounds or check the radii")
-    free = available_bytes()
-    if free is not None and nbytes > free:
-        raise ValueError(f"the output grid would be {shown} voxels, {human_bytes(nbytes)}, but only "
-                         f"{human_bytes(free)} of memory is available")
+    check_allocation(shape, bytes_per_voxel, "the output grid", "give smaller --bounds or check the radii")
 
 
 def posed_centres(tskel: Tskel) -> np.ndarray:

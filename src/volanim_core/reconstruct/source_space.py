@@ -33,18 +33,18 @@ def source_geometry_for(frame: Geometry, source: Geometry) -> tuple[Geometry, st
                     f"({source.describe()})")
 
 
-def check_source_overlap(tskel: Connectivity, source_shape, source_geometry: Geometry | None) -> None:
+def check_source_overlap(frame: Connectivity, source_shape, source_geometry: Geometry | None) -> None:
     """Refuse a sampled reconstruction whose rest points mostly miss the source (it would read 0s):
     the frame and the source are then in different places, and the message says both."""
-    if not len(tskel):
+    if not len(frame):
         return
-    to_source = np.eye(4) if source_geometry is None else tskel.geometry.index_map(source_geometry)
-    idx = tskel.points @ to_source[:3, :3] + to_source[3, :3]
+    to_source = np.eye(4) if source_geometry is None else frame.geometry.index_map(source_geometry)
+    idx = frame.points @ to_source[:3, :3] + to_source[3, :3]
     inside = np.all((idx > -0.5) & (idx < np.asarray(source_shape[:3]) - 0.5), axis=1)
     if inside.mean() < 0.5:
-        where = source_geometry or tskel.geometry
+        where = source_geometry or frame.geometry
         raise ValueError(f"only {inside.mean():.0%} of the frame's rest points fall inside the source volume, "
                          f"so the sampled volume would be mostly empty; the frame's grid: "
-                         f"{tskel.geometry.describe()}; the source: {where.describe()}, "
+                         f"{frame.geometry.describe()}; the source: {where.describe()}, "
                          f"{'x'.join(str(n) for n in source_shape[:3])} voxels")
 

@@ -140,18 +140,6 @@ def read_frame(path: str | Path, index: int) -> np.ndarray:
     return np.asarray(open_frames(path)[index]).T
 
 
-def geometry(path: str | Path):
-    """Where the store's voxel ``[0, 0, 0]`` is in physical space (the identity shifted to its origin for a
-    store made before geometry was recorded)."""
-    import zarr
-
-    from volanim_core.geometry import Geometry
-
-    attrs = zarr.open_group(str(path), mode="r").attrs["volanim"]
-    text = attrs.get("geometry")
-    return Geometry.parse(text) if text else Geometry(origin=tuple(float(v) for v in attrs["origin_xyz"]))
-
-
 def origin(path: str | Path) -> tuple[int, int, int]:
     import zarr
 
