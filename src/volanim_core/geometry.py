@@ -166,8 +166,8 @@ class Geometry:
 
     def header_value(self) -> str:
         """The value of a ``# geometry:`` header line (docs/formats.md)."""
-        def fmt(values):
-            return " ".join(f"{v:.10g}" for v in values)
+        def fmt(values):  # the shortest text that reads back as the same float: files keep exact geometry
+            return " ".join(np.format_float_positional(float(v) + 0.0, unique=True, trim="-") for v in values)
 
         return f"spacing {fmt(self.spacing)} origin {fmt(self.origin)} direction {fmt(self.direction)}"
 

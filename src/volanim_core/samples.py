@@ -27,8 +27,9 @@ from volanim_core.rig.bones import Bone, BoneSkeleton
 
 NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog")
 #: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence;
-#: ``mannequin-ct`` writes the mannequin as a CT scan arrives, a DICOM series (:func:`write_mannequin_ct`).
-FILE_SAMPLES = ("walk", "mannequin-ct")
+#: ``mannequin-ct`` writes the mannequin as a CT scan arrives, a DICOM series (:func:`write_mannequin_ct`);
+#: ``ant`` copies the closed ant mesh pyvista's wheel ships (``ant.ply``), a model to voxelize.
+FILE_SAMPLES = ("walk", "mannequin-ct", "ant")
 
 # Tissue values: distinct so sampled reconstruction shows the interior moving.
 SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
@@ -357,6 +358,12 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     if name == "mannequin-ct":
         return write_mannequin_ct(folder, progress)
+    if name == "ant":
+        from pyvista import examples  # lazy: VTK only here
+
+        written = [folder / "ant.ply"]
+        atomic_write_bytes(written[0], Path(examples.antfile).read_bytes())
+        return written
     if name == "walk":
         clip = walk_clip()
         written = [folder / clip.name, folder / f"{clip.name}.LICENSE"]

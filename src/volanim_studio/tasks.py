@@ -7,25 +7,32 @@ work; nothing here knows a window exists.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from volanim_core import samples
+from volanim_core.geometry import IDENTITY
 from volanim_core.io import read_mskel, read_scan
 from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter, stage
 from volanim_core.skeleton.hull import display_hulls
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
-from volanim_core.volume import segment
+from volanim_core.volume import isotropic_mask, resample, segment
 
 
 def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: bool, metric: str = "euclid",
-                   min_thinness: float = DEFAULT_MIN_THINNESS, skeleton_path=None, grey=None, progress=None,
-                   cancel=None) -> dict:
+                   min_thinness: float = DEFAULT_MIN_THINNESS, skeleton_path=None, grey=None, geometry=None,
+                   progress=None, cancel=None) -> dict:
     """Segment, skeletonize and isosurface a loaded volume.
 
     ``skeleton_path``: a saved ``.mskel`` of this segmentation (a reopened
     project) is read instead of skeletonizing again. ``grey``: a colour volume's
     luminance when the caller has it (:func:`load_volume_file` made it already).
+    ``geometry``: where the scan's voxels are. When they are not cubes, the mask is
+    resampled to cubes as ``volanim skeletonize`` does (:func:`volume.isotropic_mask`)
+    and the volume with it (nearest voxel: the values sampled mode reads), so the
+    studio works on the same grid as the command line; the result's ``geometry`` is it.
     """
     report = Reporter(progress, cancel)
     report(0, 100)
@@ -34,24 +41,42 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     mask = segment(grey, lo, hi, fill=fill)  # the command line's own segmentation
     if not mask.any():
         raise ValueError(f"no voxel lies in the threshold range {lo}..{hi if hi is not None else 'max'}")
+    report(5, 100)
+    if geometry is not None and not geometry.is_isotropic:
+        mask, cubes = isotropic_mask(mask, geometry, progress=stage(report, 5, 8), cancel=cancel)
+        volume = on_grid(volume, geometry, cubes)
+        geometry = cubes
     report(10, 100)
 
     if skeleton_path:
         skel = read_mskel(skeleton_path)
     else:
-        skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, progress=stage(report, 10, 80),
-                           cancel=cancel)
+        skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, geometry=geometry or IDENTITY,
+                           progress=stage(report, 10, 80), cancel=cancel)
     report(80, 100)
     hull, lod = display_hulls(mask)  # lod: drawn while a slider is held
     report(100, 100)
     return {"volume": volume, "mask": mask, "skeleton": skel, "hull": hull, "hull_lod": lod,
-            "skeleton_path": skeleton_path,
+            "skeleton_path": skeleton_path, "geometry": geometry,
             "segmentation": {"lo": lo, "hi": hi, "fill": fill, "metric": metric, "min_thinness": min_thinness}}
+
+
+def on_grid(volume: np.ndarray, geometry, target) -> np.ndarray:
+    """``volume`` (grey or colour) resampled onto ``target``'s voxel size, nearest voxel: its own values."""
+    if is_colour(volume):
+        return np.stack([resample(volume[..., c], geometry, target.spacing, order=0)[0] for c in range(3)], axis=3)
+    return resample(volume, geometry, target.spacing, order=0)[0]
 
 
 def load_volume_file(path: str, dims=None) -> dict:
     """Read any supported volume (fast; the heavy part is :func:`prepare_volume`). A colour volume
     stays in colour (``volume``); ``grey`` is what its threshold is chosen on."""
+    from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh, voxelize
+
+    if Path(path).suffix.lower() in MESH_SUFFIXES:  # a closed surface: filled, as `volanim voxelize` fills it
+        data, geometry = voxelize(read_mesh(path))
+        return {"volume": data, "grey": data, "spacing": geometry.spacing, "path": path, "geometry": geometry,
+                "segments": {}}
     scan = read_scan(path, dims=dims, colour=True)
     data = scan.data
     return {"volume": data, "grey": to_grey(data) if is_colour(data) else data, "spacing": scan.geometry.spacing,

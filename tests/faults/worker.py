@@ -33,6 +33,7 @@ def readers() -> dict:
 
 CHECKS = {
     "shape_3_4_5": lambda r: tuple(r.shape) == (3, 4, 5),
+    "shape_5_4_3": lambda r: tuple(r.shape) == (5, 4, 3),
     "shape_2_3_4": lambda r: tuple(r.shape) == (2, 3, 4) and r[1, 0, 0] == 1 and r[0, 1, 0] == 2,
     "grey_of_rgb_2_3_4": lambda r: tuple(r.shape) == (2, 3, 4) and r[0, 0, 0] == 1 and r[1, 0, 0] == 4,
     "len_3": lambda r: len(r) == 3,

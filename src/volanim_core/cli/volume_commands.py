@@ -27,6 +27,7 @@ from ._common import (
     load_scan,
     parse_range,
     positive_float,
+    positive_int,
     save,
 )
 
@@ -224,6 +225,16 @@ def _resample(args):
     save(args.output, vol, geometry)
 
 
+def _voxelize(args):
+    from volanim_core.io.mesh_files import read_mesh, voxelize
+
+    mesh = read_mesh(args.mesh)
+    vol, geometry = voxelize(mesh, spacing=args.spacing, size=args.size, value=args.value)
+    print(f"{args.mesh}: {mesh.n_points} vertices, {mesh.n_cells} faces -> {int(np.count_nonzero(vol))} voxels inside, "
+          f"cubes of {geometry.spacing[0]:g} (the mesh's units, taken as mm)")
+    save(args.output, vol, geometry)
+
+
 def _samples(args):
     for name in (*samples.NAMES, *samples.FILE_SAMPLES) if args.name == "all" else [args.name]:
         bar = TextProgress(f"making {name}")
@@ -236,7 +247,7 @@ def _samples(args):
 def _io(p, output=True):
     add_volume_in(p, "input")
     if output:
-        p.add_argument("output", help="output volume (.vol, .VOL, .vti or .nrrd)")
+        p.add_argument("output", help="output volume (.vol, .VOL, .vti, .nrrd, .nii, .nii.gz or .mha)")
     add_dims(p)
 
 
@@ -344,8 +355,19 @@ def register(sub) -> None:
     how.add_argument("--size", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="new dimensions")
     p.add_argument("--labels", action="store_true", help="nearest voxel (labels, masks) instead of linear")
 
+    p = add_command(sub, "voxelize", "Fill a closed surface mesh (.ply, .obj, .stl, .vtp) into a binary volume "
+                    "with its geometry, ready to skeletonize.",
+                    "volanim voxelize ant.ply ant.nrrd --size 160", _voxelize)
+    p.add_argument("mesh", help="closed surface mesh (.ply, .obj, .stl, .vtp)")
+    p.add_argument("output", help="output volume (.nrrd, .nii, .mha, .vti keep the geometry; .VOL, .vol do not)")
+    size = p.add_mutually_exclusive_group()
+    size.add_argument("--spacing", type=positive_float, metavar="S", help="voxel size, in the mesh's units")
+    size.add_argument("--size", type=positive_int, metavar="N", help="voxels along the longest side (default 128)")
+    p.add_argument("--value", type=ascii_int, default=255, help="value inside (default 255)")
+
     p = add_command(sub, "samples",
-                    "Write a demo dataset: mannequin (-colour, -large), aliascube, frog, the walk clip, or all.",
+                    "Write a demo dataset: mannequin (-colour, -large, -ct as DICOM), aliascube, frog, the walk clip, "
+                    "the ant mesh, or all.",
                     "volanim samples all -o .", _samples)
     p.add_argument("name", choices=(*samples.NAMES, *samples.FILE_SAMPLES, "all"))
     p.add_argument("-o", "--output", default=".", help="folder (default: current)")

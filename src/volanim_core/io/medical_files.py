@@ -83,20 +83,39 @@ def read_nibabel(path: str | Path):
     return _rescale(raw, [slope] * shape[2], [inter] * shape[2]), _geometry_from_ras(path, img.affine)
 
 
+_MGH_ITEMSIZE = {0: 1, 1: 4, 3: 4, 4: 2}  # MRI_UCHAR, MRI_INT, MRI_FLOAT, MRI_SHORT
+_MGH_HEADER, _MGH_TAGS = 284, 1 << 16  # the fixed header; what may follow the data (TR, flip angle, tags)
+
+
 def _mgh_bytes(path: Path) -> bytes:
-    """An MGH file's bytes; ``.mgz`` inflated with a cap (the memory free), so a bomb is refused."""
-    from volanim_core.limits import available_bytes
+    """An MGH file's bytes. A ``.mgz`` is inflated only as far as its header's sizes say (plus room for
+    the optional tags after the data): a small bomb is refused instead of filling the memory."""
+    import struct
 
     from ._inflate import inflate_capped
 
     with path.open("rb") as fh:
         if path.suffix.lower() != ".mgz":
             return fh.read()
-        cap = available_bytes() or 1 << 36
-        body = b"".join(inflate_capped(path, fh, cap + 1))
-    if len(body) > cap:
-        raise FormatError(path, "its compressed data inflate to more than the memory free")
-    return body
+        chunks = inflate_capped(path, fh, 1 << 62)
+        body = bytearray()  # grown in place: bytes += would copy the whole body for each chunk
+        for chunk in chunks:
+            body += chunk
+            if len(body) >= _MGH_HEADER:
+                break
+        if len(body) < _MGH_HEADER:
+            raise FormatError(path, f"its inflated data hold {len(body)} bytes, less than an MGH header (284)")
+        _, x, y, z, frames, kind = struct.unpack(">6i", body[:24])
+        if kind not in _MGH_ITEMSIZE:
+            raise FormatError(path, f"MGH data type {kind} is not one of uchar, short, int, float")
+        checked_grid(path, (x, y, z), _MGH_ITEMSIZE[kind] * max(frames, 1), what="its MGH dimensions")
+        most = _MGH_HEADER + x * y * z * max(frames, 1) * _MGH_ITEMSIZE[kind] + _MGH_TAGS
+        for chunk in chunks:
+            body += chunk
+            if len(body) > most:
+                raise FormatError(path, f"its compressed data inflate to more than the {most:,} bytes its header "
+                                        "accounts for")
+    return bytes(body)
 
 
 # --- DICOM ------------------------------------------------------------------------------------

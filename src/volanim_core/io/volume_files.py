@@ -269,6 +269,11 @@ def _read_any(path: Path, dims, colour: bool, series):
         return (*_read_vtk(path), {})
     if suffix in DICOM_SUFFIXES or medical_files.is_dicom_file(path):
         return (*medical_files.read_dicom(path, series=series), {})
+    from .mesh_files import MESH_SUFFIXES
+
+    if suffix in MESH_SUFFIXES:
+        raise FormatError(path, f"is a surface mesh, not a volume: fill it first with `volanim voxelize {path.name} "
+                                f"{path.stem}.nrrd` (the studio's File > Open volume fills a mesh itself)")
     raise FormatError(path, f"unknown volume format {path.suffix!r}; expected "
                       + ", ".join(READ_SUFFIXES) + ", a DICOM folder or a folder of slice images")
 

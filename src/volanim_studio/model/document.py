@@ -178,8 +178,10 @@ class Document:
         """What the status bar shows for a point: position, DT, thinness, its bone."""
         s = self.skeleton
         p = s.points[index]
+        mm = s.geometry.to_physical(p[None])[0]  # where it is in the scan (LPS millimetres)
         return {"x": int(p[0]), "y": int(p[1]), "z": int(p[2]), "dt": float(s.dt[index]),
-                "thinness": float(s.thinness[index]), "bone": self.bone_of_point(index)}
+                "thinness": float(s.thinness[index]), "bone": self.bone_of_point(index),
+                "mm": tuple(float(v) for v in mm), "dt_mm": float(s.dt[index]) * s.geometry.spacing[0]}
 
     def bone_of_point(self, index: int) -> str | None:
         """The bone a point is attached to, or None."""

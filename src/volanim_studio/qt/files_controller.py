@@ -25,11 +25,16 @@ from .controller import FAILED, Controller
 from .threshold_dialog import ThresholdDialog
 from .worker import Worker
 
+#: What File > Open volume lists: every format ``io.read_scan`` reads as a file.
+VOLUME_PATTERNS = " ".join(f"*{s}" for s in (".vol", ".VOL", ".vti", ".nrrd", ".nhdr", ".seg.nrrd", ".nii", ".nii.gz",
+                                             ".mha", ".mhd", ".mgh", ".mgz", ".tif", ".tiff", ".dcm"))
+
 
 class FilesController(Controller):
     def fill_menu(self, menu, action) -> None:
         """The File menu's open and save entries; ``action(text, slot, shortcut=None, menu=None)``."""
         action("Open &volume…", lambda: self.open_volume_dialog(), "Ctrl+O", menu=menu)
+        action("Open &DICOM folder…", lambda: self.open_dicom_folder_dialog(), menu=menu)
         action("Open &skeleton (.mskel)…", lambda: self.open_dialog("mskel"), menu=menu)
         action("Open &bones…", lambda: self.open_dialog("bones"), menu=menu)
         action("Open connections…", lambda: self.open_dialog("connections"), menu=menu)
@@ -58,7 +63,7 @@ class FilesController(Controller):
     def view_file_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
             self.window, "View volume or mesh", self.folder(),
-            "Volumes and meshes (*.vti *.nrrd *.nii *.nii.gz *.mha *.VOL *.vol *.ply *.vtp *.obj *.stl);;All files (*)")
+            f"Volumes and meshes ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl);;All files (*)")
         if path:
             self.view_file(path)
 
@@ -90,33 +95,52 @@ class FilesController(Controller):
         if loaded is FAILED:
             return None
         if params is None:
-            dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"])
+            dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"],
+                                     segments=loaded["segments"])
             if dialog.exec() != ThresholdDialog.Accepted:
                 return None
             params = dialog.parameters()
         params = dict(params)
         spacing = tuple(float(v) for v in params.pop("spacing", None) or loaded["spacing"])
         vol, grey = loaded["volume"], loaded["grey"]
+        geometry = loaded["geometry"].with_spacing(spacing)  # the voxel size the user confirmed
 
         def done(r):
             r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
-            self._apply_prepared(r, path=path, spacing=spacing, dims=dims)
+            self._apply_prepared(r, path=path, spacing=r["geometry"].spacing, dims=dims)
             if then is not None:
                 then()
 
         return self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
-            vol, skeleton_path=skeleton_path, grey=grey, progress=progress, cancel=cancel, **params), done)
+            vol, skeleton_path=skeleton_path, grey=grey, geometry=geometry, progress=progress, cancel=cancel,
+            **params), done)
 
     def open_volume_dialog(self) -> None:
         self.window.session.when_saved_or_discarded(self._ask_volume, "opening another volume")
 
     def _ask_volume(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", self.folder(),
-                                              "Volumes, grey or RGB "
-                                              "(*.vol *.VOL *.vti *.nrrd *.nii *.nii.gz *.mha *.mhd);;"
+                                              f"Volumes, grey or RGB ({VOLUME_PATTERNS});;"
+                                              "Closed meshes, filled (*.ply *.obj *.stl *.vtp);;DICOM files (*.dcm *);;"
                                               "All files (*)")
         if path:
-            self.open_volume(path)
+            self.open_volume(self._dicom_series_folder(path))
+
+    def open_dicom_folder_dialog(self) -> None:
+        self.window.session.when_saved_or_discarded(self._ask_dicom_folder, "opening another volume")
+
+    def _ask_dicom_folder(self) -> None:
+        folder = QFileDialog.getExistingDirectory(self.window, "Open a DICOM series (its folder)", self.folder())
+        if folder:
+            self.open_volume(folder)
+
+    @staticmethod
+    def _dicom_series_folder(path: str) -> str:
+        """One file of a DICOM series stands for its series: the folder is read (ordered by position)."""
+        from volanim_core.io.medical_files import is_dicom_file
+
+        p = Path(path)
+        return str(p.parent) if p.is_file() and is_dicom_file(p) and len(list(p.parent.iterdir())) > 1 else path
 
     def open_mskel(self, path) -> bool:
         def load():

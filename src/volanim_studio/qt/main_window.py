@@ -302,8 +302,9 @@ class MainWindow(QMainWindow):
             self.point_label.setText("")
             return
         i = self.doc.point_info(index)
-        self.point_label.setText(f"x {i['x']}  y {i['y']}  z {i['z']}   DT {i['dt']:.3f}   "
-                                 f"thinness {i['thinness']:.3f}   bone {i['bone'] or '—'}")
+        self.point_label.setText(f"x {i['x']}  y {i['y']}  z {i['z']}   ({', '.join(f'{v:.1f}' for v in i['mm'])}) mm"
+                                 f"   DT {i['dt']:.3f} ({i['dt_mm']:.2f} mm)   thinness {i['thinness']:.3f}   "
+                                 f"bone {i['bone'] or '—'}")
 
     def show_shortcuts(self) -> None:
         rows = "".join(f"<tr><td><b>{k}</b></td><td>{v}</td></tr>" for k, v in SHORTCUTS)

@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from volanim_core.io.volume_files import finite_range
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
 
@@ -51,11 +52,12 @@ class HistogramWidget(QWidget):
 class ThresholdDialog(QDialog):
     """Choose the object's value range, cavity filling and the skeleton's settings."""
 
-    def __init__(self, volume: np.ndarray, name: str, parent=None, spacing=(1.0, 1.0, 1.0)):
+    def __init__(self, volume: np.ndarray, name: str, parent=None, spacing=(1.0, 1.0, 1.0), segments=None):
         super().__init__(parent)
         self.setWindowTitle(f"Segment {name}")
-        vmin, vmax = float(volume.min()), float(volume.max())
+        vmin, vmax = finite_range(volume) or (0.0, 0.0)  # NaN (resampled MRI) is background, not a value
         sample = volume.ravel()[:: max(1, volume.size // 2_000_000)]
+        sample = sample[np.isfinite(sample)] if sample.dtype.kind == "f" else sample
         counts, edges = np.histogram(sample, bins=256, range=(vmin, vmax if vmax > vmin else vmin + 1))
         self.histogram = HistogramWidget(counts, edges)
         self.lo = QDoubleSpinBox(decimals=2, minimum=vmin, maximum=vmax)
@@ -86,6 +88,15 @@ class ThresholdDialog(QDialog):
                                      "(finer reconstructions, slower studio); the Display tab's slider shows "
                                      "a prefix of what is kept.")
         form = QFormLayout()
+        # a 3D Slicer segmentation names its labels: pick one by name instead of by value
+        self.segments = dict(segments or {})
+        self.segment_box = QComboBox()
+        self.segment_box.addItem("(a value range)", None)
+        for value, label in sorted(self.segments.items()):
+            self.segment_box.addItem(f"{label} ({value})", value)
+        self.segment_box.currentIndexChanged.connect(self._segment_chosen)
+        if self.segments:
+            form.addRow("Segment", self.segment_box)
         form.addRow("Object from", self.lo)
         form.addRow("to", self.hi)
         form.addRow(self.fill)
@@ -105,6 +116,13 @@ class ThresholdDialog(QDialog):
         self.hi.valueChanged.connect(self._sync)
         self._sync()
         self.setAttribute(Qt.WA_DeleteOnClose, False)
+
+    def _segment_chosen(self, _index: int) -> None:
+        value = self.segment_box.currentData()
+        if value is not None:
+            self.lo.setValue(value)
+            self.hi.setValue(value)
+            self.fill.setChecked(False)  # a segment is what it is: its holes are other segments
 
     def _sync(self) -> None:
         self.histogram.set_range(self.lo.value(), self.hi.value())

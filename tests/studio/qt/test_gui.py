@@ -353,9 +353,17 @@ def test_the_voxel_spacing_is_shown_kept_and_saved(qtbot, tmp_path):
     qtbot.addWidget(w)
     w.files.open_volume(tmp_path / "box.vti", params=params)
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
-    assert w.doc.spacing == (1.0, 1.0, 2.0)
+    # the user's 1 x 1 x 2 mm is kept; the studio works, as `volanim skeletonize` does, on 1 mm cubes
+    # (#35: spheres are spheres in the body), so the 16 slices 2 mm apart became 31 slices 1 mm apart
+    assert w.doc.segmentation["spacing"] == [1.0, 1.0, 2.0]
+    assert w.doc.spacing == (1.0, 1.0, 1.0) and w.doc.volume.shape == (30, 20, 31)
+    assert w.doc.skeleton.geometry.spacing == (1.0, 1.0, 1.0)
+    w.doc.pick_point(0)  # the status bar says where the point is in the scan, in millimetres
+    p = w.doc.skeleton.points[0]
+    assert f"({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm" in w.point_label.text()
     again = save_close_reopen(qtbot, w, tmp_path / "box.volanim")
-    assert again.doc.spacing == (1.0, 1.0, 2.0) and again.last_error is None
+    assert again.doc.segmentation["spacing"] == [1.0, 1.0, 2.0] and again.last_error is None
+    assert again.doc.volume.shape == (30, 20, 31)
     again.close()
 
 
