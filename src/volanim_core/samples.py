@@ -328,7 +328,7 @@ def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
     """
     from volanim_core.geometry import Geometry
     from volanim_core.io import write_bones
-    from volanim_core.io.medical_files import write_dicom_series
+    from volanim_core.io.dicom_files import write_dicom_series
     from volanim_core.volume import resample
 
     folder = Path(folder)

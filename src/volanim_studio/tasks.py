@@ -68,7 +68,7 @@ def on_grid(volume: np.ndarray, geometry, target) -> np.ndarray:
     return resample(volume, geometry, target.spacing, order=0)[0]
 
 
-def load_volume_file(path: str, dims=None) -> dict:
+def load_volume_file(path: str, dims=None, series: str | None = None) -> dict:
     """Read any supported volume (fast; the heavy part is :func:`prepare_volume`). A colour volume
     stays in colour (``volume``); ``grey`` is what its threshold is chosen on."""
     from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh, voxelize
@@ -77,7 +77,7 @@ def load_volume_file(path: str, dims=None) -> dict:
         data, geometry = voxelize(read_mesh(path))
         return {"volume": data, "grey": data, "spacing": geometry.spacing, "path": path, "geometry": geometry,
                 "segments": {}}
-    scan = read_scan(path, dims=dims, colour=True)
+    scan = read_scan(path, dims=dims, colour=True, series=series)
     data = scan.data
     return {"volume": data, "grey": to_grey(data) if is_colour(data) else data, "spacing": scan.geometry.spacing,
             "path": path, "geometry": scan.geometry, "segments": scan.segments}

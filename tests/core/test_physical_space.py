@@ -178,3 +178,24 @@ def test_resample_keeps_voxels_in_place(tmp_path):
     idx = np.argwhere(out.data)
     centre = out.geometry.to_physical(idx).mean(axis=0)
     assert np.allclose(centre, g.to_physical(np.argwhere(vol)).mean(axis=0), atol=0.3)
+
+
+def test_palette_apply_keeps_the_geometry(tmp_path):
+    rgb = np.zeros((6, 5, 4, 3), np.uint8)
+    rgb[1:4, 1:4, 1:3] = (200, 40, 30)
+    g = Geometry((0.5, 0.5, 1.5), (10, 20, 30))
+    io.write_volume(tmp_path / "c.nrrd", rgb, g)
+    run(["palette", "build", tmp_path / "c.nrrd", "-o", tmp_path / "c.palette"])
+    run(["palette", "apply", tmp_path / "c.nrrd", tmp_path / "c.palette", "-o", tmp_path / "i.nrrd"])
+    assert io.read_scan(tmp_path / "i.nrrd").geometry == g
+
+
+def test_pyvistas_frog_keeps_its_slices_1_5_mm_apart(tmp_path):
+    """`convert frog_tissues.vti frog.nrrd` wrote spacing (1, 1, 1) for the (1, 1, 1.5) scan."""
+    from pathlib import Path
+
+    from pyvista import examples
+
+    frog = Path(examples.__file__).parent / "frog_tissues.vti"  # the wheel's copy: offline
+    run(["convert", frog, tmp_path / "frog.nrrd"])
+    assert io.read_scan(tmp_path / "frog.nrrd").geometry.spacing == (1.0, 1.0, 1.5)

@@ -18,6 +18,7 @@ import numpy as np
 
 from volanim_core.colour.palette import NearestColour, unique_colours
 from volanim_core.errors import FormatError
+from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.io import raw_volumes, volume_files
 from volanim_core.io._atomic import atomic_open
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
@@ -33,6 +34,7 @@ class ColourSlabs:
     shape: tuple[int, int, int]
     _array: np.ndarray | None = None  # memory-mapped or loaded [x, y, z, 3]
     _files: list = field(default_factory=list)  # slice images, for a folder
+    geometry: Geometry = IDENTITY  # where the voxels are: the index volume keeps it
 
     @classmethod
     def open(cls, path, dims=None) -> ColourSlabs:
@@ -43,14 +45,15 @@ class ColourSlabs:
             if first.ndim != 3:
                 raise FormatError(files[0], "is a grey image; the palette tools need colour (RGB) slices")
             return cls(path, (first.shape[0], first.shape[1], len(files)), None, files)
+        geometry = IDENTITY
         if path.suffix.lower() == ".vol":
             vol = raw_volumes.read_raw(path, dims, mmap=True)
         else:
-            vol = volume_files.read_volume(path, dims=dims, colour=True)
+            vol, geometry, _ = volume_files.read_scan(path, dims=dims, colour=True)
         if not volume_files.is_colour(vol):
             raise FormatError(path, "is a grey volume (one value a voxel); the palette tools need colour "
                                     "(RGB: 3 bytes a voxel, RGB slices, or a 3-component .vti/.nrrd)")
-        return cls(path, tuple(int(n) for n in vol.shape[:3]), vol)
+        return cls(path, tuple(int(n) for n in vol.shape[:3]), vol, geometry=geometry)
 
     @property
     def depth(self) -> int:
@@ -116,5 +119,5 @@ def apply_palette(slabs: ColourSlabs, palette: np.ndarray, output, *, progress: 
     for z0, z1, slab in slabs.slabs(report):
         out[:, :, z0:z1] = mapper(slab)
     counts += np.bincount(out.ravel(order="K"), minlength=256)
-    volume_files.write_volume(output, out)
+    volume_files.write_volume(output, out, slabs.geometry)
     return Path(output), counts

@@ -6,8 +6,8 @@
     .nrrd .nhdr .seg.nrrd          nrrd_files (ours: guarded, every encoding, segment names)
     .mha .mhd                      metaimage_files (ours: VTK drops the direction)
     .nii .nii.gz .mgh .mgz         nibabel          } medical_files
-    DICOM folder or file           pydicom          }
     .tif/.tiff (one 3-D file)      tifffile         }
+    DICOM folder or file           pydicom            dicom_files
     folder of 2-D images           scikit-image, stacked along z
 
 Geometry is LPS millimetres (:mod:`volanim_core.geometry`); every writer but ``.vol``/``.VOL``
@@ -246,11 +246,11 @@ def read_scan(path: str | Path, *, dims=None, rescale: bool = False, colour: boo
 
 
 def _read_any(path: Path, dims, colour: bool, series):
-    from . import medical_files
+    from . import dicom_files, medical_files
 
     if path.is_dir():
-        if medical_files.is_dicom_folder(path):
-            return (*medical_files.read_dicom(path, series=series), {})
+        if dicom_files.is_dicom_folder(path):
+            return (*dicom_files.read_dicom(path, series=series), {})
         return read_image_folder(path, colour=colour), IDENTITY, {}
     if not path.exists():
         raise FormatError(path, "no such file or folder")
@@ -267,8 +267,8 @@ def _read_any(path: Path, dims, colour: bool, series):
         return (*medical_files.read_tiff_stack(path), {})
     if suffix in VTK_SUFFIXES:
         return (*_read_vtk(path), {})
-    if suffix in DICOM_SUFFIXES or medical_files.is_dicom_file(path):
-        return (*medical_files.read_dicom(path, series=series), {})
+    if suffix in DICOM_SUFFIXES or dicom_files.is_dicom_file(path):
+        return (*dicom_files.read_dicom(path, series=series), {})
     from .mesh_files import MESH_SUFFIXES
 
     if suffix in MESH_SUFFIXES:

@@ -39,7 +39,8 @@ from .timeline import Timeline
 PROJECT_FORMAT = "volanim project"
 PROJECT_VERSION = 3
 DEFAULT_SEGMENTATION = {"lo": 1, "hi": None, "fill": False, "metric": "euclid", "min_thinness": DEFAULT_MIN_THINNESS,
-                        "spacing": None}  # spacing: the voxel size the user confirmed (None: the file's)
+                        "spacing": None,  # spacing: the voxel size the user confirmed (None: the file's)
+                        "series": None}  # series: the DICOM series chosen from a folder of several
 DATA_FILES = ("mskel", "bones", "connect")
 _stored_skeletons: dict = {}  # (store folder, id(skeleton)) -> (skeleton, relative path, sha256): written once
 
@@ -185,6 +186,8 @@ def _checked_segmentation(path, seg: dict) -> dict:
     if sp is not None and not (isinstance(sp, list) and len(sp) == 3 and all(
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) and v > 0 for v in sp)):
         raise FormatError(path, f"\"segmentation\": \"spacing\" must be three positive numbers, got {sp!r}")
+    if seg["series"] is not None and not (isinstance(seg["series"], str) and 0 < len(seg["series"]) <= 128):
+        raise FormatError(path, f"\"segmentation\": \"series\" must be a DICOM series UID, got {seg['series']!r}")
     if seg["metric"] not in ("euclid", "345"):
         raise FormatError(path, f"\"segmentation\": \"metric\" must be \"euclid\" or \"345\", got {seg['metric']!r}")
     return seg

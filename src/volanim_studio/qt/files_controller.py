@@ -90,8 +90,11 @@ class FilesController(Controller):
     def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None,
                     then: Callable[[], None] | None = None) -> Worker | None:
         """Read a volume; ask for the threshold (unless ``params``); segment it in a worker;
-        ``then()`` runs right after it is applied."""
-        loaded = self.attempt("Open volume", lambda: tasks.load_volume_file(str(path), dims))
+        ``then()`` runs right after it is applied. A DICOM folder of several series asks which."""
+        series = (params or {}).get("series") or self._choose_series(path)
+        if series is FAILED:
+            return None
+        loaded = self.attempt("Open volume", lambda: tasks.load_volume_file(str(path), dims, series))
         if loaded is FAILED:
             return None
         if params is None:
@@ -101,12 +104,14 @@ class FilesController(Controller):
                 return None
             params = dialog.parameters()
         params = dict(params)
+        params.pop("series", None)
         spacing = tuple(float(v) for v in params.pop("spacing", None) or loaded["spacing"])
         vol, grey = loaded["volume"], loaded["grey"]
         geometry = loaded["geometry"].with_spacing(spacing)  # the voxel size the user confirmed
 
         def done(r):
             r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
+            r["segmentation"]["series"] = series  # and which series of a DICOM folder
             self._apply_prepared(r, path=path, spacing=r["geometry"].spacing, dims=dims)
             if then is not None:
                 then()
@@ -134,10 +139,26 @@ class FilesController(Controller):
         if folder:
             self.open_volume(folder)
 
+    def _choose_series(self, path):
+        """None for anything but a DICOM folder of several series; else the UID the user picks (FAILED
+        when they cancel)."""
+        from PySide6.QtWidgets import QInputDialog
+
+        from volanim_core.io.dicom_files import is_dicom_folder, list_series
+
+        if not Path(path).is_dir() or not is_dicom_folder(Path(path)):
+            return None
+        choices = list_series(path)
+        if len(choices) < 2:
+            return None
+        line, ok = QInputDialog.getItem(self.window, "Which series?", f"{Path(path).name} holds {len(choices)} "
+                                        "DICOM series:", [text for _, text in choices], 0, False)
+        return next(uid for uid, text in choices if text == line) if ok else FAILED
+
     @staticmethod
     def _dicom_series_folder(path: str) -> str:
         """One file of a DICOM series stands for its series: the folder is read (ordered by position)."""
-        from volanim_core.io.medical_files import is_dicom_file
+        from volanim_core.io.dicom_files import is_dicom_file
 
         p = Path(path)
         return str(p.parent) if p.is_file() and is_dicom_file(p) and len(list(p.parent.iterdir())) > 1 else path

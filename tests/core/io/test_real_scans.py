@@ -216,7 +216,7 @@ def write_ct_series(folder: Path, volume_hu: np.ndarray, *, spacing=(0.7, 0.7, 2
     the oracles): stored = HU + 1024, file names shuffled so only ImagePositionPatient gives the order."""
     from pydicom.uid import generate_uid
 
-    from volanim_core.io.medical_files import write_dicom_series
+    from volanim_core.io.dicom_files import write_dicom_series
 
     names = [f"IM{k:04d}.dcm" for k in range(volume_hu.shape[2])]
     if shuffle:

@@ -408,7 +408,7 @@ def test_reopening_a_project_gives_back_the_skeleton_that_was_connected(qtbot, t
     skeleton = first.doc.skeleton
     second = save_close_reopen(qtbot, first, tmp_path / "box.volanim")
     assert second.doc.skeleton == skeleton and second.doc.skeleton.metric == "345"
-    assert second.doc.segmentation == {**params, "spacing": [1.0, 1.0, 1.0]}
+    assert second.doc.segmentation == {**params, "spacing": [1.0, 1.0, 1.0], "series": None}
     assert bool(second.doc.mask[20, 15, 15])  # the cavity is filled
     second.close()
 

@@ -7,7 +7,7 @@ import pytest
 
 from volanim_core import io
 from volanim_core.geometry import Geometry
-from volanim_core.io.medical_files import write_dicom_series
+from volanim_core.io.dicom_files import write_dicom_series
 
 from ..conftest import JOB_TIMEOUT_MS
 
@@ -80,3 +80,30 @@ def test_the_threshold_dialog_on_an_mri_with_nan(qtbot, tmp_path):
     qtbot.addWidget(dialog)
     assert dialog.hi.maximum() == pytest.approx(100.0) and dialog.lo.minimum() > 0
     assert np.isfinite(dialog.histogram.counts).all() and np.count_nonzero(dialog.histogram.counts) > 50
+
+
+def test_a_folder_of_two_series_asks_which_and_the_project_remembers(qtbot, tmp_path, monkeypatch):
+    from PySide6.QtWidgets import QInputDialog
+
+    from volanim_studio.qt.main_window import MainWindow
+
+    hu = np.full((20, 16, 6), -1000, np.int16)
+    hu[4:16, 4:12, 1:5] = 40
+    write_dicom_series(tmp_path / "two", hu, CT, series_uid="1.2.3.1", description="body")
+    write_dicom_series(tmp_path / "two", np.where(hu > 0, 300, hu).astype(np.int16), CT, series_uid="1.2.3.2",
+                       description="contrast", names=[f"B{k}.dcm" for k in range(6)])
+    offered = []
+
+    def pick_contrast(parent, title, label, items, current, editable):  # Qt's modal dialog, answered
+        offered.extend(items)
+        return next(i for i in items if "contrast" in i), True
+
+    monkeypatch.setattr(QInputDialog, "getItem", staticmethod(pick_contrast))
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.files.open_volume(tmp_path / "two", params={"lo": -300, "hi": 3000, "fill": False, "metric": "euclid",
+                                                  "min_thinness": 0.5})
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert len(offered) == 2 and any("body" in i for i in offered)
+    assert w.doc.volume.max() == 300 and w.doc.segmentation["series"] == "1.2.3.2"
+    w.close()
