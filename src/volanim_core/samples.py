@@ -340,7 +340,9 @@ def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
     ct, geometry = resample(hu, Geometry(origin=CT_ORIGIN), CT_SPACING, order=0, progress=stage(progress, 0, 30))
     write_dicom_series(folder / "mannequin-ct", ct, geometry, description="mannequin CT (volanim sample)")
     cube = CT_SPACING[0]  # skeletonize's default voxel: the smallest spacing
-    bones = BoneSkeleton({n: np.round(np.asarray(p) / cube, 3) for n, p in s.bones.joints.items()}, list(s.bones.bones))
+    cubes = geometry.with_spacing((cube,) * 3)  # the grid skeletonize makes: the bones record it
+    bones = BoneSkeleton({n: np.round(np.asarray(p) / cube, 3) for n, p in s.bones.joints.items()}, list(s.bones.bones),
+                         cubes)
     write_bones(folder / "mannequin-ct.bones", bones)
     if progress is not None:
         progress(1, 1)

@@ -199,3 +199,21 @@ def test_pyvistas_frog_keeps_its_slices_1_5_mm_apart(tmp_path):
     frog = Path(examples.__file__).parent / "frog_tissues.vti"  # the wheel's copy: offline
     run(["convert", frog, tmp_path / "frog.nrrd"])
     assert io.read_scan(tmp_path / "frog.nrrd").geometry.spacing == (1.0, 1.0, 1.5)
+
+
+# spec: docs/formats.md#physical-space
+def test_bones_drawn_on_another_grid_land_where_they_were_drawn(man, tmp_path):
+    """Bones placed on the scan at 1 mm voxels, a skeleton made on 0.5 mm cubes: connect maps the joints
+    through millimetres, so the attachments are those of bones drawn on the skeleton's own grid."""
+    place = Geometry(spacing=(1, 1, 1), origin=(-40, -25, -900))
+    fine = place.with_spacing((0.5, 0.5, 0.5))
+    io.write_bones(tmp_path / "coarse.bones", man.bones, place)  # recorded: joints in 1 mm voxels
+    assert io.read_bones(tmp_path / "coarse.bones").geometry == place
+    io.write_bones(tmp_path / "fine.bones", scaled_bones(man.bones, 2.0), fine)  # the same joints, 0.5 mm voxels
+    cubes, _ = volume.resample(man.mask, place, 0.5, order=0)
+    skel = skeletonize(cubes, geometry=fine)
+    io.write_mskel(tmp_path / "man.mskel", skel)
+    for name in ("coarse", "fine"):
+        run(["connect", tmp_path / "man.mskel", tmp_path / f"{name}.bones", "-o", tmp_path / f"{name}.connect"])
+    a, b = io.read_connect(tmp_path / "coarse.connect"), io.read_connect(tmp_path / "fine.connect")
+    assert np.array_equal(a.bone, b.bone) and a.bones == b.bones and a.geometry == fine

@@ -53,7 +53,7 @@ def tiff_stack(shape=(3, 4, 5)) -> bytes:
     import tifffile
 
     out = bytes_io.BytesIO()
-    tifffile.imwrite(out, np.ones(shape, np.uint8))
+    tifffile.imwrite(out, np.ones(shape, np.uint8), photometric="minisblack")
     return out.getvalue()
 
 

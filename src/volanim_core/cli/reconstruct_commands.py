@@ -32,7 +32,7 @@ def _connect(args):
     skel = read_mskel(args.mskel)
     if args.thinness is not None:
         skel = skel.at(args.thinness)
-    conn = connect_nearest(skel, read_bones(args.bones))
+    conn = connect_nearest(skel, read_bones(args.bones).on_grid(skel.geometry))
     write_connect(args.output, conn, thinness=args.thinness)
     counts = np.bincount(conn.bone, minlength=len(conn.bones))
     print(f"attached {len(conn)} points to {len(conn.bones)} bones (nearest segment); "

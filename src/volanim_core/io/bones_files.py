@@ -12,7 +12,7 @@ from pathlib import Path
 from volanim_core.rig.bones import Bone, BoneSkeleton, bone_cycle
 
 from ._atomic import atomic_write_text
-from ._text import fmt_float, parse_float, read_records
+from ._text import fmt_float, parse_float, parse_geometry, read_records
 
 
 def read_bones(path: str | Path) -> BoneSkeleton:
@@ -51,12 +51,14 @@ def read_bones(path: str | Path) -> BoneSkeleton:
     if cycle:
         raise rec.error(bone_lines[max(cycle)], "the bones form a cycle ("
                         + " -> ".join(bones[i].label for i in cycle) + "); a bone skeleton must be a tree")
-    return BoneSkeleton(joints, bones)
+    return BoneSkeleton(joints, bones, parse_geometry(rec))
 
 
-def write_bones(path: str | Path, skeleton: BoneSkeleton) -> None:
-    """Write a ``.bones`` file atomically; bone lines in root order."""
-    lines = ["# volanim bones 1"]
+def write_bones(path: str | Path, skeleton: BoneSkeleton, geometry=None) -> None:
+    """Write a ``.bones`` file atomically; bone lines in root order. ``geometry``: the grid the joints
+    are on, when the caller knows it better than the bones do (the studio's skeleton)."""
+    geometry = skeleton.geometry if geometry is None else geometry
+    lines = ["# volanim bones 1"] + ([] if geometry.is_identity else [f"# geometry: {geometry.header_value()}"])
     for name, xyz in skeleton.joints.items():
         lines.append(f"joint {name} " + " ".join(fmt_float(v) for v in xyz))
     for b in skeleton.bones:

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volanim_core.geometry import IDENTITY, Geometry
+
 
 @dataclass(frozen=True)
 class Bone:
@@ -31,6 +33,7 @@ class BoneSkeleton:
 
     joints: dict[str, np.ndarray] = field(default_factory=dict)
     bones: list[Bone] = field(default_factory=list)
+    geometry: Geometry = IDENTITY  # the voxel grid of the joints' coordinates (a .bones file's "# geometry:")
 
     def __post_init__(self):
         self.joints = {k: np.asarray(v, dtype=np.float64).reshape(3) for k, v in self.joints.items()}
@@ -65,6 +68,20 @@ class BoneSkeleton:
 
     def __len__(self) -> int:
         return len(self.bones)
+
+    def on_grid(self, geometry: Geometry) -> BoneSkeleton:
+        """These bones in the voxels of ``geometry`` (a skeleton's grid), through physical space.
+
+        Where either side records no geometry (files from before it was recorded), the joints are
+        taken to be on that grid already, as they always were; bones drawn on another grid (another
+        voxel size, a scan placed elsewhere, 3D Slicer's) land where they were drawn in the body.
+        """
+        if self.geometry.is_identity or geometry.is_identity or self.geometry == geometry:
+            known = geometry if not geometry.is_identity else self.geometry
+            return self if known == self.geometry else BoneSkeleton(self.joints, self.bones, known)
+        names = list(self.joints)
+        where = geometry.to_index(self.geometry.to_physical(np.array([self.joints[n] for n in names])))
+        return BoneSkeleton(dict(zip(names, np.round(where, 6))), self.bones, geometry)
 
     def segment(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         b = self.bones[i]

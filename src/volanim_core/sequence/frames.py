@@ -87,6 +87,7 @@ def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward) -> list[Fra
 
     if bones is None:
         raise ValueError(f"{path.name}: a BVH clip needs the bone skeleton it drives (--bones MODEL.bones)")
+    bones = bones.on_grid(conn.geometry)  # bones drawn on another grid land where they were drawn
     check_root_order(conn.bones, root_bones(bones), ".bones")
     motion = read_bvh(path)
     if mapping is not None:

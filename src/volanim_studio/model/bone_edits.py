@@ -289,6 +289,8 @@ class BoneEdits:
     def load_bones(self, path, bones=None) -> None:
         """Load a ``.bones`` file (or ``bones`` already read from ``path``); one undo step."""
         bones = io.read_bones(path) if bones is None else bones
+        if self.doc.skeleton is not None:  # onto the skeleton's grid: a file's joints may be in other voxels
+            bones = bones.on_grid(self.doc.skeleton.geometry)
         self.set_bones(bones, f"Load {Path(path).name}")
         self.doc.bones_path = str(path)
 
@@ -307,7 +309,7 @@ class BoneEdits:
         self.set_bones(new, f"Load {Path(path).name}")
 
     def save_bones(self, path) -> None:
-        io.write_bones(path, self.doc.bones)
+        io.write_bones(path, self.doc.bones, self.doc.grid)
         self.doc.bones_path = str(path)
 
     def save_connections(self, path) -> None:

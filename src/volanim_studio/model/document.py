@@ -174,6 +174,13 @@ class Document:
         self.picked_joint = name
         self.events.picked.emit(index=self.picked_point)
 
+    @property
+    def grid(self):
+        """Where the voxels of the skeleton, bones and attachments are (the identity before a skeleton)."""
+        from volanim_core.geometry import IDENTITY
+
+        return self.skeleton.geometry if self.skeleton is not None else IDENTITY
+
     def point_info(self, index: int) -> dict:
         """What the status bar shows for a point: position, DT, thinness, its bone."""
         s = self.skeleton

@@ -63,7 +63,7 @@ def write_project(doc, path, camera: dict | None = None) -> dict:
     path = Path(path)
     stored = {}
     if len(doc.bones):  # a .bones file with no bones is not a valid file: a project without bones has none
-        stored["bones"] = bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones))
+        stored["bones"] = bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones, doc.grid))
     if doc.skeleton is not None:
         stored["mskel"] = _store_skeleton(path, doc.skeleton)
     if len(doc.attachments.bone) and (doc.attachments.bone >= 0).any():

@@ -121,7 +121,8 @@ def test_symmetrize_left_arm_into_right(doc):
 
 def test_project_round_trip(tmp_path, doc):
     io.write_volume(tmp_path / "m.VOL", doc.volume)
-    seg = {"lo": 1, "hi": 255, "fill": True, "metric": "345", "min_thinness": 0.25, "spacing": [1.0, 1.0, 2.5]}
+    seg = {"lo": 1, "hi": 255, "fill": True, "metric": "345", "min_thinness": 0.25, "spacing": [1.0, 1.0, 2.5],
+           "series": None}
     doc.set_volume(doc.volume, doc.mask, path=tmp_path / "m.VOL", segmentation=seg)
     doc.bone_edits.add_bone((100, 50, 200), (110, 50, 180))
     doc.thinness = 0.7
@@ -159,7 +160,8 @@ def test_version_1_projects_read_with_their_defaults(tmp_path):
     path = tmp_path / "old.volanim"
     path.write_text('{"format": "volanim project", "version": 1, "threshold": [20, 200], "thinness": 0.5}')
     seg = read_project(path)["segmentation"]
-    assert seg == {"lo": 20, "hi": 200, "fill": False, "metric": "euclid", "min_thinness": 0.5, "spacing": None}
+    assert seg == {"lo": 20, "hi": 200, "fill": False, "metric": "euclid", "min_thinness": 0.5, "spacing": None,
+                   "series": None}
 
 
 @pytest.mark.parametrize("content, message", [

@@ -177,3 +177,22 @@ def test_declined_recovery_is_kept_a_week_and_not_offered(tmp_path, doc):
     assert autosave.find_recoveries(root) == []
     assert autosave.prune(root) == 0 and saver.path.exists()
     assert autosave.prune(root, now=time.time() + 8 * 24 * 3600) == 1 and not saver.folder.exists()
+
+
+def test_bones_follow_the_skeletons_grid_in_and_out(tmp_path):
+    """The studio's bones are on its skeleton's grid: a .bones drawn on another grid is mapped onto it
+    when loaded, and saved bones record the grid, so another tool reads them where they are (#35)."""
+    from volanim_core.geometry import Geometry
+    from volanim_core.rig.bones import BoneSkeleton
+    from volanim_core.skeleton.points import Skeleton
+    from volanim_studio.model import Document
+
+    cubes = Geometry((0.5, 0.5, 0.5), (-40, -25, -900))
+    doc = Document()
+    doc.set_skeleton(Skeleton([[10, 10, 10], [20, 10, 10]], [2.0, 2.0], [0.9, 0.8], "euclid", cubes))
+    drawn = BoneSkeleton({"A": (5, 5, 5), "B": (10, 5, 5)}, [], Geometry((1, 1, 1), (-40, -25, -900)))
+    io.write_bones(tmp_path / "drawn.bones", drawn)
+    doc.bone_edits.load_bones(tmp_path / "drawn.bones")
+    assert np.allclose(doc.bones.joints["B"], (20, 10, 10))  # 10 mm from the origin: 20 cubes of 0.5 mm
+    doc.bone_edits.save_bones(tmp_path / "saved.bones")
+    assert io.read_bones(tmp_path / "saved.bones").geometry == cubes
