@@ -50,7 +50,7 @@ def main(argv=None) -> int:
 
     from volanim_core import io, samples
     from volanim_core.geometry import Geometry
-    from volanim_core.io.medical_files import write_dicom_series
+    from volanim_core.io.dicom_files import write_dicom_series
     from volanim_core.reconstruct.engine import reconstruct
     from volanim_core.rig.attach import connect_nearest
     from volanim_core.rig.tskel import identity_tskel
