@@ -181,13 +181,11 @@ def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Pat
 def _movie(sequence: Path, out: Path) -> Path:
     """The sequence as a small looping GIF, seen from the side (where a walk reads best), off-screen."""
     from volanim_core.parallel import default_workers
-    from volanim_core.render.camera import named_view
-    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.run import open_inputs, place_camera, render
     from volanim_core.render.scene import RenderSettings
 
-    inputs = open_inputs([sequence])
-    settings = RenderSettings(named_view("side", inputs.lo, inputs.hi, aspect=320 / 240), preset=inputs.mode,
-                              vmax=inputs.vmax, size=(320, 240), background="#1e1e24")
+    camera, inputs = place_camera(open_inputs([sequence]), "side", aspect=320 / 240)  # every frame's body in view
+    settings = RenderSettings(camera, preset=inputs.mode, vmax=inputs.vmax, size=(320, 240), background="#1e1e24")
     rep = render(inputs, settings, out, workers=min(default_workers(), 4))
     _say(f"[8] render: {rep.frames} frames, 320x240, surface style from the side, {rep.workers}, "
          f"{rep.seconds:.1f} s -> {out.name}")

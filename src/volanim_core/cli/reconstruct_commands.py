@@ -103,7 +103,7 @@ def _reconstruct(args):
     bar = TextProgress("reconstruct")
     r = reconstruct(t, mode=args.mode, source=source, source_geometry=source_geometry, kernel=args.kernel,
                     bounds=bounds, padding=args.padding, threads=args.threads, progress=bar)
-    output, note = write_output(args.output, r.volume, r.geometry)
+    output, note = write_output(args.output, r.volume, r.geometry, args.mode)
     if note:
         print(f"note: {note}")
     s = r.stats

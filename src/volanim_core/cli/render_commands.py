@@ -22,6 +22,7 @@ EXAMPLE = (
     "volanim render arm.vti -o arm.png --style volume --save-tf arm.tf   # the preset, to edit",
     "volanim render arm.vti -o arm-edited.png --style volume --tf arm.tf",
     "volanim render walk.zarr -o frames/ --camera front.camera --cut 80 50 150 0 -1 0   # cut away the front half",
+    "volanim render walk.zarr -o walk-follow.mp4 --camera follow --view side   # the camera walks along",
 )
 
 
@@ -45,27 +46,30 @@ class CutAction(argparse.Action):
 
 
 def _render(args):
+    import numpy as np
+
     from volanim_core import io
-    from volanim_core.render.camera import named_view
-    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.run import open_inputs, place_camera, render
     from volanim_core.render.scene import RenderSettings, transfer_of
 
     inputs = open_inputs(args.inputs, args.range, dims=args.dims)
     preset = args.preset or inputs.mode or "sampled"
     w, h = args.size
-    if args.camera:
-        camera = io.read_camera(args.camera)
-    else:
-        camera = named_view(args.view, inputs.lo, inputs.hi, aspect=w / h)
+    if args.view and args.camera not in (None, "follow"):
+        raise ValueError("--view and a camera file both place the camera: give one (or --camera follow --view ...)")
+    args.view = args.view or "three-quarter"
+    voxels = 1 / np.asarray(inputs.spacing)  # camera files are in voxels, the scene in voxel x spacing
+    given = args.camera if args.camera in (None, "follow") else io.read_camera(args.camera).scaled(inputs.spacing)
+    camera, inputs = place_camera(inputs, args.view, given, aspect=w / h)
     if args.save_camera:
-        io.write_camera(args.save_camera, camera)
+        io.write_camera(args.save_camera, camera.scaled(voxels))
     cut = None
     if args.cut:
         cut = (tuple(args.cut[:3]), tuple(args.cut[3:]))
     settings = RenderSettings(camera, style=args.style, preset=preset, vmax=inputs.vmax,
                               transfer=io.read_transfer_function(args.tf) if args.tf else None, size=(w, h),
                               background=args.background, cut=cut, title=args.title,
-                              frame_numbers=args.frame_numbers, mapper=args.mapper)
+                              frame_numbers=args.frame_numbers, mapper=args.mapper, spacing=inputs.spacing)
     if args.save_tf:
         io.write_transfer_function(args.save_tf, transfer_of(settings))
         print(f"wrote {args.save_tf} (the {'--tf' if args.tf else preset + ' preset'}'s transfer function)")
@@ -96,10 +100,10 @@ def register(sub) -> None:
     p.add_argument("--preset", choices=MODES, help="colours for this reconstruction mode (default: the "
                    "sequence's mode, else sampled)")
     p.add_argument("--tf", metavar="FILE.tf", help="a transfer function: VALUE RED GREEN BLUE ALPHA per line (0..1)")
-    where = p.add_mutually_exclusive_group()
-    where.add_argument("--view", choices=VIEWS, default="three-quarter", help="a named view (default three-quarter)")
-    where.add_argument("--camera", metavar="FILE.camera", help="a camera file (the studio: View > Save view as "
-                       "camera file)")
+    p.add_argument("--view", choices=VIEWS, help="a named view (default three-quarter)")
+    p.add_argument("--camera", metavar="FILE.camera|follow", help="a camera file (the studio: View > Save "
+                       "view as camera file), or follow: the --view direction, each frame centred on its body "
+                       "(smoothed). Default: --view framing every frame's body")
     p.add_argument("--save-camera", metavar="FILE.camera", help="also write the camera used, to edit or reuse")
     p.add_argument("--save-tf", metavar="FILE.tf", help="also write the transfer function used (the preset's, "
                    "for a label preset one colour step per label), to edit and pass to --tf")

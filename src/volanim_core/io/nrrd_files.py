@@ -107,7 +107,7 @@ def _read_header(path: Path, fh) -> tuple[dict, dict, dict]:
         lines[key.strip().lower()] = number
 
 
-def read_nrrd(path: str | Path):
+def read_nrrd(path: str | Path, pairs: bool = False):
     """Read a 3-D NRRD: ``(data[x, y, z], Geometry, segments)``.
 
     ``segments`` maps label values to names for a 3D Slicer segmentation (``.seg.nrrd``; a layered
@@ -118,13 +118,18 @@ def read_nrrd(path: str | Path):
     path = Path(path)
     try:
         with path.open("rb") as fh:
-            return _read_nrrd(path, fh)
+            return _read_nrrd(path, fh, pairs)
     except OSError as exc:
         raise FormatError(getattr(exc, "filename", None) or path, f"cannot read file: {exc.strerror or exc}") from exc
 
 
-def _read_nrrd(path: Path, fh):
+def _read_nrrd(path: Path, fh, with_pairs: bool = False):
     fields, lines, pairs = _read_header(path, fh)
+    data, geometry, segments = _read_volume(path, fh, fields, lines, pairs)
+    return (data, geometry, segments, pairs) if with_pairs else (data, geometry, segments)
+
+
+def _read_volume(path: Path, fh, fields: dict, lines: dict, pairs: dict):
     if "type" not in fields or fields["type"].lower() not in _TYPES:
         raise FormatError(path, f"NRRD type {fields.get('type')!r} is missing or not supported", lines.get("type"))
     dtype = np.dtype(_TYPES[fields["type"].lower()])
@@ -330,8 +335,8 @@ def _flatten_layers(path: Path, layers: np.ndarray, pairs: dict) -> np.ndarray:
     return out
 
 
-def write_nrrd(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY) -> None:
-    """Write a 3-D NRRD (raw encoding, little endian, LPS space) atomically."""
+def write_nrrd(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY, pairs: dict | None = None) -> None:
+    """Write a 3-D NRRD (raw encoding, little endian, LPS space) atomically; ``pairs``: ``key:=value`` lines."""
     name = _WRITE_TYPES.get(vol.dtype.str[1:])
     if name is None:
         raise ValueError(f"cannot write {vol.dtype} to .nrrd")
@@ -345,7 +350,8 @@ def write_nrrd(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY)
         f"sizes: {'3 ' if rgb else ''}{vol.shape[0]} {vol.shape[1]} {vol.shape[2]}\n"
         f"space directions: {'none ' if rgb else ''}{dirs}\n"
         f"kinds: {'RGB-color ' if rgb else ''}domain domain domain\nendian: little\nencoding: raw\n"
-        f"space origin: ({o})\n\n"
+        f"space origin: ({o})\n"
+        + "".join(f"{k}:={v}\n" for k, v in (pairs or {}).items()) + "\n"
     )
     data = vol.transpose(2, 1, 0, 3) if rgb else vol.T
     with atomic_open(path, "wb") as fh:

@@ -59,6 +59,7 @@ class Scan(NamedTuple):
     data: np.ndarray
     geometry: Geometry
     segments: dict
+    mode: str | None = None  # the reconstruction mode a volanim result was made in (its colours), if recorded
 
 
 def _suffix(path: Path) -> str:
@@ -147,15 +148,27 @@ def _read_vtk(path: Path):
         geometry = Geometry(tuple(img.spacing), tuple(img.origin), tuple(np.asarray(img.direction_matrix).ravel()))
     except ValueError as exc:
         raise FormatError(path, f"bad geometry: {exc}") from None
+    mode = _recorded_mode(img.field_data[MODE_KEY][0] if MODE_KEY in img.field_data else None)
     scalars = np.asarray(img.point_data.active_scalars)
     if scalars.ndim > 1 and scalars.shape[1] in (3, 4) and scalars.dtype == np.uint8:  # RGB(A): drop alpha
         nx, ny, nz = img.dimensions
         data = scalars[:, :3].reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
-        return data, geometry
+        return data, geometry, mode
     if scalars.ndim > 1:  # other vector data: take the first component
         scalars = scalars[:, 0]
     data = scalars.reshape(img.dimensions, order="F")
-    return data, geometry
+    return data, geometry, mode
+
+
+MODE_KEY = "volanim_mode"  # .vti field data and a .nrrd key: the reconstruction mode of a result
+
+
+def _recorded_mode(text) -> str | None:
+    """A recorded mode when it is one we know (anything else is ignored: a hint, never an error)."""
+    from volanim_core.modes import MODES
+
+    text = str(text).strip() if text is not None else None
+    return text if text in MODES else None
 
 
 def _natural_key(name: str):
@@ -235,14 +248,14 @@ def read_scan(path: str | Path, *, dims=None, rescale: bool = False, colour: boo
     """
     path = Path(path)
     try:
-        data, geometry, segments = _read_any(path, dims, colour, series)
+        data, geometry, segments, *mode = _read_any(path, dims, colour, series)
     except OSError as exc:  # permissions, a file that vanished, disk errors: one error type, the file named
         raise FormatError(getattr(exc, "filename", None) or path, f"cannot read: {exc.strerror or exc}") from exc
     if is_colour(data) and not colour:
         data = np.asfortranarray(to_grey(data))
     if rescale and data.dtype != np.uint8:
         data = float_to_uint8(data)
-    return Scan(data, geometry, segments)
+    return Scan(data, geometry, segments, mode[0] if mode else None)
 
 
 def _read_any(path: Path, dims, colour: bool, series):
@@ -258,7 +271,8 @@ def _read_any(path: Path, dims, colour: bool, series):
     if suffix == ".vol":
         return raw_volumes.read_raw(path, dims), IDENTITY, {}
     if suffix in NRRD_SUFFIXES:
-        return read_nrrd(path)
+        data, geometry, segments, pairs = read_nrrd(path, pairs=True)
+        return data, geometry, segments, _recorded_mode(pairs.get(MODE_KEY))
     if suffix in META_SUFFIXES:
         return (*read_metaimage(path), {})
     if suffix in NIBABEL_SUFFIXES:
@@ -266,7 +280,8 @@ def _read_any(path: Path, dims, colour: bool, series):
     if suffix in TIFF_SUFFIXES:
         return (*medical_files.read_tiff_stack(path), {})
     if suffix in VTK_SUFFIXES:
-        return (*_read_vtk(path), {})
+        data, geometry, mode = _read_vtk(path)
+        return data, geometry, {}, mode
     if suffix in DICOM_SUFFIXES or dicom_files.is_dicom_file(path):
         return (*dicom_files.read_dicom(path, series=series), {})
     from .mesh_files import MESH_SUFFIXES
@@ -283,7 +298,7 @@ def read_volume(path: str | Path, *, dims=None, rescale: bool = False, colour: b
     return read_scan(path, dims=dims, rescale=rescale, colour=colour).data
 
 
-def _write_vti(path: Path, vol: np.ndarray, geometry: Geometry) -> None:
+def _write_vti(path: Path, vol: np.ndarray, geometry: Geometry, mode: str | None = None) -> None:
     import pyvista as pv
 
     img = pv.ImageData(dimensions=vol.shape[:3], origin=geometry.origin, spacing=geometry.spacing)
@@ -292,6 +307,8 @@ def _write_vti(path: Path, vol: np.ndarray, geometry: Geometry) -> None:
         img.point_data["rgb"] = np.ascontiguousarray(vol.transpose(2, 1, 0, 3)).reshape(-1, 3)
     else:
         img.point_data["values"] = vol.ravel(order="F")
+    if mode:
+        img.field_data[MODE_KEY] = [mode]
     atomic_vtk_save(path, img)
 
 
@@ -309,7 +326,8 @@ def saturate_for_raw(path: str | Path, vol: np.ndarray) -> tuple[np.ndarray, str
     return np.minimum(vol, 255).astype(np.uint8), note
 
 
-def write_output(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY) -> tuple[Path, str | None]:
+def write_output(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY, mode: str | None = None
+                 ) -> tuple[Path, str | None]:
     """Write a result where the user asked, with what raw formats need: counts above 255 saturate
     (:func:`saturate_for_raw`), a headerless ``.vol`` is named ``NAME.XxYxZ.vol``
     (:func:`raw_volumes.raw_name_for`), and a geometry ``.vol``/``.VOL`` cannot hold is said.
@@ -319,15 +337,18 @@ def write_output(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTIT
     """
     vol, note = saturate_for_raw(path, np.asarray(vol))
     path = raw_volumes.raw_name_for(path, vol.shape[:3])
-    write_volume(path, vol, geometry)
+    write_volume(path, vol, geometry, mode)
     if path.suffix.lower() == ".vol" and not geometry.is_identity:
         lost = f"{path.name} holds no geometry ({geometry.describe()}): write .nrrd, .nii, .mha or .vti to keep it"
         note = f"{note}; {lost}" if note else lost
     return path, note
 
 
-def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY) -> None:
+def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY, mode: str | None = None) -> None:
     """Write a volume as ``.vol``, ``.VOL``, ``.vti``, ``.nrrd``, ``.nii``/``.nii.gz`` or ``.mha``, atomically.
+
+    ``mode``: the reconstruction mode of a result, recorded in ``.vti`` and ``.nrrd`` so a viewer draws
+    it in that mode's colours (a bone volume in bone colours, not a grey ramp).
 
     ``.vol``/``.VOL`` hold uint8 only and no geometry: :func:`write_output` says so.
     """
@@ -341,9 +362,9 @@ def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTIT
     if suffix == ".vol":
         raw_volumes.write_raw(path, vol)
     elif suffix == ".vti":
-        _write_vti(path, vol, geometry)
+        _write_vti(path, vol, geometry, mode)
     elif suffix == ".nrrd":
-        write_nrrd(path, vol, geometry)
+        write_nrrd(path, vol, geometry, {MODE_KEY: mode} if mode else None)
     elif suffix == ".mha":
         write_metaimage(path, vol, geometry)
     elif suffix in (".nii", ".nii.gz"):

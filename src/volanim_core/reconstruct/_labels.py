@@ -6,6 +6,7 @@
     group_starts(counts, skip)         -> where each piece's rows start in piece_voxels' output
     piece_voxels(..., skip)            -> every voxel of each piece but ``skip``, grouped by piece
     boundary_voxels(zyx, ..., piece)   -> the piece's voxels with an empty 6-neighbour in the grid
+    piece_at(..., points)              -> the piece each voxel lies in (0: empty)
 
 Pieces are numbered as ``scipy.ndimage.label(zyx != 0, structure=np.ones((3, 3, 3)))``
 numbers them: in the order of their first voxel in ``(z, y, x)`` order.
@@ -200,3 +201,26 @@ def boundary_voxels(zyx, first, x0, x1, piece, label):
                     out[f, 0], out[f, 1], out[f, 2] = z, y, x
                     f += 1
     return out[:f]
+
+
+@njit(cache=True, nogil=True)
+def piece_at(first, x0, x1, piece, shape, zyx_points):
+    """The piece (1..n, 0: empty or outside) of each ``(z, y, x)`` point of a grid of ``shape``, by a
+    binary search among its row's runs (no label grid)."""
+    nz, ny, nx = shape
+    out = np.zeros(len(zyx_points), np.int64)
+    for i in range(len(zyx_points)):
+        z, y, x = zyx_points[i, 0], zyx_points[i, 1], zyx_points[i, 2]
+        if z < 0 or y < 0 or x < 0 or z >= nz or y >= ny or x >= nx:
+            continue
+        row = z * ny + y
+        lo, hi = first[row], first[row + 1]
+        while lo < hi:  # the first run ending at or after x
+            mid = (lo + hi) // 2
+            if x1[mid] < x:
+                lo = mid + 1
+            else:
+                hi = mid
+        if lo < first[row + 1] and x0[lo] <= x:
+            out[i] = piece[lo]
+    return out

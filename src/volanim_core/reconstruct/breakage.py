@@ -58,8 +58,9 @@ class BreakageReport:
     hotspot_mean: float
     joints: list[JointLoss] = field(default_factory=list)
     cracks: int = 0
-    pieces: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid) of detached parts
+    pieces: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid) of torn-off parts
     stumps: list = field(default_factory=list)  # Stump, largest first
+    rest_pieces: int = 1  # the body's pieces at rest: pieces the pose keeps apart are not breakage
 
     @property
     def loss_percent(self) -> float:
@@ -68,24 +69,28 @@ class BreakageReport:
 
     @property
     def healthy(self) -> bool:
-        return len(self.components) == 1 and not self.stumps
+        """No piece torn off and no stump: measured against the rest pose, not against "one piece"."""
+        return not self.pieces and not self.stumps
 
     @property
     def verdict(self) -> str:
         """One line for the status bar: the worst finding first."""
-        if len(self.components) > 1:
-            where = f" (near {self.pieces[0][1]})" if self.pieces else ""
-            return f"BROKEN into {len(self.components)} pieces{where}"
+        if self.pieces:
+            where = f" (near {self.pieces[0][1]})" if self.pieces[0][1] else ""
+            return f"BROKEN: the pose tore off {len(self.pieces)} piece{'s' if len(self.pieces) > 1 else ''}{where}"
         if self.stumps:
             s = self.stumps[0]
             return f"STUMP left behind near {s.joint}: {s.points} points of {s.attached} lie along {s.lies_along}"
+        if self.rest_pieces > 1:
+            return f"healthy: nothing torn off (the rest pose too is {self.rest_pieces:,} pieces), no stump"
         return "healthy: one piece, no stump"
 
     def lines(self) -> list[str]:
         out = [f"{len(self.components)} connected component(s)"
                + ("" if len(self.components) == 1 else ": " + ", ".join(str(c) for c in self.components[:6])
-                  + " voxels"),
-               *(f"detached piece of {n} voxels near {j}" for n, j, _ in self.pieces[:5]),
+                  + " voxels")
+               + (f"; {self.rest_pieces:,} at rest" if self.rest_pieces > 1 else ""),
+               *(f"piece of {n} voxels torn off near {j}" for n, j, _ in self.pieces[:5]),
                *(s.text() for s in self.stumps[:5]),
                f"{self.posed_voxels} voxels, {self.loss_percent:+.2f} % loss against the rest pose "
                f"({self.lost_voxels} rest voxels not covered in the pose)",
@@ -159,12 +164,13 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
 
 def components(volume: np.ndarray) -> list[int]:
     """Sizes of the 26-connected components of the non-zero voxels, largest first."""
-    return [n for n, _ in _components(volume)]
+    return [n for n, _, _ in _components(volume)[0]]
 
 
-def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
-    """(size, where it broke off) per 26-connected component, largest first (equal sizes in the
-    order they are met scanning the ``[z, y, x]`` grid), array coordinates.
+def _components(volume: np.ndarray) -> tuple[list[tuple[int, np.ndarray, int]], tuple]:
+    """(size, where it broke off, piece number) per 26-connected component, largest first (equal sizes
+    in the order they are met scanning the ``[z, y, x]`` grid), array coordinates; and the labelled
+    runs ``(first, x0, x1, piece, n)`` (:mod:`._labels`), to ask which piece a voxel is in.
 
     For the largest "where" is its centroid; for every other piece it is the
     piece's voxel nearest to the largest one -- the place of the break (ties: the
@@ -181,16 +187,16 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
     """
     zyx = np.ascontiguousarray(np.asarray(volume).T)
     ny = zyx.shape[1]
-    first, x0, x1, piece, n = L.label_runs(zyx)
+    first, x0, x1, piece, n = labels = L.label_runs(zyx)
     if n == 0:
-        return []
+        return [], labels
     counts, sums = L.piece_stats(first, x0, x1, piece, n, ny)
     sizes = counts[1:]
     order = np.argsort(-sizes, kind="stable")
     main = int(order[0]) + 1
-    out = [(int(sizes[order[0]]), (sums[main] / counts[main])[::-1])]
+    out = [(int(sizes[order[0]]), (sums[main] / counts[main])[::-1], main)]
     if n == 1:
-        return out
+        return out, labels
     from scipy.spatial import cKDTree
 
     start, pieces = L.piece_voxels(first, x0, x1, piece, counts, main, ny)  # every other piece's voxels
@@ -206,8 +212,37 @@ def _components(volume: np.ndarray) -> list[tuple[int, np.ndarray]]:
             if np.isfinite(d).any():
                 break
             reach *= 4.0
-        out.append((int(sizes[k - 1]), voxels[int(np.argmin(d))][::-1].astype(np.float64)))
-    return out
+        out.append((int(sizes[k - 1]), voxels[int(np.argmin(d))][::-1].astype(np.float64), int(k)))
+    return out, labels
+
+
+def pieces_at(labels: tuple, volume: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The piece number (``labels``: :func:`_components`' runs of ``volume``) of each voxel ``points``
+    ``(K, 3)`` (array coordinates ``[x, y, z]``; 0: empty or outside the grid)."""
+    first, x0, x1, piece, _ = labels
+    shape = np.array(np.shape(volume)[::-1], np.int64)
+    return L.piece_at(first, x0, x1, piece, shape, np.ascontiguousarray(np.asarray(points, np.int64)[:, ::-1]))
+
+
+def torn_off(rest_piece: np.ndarray, posed_piece: np.ndarray, n_posed: int) -> np.ndarray:
+    """The posed pieces the pose tore off: those that are no rest piece's home.
+
+    ``rest_piece``/``posed_piece``: per rest voxel, the rest piece it belongs to and the posed piece its
+    image under its bone lands in (0: empty). A rest piece's home is the posed piece most of its voxels
+    land in; a rest piece split by the pose leaves its other parts homeless. A body already in several
+    pieces at rest (the frog's 6,069 specks) whose pose keeps them apart tears nothing off; two rest
+    pieces the pose joins share a home, which is not breakage either.
+    Returns the torn-off posed piece numbers (1..n), ascending.
+    """
+    hit = posed_piece > 0
+    keys, counts = np.unique(rest_piece[hit] * (n_posed + 1) + posed_piece[hit], return_counts=True)
+    r, p = keys // (n_posed + 1), keys % (n_posed + 1)
+    order = np.lexsort((-counts, r))  # per rest piece, its most-hit posed piece first
+    home = p[order][np.r_[True, r[order][1:] != r[order][:-1]]] if len(order) else np.zeros(0, np.int64)
+    torn = np.ones(n_posed + 1, bool)
+    torn[0] = False
+    torn[home] = False
+    return np.flatnonzero(torn)
 
 
 @njit(cache=True, nogil=True)
@@ -264,14 +299,21 @@ def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
     return voxels[:, ::-1] + np.asarray(rest_bone.origin), bone
 
 
+def posed_images(points: np.ndarray, owner: np.ndarray, posed: Reconstruction, matrices: np.ndarray) -> np.ndarray:
+    """Where rest voxels ``points`` (bones ``owner``) land in the pose: ``(K, 3)`` array coordinates of
+    ``posed``'s grid (possibly outside it)."""
+    moved = apply_matrices(points, owner, matrices)
+    return np.floor(moved + 0.5).astype(np.int64) - np.asarray(posed.origin)
+
+
 def lost_voxels(rest_bone: Reconstruction, posed: Reconstruction, matrices: np.ndarray,
-                rest: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                rest: tuple[np.ndarray, np.ndarray] | None = None, images: np.ndarray | None = None) -> np.ndarray:
     """Rest voxels (``(K, 3)`` rest coordinates) whose posed image under their bone is empty.
 
-    ``rest``: :func:`rest_voxels` of ``rest_bone``, when the caller keeps them."""
+    ``rest``: :func:`rest_voxels` of ``rest_bone``, when the caller keeps them; ``images``: their
+    :func:`posed_images`, when made already."""
     points, owner = rest_voxels(rest_bone) if rest is None else rest
-    moved = apply_matrices(points, owner, matrices)
-    q = np.floor(moved + 0.5).astype(np.int64) - np.asarray(posed.origin)
+    q = posed_images(points, owner, posed, matrices) if images is None else images
     shape = np.asarray(posed.volume.shape)
     inside = ((q >= 0) & (q < shape)).all(1)
     filled = np.zeros(len(q), bool)
@@ -331,12 +373,17 @@ class RestParts:
     rest_bone: Reconstruction
     voxels: tuple[np.ndarray, np.ndarray]
     pairs: tuple
+    piece: np.ndarray | None = None  # per rest voxel, the rest piece it belongs to (1..pieces)
+    pieces: int = 1  # how many 26-connected pieces the body is at rest
 
     @classmethod
     def of(cls, conn: Connectivity, cancel=None) -> RestParts:
         rest = identity_tskel(conn)
         rest_bone = reconstruct(rest, mode="bone", cancel=cancel)
-        return cls(rest_bone, rest_voxels(rest_bone), touching_pairs(rest))
+        voxels = rest_voxels(rest_bone)
+        parts, labels = _components(rest_bone.volume)
+        piece = pieces_at(labels, rest_bone.volume, voxels[0] - np.asarray(rest_bone.origin))
+        return cls(rest_bone, voxels, touching_pairs(rest), piece, len(parts))
 
 
 def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: dict[str, np.ndarray], *,
@@ -360,20 +407,23 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
         rest = RestParts.of(tskel.connectivity, cancel)
     hot = reconstruct(tskel, mode="hotspot", bounds=posed.bounds, cancel=cancel)
     check(0, 1)
-    lost = lost_voxels(rest.rest_bone, posed, tskel.matrices, rest.voxels)
+    images = posed_images(*rest.voxels, posed, tskel.matrices)
+    lost = lost_voxels(rest.rest_bone, posed, tskel.matrices, rest.voxels, images)
     where, gaps = cracks(tskel, pairs=rest.pairs)
     check(0, 1)
-    parts = _components(posed.volume)
-    report = BreakageReport([n for n, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
+    parts, labels = _components(posed.volume)
+    torn = set(torn_off(rest.piece, pieces_at(labels, posed.volume, images), labels[4]).tolist()) \
+        if rest.piece is not None else {k for _, _, k in parts[1:]}
+    report = BreakageReport([n for n, _, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
-                            cracks=len(gaps), stumps=stumps(tskel, joints))
+                            cracks=len(gaps), stumps=stumps(tskel, joints), rest_pieces=rest.pieces)
     names = list(joints)
-    if len(parts) > 1 and names:
-        posed_pos = np.array([posed_joints.get(n, joints[n]) for n in names], np.float64)
-        for size, centroid in parts[1:]:
+    posed_pos = np.array([posed_joints.get(n, joints[n]) for n in names], np.float64) if names else None
+    for size, centroid, k in parts:
+        if k in torn:
             c = centroid + np.asarray(posed.origin)
-            k = int(((posed_pos - c) ** 2).sum(1).argmin())
-            report.pieces.append((size, names[k], c))
+            near = names[int(((posed_pos - c) ** 2).sum(1).argmin())] if names else ""
+            report.pieces.append((size, near, c))
     if len(gaps) and names:
         from scipy.spatial import cKDTree
 

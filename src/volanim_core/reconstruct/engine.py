@@ -43,9 +43,9 @@ from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.sampling import sample_source
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.pose import apply_matrices
+from volanim_core.modes import MODES
 from volanim_core.volume import Bounds
 
-MODES = ("binary", "mottled", "bone", "sampled", "hotspot")
 _MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT}
 SNAP = 2.0**20
 LAUNCH_SECONDS = 0.25  # aimed length of one parallel launch: the progress and cancel granularity

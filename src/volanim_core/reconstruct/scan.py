@@ -1,6 +1,7 @@
 """Scan a whole animation for breakage: one verdict per frame, so the user jumps to the worst one.
 
-    once:       the sphere pairs that touch at rest, the neighbour lists   (pose-independent)
+    once:       the sphere pairs that touch at rest, the neighbour lists,
+                the rest pose's pieces on the coarse grid                   (pose-independent)
     per frame:  cracks and stumps from the posed sphere centres             (no voxels: cheap)
                 connected components of a ``factor``-times coarser bone reconstruction
 
@@ -33,14 +34,16 @@ class FrameVerdict:
     gap: float  # their summed opening, voxels
     worst_joint: str  # the joint nearest the widest cracks ('' when none)
     stump: int = 0  # points left behind along another bone (breakage.stumps), summed
+    rest_pieces: int = 1  # pieces of the rest pose on the same coarse grid: only more than these is breakage
 
     @property
     def healthy(self) -> bool:
-        return self.pieces <= 1 and self.cracks == 0 and self.stump == 0
+        return self.pieces <= self.rest_pieces and self.cracks == 0 and self.stump == 0
 
     def badness(self) -> tuple:
         """Sort key, worst first: detached pieces outrank stumps, stumps outrank cracks, then how much."""
-        return (-min(self.pieces - 1, 1), -self.detached, -min(self.stump, 1), -self.stump, -self.gap)
+        return (-min(max(self.pieces - self.rest_pieces, 0), 1), -self.detached, -min(self.stump, 1), -self.stump,
+                -self.gap)
 
 
 def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints: dict | None = None,
@@ -51,6 +54,8 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     frames = list(range(len(matrices))) if frames is None else [int(f) for f in frames]
     report = Reporter(progress, cancel)
     rest = identity_tskel(conn)
+    # a body in several pieces at rest (the frog's specks) is not broken by a pose that keeps them
+    rest_pieces = max(len(components(reconstruct(coarse_tskel(rest, factor), mode="bone", padding=1).volume)), 1)
     pairs = touching_pairs(rest)
     misplaced = misplaced_points(rest)
     names = list(joints or {})
@@ -67,9 +72,9 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
             worst = names[int(np.bincount(k, weights=gaps, minlength=len(names)).argmax())]
         sizes = components(reconstruct(coarse_tskel(posed, factor), mode="bone", padding=1).volume)
         behind = stumps(posed, joints or {}, misplaced)
-        out.append(FrameVerdict(frame, len(sizes), int(sum(sizes[1:])) * factor ** 3, len(gaps),
+        out.append(FrameVerdict(frame, len(sizes), int(sum(sizes[rest_pieces:])) * factor ** 3, len(gaps),
                                 float(gaps.sum()), worst or (behind[0].joint if behind else ""),
-                                sum(b.points for b in behind)))
+                                sum(b.points for b in behind), rest_pieces))
     report(len(frames), len(frames))
     return out
 

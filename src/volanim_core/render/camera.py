@@ -107,13 +107,15 @@ def natural_axes(lo, hi, clearly: float = 1.15) -> np.ndarray:
 
 
 def named_view(name: str, lo, hi, aspect: float = 4 / 3, view_angle: float = 30.0, margin: float = 0.05,
-               axes=None) -> Camera:
-    """A camera from direction ``name`` at the distance where the box ``lo..hi`` (voxel coordinates) just
-    fits a picture of width/height ``aspect`` (plus ``margin`` around it): every corner of the box, seen
-    in perspective, is inside the picture. ``axes`` (e.g. :func:`natural_axes`) turns the view table."""
+               axes=None, faces: float = 0.5) -> Camera:
+    """A camera from direction ``name`` at the distance where the box ``lo..hi`` just fits a picture of
+    width/height ``aspect`` (plus ``margin`` around it): every corner of the box, seen in perspective,
+    is inside the picture. ``axes`` (e.g. :func:`natural_axes`) turns the view table. ``lo..hi`` are
+    voxel centres, widened by ``faces`` to the voxels' faces (0: a box already to the faces, in world
+    units)."""
     if name not in _DIRECTIONS:
         raise ValueError(f"unknown view {name!r}; choose one of {', '.join(VIEWS)}")
-    lo, hi = np.asarray(lo, np.float64) - 0.5, np.asarray(hi, np.float64) + 0.5  # voxel centres -> their faces
+    lo, hi = np.asarray(lo, np.float64) - faces, np.asarray(hi, np.float64) + faces
     centre = (lo + hi) / 2
     direction, up = (np.asarray(v, np.float64) for v in _DIRECTIONS[name])
     if axes is not None:
@@ -129,3 +131,31 @@ def named_view(name: str, lo, hi, aspect: float = 4 / 3, view_angle: float = 30.
     distance = max(1.0, float(np.max(np.maximum(np.abs(corners @ up) / tan_v, np.abs(corners @ right) / tan_h)
                                      + toward)))
     return Camera(tuple(centre + direction * distance), tuple(centre), tuple(up), float(view_angle))
+
+
+def follow_cameras(name: str, boxes, aspect: float = 4 / 3, view_angle: float = 30.0, axes=None,
+                   smooth: int = 9) -> list[Camera]:
+    """One camera per frame from direction ``name`` that keeps the body in the middle (``--camera follow``).
+
+    ``boxes``: per frame the body's world box ``(lo, hi)`` to the voxels' faces, or None (an empty frame:
+    it keeps its neighbours' camera). The centres are smoothed by a moving average over ``smooth``
+    frames (no jitter from a swinging arm); every camera stands at the one distance at which the
+    largest box, around its smoothed centre, fits the picture -- so no frame leaves it.
+    """
+    known = [k for k, b in enumerate(boxes) if b is not None]
+    if not known:
+        raise ValueError("every frame is empty: there is no body to follow")
+    centres = np.array([(np.asarray(b[0], np.float64) + np.asarray(b[1], np.float64)) / 2 for b in boxes
+                        if b is not None])
+    index = np.arange(len(boxes))
+    track = np.stack([np.interp(index, known, centres[:, a]) for a in range(3)], axis=1)  # gaps: held / blended
+    half_window = max(int(smooth), 1) // 2
+    padded = np.concatenate([track[:1].repeat(half_window, 0), track, track[-1:].repeat(half_window, 0)])
+    kernel = np.ones(2 * half_window + 1) / (2 * half_window + 1)
+    smoothed = np.stack([np.convolve(padded[:, a], kernel, mode="valid") for a in range(3)], axis=1)
+    reach = np.zeros(3)
+    for k in known:  # the box around each frame's smoothed centre that holds its body
+        lo, hi = (np.asarray(v, np.float64) for v in boxes[k])
+        reach = np.maximum(reach, np.maximum(hi - smoothed[k], smoothed[k] - lo))
+    return [named_view(name, c - reach, c + reach, aspect=aspect, view_angle=view_angle, axes=axes, faces=0.0)
+            for c in smoothed]

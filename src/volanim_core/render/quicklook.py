@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import Renderer, RenderSettings
+from .scene import Renderer, RenderSettings, reset_clipping
 
 
 def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str = "surface",
@@ -22,22 +22,23 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
 
     from .camera import named_view
     from .colours import SKIN
-    from .run import open_inputs, read_frame
+    from .run import open_inputs, place_camera, read_frame
 
     path = Path(path)
     w, h = size
     if path.suffix.lower() in MESH_SUFFIXES:
         mesh = read_mesh(path)
         lo, hi = tuple(np.asarray(mesh.bounds[0::2])), tuple(np.asarray(mesh.bounds[1::2]))
-        settings = RenderSettings(named_view(view, lo, hi, aspect=w / h), size=(w, h))
+        settings = RenderSettings(named_view(view, lo, hi, aspect=w / h, faces=0.0), size=(w, h))
         renderer = Renderer(settings, off_screen=off_screen, plotter=plotter)
         renderer.plotter.add_mesh(mesh, color=SKIN, smooth_shading=True, name="body", reset_camera=False)
         settings.camera.apply(renderer.plotter.camera)  # (a volume's draw() applies it itself)
+        reset_clipping(renderer.plotter.renderer)
         what = f"{mesh.n_points:,} points, {mesh.n_cells:,} faces"
     else:
-        inputs = open_inputs([path], slice(frame, frame + 1), dims=dims)
-        settings = RenderSettings(named_view(view, inputs.lo, inputs.hi, aspect=w / h), style=style,
-                                  preset=preset or inputs.mode or "sampled", vmax=inputs.vmax, size=(w, h))
+        camera, inputs = place_camera(open_inputs([path], slice(frame, frame + 1), dims=dims), view, aspect=w / h)
+        settings = RenderSettings(camera, style=style, preset=preset or inputs.mode or "sampled", vmax=inputs.vmax,
+                                  size=(w, h), spacing=inputs.spacing)
         renderer = Renderer(settings, off_screen=off_screen, plotter=plotter)
         ref = inputs.frames[0]
         volume, origin = read_frame(ref, dims)

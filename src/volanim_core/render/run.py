@@ -18,7 +18,7 @@ import os
 import shutil
 import time
 from concurrent.futures import FIRST_COMPLETED, wait
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +26,7 @@ import numpy as np
 from volanim_core.errors import FormatError
 from volanim_core.parallel import executor
 
+from .camera import Camera, named_view
 from .scene import Renderer, RenderSettings
 
 KEY_FILE = "volanim-render.json"
@@ -37,17 +38,45 @@ class FrameRef:
     path: str
     index: int  # the frame inside a zarr sequence (-1: a volume file)
     number: int  # the frame's number (file names, the overlay)
+    camera: Camera | None = None  # this frame's own camera (``--camera follow``), else the settings'
 
 
 @dataclass
 class RenderInputs:
     frames: list[FrameRef]
-    lo: tuple  # the voxel box every frame fits in (the camera frames it)
+    lo: tuple  # the voxel box every frame's body fits in (the camera frames it): the union of ``boxes``
     hi: tuple
     mode: str | None  # the reconstruction mode, when the input says
     vmax: float  # the top of the colour range over every frame
     fps: float | None
     fingerprint: list  # what the pictures depend on besides the settings (for resuming)
+    boxes: list | None = None  # per frame: its filled voxels' (lo, hi), None when empty; None: not known
+    spacing: tuple = (1.0, 1.0, 1.0)  # world units per voxel (files: their own; sequences: voxels)
+
+    def world_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The box every frame's body fits in, in world units (voxel x spacing), to the voxels' faces."""
+        sp = np.asarray(self.spacing, np.float64)
+        return (np.asarray(self.lo) - 0.5) * sp, (np.asarray(self.hi) + 0.5) * sp
+
+    def follow(self, view: str, aspect: float, axes=None) -> list[FrameRef]:
+        """The frames, each with a camera that keeps its body in the middle (:func:`follow_cameras`)."""
+        from .camera import follow_cameras
+
+        sp = np.asarray(self.spacing, np.float64)
+        boxes = self.boxes or [(self.lo, self.hi)] * len(self.frames)
+        world = [None if b is None else ((np.asarray(b[0]) - 0.5) * sp, (np.asarray(b[1]) + 0.5) * sp) for b in boxes]
+        cams = follow_cameras(view, world, aspect=aspect, axes=axes)
+        return [replace(f, camera=c) for f, c in zip(self.frames, cams)]
+
+
+def union_box(boxes, lo, hi) -> tuple[tuple, tuple]:
+    """The box holding every known, non-empty box of ``boxes`` (``(lo, hi)`` each); ``lo..hi`` (the grid)
+    when there is none: a camera then frames the grid rather than nothing."""
+    known = [b for b in boxes if b is not None]
+    if not known:
+        return tuple(lo), tuple(hi)
+    return (tuple(int(v) for v in np.min([b[0] for b in known], 0)),
+            tuple(int(v) for v in np.max([b[1] for b in known], 0)))
 
 
 def open_inputs(paths, frames: slice = slice(None), dims=None) -> RenderInputs:
@@ -92,8 +121,13 @@ def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
     scale = zarr.open_group(str(path), mode="r").attrs["ome"]["multiscales"][0]["datasets"][0][
         "coordinateTransformations"][0]["scale"][0]
     refs = [FrameRef(str(path.resolve()), i, int(plan["numbers"][i])) for i in indices]
-    return RenderInputs(refs, tuple(lo), hi, mode, vmax, 1.0 / float(scale),
-                        [plan["key"], *[done[i]["sha256"] for i in indices]])
+    boxes = None
+    if all("box" in done[i] for i in indices):  # stores written before boxes were recorded: the grid
+        boxes = [None if done[i]["box"] is None else (tuple(done[i]["box"][0]), tuple(done[i]["box"][1]))
+                 for i in indices]
+    body_lo, body_hi = union_box(boxes or [], lo, hi)
+    return RenderInputs(refs, body_lo, body_hi, mode, vmax, 1.0 / float(scale),
+                        [plan["key"], *[done[i]["sha256"] for i in indices]], boxes)
 
 
 def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
@@ -105,19 +139,54 @@ def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
     pairs = sorted(zip(numbers, paths))[frames]
     if not pairs:
         raise ValueError("the frame range selects none of the files")
-    los, his, vmax, fingerprint = [], [], 1.0, []
+    from volanim_core.volume import tight_bounds
+
+    los, his, boxes, vmax, fingerprint, spacing, modes = [], [], [], 1.0, [], None, set()
     for _, p in pairs:  # every file once: the box and the colour range must hold for all of them
-        vol, origin, _ = _read(p, dims)
+        vol, origin, sp, mode = _read(p, dims)
+        modes.add(mode)
+        if spacing is None:
+            spacing = tuple(float(v) for v in sp)
+        elif not np.allclose(sp, spacing, rtol=1e-4):
+            raise ValueError(f"{p}: voxels of {_mm(sp)}, the first file's are {_mm(spacing)}; render files of one "
+                             f"voxel size together (volanim resample makes them so)")
         o = np.rint(np.asarray(origin, np.float64)).astype(int)
         los.append(o)
         his.append(o + np.array(vol.shape[:3]) - 1)
+        box = tight_bounds(vol.any(axis=3) if vol.ndim == 4 else vol)
+        boxes.append(None if box is None else (tuple((o + box.lo).tolist()), tuple((o + box.hi).tolist())))
         if vol.size:
             vmax = max(vmax, float(vol.max()))
         st = p.stat()
         fingerprint.append([str(p.resolve()), st.st_size, st.st_mtime_ns])
     refs = [FrameRef(str(p.resolve()), -1, int(n)) for n, p in pairs]
-    return RenderInputs(refs, tuple(np.min(los, 0).tolist()), tuple(np.max(his, 0).tolist()), None, vmax, None,
-                        fingerprint)
+    lo, hi = union_box(boxes, np.min(los, 0).tolist(), np.max(his, 0).tolist())
+    mode = modes.pop() if len(modes) == 1 else None  # the files' recorded mode, when they agree
+    return RenderInputs(refs, lo, hi, mode, vmax, None, fingerprint, boxes, spacing)
+
+
+def place_camera(inputs: RenderInputs, view: str = "three-quarter", camera: Camera | str | None = None,
+                 aspect: float = 4 / 3, axes=None) -> tuple[Camera, RenderInputs]:
+    """The camera a render uses and the inputs to draw (every path that renders frames: ``volanim render``
+    and ``view``, the demo, the studio's movie).
+
+    ``camera``: None (the named ``view`` framing every frame's body: the union of their boxes), a
+    :class:`Camera` in world units, or ``"follow"`` (each frame its own camera, :meth:`RenderInputs.follow`;
+    the one returned is the middle frame's, for ``--save-camera``).
+    """
+    if camera == "follow":
+        frames = inputs.follow(view, aspect, axes)
+        return frames[len(frames) // 2].camera, replace(inputs, frames=frames)
+    if isinstance(camera, Camera):
+        return camera, inputs
+    if camera is not None:
+        raise ValueError(f"camera: a Camera or 'follow', got {camera!r}")
+    lo, hi = inputs.world_box()
+    return named_view(view, lo, hi, aspect=aspect, axes=axes, faces=0.0), inputs
+
+
+def _mm(spacing) -> str:
+    return " x ".join(f"{v:g}" for v in spacing) + " mm"
 
 
 def _read(path, dims=None):
@@ -125,7 +194,7 @@ def _read(path, dims=None):
 
     scan = read_scan(path, dims=dims, colour=True)  # a colour volume is drawn in its colours
     g = scan.geometry  # frames are drawn in voxels: the origin in voxels of the frame's own spacing
-    return scan.data, tuple(np.asarray(g.origin) / np.asarray(g.spacing)), g.spacing
+    return scan.data, tuple(np.asarray(g.origin) / np.asarray(g.spacing)), g.spacing, scan.mode
 
 
 @dataclass
@@ -165,7 +234,7 @@ def render_task(job: RenderJob | None, ref: FrameRef) -> tuple[int, np.ndarray]:
             _RENDERER.close()
         _RENDERER, _JOB = Renderer(job.settings), job  # one plotter per worker, reused for every frame
     volume, origin = read_frame(ref, job.dims)
-    return ref.number, _RENDERER.render(volume, origin, ref.number)
+    return ref.number, _RENDERER.render(volume, origin, ref.number, camera=ref.camera)
 
 
 def read_frame(ref: FrameRef, dims=None) -> tuple[np.ndarray, tuple]:
@@ -174,7 +243,7 @@ def read_frame(ref: FrameRef, dims=None) -> tuple[np.ndarray, tuple]:
         from volanim_core.sequence import store
 
         return store.read_frame(ref.path, ref.index), store.origin(ref.path)
-    volume, origin, _ = _read(ref.path, dims)
+    volume, origin, *_ = _read(ref.path, dims)
     return volume, origin
 
 

@@ -34,6 +34,7 @@ from volanim_core.render.transfer import (
     apply_rgba,
     label_colours,
     rgba_points,
+    volume_mapper,
 )
 from volanim_core.render.transfer_function import TransferFunction
 
@@ -195,9 +196,10 @@ class Renderer:
         settings.camera.apply(self.plotter.camera)
         self.plotter.camera_set = True  # never reset to fit a frame: the camera is the sequence's
 
-    def render(self, volume: np.ndarray, origin, number: int | None = None) -> np.ndarray:
-        """Draw a frame and return its picture, ``(H, W, 3)`` uint8."""
-        self.draw(volume, origin, number)
+    def render(self, volume: np.ndarray, origin, number: int | None = None, camera: Camera | None = None
+               ) -> np.ndarray:
+        """Draw a frame (with its own ``camera``, else the settings') and return its picture, ``(H, W, 3)`` uint8."""
+        self.draw(volume, origin, number, camera)
         if self._first:  # pyvista renders an off-screen plotter at its first screenshot only
             self._first = False
             image = self.plotter.screenshot(return_img=True)
@@ -206,7 +208,7 @@ class Renderer:
             image = self.plotter.image
         return np.asarray(image, np.uint8)[..., :3].copy()
 
-    def draw(self, volume: np.ndarray, origin, number: int | None = None) -> None:
+    def draw(self, volume: np.ndarray, origin, number: int | None = None, camera: Camera | None = None) -> None:
         """Put a frame's actors in the scene (no rendering yet)."""
         s = self.settings
         if s.cut is not None:
@@ -224,10 +226,8 @@ class Renderer:
         if s.frame_numbers and number is not None:
             self.plotter.add_text(f"frame {number}", position="upper_right", font_size=12, name="frame",
                                   color=_contrast(s.background), render=False)
-        s.camera.apply(self.plotter.camera)  # adding actors must not have moved it
-        # near and far planes from what is in view now: a camera placed far from the body (a long walk's
-        # shared grid, a large scan) otherwise keeps planes that cut the whole body away (black frames)
-        self.plotter.renderer.ResetCameraClippingRange()
+        (camera or s.camera).apply(self.plotter.camera)  # adding actors must not have moved it
+        reset_clipping(self.plotter.renderer)
 
     def close(self) -> None:
         self.plotter.close()
@@ -267,7 +267,8 @@ class Renderer:
         grid = pv.ImageData(dimensions=volume.shape[:3], origin=key[1], spacing=s.spacing)
         grid.point_data["v"] = data
         actor = add_volume_uncopied(self.plotter, grid, "v", name="body", reset_camera=False, show_scalar_bar=False,
-                                    mapper="fixed_point" if self._cpu_caster() else "smart", render=False)
+                                    mapper=volume_mapper("fixed_point" if self._cpu_caster() else "smart",
+                                                         1 if data.ndim == 1 else data.shape[1]), render=False)
         self._grid, self._grid_key = actor.GetMapper().GetInput(), key
         prop = actor.GetProperty()
         if volume.ndim == 4:
@@ -305,6 +306,13 @@ class Renderer:
             text.SetColor(*rgb(_contrast(s.background)))
         self.plotter.add_actor(bar, reset_camera=False, name="colour bar", render=False)
         self._bar = bar
+
+
+def reset_clipping(renderer) -> None:
+    """Near and far planes from what is in view now. Every path that moves a camera or changes what is
+    drawn calls this: a camera placed far from the body (a long walk's shared grid, a large scan, a
+    camera file) otherwise keeps planes that cut the whole body away -- black or half pictures."""
+    renderer.ResetCameraClippingRange()
 
 
 def check_colour(text: str) -> None:

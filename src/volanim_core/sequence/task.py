@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.rig.connectivity import Connectivity
-from volanim_core.volume import Bounds
+from volanim_core.volume import Bounds, tight_bounds
 
 from .frames import FrameSpec
 from .store import CHUNK_EDGE, frame_checksum, open_frames
@@ -100,10 +100,12 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
         zyx = np.ascontiguousarray(fall(r.volume, spec.crumble, spec.down).T)
         region = occupied(zyx)
         part = zyx[region]
+        box = tight_bounds(zyx.T)
     else:  # the frame's grid, placed in the shared grid
         placed = Bounds(tuple(np.subtract(grid.lo, p.bounds.lo)), tuple(np.subtract(grid.hi, p.bounds.lo)))
         region = placed.slices()[::-1]
         part = zyx
+        box = tight_bounds(r.volume)
     # shard ``index`` is this task's alone; only the chunks the body reaches are written (the shared
     # grid of a walk is mostly empty: writing all of it cost 3x the reconstruction)
     import zarr
@@ -117,15 +119,22 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
 
         whole = np.zeros(p.bounds.shape[::-1], part.dtype)  # per-frame files line up too: the shared grid
         whole[region] = part
-        io.write_output(frame_file(p.every_frame_as, spec.number), whole.T, p.conn.geometry.shifted(p.bounds.lo))
+        io.write_output(frame_file(p.every_frame_as, spec.number), whole.T, p.conn.geometry.shifted(p.bounds.lo),
+                        p.mode)
     s = r.stats
     return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
-            "filled": int(s["filled"]), "clipped": int(s.get("clipped", 0)),
+            "filled": int(s["filled"]), "box": None if box is None else _in_grid(box, grid.lo), "clipped": int(s.get("clipped", 0)),
             "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
             "dt_scale": round(float(np.mean(spec.dt_scale)), 6), "crumble": spec.crumble,
             "seconds": round(time.perf_counter() - t0, 4), "finished": round(time.time(), 4),
             "worker": f"{socket.gethostname()}:{os.getpid()}",
             "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
+
+
+def _in_grid(box, lo) -> list[list[int]]:
+    """A frame's filled box (voxels of its own grid, whose corner is ``lo``) in the shared grid's voxel
+    coordinates, as the store records it: what a render's camera frames (``render.run``)."""
+    return [[int(a + b) for a, b in zip(box.lo, lo)], [int(a + b) for a, b in zip(box.hi, lo)]]
 
 
 def reconstruct_frames(payload: Payload | None, work: list[tuple[int, FrameSpec, Bounds]]) -> list[dict]:

@@ -185,7 +185,7 @@ class PreviewController(Controller):
             return False
         shape = p.reconstruction.volume.shape
         return self.attempt(
-            "Export", lambda: io.write_output(path, p.reconstruction.volume, p.reconstruction.geometry),
+            "Export", lambda: io.write_output(path, p.reconstruction.volume, p.reconstruction.geometry, p.mode),
             lambda written: f"Exported {shape[0]}x{shape[1]}x{shape[2]} ({p.mode}) to {written[0]}; origin "
             f"{tuple(int(v) for v in p.origin_voxels)}." + (f" Note: {written[1]}." if written[1] else "")
         ) is not FAILED

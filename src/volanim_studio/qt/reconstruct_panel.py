@@ -87,7 +87,7 @@ class ReconstructPanel(QWidget):
         self.report.setText(verdict_html(r) + "<br>" + "<br>".join(r.lines()))
         self.joints.clear()
         for size, joint, _ in r.pieces:
-            item = QListWidgetItem(f"detached piece: {size} voxels near {joint}")
+            item = QListWidgetItem(f"torn-off piece: {size} voxels near {joint}")
             item.setData(Qt.UserRole, joint)
             self.joints.addItem(item)
         for s in r.stumps:

@@ -25,7 +25,8 @@ def preset_view(renderer, name: str = "front") -> bool:
         return False
     lo, hi = np.array(b[0::2]), np.array(b[1::2])
     w, h = renderer.GetSize()
-    cam = named_view(name, lo, hi, aspect=w / h if w and h else 4 / 3, view_angle=30.0, axes=natural_axes(lo, hi))
+    cam = named_view(name, lo, hi, aspect=w / h if w and h else 4 / 3, view_angle=30.0, axes=natural_axes(lo, hi),
+                     faces=0.0)
     cam.apply(renderer.GetActiveCamera())
     renderer.ResetCameraClippingRange()
     return True

@@ -21,6 +21,7 @@ from volanim_core.render.transfer import (
     gl_renderer,
     rgba_points,
     software_gl,
+    volume_mapper,
     volume_style,
 )
 from volanim_core.rig.pose import apply_matrices
@@ -133,10 +134,12 @@ class PoseLayer:
             plotter.remove_actor("preview", render=False)
             if plotter.scalar_bars:
                 plotter.remove_scalar_bar()
-            style = volume_style(mode, volume, n_bones) if volume.ndim == 3 else {"show_scalar_bar": False}
+            colour = volume.ndim == 4
+            style = volume_style(mode, volume, n_bones) if not colour else {"show_scalar_bar": False}
             labels = style.pop("categories", None)
             self.preview_actor = add_volume_uncopied(plotter, img, "values", name="preview", render=False,
-                                                     reset_camera=False, mapper=self.volume_mapper(), **style)
+                                                     reset_camera=False, **style,
+                                                     mapper=volume_mapper(self.volume_mapper(), 4 if colour else 1))
             if labels is not None:
                 apply_labels(self.preview_actor, labels)
             if volume.ndim == 4:

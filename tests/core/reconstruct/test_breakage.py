@@ -123,10 +123,15 @@ def test_pieces_and_where_they_broke_off_match_a_brute_force_answer():
         piece = np.argwhere(labels == k)  # C order of [z, y, x]: x fastest
         d2 = ((piece[:, None, :] - body[None, :, :]) ** 2).sum(-1).min(1)
         want.append((int(sizes[k - 1]), piece[int(np.argmin(d2))][::-1].astype(float)))
-    got = _components(vol)
-    assert [s for s, _ in got] == [s for s, _ in want]
-    for (_, a), (_, b) in zip(got, want):
+    got, runs = _components(vol)
+    assert [s for s, _, _ in got] == [s for s, _ in want]
+    for (_, a, _), (_, b) in zip(got, want):
         assert np.allclose(a, b)
+    assert [k for _, _, k in got] == [int(k) for k in order + 1]  # numbered as scipy numbers them
+    from volanim_core.reconstruct.breakage import pieces_at
+
+    probe = np.argwhere(np.ones(vol.shape, bool))[::7]  # filled and empty voxels, and their pieces
+    assert np.array_equal(pieces_at(runs, vol, probe), labels.T[tuple(probe.T)])
 
 
 def test_a_piece_far_from_the_main_body_is_located_where_it_is_nearest():
@@ -138,8 +143,8 @@ def test_a_piece_far_from_the_main_body_is_located_where_it_is_nearest():
     vol[2:20, 2:20, 2:20] = 1  # the main body
     vol[45:50, 30:33, 25:27] = 1  # a piece far off, nearest to the body's corner (19, 19, 19)
     vol[6, 28, 3] = 1  # and a one-voxel piece 8 beyond the body's y face
-    got = _components(vol)
-    assert [n for n, _ in got] == [18**3, 30, 1]
+    got = _components(vol)[0]
+    assert [n for n, _, _ in got] == [18**3, 30, 1]
     assert np.allclose(got[1][1], (45, 30, 25)) and np.allclose(got[2][1], (6, 28, 3))
 
 

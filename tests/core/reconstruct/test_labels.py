@@ -90,5 +90,5 @@ def test_no_pieces_and_one_piece():
     assert breakage.components(np.zeros((4, 5, 6), np.uint8)) == []
     v = np.zeros((4, 5, 6), np.uint8)
     v[1:3, 2:4, 0:6] = 9
-    got = breakage._components(v)
+    got = breakage._components(v)[0]
     assert len(got) == 1 and got[0][0] == 24 and np.allclose(got[0][1], (1.5, 2.5, 2.5))

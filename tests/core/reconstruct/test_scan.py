@@ -43,3 +43,33 @@ def test_the_scan_reports_progress_and_stops_on_cancel():
     assert seen[0] == (0, 5) and seen[-1] == (5, 5)
     with pytest.raises(Cancelled):
         scan_frames(conn, frames, cancel=lambda: True)
+
+
+def speckled_arm():
+    """The arm, and a speck of its own attached to the spine: two pieces at rest (as the frog's scan has
+    6,069 specks of tissue), which no pose should be blamed for."""
+    bones, conn = arm_connectivity()
+    points = np.vstack([conn.points, [[40.0, 40.0, 40.0]]])
+    return bones, Connectivity(conn.bones, points, np.append(conn.dt, 1.5), np.append(conn.thinness, 1.0),
+                               np.append(conn.bone, 0))
+
+
+def test_pieces_apart_at_rest_are_not_breakage_a_torn_forearm_still_is():
+    """Before: the unposed frog was "BROKEN into 6069 pieces", every speck of it counted as breakage."""
+    from volanim_core.reconstruct.breakage import breakage_report
+    from volanim_core.rig.connectivity import Trans
+    from volanim_core.rig.pose import posed_joints
+    from volanim_core.rig.tskel import connect_to_tskel
+
+    bones, conn = speckled_arm()
+    rest, torn = pose_matrices(bones), pose_matrices(bones, translations={2: [12.0, 0.0, 0.0]})
+    v = scan_frames(conn, np.stack([rest, torn]), joints=dict(bones.joints))
+    assert v[0].pieces == 2 and v[0].rest_pieces == 2 and v[0].healthy
+    assert v[1].pieces == 3 and not v[1].healthy and [x.frame for x in worst_first(v)] == [1, 0]
+    joints = dict(bones.joints)
+    r = breakage_report(connect_to_tskel(conn, Trans(root_bones(bones), rest)), joints, joints)
+    assert r.healthy and len(r.components) == 2 and r.rest_pieces == 2 and not r.pieces
+    assert r.verdict == "healthy: nothing torn off (the rest pose too is 2 pieces), no stump"
+    r = breakage_report(connect_to_tskel(conn, Trans(root_bones(bones), torn)), joints, posed_joints(bones, torn))
+    assert not r.healthy and len(r.pieces) == 1 and r.verdict.startswith("BROKEN: the pose tore off 1 piece (near ")
+    assert r.pieces[0][0] < r.components[0]  # the forearm, not the speck or the upper arm
