@@ -72,7 +72,8 @@ class Camera:
 
     @classmethod
     def of(cls, vtk_camera) -> Camera:
-        """The camera a ``vtkCamera`` has now (the studio's view)."""
+        """The camera a ``vtkCamera`` has now (the studio's view: ``renderer.GetActiveCamera()``; not pyvista's
+        ``plotter.camera``, whose first read resets a camera pyvista did not place to its own default view)."""
         parallel = bool(vtk_camera.GetParallelProjection())
         return cls(tuple(vtk_camera.GetPosition()), tuple(vtk_camera.GetFocalPoint()), tuple(vtk_camera.GetViewUp()),
                    float(vtk_camera.GetViewAngle()), float(vtk_camera.GetParallelScale()) if parallel else None)

@@ -246,7 +246,7 @@ class TimelineController(Controller):
     # ---------------------------------------------------------- movies
     def camera(self) -> Camera:
         """The view's camera in world units (voxel x spacing), as the studio draws."""
-        return Camera.of(self.scene.plotter.camera)
+        return Camera.of(self.scene.plotter.renderer.GetActiveCamera())
 
     def save_camera(self, path) -> None:
         """The view's camera in voxel coordinates, for ``volanim render --camera``."""

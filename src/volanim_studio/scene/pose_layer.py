@@ -54,21 +54,23 @@ class PoseLayer:
         view.plotter.remove_actor("stumps", render=False)  # they were where the previous pose put them
         if not view.posing:
             return
-        view.plotter.remove_actor("posed_bones", render=False)
+        view.xray.remove("posed_bones")
         bones = view.doc.bones
         if len(bones):
             pj = view.doc.pose.posed_joints()
             poly = bone_lines(view.world(np.array([[pj[b.proximal], pj[b.distal]] for b in bones.bones])))
             poly.cell_data["rgb"] = label_table(len(bones))[1:]
-            view.plotter.add_mesh(poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True,
-                                  name="posed_bones", render=False, reset_camera=False)
+            # over the preview (x-ray): the bones the user poses and clicks are never hidden inside it
+            view.xray.put("posed_bones", view.plotter.add_mesh(
+                poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True, name="posed_bones",
+                render=False, reset_camera=False))
         self.draw_axes()
 
     def draw_axes(self) -> None:
         """The axes the Pose sliders turn the working bone about, at its posed proximal joint: x red,
         y green, z blue (the rest axes carried by the parent's pose, as ``pose_frames`` composes them)."""
         view = self.view
-        view.plotter.remove_actor("rot_axes", render=False)
+        view.xray.remove("rot_axes")
         doc = view.doc
         b = doc.working_bone
         if b is not None and b < len(doc.bones):
@@ -85,8 +87,8 @@ class PoseLayer:
                                  scale="auto", tip_length=0.2, shaft_radius=0.03, tip_radius=0.08)
                 arrow.cell_data["rgb"] = np.tile(np.array(colour, np.uint8), (arrow.n_cells, 1))
                 arrows.append(arrow)
-            view.plotter.add_mesh(pv.merge(arrows), scalars="rgb", rgb=True, name="rot_axes", render=False,
-                                  reset_camera=False, pickable=False)
+            view.xray.put("rot_axes", view.plotter.add_mesh(pv.merge(arrows), scalars="rgb", rgb=True, name="rot_axes",
+                                                            render=False, reset_camera=False, pickable=False))
         view.apply_stage()
         view.render()
 

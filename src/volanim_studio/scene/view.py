@@ -27,6 +27,7 @@ from .names_layer import NamesLayer
 from .overlays import CubeOverlay, LassoOverlay
 from .pose_layer import PoseLayer, bone_lines
 from .projection import CLICK_SLOP, nearest_in_radius, project, segment_distance_2d
+from .xray_layer import XRayLayer
 
 LOD_POINTS = 30_000  # drawn while the thinness slider is held: with the hull, a frame in ~50 ms of software GL
 PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
@@ -80,6 +81,7 @@ class SceneView:
         st.colour_by.connect(self._on_colour_by_changed)
         st.point_size.connect(lambda **_: self._update_cloud())
         st.spheres.connect(lambda **_: self._update_cloud())
+        self.xray = XRayLayer(plotter)  # posed bones and their axes, drawn over the preview
         self.names = NamesLayer(self)  # first: the other layers switch stages, which the labels follow
         self.hull = HullLayer(self)
         self.cube = CubeOverlay(self)
@@ -192,13 +194,17 @@ class SceneView:
         No skeleton points are projected: cheap enough for every mouse move (hover)."""
         radius = PICK_RADIUS * self.pixel_ratio()
         joint = bone = None
-        names = list(self.doc.bones.joints)
+        bones = self.doc.bones
+        names = list(bones.joints)
         if names:
-            jw = self.world(np.array([self.doc.bones.joints[k] for k in names]))
+            # in Pose mode where the pose drew them: the posed forearm is clicked where it is seen
+            joints = self.doc.pose.posed_joints() if self.posing else bones.joints
+            jw = self.world(np.array([joints[k] for k in names]))
             jxy, jdepth = self.project_world(jw)
             k = nearest_in_radius(jxy, jdepth, (x, y), radius)
             joint = names[k] if k is not None else None
-            segs = self.doc.bones.segments()
+            segs = np.array([[joints[b.proximal], joints[b.distal]] for b in bones.bones]) if self.posing \
+                else bones.segments()
             if len(segs):
                 a, _ = self.project_world(self.world(segs[:, 0]))
                 b, _ = self.project_world(self.world(segs[:, 1]))
@@ -418,6 +424,7 @@ class SceneView:
         for name in self.POSE_ACTORS:
             if name in actors:
                 actors[name].SetVisibility(self.posing)
+        self.xray.show(self.posing)
         self.names.show(not self.posing)
 
     def render(self) -> None:

@@ -96,7 +96,7 @@ def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
     assert "BROKEN" in w.reconstruct_panel.report.text()
     first = w.reconstruct_panel.joints.item(0)
-    assert "detached piece" in first.text() and "L_SHOULDER" in first.text()
+    assert "torn-off piece" in first.text() and "L_SHOULDER" in first.text()
     w.reconstruct_panel.joints.itemClicked.emit(first)  # the view jumps to the shoulder
     focal = np.array(w.plotter.renderer.GetActiveCamera().GetFocalPoint())
     assert np.allclose(focal, w.doc.pose.posed_joints()["L_SHOULDER"])
@@ -187,13 +187,13 @@ def test_the_axes_the_sliders_turn_about_are_drawn_on_the_selected_bone(qtbot, p
     doc.select_bones([fa])  # its axes are the rest axes turned with the upper arm
 
     def red_tip():
-        mesh = w.plotter.renderer.actors["rot_axes"].mapper.dataset
+        mesh = w.scene.xray.actors["rot_axes"].mapper.dataset
         red = mesh.extract_cells(np.flatnonzero((mesh.cell_data["rgb"] == [230, 60, 60]).all(1)))
         start = w.scene.world(doc.pose.posed_joints()["L_ELBOW"][None])[0]
         far = red.points[np.argmax(np.linalg.norm(red.points - start, axis=1))]
         return (far - start) / np.linalg.norm(far - start)
 
-    assert w.plotter.renderer.actors["rot_axes"].GetVisibility()
+    assert w.scene.xray.renderer.GetDraw() and "rot_axes" in w.scene.xray.actors  # over the preview
     x_now = doc.pose.matrices()[ua][0, :3]  # where the rest x axis points after the upper arm's turn
     assert np.allclose(red_tip(), x_now / np.linalg.norm(x_now), atol=0.02)
     assert not np.allclose(x_now, [1, 0, 0], atol=0.1)  # (so the test tells the frames apart)
@@ -201,4 +201,4 @@ def test_the_axes_the_sliders_turn_about_are_drawn_on_the_selected_bone(qtbot, p
         slider.setValue(end)  # the ends of the sliders are exactly +-180 degrees
     assert doc.pose.angles_of(fa)[0] == 180 and doc.pose.angles_of(fa)[2] == -180
     qtbot.keyClick(w, Qt.Key_V)  # leaving Pose hides them with the pose stage
-    assert not w.plotter.renderer.actors["rot_axes"].GetVisibility()
+    assert not w.scene.xray.renderer.GetDraw()

@@ -165,7 +165,7 @@ def test_render_a_movie_of_the_keys_with_the_views_camera_and_save_the_view(qtbo
 
     w.timeline.save_camera(tmp_path / "view.camera")
     saved = io.read_camera(tmp_path / "view.camera")
-    view = Camera.of(w.scene.plotter.camera)
+    view = Camera.of(w.scene.plotter.renderer.GetActiveCamera())
     assert np.allclose(saved.position, view.position) and np.allclose(saved.focal_point, view.focal_point)
 
     worker = w.timeline.render_movie(tmp_path / "wave.gif", first=0, last=3, step=1, size=(160, 120), workers=1)
