@@ -40,7 +40,7 @@ def test_studio_help():
 
 # Where VTK/pyvista may be imported in the core: file formats, rendering, and the sample that
 # locates the frog file inside pyvista's wheel (it is then read like any other .vti).
-VTK_ALLOWED = ("volanim_core/io/", "volanim_core/render/", "volanim_core/samples.py")
+VTK_ALLOWED = ("volanim_core/io/", "volanim_core/render/", "volanim_core/samples.py", "volanim_core/isosurface.py")
 
 
 def _imports(path) -> set[str]:
@@ -106,3 +106,62 @@ def test_no_module_over_450_lines():
     roots = [Path(volanim_core.__file__).parent, Path(volanim_studio.__file__).parent]
     long = {p.name: n for r in roots for p in r.rglob("*.py") if (n := len(p.read_text().splitlines())) > 450}
     assert not long, long
+
+
+# The core's layers, lowest first (napari checks its own with import-linter contracts): a package
+# imports only packages of its layer or below. io, colour and skeleton read and write the camera,
+# transfer functions and surfaces as plain data (volanim_core.camera, .transfer_function,
+# .isosurface), never through the renderer; nothing below the command line imports it.
+LAYERS = [
+    {"errors", "limits", "progress", "geometry", "modes", "camera", "transfer_function", "isosurface", "parallel"},
+    # files hold skeletons and bones (io reads them into their types), volume tools convert with io's:
+    # one layer, which never imports the renderer
+    {"volume", "io", "skeleton", "colour", "rig"},
+    {"reconstruct", "motion"},
+    {"sequence", "render", "samples", "warmup"},
+    {"pipeline_demo"},
+    {"cli", "__main__"},
+]
+
+
+def _core_imports(path, package: str) -> set[str]:
+    """The top-level ``volanim_core`` modules/packages a file imports (absolute or relative)."""
+    import ast
+
+    out = set()
+    parts = package.split(".")
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            out |= {a.name.split(".")[1] for a in node.names if a.name.startswith("volanim_core.")}
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = parts[: len(parts) - node.level + 1]
+                name = ".".join(base + ([node.module] if node.module else []))
+            else:
+                name = node.module or ""
+            if name.startswith("volanim_core."):
+                out.add(name.split(".")[1])
+            elif name == "volanim_core":
+                out |= {a.name for a in node.names}
+    return out
+
+
+def test_the_core_s_layers_import_only_downwards():
+    from pathlib import Path
+
+    root = Path(volanim_core.__file__).parent
+    rank = {name: k for k, layer in enumerate(LAYERS) for name in layer}
+    top = {p.stem if p.is_file() else p.name for p in root.iterdir()
+           if (p.suffix == ".py" and p.stem != "__init__") or (p.is_dir() and (p / "__init__.py").exists())}
+    assert top <= set(rank), f"put these in a layer: {sorted(top - set(rank))}"
+    bad = []
+    for path in root.rglob("*.py"):
+        rel = path.relative_to(root)
+        if rel.parts[0] == "__init__.py":
+            continue
+        own = rel.parts[0].removesuffix(".py")
+        package = ".".join(["volanim_core", *rel.parts[:-1]]) if len(rel.parts) > 1 else "volanim_core"
+        for used in _core_imports(path, package):
+            if used in rank and rank[used] > rank[own]:
+                bad.append(f"{rel} imports {used}")
+    assert not bad, bad

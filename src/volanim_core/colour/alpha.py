@@ -3,7 +3,7 @@ AlphaFactor and MergeMaps).
 
 An alpha map is ``(indices, alphas)``: opacity 0..1 at control indices, linear
 between and held beyond the ends (``io.palette_files``). Merged with a palette it
-becomes a :class:`~volanim_core.render.transfer_function.TransferFunction` with
+becomes a :class:`~volanim_core.transfer_function.TransferFunction` with
 one point per palette index, which ``volanim render --tf`` draws.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.render.transfer_function import TransferFunction
+from volanim_core.transfer_function import TransferFunction
 
 
 def _check(indices, alphas) -> tuple[np.ndarray, np.ndarray]:

@@ -21,8 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.render.camera import Camera
-from volanim_core.render.transfer_function import TransferFunction
+from volanim_core.camera import Camera
+from volanim_core.transfer_function import TransferFunction
 
 from ._atomic import atomic_write_text
 from ._text import fmt_float, parse_float, read_records

@@ -30,6 +30,7 @@ import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.limits import MAX_COORD, check_allocation
+from volanim_core.modes import MODES
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
 from volanim_core.reconstruct._clipped import count_outside
@@ -43,7 +44,6 @@ from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.sampling import sample_source
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.pose import apply_matrices
-from volanim_core.modes import MODES
 from volanim_core.volume import Bounds
 
 _MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT}

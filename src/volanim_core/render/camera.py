@@ -1,7 +1,8 @@
 """A camera that stays put for a whole sequence: named views, or one saved from the studio.
 
-    named_view(name, bounds) --> Camera looking at the middle of ``bounds`` (the shared grid)
-    Camera <--> a ``.camera`` text file (io.render_files)
+    named_view(name, bounds) --> Camera looking at the middle of ``bounds`` (every frame's body)
+    follow_cameras(name, boxes) --> a Camera per frame, centred on its body (``--camera follow``)
+    (Camera, the data type, is volanim_core.camera's: io reads camera files without the renderer)
 
 Our figures stand z up and face -y (docs/formats.md's voxel axes), so *front*
 looks from -y, *side* from +x (the figure's left), *top* from +z with the
@@ -11,9 +12,11 @@ left, a little above.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from volanim_core.camera import Camera
+
+__all__ = ["VIEWS", "Camera", "follow_cameras", "named_view", "natural_axes"]
 
 VIEWS = ("front", "side", "top", "three-quarter", "back")
 _DIRECTIONS = {  # from the focal point to the camera, and the picture's up
@@ -23,60 +26,6 @@ _DIRECTIONS = {  # from the focal point to the camera, and the picture's up
     "top": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
     "three-quarter": ((0.6, -0.75, 0.3), (0.0, 0.0, 1.0)),
 }
-
-
-@dataclass(frozen=True)
-class Camera:
-    position: tuple[float, float, float]
-    focal_point: tuple[float, float, float]
-    view_up: tuple[float, float, float] = (0.0, 0.0, 1.0)
-    view_angle: float = 30.0  # degrees, perspective
-    parallel_scale: float | None = None  # set: a parallel projection, half the picture's height in voxels
-
-    def check(self, where: str = "camera") -> None:
-        """Refuse a camera that cannot make a picture (ValueError naming the fault)."""
-        pos, focal, up = (np.asarray(v, np.float64) for v in (self.position, self.focal_point, self.view_up))
-        if not all(np.all(np.isfinite(v)) for v in (pos, focal, up)):
-            raise ValueError(f"{where}: every number must be finite")
-        look = focal - pos
-        if np.linalg.norm(look) == 0:
-            raise ValueError(f"{where}: the position and the focal point are the same point")
-        if np.linalg.norm(np.cross(look, up)) <= 1e-9 * np.linalg.norm(look) * np.linalg.norm(up):
-            raise ValueError(f"{where}: view_up must not be zero or point along the line of sight")
-        if not 0 < self.view_angle < 180:
-            raise ValueError(f"{where}: view_angle must be between 0 and 180 degrees, got {self.view_angle:g}")
-        if self.parallel_scale is not None and not self.parallel_scale > 0:
-            raise ValueError(f"{where}: parallel_scale must be above 0, got {self.parallel_scale:g}")
-
-    def apply(self, vtk_camera) -> None:
-        """Set a ``vtkCamera`` (e.g. ``plotter.camera``) to this camera."""
-        vtk_camera.SetPosition(*self.position)
-        vtk_camera.SetFocalPoint(*self.focal_point)
-        vtk_camera.SetViewUp(*self.view_up)
-        vtk_camera.SetViewAngle(self.view_angle)
-        vtk_camera.SetParallelProjection(self.parallel_scale is not None)
-        if self.parallel_scale is not None:
-            vtk_camera.SetParallelScale(self.parallel_scale)
-        vtk_camera.OrthogonalizeViewUp()
-
-    def scaled(self, factor) -> Camera:
-        """This camera with world coordinates multiplied by ``factor`` per axis (e.g. ``1 / spacing``:
-        a view of a volume with anisotropic voxels, in voxel coordinates as camera files are)."""
-        f = np.asarray(factor, np.float64) * np.ones(3)
-        up = np.asarray(self.view_up, np.float64)
-        up = up / np.linalg.norm(up)
-        stretched = up * f  # the picture's height is measured along view_up: it stretches as up does
-        scale = None if self.parallel_scale is None else self.parallel_scale * float(np.linalg.norm(stretched))
-        return Camera(tuple(np.asarray(self.position) * f), tuple(np.asarray(self.focal_point) * f),
-                      tuple(stretched / np.linalg.norm(stretched)), self.view_angle, scale)
-
-    @classmethod
-    def of(cls, vtk_camera) -> Camera:
-        """The camera a ``vtkCamera`` has now (the studio's view: ``renderer.GetActiveCamera()``; not pyvista's
-        ``plotter.camera``, whose first read resets a camera pyvista did not place to its own default view)."""
-        parallel = bool(vtk_camera.GetParallelProjection())
-        return cls(tuple(vtk_camera.GetPosition()), tuple(vtk_camera.GetFocalPoint()), tuple(vtk_camera.GetViewUp()),
-                   float(vtk_camera.GetViewAngle()), float(vtk_camera.GetParallelScale()) if parallel else None)
 
 
 def natural_axes(lo, hi, clearly: float = 1.15) -> np.ndarray:
@@ -140,7 +89,7 @@ def follow_cameras(name: str, boxes, aspect: float = 4 / 3, view_angle: float = 
 
     ``boxes``: per frame the body's world box ``(lo, hi)`` to the voxels' faces, or None (an empty frame:
     it keeps its neighbours' camera). The centres are smoothed by a moving average over ``smooth``
-    frames (no jitter from a swinging arm); every camera stands at the one distance at which the
+    frames (no jitter from a swinging arm; fewer in a clip under 16 x ``smooth`` frames); every camera stands at the one distance at which the
     largest box, around its smoothed centre, fits the picture -- so no frame leaves it.
     """
     known = [k for k, b in enumerate(boxes) if b is not None]
@@ -150,7 +99,7 @@ def follow_cameras(name: str, boxes, aspect: float = 4 / 3, view_angle: float = 
                         if b is not None])
     index = np.arange(len(boxes))
     track = np.stack([np.interp(index, known, centres[:, a]) for a in range(3)], axis=1)  # gaps: held / blended
-    half_window = max(int(smooth), 1) // 2
+    half_window = min(max(int(smooth), 1) // 2, len(boxes) // 16)  # a short clip is not smoothed flat
     padded = np.concatenate([track[:1].repeat(half_window, 0), track, track[-1:].repeat(half_window, 0)])
     kernel = np.ones(2 * half_window + 1) / (2 * half_window + 1)
     smoothed = np.stack([np.convolve(padded[:, a], kernel, mode="valid") for a in range(3)], axis=1)

@@ -35,8 +35,9 @@ from volanim_core.render.transfer import (
     label_colours,
     rgba_points,
     volume_mapper,
+    vtk_functions,
 )
-from volanim_core.render.transfer_function import TransferFunction
+from volanim_core.transfer_function import TransferFunction
 
 STYLES = ("surface", "volume")
 MAPPERS = ("auto", "cpu", "gpu")
@@ -278,7 +279,7 @@ class Renderer:
                        else label_colours(s.preset, LABELS))
             apply_labels(actor, colours, opacity=1.0)
         else:
-            ctf, otf = (s.transfer or preset_transfer(s.preset, s.vmax)).to_vtk()
+            ctf, otf = vtk_functions(s.transfer or preset_transfer(s.preset, s.vmax))
             prop.SetColor(ctf)
             prop.SetScalarOpacity(otf)
             prop.SetInterpolationTypeToLinear()
@@ -294,7 +295,7 @@ class Renderer:
         import vtk
 
         s = self.settings
-        ctf, _ = (s.transfer or preset_transfer("hotspot", s.vmax)).to_vtk()
+        ctf, _ = vtk_functions(s.transfer or preset_transfer("hotspot", s.vmax))
         bar = vtk.vtkScalarBarActor()
         bar.SetLookupTable(ctf)
         bar.SetTitle("spheres per voxel")

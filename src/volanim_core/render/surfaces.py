@@ -55,15 +55,3 @@ def filled_voxel_values(volume: np.ndarray, at: np.ndarray) -> np.ndarray:
     if volume.ndim == 4:
         return np.where(hi.any(axis=1, keepdims=True), hi, lo).astype(np.uint8)
     return np.maximum(lo, hi)
-
-
-def flying_edges(box: np.ndarray, origin=(0, 0, 0), level: float = 0.5, spacing: float = 1.0
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """VTK flying edges on ``box`` (indexed ``[x, y, z]``): ``(V, 3)`` float32 vertices, ``(F, 3)`` int64 faces."""
-    import pyvista as pv
-
-    img = pv.ImageData(dimensions=box.shape, origin=tuple(float(v) for v in origin), spacing=(spacing,) * 3)
-    img.point_data["m"] = np.asarray(box).ravel(order="F")
-    surf = img.contour([level], scalars="m", method="flying_edges")
-    faces = surf.faces.reshape(-1, 4)[:, 1:] if surf.n_cells else np.zeros((0, 3), np.int64)
-    return np.asarray(surf.points, np.float32), faces.astype(np.int64)

@@ -30,6 +30,18 @@ def volume_style(mode: str, volume: np.ndarray, n_bones: int) -> dict:
     return {"cmap": "gray", "clim": (0, max(vmax, 1.0)), "opacity": "sigmoid_5", "show_scalar_bar": False}
 
 
+def vtk_functions(tf) -> tuple:
+    """A :class:`~volanim_core.transfer_function.TransferFunction` as VTK's
+    ``(vtkColorTransferFunction, vtkPiecewiseFunction)``, with exactly its points."""
+    import vtk
+
+    ctf, otf = vtk.vtkColorTransferFunction(), vtk.vtkPiecewiseFunction()
+    for v, (r, g, b, a) in zip(tf.values, tf.rgba):
+        ctf.AddRGBPoint(float(v), float(r), float(g), float(b))
+        otf.AddPoint(float(v), float(a))
+    return ctf, otf
+
+
 def label_colours(mode: str, n_bones: int) -> np.ndarray:
     """RGB (0..1) per label value 1..N: bone colours, a per-sphere mottle, or one colour."""
     if mode == "bone":

@@ -123,7 +123,8 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
                         p.mode)
     s = r.stats
     return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
-            "filled": int(s["filled"]), "box": None if box is None else _in_grid(box, grid.lo), "clipped": int(s.get("clipped", 0)),
+            "filled": int(s["filled"]), "box": None if box is None else _in_grid(box, grid.lo),
+            "clipped": int(s.get("clipped", 0)),
             "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
             "dt_scale": round(float(np.mean(spec.dt_scale)), 6), "crumble": spec.crumble,
             "seconds": round(time.perf_counter() - t0, 4), "finished": round(time.time(), 4),

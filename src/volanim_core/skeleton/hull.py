@@ -65,7 +65,7 @@ def isosurface(mask, *, step: int = 1, engine: str = "vtk") -> tuple[np.ndarray,
 
         verts, faces, _, _ = marching_cubes(box, 0.5, step_size=step, allow_degenerate=False)
         return (verts + lo).astype(np.float32), faces.astype(np.int64)
-    from volanim_core.render.surfaces import flying_edges
+    from volanim_core.isosurface import flying_edges
 
     return flying_edges(box, origin=lo)
 
@@ -103,7 +103,7 @@ def display_hulls(mask) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray
 
 
 def _block_isosurface(mask, f: int) -> tuple[np.ndarray, np.ndarray]:
-    from volanim_core.render.surfaces import flying_edges
+    from volanim_core.isosurface import flying_edges
 
     box, lo = _padded_box(mask)
     # pad to whole blocks, with a block of background all round so the coarse surface is closed

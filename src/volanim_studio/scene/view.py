@@ -135,8 +135,7 @@ class SceneView:
         camera.set_camera_state(self.plotter.renderer, data)
         self.render()
 
-    def front_view(self) -> None:
-        """The front of the object (stood up by its shape), everything in view."""
+    def front_view(self) -> None:  # the front of the object (stood up by its shape), everything in view
         self.view_preset("front")
 
     def view_preset(self, name: str) -> None:
@@ -148,12 +147,16 @@ class SceneView:
         if camera.frame(self.plotter.renderer):
             self.render()
 
+    def shown_joints(self) -> dict:
+        """Joint positions as drawn: where the pose put them in Pose mode, at rest otherwise."""
+        return self.doc.pose.posed_joints() if self.posing else self.doc.bones.joints
+
     def frame_selected(self) -> bool:
         """Fill the view with the selected bones, else the picked point, else the cube/lasso selection."""
         doc = self.doc
         pts = []
         if doc.selected_bones and len(doc.bones):
-            joints = doc.pose.posed_joints() if self.posing else doc.bones.joints
+            joints = self.shown_joints()
             pts = np.array([joints[j] for i in doc.selected_bones if i < len(doc.bones)
                             for j in (doc.bones.bones[i].proximal, doc.bones.bones[i].distal)])
         elif doc.picked_point is not None:
@@ -197,14 +200,11 @@ class SceneView:
         bones = self.doc.bones
         names = list(bones.joints)
         if names:
-            # in Pose mode where the pose drew them: the posed forearm is clicked where it is seen
-            joints = self.doc.pose.posed_joints() if self.posing else bones.joints
-            jw = self.world(np.array([joints[k] for k in names]))
-            jxy, jdepth = self.project_world(jw)
+            joints = self.shown_joints()  # Pose mode: the posed forearm is clicked where it is drawn
+            jxy, jdepth = self.project_world(self.world(np.array([joints[k] for k in names])))
             k = nearest_in_radius(jxy, jdepth, (x, y), radius)
             joint = names[k] if k is not None else None
-            segs = np.array([[joints[b.proximal], joints[b.distal]] for b in bones.bones]) if self.posing \
-                else bones.segments()
+            segs = np.array([[joints[b.proximal], joints[b.distal]] for b in bones.bones])
             if len(segs):
                 a, _ = self.project_world(self.world(segs[:, 0]))
                 b, _ = self.project_world(self.world(segs[:, 1]))
@@ -428,11 +428,8 @@ class SceneView:
         self.names.show(not self.posing)
 
     def render(self) -> None:
-        """Request a frame; many model changes in one event-loop pass draw once.
-
-        Software GL (no GPU) takes 100-500 ms for a large cloud, so drawing on
-        every slider step would stall the drag.
-        """
+        """Request a frame; many model changes in one event-loop pass draw once (software GL takes
+        100-500 ms for a large cloud: drawing on every slider step would stall the drag)."""
         if self._render_pending:
             return
         self._render_pending = True

@@ -17,8 +17,8 @@ from volanim_core.geometry import Geometry
 from volanim_core.render.camera import Camera, named_view
 from volanim_core.render.run import frame_path, open_inputs, render
 from volanim_core.render.scene import Renderer, RenderSettings
-from volanim_core.render.transfer_function import TransferFunction
 from volanim_core.sequence import store
+from volanim_core.transfer_function import TransferFunction
 
 W, H = 320, 240
 

@@ -37,10 +37,6 @@ def studio_picture(w, below: float = 0.75):
     h, w_ = fg.shape
     corner = [(int(h * 0.75), h, 0, int(w_ * 0.25)), (int(h * below), h, 0, w_)]  # the axes; a colour bar
     fg, sil = mask_region(fg, corner), mask_region(sil, corner)
-    import os
-    if os.environ.get("ORACLE_DUMP"):
-        import imageio.v3 as iio
-        iio.imwrite(os.environ["ORACLE_DUMP"], np.concatenate([image, np.repeat(sil[..., None] * 255, 3, 2).astype(np.uint8)], 1))
     return compare(fg, sil), outside
 
 

@@ -36,13 +36,3 @@ class TransferFunction:
         """RGBA of ``x`` (linear between points, held beyond the ends), shape ``x.shape + (4,)``."""
         x = np.asarray(x, np.float64)
         return np.stack([np.interp(x, self.values, self.rgba[:, k]) for k in range(4)], axis=-1)
-
-    def to_vtk(self):
-        """``(vtkColorTransferFunction, vtkPiecewiseFunction)`` with exactly these points."""
-        import vtk
-
-        ctf, otf = vtk.vtkColorTransferFunction(), vtk.vtkPiecewiseFunction()
-        for v, (r, g, b, a) in zip(self.values, self.rgba):
-            ctf.AddRGBPoint(float(v), float(r), float(g), float(b))
-            otf.AddPoint(float(v), float(a))
-        return ctf, otf
