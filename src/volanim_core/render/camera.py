@@ -89,8 +89,9 @@ def follow_cameras(name: str, boxes, aspect: float = 4 / 3, view_angle: float = 
 
     ``boxes``: per frame the body's world box ``(lo, hi)`` to the voxels' faces, or None (an empty frame:
     it keeps its neighbours' camera). The centres are smoothed by a moving average over ``smooth``
-    frames (no jitter from a swinging arm; fewer in a clip under 16 x ``smooth`` frames); every camera stands at the one distance at which the
-    largest box, around its smoothed centre, fits the picture -- so no frame leaves it.
+    frames (no jitter from a swinging arm; fewer in a clip under 16 x ``smooth`` frames); every
+    camera stands at the one distance at which the largest box, around its smoothed centre, fits
+    the picture -- so no frame leaves it.
     """
     known = [k for k, b in enumerate(boxes) if b is not None]
     if not known:
