@@ -26,8 +26,8 @@ VTK stores x fastest, exactly like ``.vol``, so its flat scalars reshape with
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 
@@ -52,14 +52,20 @@ READ_SUFFIXES = (".vol", ".VOL", *VTK_SUFFIXES, *NRRD_SUFFIXES, *META_SUFFIXES, 
 WRITE_SUFFIXES = (".vol", ".VOL", ".vti", ".nrrd", ".nii", ".nii.gz", ".mha")
 
 
-class Scan(NamedTuple):
+@dataclass(frozen=True)
+class Scan:
     """A volume as read: its voxels ``data[x, y, z]`` (``[x, y, z, 3]`` colour), where they are
-    (``geometry``) and, for a segmentation, the names of its labels (``segments``: value -> name)."""
+    (``geometry``) and, for a segmentation, the names of its labels (``segments``: value -> name).
+    It unpacks as ``data, geometry, segments``; ``mode`` is the reconstruction mode a volanim result
+    was made in (its colours), when the file records it."""
 
     data: np.ndarray
     geometry: Geometry
     segments: dict
-    mode: str | None = None  # the reconstruction mode a volanim result was made in (its colours), if recorded
+    mode: str | None = None
+
+    def __iter__(self):
+        return iter((self.data, self.geometry, self.segments))
 
 
 def _suffix(path: Path) -> str:
