@@ -94,15 +94,20 @@ def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> d
 
 def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spacing=(1.0, 1.0, 1.0),
                  style: str = "surface", size=(640, 480), fps: float = 24.0, frame_numbers: bool = False,
-                 background: str = "#1e1f24", workers: int | None = None, progress=None, cancel=None) -> dict:
+                 background: str = "#1e1f24", workers: int | None = None, follow: bool = False, progress=None,
+                 cancel=None) -> dict:
     """The timeline's frames reconstructed (a sequence in one grid) and rendered to ``out`` with the
     studio's camera: the command line's ``volanim sequence`` + ``volanim render``, in worker processes.
+
+    ``follow``: each frame's camera is ``camera`` moved with the body (``RenderInputs.follow``: its
+    direction and distance kept, centred on the frame's smoothed filled box), as the timeline follows it.
 
     The sequence is kept beside the movie (``.NAME.zarr``) until the movie is written, and the render's
     pictures likewise, so a cancelled run picks up where it stopped when started again with the same pose.
     """
     import shutil
     import time
+    from dataclasses import replace
     from pathlib import Path
 
     from volanim_core.parallel import default_workers
@@ -126,7 +131,9 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
     workers = workers or default_workers()
     run_sequence(conn, frames, cache, mode=mode, source=source if mode == "sampled" else None, fps=fps,
                  workers=workers, replace_other=True, on_frame=lambda rec, done, n: report(done, total))
-    inputs = open_inputs([cache])
+    inputs = replace(open_inputs([cache]), spacing=tuple(float(s) for s in spacing))  # the studio's world
+    if follow:
+        inputs = replace(inputs, frames=inputs.follow("front", size[0] / size[1], base=camera))
     settings = RenderSettings(camera, style=style, preset=mode, vmax=inputs.vmax, size=tuple(size),
                               background=background, frame_numbers=frame_numbers,
                               spacing=tuple(float(s) for s in spacing))

@@ -84,14 +84,15 @@ def named_view(name: str, lo, hi, aspect: float = 4 / 3, view_angle: float = 30.
 
 
 def follow_cameras(name: str, boxes, aspect: float = 4 / 3, view_angle: float = 30.0, axes=None,
-                   smooth: int = 9) -> list[Camera]:
+                   smooth: int = 9, base: Camera | None = None) -> list[Camera]:
     """One camera per frame from direction ``name`` that keeps the body in the middle (``--camera follow``).
 
     ``boxes``: per frame the body's world box ``(lo, hi)`` to the voxels' faces, or None (an empty frame:
     it keeps its neighbours' camera). The centres are smoothed by a moving average over ``smooth``
     frames (no jitter from a swinging arm; fewer in a clip under 16 x ``smooth`` frames); every
     camera stands at the one distance at which the largest box, around its smoothed centre, fits
-    the picture -- so no frame leaves it.
+    the picture -- so no frame leaves it. With ``base`` (the studio's view), each camera is ``base`` moved
+    to the smoothed centre instead: the user's direction, distance and zoom.
     """
     known = [k for k, b in enumerate(boxes) if b is not None]
     if not known:
@@ -104,6 +105,10 @@ def follow_cameras(name: str, boxes, aspect: float = 4 / 3, view_angle: float = 
     padded = np.concatenate([track[:1].repeat(half_window, 0), track, track[-1:].repeat(half_window, 0)])
     kernel = np.ones(2 * half_window + 1) / (2 * half_window + 1)
     smoothed = np.stack([np.convolve(padded[:, a], kernel, mode="valid") for a in range(3)], axis=1)
+    if base is not None:
+        focal = np.asarray(base.focal_point, np.float64)
+        return [Camera(tuple(np.asarray(base.position) + c - focal), tuple(c), base.view_up, base.view_angle,
+                       base.parallel_scale) for c in smoothed]
     reach = np.zeros(3)
     for k in known:  # the box around each frame's smoothed centre that holds its body
         lo, hi = (np.asarray(v, np.float64) for v in boxes[k])

@@ -58,14 +58,15 @@ class RenderInputs:
         sp = np.asarray(self.spacing, np.float64)
         return (np.asarray(self.lo) - 0.5) * sp, (np.asarray(self.hi) + 0.5) * sp
 
-    def follow(self, view: str, aspect: float, axes=None) -> list[FrameRef]:
-        """The frames, each with a camera that keeps its body in the middle (:func:`follow_cameras`)."""
+    def follow(self, view: str, aspect: float, axes=None, base: Camera | None = None) -> list[FrameRef]:
+        """The frames, each with a camera that keeps its body in the middle (:func:`follow_cameras`; ``base``:
+        a camera whose direction and distance every frame keeps, e.g. the studio's view)."""
         from .camera import follow_cameras
 
         sp = np.asarray(self.spacing, np.float64)
         boxes = self.boxes or [(self.lo, self.hi)] * len(self.frames)
         world = [None if b is None else ((np.asarray(b[0]) - 0.5) * sp, (np.asarray(b[1]) + 0.5) * sp) for b in boxes]
-        cams = follow_cameras(view, world, aspect=aspect, axes=axes)
+        cams = follow_cameras(view, world, aspect=aspect, axes=axes, base=base)
         return [replace(f, camera=c) for f, c in zip(self.frames, cams)]
 
 

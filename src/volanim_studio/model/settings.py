@@ -92,6 +92,7 @@ SETTINGS: dict[str, Setting] = {
     "auto_overwrite": Setting(False, flag, "auto-connect may replace existing attachments"),
     # timeline
     "current_frame": Setting(0, number(0, 10**7, int), "the frame shown (motion and sequences)"),
+    "follow_body": Setting(True, flag, "the camera follows the body as the timeline plays or steps, and in movies"),
 }
 
 

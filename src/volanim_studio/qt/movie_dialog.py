@@ -22,7 +22,7 @@ SIZES = ("640x480", "1280x720", "1920x1080", "320x240")
 class MovieDialog(QDialog):
     """Ask for the movie's file, frame range, style, size and overlay; :meth:`options` reads them."""
 
-    def __init__(self, parent, frame_count: int, default_path: str):
+    def __init__(self, parent, frame_count: int, default_path: str, follow: bool = True):
         super().__init__(parent)
         self.setWindowTitle("Render movie")
         form = QFormLayout(self)
@@ -52,6 +52,9 @@ class MovieDialog(QDialog):
         form.addRow("Size", self.size_box)
         self.frame_numbers = QCheckBox("Frame numbers in the corner")
         form.addRow(self.frame_numbers)
+        self.follow = QCheckBox("The camera follows the body (this view's direction and distance)")
+        self.follow.setChecked(follow)
+        form.addRow(self.follow)
         buttons = QDialogButtonBox(QDialogButtonBox.Ok | QDialogButtonBox.Cancel)
         buttons.accepted.connect(self.accept)
         buttons.rejected.connect(self.reject)
@@ -66,4 +69,4 @@ class MovieDialog(QDialog):
         w, h = (int(v) for v in self.size_box.currentText().split("x"))
         return {"out": self.path.text().strip(), "first": self.first.value(), "last": self.last.value(),
                 "step": self.step.value(), "style": self.style_box.currentText(), "size": (w, h),
-                "frame_numbers": self.frame_numbers.isChecked()}
+                "frame_numbers": self.frame_numbers.isChecked(), "follow": self.follow.isChecked()}

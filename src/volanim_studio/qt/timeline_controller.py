@@ -14,6 +14,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QDialog, QFileDialog
 
@@ -85,7 +86,18 @@ class TimelineController(Controller):
     # ------------------------------------------------------------ frames
     def _frame_changed(self) -> None:
         if self.doc.timeline.active:
+            if self.doc.settings.follow_body and self.scene.posing:  # the posed body is what the view shows
+                self.follow_body(blend=0.35 if self.playing else 1.0)
             self.previews.live_preview_soon()
+
+    def follow_body(self, blend: float = 1.0) -> None:
+        """Centre the view on the posed body (the middle of its posed joints' box): a walk's figure, which
+        travels metres through the clip, stays in the picture instead of walking out of it."""
+        joints = self.doc.pose.posed_joints()
+        if not joints:
+            return
+        p = np.array(list(joints.values()), np.float64)
+        self.scene.follow(self.scene.world(((p.min(0) + p.max(0)) / 2)[None])[0], blend)
 
     def step(self, delta: int) -> None:
         self.doc.timeline.step(delta)
@@ -260,9 +272,11 @@ class TimelineController(Controller):
             self.save_camera(path)
 
     def render_movie(self, out, *, first: int = 0, last: int | None = None, step: int = 1, style: str = "surface",
-                     size=(640, 480), frame_numbers: bool = False, workers: int | None = None):
+                     size=(640, 480), frame_numbers: bool = False, workers: int | None = None,
+                     follow: bool | None = None):
         """Reconstruct frames ``first..last`` (every ``step``) in the preview's mode and render them with
-        the view's camera, in the background with progress and cancel."""
+        the view's camera -- moved with the body when ``follow`` (default: the Follow the body setting) --
+        in the background with progress and cancel."""
         from volanim_studio.tasks import render_movie
 
         tl, st = self.doc.timeline, self.doc.settings
@@ -287,13 +301,15 @@ class TimelineController(Controller):
             return None
         mats, numbers = tl.matrices(frames), [tl.frame_number(f) for f in frames]
         camera, spacing, mode, source = self.camera(), tuple(self.scene.spacing), st.preview_mode, self.doc.volume
+        follow = st.follow_body if follow is None else follow
         if source is not None and source.ndim == 4:  # sequences hold one value a voxel: a colour body's luminance
             source = to_grey(source)
             self.doc.message("The movie samples the colour volume's luminance (grey); the preview shows its colours.")
         fps = tl.frame_rate / step
         return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
             conn, mats, numbers, out, mode=mode, source=source, camera=camera, spacing=spacing, style=style,
-            size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, progress=progress, cancel=cancel),
+            size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, follow=follow, progress=progress,
+            cancel=cancel),
             lambda r: self.doc.message(f"Rendered {r['frames']} frames to {r['out']} in {r['seconds']:.1f} s "
                                        f"({r['workers']})."))
 
@@ -303,7 +319,8 @@ class TimelineController(Controller):
             self.show_error("Render movie", "nothing to render: load a clip or set keys first")
             return
         stem = tl.clip.name if tl.clip is not None else "keys"
-        dialog = MovieDialog(self.window, tl.frame_count, str(Path.cwd() / f"{stem}.mp4"))
+        dialog = MovieDialog(self.window, tl.frame_count, str(Path.cwd() / f"{stem}.mp4"),
+                             self.doc.settings.follow_body)
         if dialog.exec() != QDialog.Accepted:
             return
         options = dialog.options()

@@ -91,6 +91,9 @@ class TimelinePanel(QWidget):
         self.fps.setToolTip("Frame rate of the keyed animation")
         self.scan = QPushButton("Scan clip for breakage…")
         self.export = QPushButton("Export frames (.trans)…")
+        self.follow = QCheckBox("Follow the body")
+        self.follow.setToolTip("As the clip plays or steps, the camera moves with the body (its direction and "
+                               "distance kept), so a walk never leaves the view; movies do the same")
         self.movie = QPushButton("Render movie…")
         self.movie.setToolTip("Reconstruct the frames in the preview's mode and render them with this view's camera")
 
@@ -105,8 +108,8 @@ class TimelinePanel(QWidget):
         for w in (self.set_key, self.delete_key, self.keys_label):
             bottom.addWidget(w)
         bottom.addStretch(1)
-        for w in (self.ease, QLabel("length"), self.length, QLabel("fps"), self.fps, self.scan, self.export,
-                  self.movie):
+        for w in (self.ease, QLabel("length"), self.length, QLabel("fps"), self.fps, self.follow, self.scan,
+                  self.export, self.movie):
             bottom.addWidget(w)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 2, 4, 2)
@@ -115,6 +118,7 @@ class TimelinePanel(QWidget):
 
         bind(self.slider, doc.settings, "current_frame", on_error=doc.message)
         bind(self.frame, doc.settings, "current_frame", on_error=doc.message)
+        bind(self.follow, doc.settings, "follow_body", on_error=doc.message)
         self.slider.sliderPressed.connect(self.scrub_started.emit)
         self.slider.sliderReleased.connect(self.scrub_finished.emit)
         self.ease.toggled.connect(lambda on: self._option(ease=on))

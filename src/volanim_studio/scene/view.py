@@ -17,6 +17,7 @@ import numpy as np
 import pyvista as pv
 
 from volanim_core.render.colours import label_table, scalar_colours
+from volanim_core.render.scene import reset_clipping
 
 from ..model.document import Document
 from ..model.modes import PickEvent
@@ -169,6 +170,10 @@ class SceneView:
         camera.frame(self.plotter.renderer, world.min(0), world.max(0))
         self.render()
         return True
+
+    def follow(self, world_target, blend: float = 1.0) -> None:
+        camera.follow(self.plotter.renderer, world_target, blend)
+        self.render()
 
     def jump_to(self, voxel_xyz) -> None:
         """Centre the view on a point and move closer."""
@@ -441,6 +446,9 @@ class SceneView:
         self._render_pending = False
         if getattr(self.plotter, "_closed", False):
             return
+        # near and far planes from what is shown now: a preview drawn where the pose or the timeline put
+        # it (a walk 900 voxels from its start) was cut away by planes fitted to the rest pose
+        reset_clipping(self.plotter.renderer)
         if self._drawn_once and self.plotter.isVisible():
             # One frame: the widget's paint renders. plotter.render() would render and then
             # have the paint render the same frame again (2x the software-GL time).

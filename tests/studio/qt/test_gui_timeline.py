@@ -232,4 +232,57 @@ def test_the_movie_dialog_reads_back_what_the_user_chose(qtbot, window):
     dialog.size_box.setCurrentText("1280x720")
     dialog.frame_numbers.setChecked(True)
     assert dialog.options() == {"out": "/tmp/walk.mp4", "first": 10, "last": 99, "step": 5, "style": "volume",
-                                "size": (1280, 720), "frame_numbers": True}
+                                "size": (1280, 720), "frame_numbers": True, "follow": True}
+
+
+def body_in_view(w) -> float:
+    """The share of the posed joints that the view shows (inside its viewport, in front of the camera)."""
+    p = np.array(list(w.doc.pose.posed_joints().values()), np.float64)
+    xy, depth = w.scene.project_world(w.scene.world(p))
+    width, height = w.plotter.renderer.GetSize()
+    inside = (xy[:, 0] >= 0) & (xy[:, 0] < width) & (xy[:, 1] >= 0) & (xy[:, 1] < height) & (np.abs(depth) <= 1)
+    return float(inside.mean())
+
+
+def test_the_view_and_the_movie_follow_the_walking_body(qtbot, rigged, tmp_path):
+    """Before: at frames 601 and 746 of the walk the view was empty (the figure had walked out of it)
+    while the status bar said healthy, and a movie from the studio lost the walker the same way."""
+    import imageio.v3 as iio
+
+    from ..conftest import front_view
+
+    w = rigged
+    assert w.timeline.load_bvh(WALK)
+    front_view(w)
+    qtbot.keyClick(w, Qt.Key_P)  # the pose stage: the posed body is what the view shows
+
+    def show(frame):
+        before = w.doc.preview
+        w.doc.settings.current_frame = frame
+        qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not before, timeout=JOB_TIMEOUT_MS)
+        qtbot.wait(20)  # the view's coalesced render (near and far planes from what it shows)
+
+    assert w.doc.settings.follow_body and w.timeline_panel.follow.isChecked()  # on by default
+    for frame in (601, 746):
+        show(frame)
+        assert body_in_view(w) == 1.0, frame
+    w.timeline_panel.follow.setChecked(False)  # the panel's box is the setting
+    assert not w.doc.settings.follow_body
+    show(0)
+    front_view(w)
+    show(746)
+    assert body_in_view(w) < 0.5  # without following, the walker has left (the test can fail)
+
+    show(0)
+    front_view(w)  # the view on the walker's first step
+    drawn = {}
+    for follow in (True, False):
+        out = tmp_path / f"walk-{follow}.gif"
+        assert w.timeline.render_movie(out, first=0, last=601, step=601, size=(160, 120), workers=1,
+                                       follow=follow) is not None
+        qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+        movie = iio.imread(out, index=None)
+        background = movie[0, 0, 0].astype(int)
+        drawn[follow] = [int((np.abs(m.astype(int) - background).max(axis=2) > 12).sum()) for m in movie]
+    assert min(drawn[True]) > 300, drawn  # every frame shows the walker
+    assert drawn[False][-1] < 50, drawn  # the view's own camera lost it
