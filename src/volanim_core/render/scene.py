@@ -309,11 +309,33 @@ class Renderer:
         self._bar = bar
 
 
+def visible_bounds(renderer) -> list[float] | None:
+    """``[x0, x1, y0, y1, z0, z1]`` of everything drawn in ``renderer``'s window with its camera -- its own
+    props and those of the layers over it (the studio's x-ray layer) -- or None when nothing is."""
+    renderers = [renderer]
+    window = renderer.GetRenderWindow()
+    if window is not None:
+        collection = window.GetRenderers()
+        renderers += [collection.GetItemAsObject(k) for k in range(collection.GetNumberOfItems())]
+    boxes = [b for r in renderers if r.GetDraw() and r.GetActiveCamera() is renderer.GetActiveCamera()
+             for b in [r.ComputeVisiblePropBounds()] if b[0] <= b[1]]
+    if not boxes:
+        return None
+    b = np.array(boxes)
+    return [float(b[:, 0].min()), float(b[:, 1].max()), float(b[:, 2].min()), float(b[:, 3].max()),
+            float(b[:, 4].min()), float(b[:, 5].max())]
+
+
 def reset_clipping(renderer) -> None:
-    """Near and far planes from what is in view now. Every path that moves a camera or changes what is
-    drawn calls this: a camera placed far from the body (a long walk's shared grid, a large scan, a
-    camera file) otherwise keeps planes that cut the whole body away -- black or half pictures."""
-    renderer.ResetCameraClippingRange()
+    """Near and far planes from what is in view now (:func:`visible_bounds`). Every path that moves a
+    camera or changes what is drawn calls this: a camera placed far from the body (a long walk's shared
+    grid, a large scan, a camera file) otherwise keeps planes that cut the whole body away -- black or
+    half pictures."""
+    bounds = visible_bounds(renderer)
+    if bounds is None:
+        renderer.ResetCameraClippingRange()
+    else:
+        renderer.ResetCameraClippingRange(*bounds)
 
 
 def check_colour(text: str) -> None:

@@ -96,8 +96,11 @@ class TimelineController(Controller):
         joints = self.doc.pose.posed_joints()
         if not joints:
             return
+        from volanim_studio.scene import camera
+
         p = np.array(list(joints.values()), np.float64)
-        self.scene.follow(self.scene.world(((p.min(0) + p.max(0)) / 2)[None])[0], blend)
+        camera.follow(self.scene.plotter.renderer, self.scene.world(((p.min(0) + p.max(0)) / 2)[None])[0], blend)
+        self.scene.render()
 
     def step(self, delta: int) -> None:
         self.doc.timeline.step(delta)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from volanim_core.render.scene import reset_clipping, visible_bounds
+
 
 def composite_matrix(renderer) -> tuple[np.ndarray, tuple[float, float, float, float]]:
     """The renderer's world -> clip matrix and its viewport ``(x0, y0, width, height)`` in pixels."""
@@ -20,28 +22,29 @@ def preset_view(renderer, name: str = "front") -> bool:
     Returns False when nothing is visible (the camera is left alone)."""
     from volanim_core.render.camera import named_view, natural_axes
 
-    b = renderer.ComputeVisiblePropBounds()
-    if b[0] > b[1]:
+    b = visible_bounds(renderer)  # the x-ray layer's posed bones too
+    if b is None:
         return False
     lo, hi = np.array(b[0::2]), np.array(b[1::2])
     w, h = renderer.GetSize()
     cam = named_view(name, lo, hi, aspect=w / h if w and h else 4 / 3, view_angle=30.0, axes=natural_axes(lo, hi),
                      faces=0.0)
     cam.apply(renderer.GetActiveCamera())
-    renderer.ResetCameraClippingRange()
+    reset_clipping(renderer)
     return True
 
 
 def frame(renderer, lo=None, hi=None) -> bool:
     """Keep the direction, move so that the box ``lo..hi`` (world; default everything shown) fills the view."""
     if lo is None:
-        b = renderer.ComputeVisiblePropBounds()
-        if b[0] > b[1]:
+        b = visible_bounds(renderer)
+        if b is None:
             return False
     else:
         pad = 0.15 * max(float(np.max(np.asarray(hi) - np.asarray(lo))), 10.0)  # a point or a joint: some room
         b = [v for lo_, hi_ in zip(lo, hi) for v in (lo_ - pad, hi_ + pad)]
     renderer.ResetCamera(*b)
+    reset_clipping(renderer)  # ResetCamera fits the planes to b alone: a framed joint must not cut the body
     return True
 
 
@@ -51,7 +54,7 @@ def move_closer_to(renderer, target) -> None:
     pos, focal = np.array(cam.GetPosition()), np.array(cam.GetFocalPoint())
     cam.SetFocalPoint(*target)
     cam.SetPosition(*(np.asarray(target, np.float64) + 0.5 * (pos - focal)))
-    renderer.ResetCameraClippingRange()
+    reset_clipping(renderer)
 
 
 def follow(renderer, target, blend: float = 1.0) -> None:
@@ -63,7 +66,7 @@ def follow(renderer, target, blend: float = 1.0) -> None:
     shift = float(blend) * (np.asarray(target, np.float64) - focal)
     cam.SetFocalPoint(*(focal + shift))
     cam.SetPosition(*(np.array(cam.GetPosition()) + shift))
-    renderer.ResetCameraClippingRange()
+    reset_clipping(renderer)
 
 
 def camera_state(renderer) -> dict:
@@ -77,7 +80,7 @@ def set_camera_state(renderer, data: dict) -> None:
     cam.SetPosition(*data["position"])
     cam.SetFocalPoint(*data["focal_point"])
     cam.SetViewUp(*data["view_up"])
-    renderer.ResetCameraClippingRange()
+    reset_clipping(renderer)
 
 
 def view_distances(renderer, world: np.ndarray) -> np.ndarray:

@@ -90,17 +90,15 @@ class SceneView:
         self.pose_layer = PoseLayer(self)
 
     def _fix_pixel_ratio(self) -> None:
-        # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen
-        # under the *cursor*, which is wrong on mixed-DPI desktops (pyvistaqt #20,
-        # VTK MR 4201); use the widget's own ratio for both size and events.
+        # VTK's QVTKRenderWindowInteractor scales events by the DPR of the screen under the *cursor*, wrong
+        # on mixed-DPI desktops (pyvistaqt #20, VTK MR 4201); the widget's own ratio for size and events.
         widget = self.plotter
         if hasattr(widget, "_getPixelRatio"):
             widget._getPixelRatio = lambda: float(widget.devicePixelRatioF())
 
     def _quiet_keys(self) -> None:
-        """No keys of VTK's or pyvista's own: W turned everything to wireframe, Q and V snapped
-        the camera, +/- changed the point size behind the Display tab's back. The window's
-        actions (Qt shortcuts) are the only keys."""
+        """No keys of VTK's or pyvista's own (W: wireframe, Q and V snapped the camera, +/- the point size
+        behind the Display tab's back): the window's actions (Qt shortcuts) are the only keys."""
         self.plotter.iren.clear_key_event_callbacks()
         # a style with an observer for an event skips its own handler (OnChar: w, s, e, q, f, r, 3, p, j, t)
         self.plotter.iren.style.AddObserver("CharEvent", lambda *_: None)
@@ -170,10 +168,6 @@ class SceneView:
         camera.frame(self.plotter.renderer, world.min(0), world.max(0))
         self.render()
         return True
-
-    def follow(self, world_target, blend: float = 1.0) -> None:
-        camera.follow(self.plotter.renderer, world_target, blend)
-        self.render()
 
     def jump_to(self, voxel_xyz) -> None:
         """Centre the view on a point and move closer."""
@@ -446,9 +440,7 @@ class SceneView:
         self._render_pending = False
         if getattr(self.plotter, "_closed", False):
             return
-        # near and far planes from what is shown now: a preview drawn where the pose or the timeline put
-        # it (a walk 900 voxels from its start) was cut away by planes fitted to the rest pose
-        reset_clipping(self.plotter.renderer)
+        reset_clipping(self.plotter.renderer)  # a preview where the walk took it, not cut by old planes
         if self._drawn_once and self.plotter.isVisible():
             # One frame: the widget's paint renders. plotter.render() would render and then
             # have the paint render the same frame again (2x the software-GL time).
