@@ -127,6 +127,20 @@ class PoseState:
         return Tskel(conn.bones, self.matrices(), conn.points[keep], conn.dt[keep], conn.thinness[keep],
                      conn.bone[keep], conn.metric, conn.geometry)
 
+    def posed_box(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The voxel box the posed spheres of every attached point fill (None: nothing attached): where the
+        posed body is, known at once, before any preview of it is drawn."""
+        from volanim_core.reconstruct.engine import posed_centres
+
+        try:
+            t = self.tskel(thinness=0.0)
+        except ValueError:  # nothing loaded
+            return None
+        if not len(t):
+            return None
+        c, r = posed_centres(t), t.dt[:, None]
+        return (c - r).min(0), (c + r).max(0)
+
     def save_tskel(self, path) -> int:
         t = self.tskel()
         io.write_tskel(path, t)

@@ -15,20 +15,23 @@ def composite_matrix(renderer) -> tuple[np.ndarray, tuple[float, float, float, f
     return np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)]), (x0, y0, width, height)
 
 
-def preset_view(renderer, name: str = "front") -> bool:
-    """Look from a named direction (``volanim_core.render.camera.VIEWS``) with everything in view,
-    the object stood up by its shape (``natural_axes``: the frog lies flat, the mannequin stands).
+def preset_view(renderer, name: str = "front", box=None, shape=None) -> bool:
+    """Look from a named direction (``volanim_core.render.camera.VIEWS``) at the world box ``box``
+    (``(lo, hi)``; default: everything drawn), the object stood up by the shape of the box ``shape``
+    (default ``box``; ``natural_axes``: the frog lies flat, the mannequin stands).
 
     Returns False when nothing is visible (the camera is left alone)."""
     from volanim_core.render.camera import named_view, natural_axes
 
-    b = visible_bounds(renderer)  # the x-ray layer's posed bones too
-    if b is None:
-        return False
-    lo, hi = np.array(b[0::2]), np.array(b[1::2])
+    if box is None:
+        b = visible_bounds(renderer)  # the x-ray layer's posed bones too
+        if b is None:
+            return False
+        box = (np.array(b[0::2]), np.array(b[1::2]))
+    lo, hi = (np.asarray(v, np.float64) for v in box)
     w, h = renderer.GetSize()
-    cam = named_view(name, lo, hi, aspect=w / h if w and h else 4 / 3, view_angle=30.0, axes=natural_axes(lo, hi),
-                     faces=0.0)
+    cam = named_view(name, lo, hi, aspect=w / h if w and h else 4 / 3, view_angle=30.0,
+                     axes=natural_axes(*(box if shape is None else shape)), faces=0.0)
     cam.apply(renderer.GetActiveCamera())
     reset_clipping(renderer)
     return True

@@ -126,8 +126,7 @@ class SceneView:
         xy, depth = self.project_world(world)
         return self._shown, xy, depth, camera.view_distances(self.plotter.renderer, world)
 
-    def camera(self) -> dict:
-        """The view's camera as plain lists (saved in projects)."""
+    def camera(self) -> dict:  # the view's camera as plain lists (saved in projects)
         return camera.camera_state(self.plotter.renderer)
 
     def set_camera(self, data: dict) -> None:
@@ -138,16 +137,19 @@ class SceneView:
         self.view_preset("front")
 
     def view_preset(self, name: str) -> None:
-        """``front``, ``side``, ``top``, ``three-quarter`` or ``back``, everything in view."""
-        if camera.preset_view(self.plotter.renderer, name):
+        """A named view of the body (in Pose mode its posed spheres' box: a preview still drawing the last
+        pose must not count), stood up by the rest skeleton's shape (a walk must not lay it down)."""
+        shape = (self._world.min(0), self._world.max(0)) if len(self._world) else None
+        box = self.doc.pose.posed_box() if self.posing else None
+        box = None if box is None else (self.world(box[0]), self.world(box[1]))
+        if camera.preset_view(self.plotter.renderer, name, box, shape):
             self.render()
 
     def frame_all(self) -> None:
         if camera.frame(self.plotter.renderer):
             self.render()
 
-    def shown_joints(self) -> dict:
-        """Joint positions as drawn: where the pose put them in Pose mode, at rest otherwise."""
+    def shown_joints(self) -> dict:  # joints as drawn: where the pose put them in Pose mode, else at rest
         return self.doc.pose.posed_joints() if self.posing else self.doc.bones.joints
 
     def frame_selected(self) -> bool:
@@ -169,8 +171,7 @@ class SceneView:
         self.render()
         return True
 
-    def jump_to(self, voxel_xyz) -> None:
-        """Centre the view on a point and move closer."""
+    def jump_to(self, voxel_xyz) -> None:  # centre the view on a point and move closer
         camera.move_closer_to(self.plotter.renderer, self.world(voxel_xyz))
         self.render()
 
@@ -191,9 +192,8 @@ class SceneView:
         return PickEvent(point=point, joint=joint, bone=bone)
 
     def joint_and_bone_at(self, x: float, y: float) -> tuple[str | None, int | None]:
-        """The joint and the bone within the pick radius of display ``(x, y)`` (each may be None).
-
-        No skeleton points are projected: cheap enough for every mouse move (hover)."""
+        """The joint and the bone within the pick radius of display ``(x, y)`` (each may be None); no points
+        are projected: cheap enough for every mouse move (hover)."""
         radius = PICK_RADIUS * self.pixel_ratio()
         joint = bone = None
         bones = self.doc.bones

@@ -281,6 +281,8 @@ def test_the_view_and_the_movie_follow_the_walking_body(qtbot, rigged, tmp_path)
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not before, timeout=JOB_TIMEOUT_MS)
     qtbot.wait(20)
     assert body_in_view(w) == 1.0
+    up = np.array(w.plotter.renderer.GetActiveCamera().GetViewUp())
+    assert up[2] > 0.95  # standing, by the rest skeleton's shape (the walk's long box laid it down)
 
     show(0)
     front_view(w)  # the view on the walker's first step
