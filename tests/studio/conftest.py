@@ -20,6 +20,19 @@ def front_view(window) -> None:
     window.plotter.render()
 
 
+def rig_and_pose(qtbot, window):
+    """The mannequin's bones and attachments from assets/, the front view, then Pose mode (P)."""
+    from paths import ASSETS
+    from volanim_studio.model.modes import Mode
+
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    front_view(window)
+    qtbot.keyClick(window, Qt.Key_P)
+    assert window.mode == Mode.POSE
+    return window
+
+
 def qt_pos(window, display_xy) -> QPoint:
     """The Qt widget position of VTK display coordinates (device pixels, origin bottom-left)."""
     w = window.plotter

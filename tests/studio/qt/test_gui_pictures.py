@@ -5,16 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PySide6.QtCore import Qt
 
-from paths import ASSETS
 from picture_oracle import compare, foreground, mask_region, silhouette
 from volanim_core import io, samples
 from volanim_core.render.camera import Camera
 from volanim_core.render.colours import rgb
-from volanim_studio.model.modes import Mode
 
-from ..conftest import JOB_TIMEOUT_MS, front_view
+from ..conftest import JOB_TIMEOUT_MS, rig_and_pose
 
 pytestmark = pytest.mark.gui
 
@@ -53,12 +50,7 @@ def colour_window(qtbot, window, tmp_path):
     io.write_volume(path, samples.mannequin_colour().volume)
     window.files.open_volume(path, params={"lo": 1, "hi": None, "fill": False})
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
-    assert window.files.open_bones(ASSETS / "mannequin.bones")
-    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
-    front_view(window)
-    qtbot.keyClick(window, Qt.Key_P)
-    assert window.mode == Mode.POSE
-    return window
+    return rig_and_pose(qtbot, window)
 
 
 def test_every_preview_mode_shows_the_voxels_it_made(qtbot, colour_window):

@@ -7,13 +7,12 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QPushButton
 
-from paths import ASSETS
 from volanim_core import samples
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.render.transfer import gl_renderer, software_gl
 from volanim_studio.model.modes import Mode
 
-from ..conftest import JOB_TIMEOUT_MS, front_view
+from ..conftest import JOB_TIMEOUT_MS, rig_and_pose
 
 pytestmark = pytest.mark.gui
 
@@ -22,12 +21,7 @@ J = samples.mannequin_bones().joints
 
 @pytest.fixture
 def posed_window(qtbot, window):
-    assert window.files.open_bones(ASSETS / "mannequin.bones")
-    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
-    front_view(window)
-    qtbot.keyClick(window, Qt.Key_P)
-    assert window.mode == Mode.POSE
-    return window
+    return rig_and_pose(qtbot, window)
 
 
 def drag(qtbot, window, axis: int, values) -> None:
