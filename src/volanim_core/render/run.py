@@ -82,7 +82,7 @@ def union_box(boxes, lo, hi) -> tuple[tuple, tuple]:
 
 def open_inputs(paths, frames: slice = slice(None), dims=None) -> RenderInputs:
     """Frames to render from one zarr sequence or from volume files (in frame-number order)."""
-    paths = [Path(p) for p in paths]
+    paths = [sequence_folder(Path(p)) for p in paths]
     if not paths:
         raise ValueError("nothing to render: give a volume file, several, or a .zarr sequence")
     zarrs = [p for p in paths if (p / "volanim-plan.json").is_file() or p.suffix.lower() == ".zarr"]
@@ -91,6 +91,16 @@ def open_inputs(paths, frames: slice = slice(None), dims=None) -> RenderInputs:
             raise ValueError("render one .zarr sequence, or volume files, not both")
         return _zarr_inputs(paths[0], frames)
     return _file_inputs(paths, frames, dims)
+
+
+def sequence_folder(path: Path) -> Path:
+    """A file picked inside a zarr sequence (its ``zarr.json`` or ``volanim-plan.json``: a file dialog
+    cannot pick a folder) stands for the sequence; any other path is itself."""
+    path = Path(path)
+    if path.name in ("zarr.json", "volanim-plan.json", ".zgroup", ".zattrs") and \
+            (path.parent / "volanim-plan.json").is_file():
+        return path.parent
+    return path
 
 
 def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:

@@ -109,6 +109,41 @@ class PoseState:
         return ({keys[i]: a for i, a in angles.items() if np.any(np.abs(a) > 1e-9)},
                 {keys[i]: t for i, t in shifts.items() if np.any(np.abs(t) > 1e-9)})
 
+    # ----------------------------------------------------------------- state
+    def to_json(self) -> dict:
+        """The pose as a project holds it: ``{"angles": [[PROXIMAL, DISTAL, rx, ry, rz], ...], "shifts": [...]}``
+        (joint names: the pose stays with its bones whatever order they are in)."""
+        def rows(table):
+            return [[p, d, *(float(v) for v in value)] for (p, d), value in sorted(table.items())]
+
+        return {"angles": rows(self.angles), "shifts": rows(self.shifts)}
+
+    @staticmethod
+    def parse(data, where: str) -> tuple[dict, dict]:
+        """``(angles, shifts)`` from :meth:`to_json`'s form; ValueError naming ``where`` and the bad row."""
+        if not isinstance(data, dict):
+            raise ValueError(f"{where}: \"pose\" must be an object, got {type(data).__name__}")
+        out = []
+        for key in ("angles", "shifts"):
+            table = {}
+            for row in data.get(key) or []:
+                if not (isinstance(row, list) and len(row) == 5 and all(isinstance(v, str) for v in row[:2])
+                        and all(isinstance(v, int | float) and not isinstance(v, bool) and np.isfinite(v)
+                                for v in row[2:])):
+                    raise ValueError(f"{where}: \"pose\" \"{key}\": expected [PROXIMAL, DISTAL, x, y, z] with "
+                                     f"finite numbers, got {row!r}")
+                table[(row[0], row[1])] = np.array(row[2:], np.float64)
+            out.append(table)
+        return out[0], out[1]
+
+    def restore(self, angles: dict, shifts: dict) -> list[str]:
+        """Take a saved pose (not an edit: no undo step); entries for bones that no longer exist are
+        dropped and said."""
+        known = {self._key(i) for i in range(len(self.doc.bones))}
+        gone = sorted({f"{p}-{d}" for p, d in [*angles, *shifts] if (p, d) not in known})
+        self._write({k: v for k, v in angles.items() if k in known}, {k: v for k, v in shifts.items() if k in known})
+        return [f"the saved pose of {', '.join(gone)} was dropped: no such bone"] if gone else []
+
     # ----------------------------------------------------------------- files
     def load_trans(self, path) -> None:
         """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order)."""

@@ -6,6 +6,7 @@
                      "bones", "connect", "mskel": "NAME.volanim.d/<kind>-<hash>.<kind>",
                      "sha256": {"bones": ..., ...},      what each data file must hash to
                      "thinness", "symmetry_x", "settings", "camera",
+                     "pose": {"angles": [[PROXIMAL, DISTAL, rx, ry, rz], ...], "shifts": [...]},   the current pose
                      "timeline": {"keys": {FRAME: [[PROXIMAL, DISTAL, rx, ry, rz, tx, ty, tz], ...]},
                                   "ease", "length", "fps", "clip": {"kind": "bvh"|"trans", "path", "mapping",
                                   "up", "forward"}}     the animation (a clip is referenced, never copied)
@@ -34,6 +35,7 @@ from volanim_core.io import bundle
 from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
+from .posing import PoseState
 from .timeline import Timeline
 
 PROJECT_FORMAT = "volanim project"
@@ -78,7 +80,7 @@ def write_project(doc, path, camera: dict | None = None) -> dict:
         **{key: rel for key, (rel, _) in stored.items()},
         "sha256": {key: digest for key, (_, digest) in stored.items()},
         "thinness": doc.thinness, "symmetry_x": doc._symmetry_x, "settings": doc.settings.as_dict(),
-        "camera": camera, "timeline": _timeline_json(doc, path),
+        "camera": camera, "timeline": _timeline_json(doc, path), "pose": doc.pose.to_json(),
     }
     bundle.commit(path, data)
     written = {"project": str(path), "bones": None, "mskel": None, "connect": None}
@@ -144,8 +146,13 @@ def _parse(path: Path, text: str) -> dict:
         value = _expect(path, data, key, int | float, "a number")
         if value is not None and (isinstance(value, bool) or not math.isfinite(value)):
             raise FormatError(path, f"\"{key}\" must be a finite number, got {value!r}")
-    for key in ("settings", "camera", "segmentation", "sha256", "timeline"):
+    for key in ("settings", "camera", "segmentation", "sha256", "timeline", "pose"):
         _expect(path, data, key, dict, "an object")
+    if data.get("pose") is not None:
+        try:
+            data["pose"] = PoseState.parse(data["pose"], path.name)
+        except ValueError as exc:
+            raise FormatError(path, str(exc).removeprefix(f"{path.name}: ")) from None
     if data.get("timeline") is not None:
         try:
             data["timeline"] = Timeline.parse(data["timeline"], path.name)
@@ -222,7 +229,12 @@ def apply_project(doc, data: dict, path, *, reset: bool = False) -> list[str]:
         doc.thinness = data["thinness"]
     if data.get("timeline") is not None:
         warnings += doc.timeline.restore(data["timeline"], Path(path).name)
+    if data.get("pose") is not None:  # after the timeline: the pose the user saved, not its frame's
+        warnings += [f"{Path(path).name}: {w}" for w in doc.pose.restore(*data["pose"])]
     warnings += [f"{Path(path).name}: {w}" for w in doc.settings.update(data.get("settings") or {})]
     doc.project_path = str(path)
+    # opening is not an edit: Ctrl+Z right after it undid "Load connect", then the bones (issue #37)
+    doc.undo.clear()
+    doc.undo.mark_clean()
     doc.events.project.emit(path=str(path))
     return warnings

@@ -63,7 +63,8 @@ class FilesController(Controller):
     def view_file_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
             self.window, "View volume or mesh", self.folder(),
-            f"Volumes and meshes ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl);;All files (*)")
+            f"Volumes and meshes ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl);;"
+            "Sequences: the zarr.json inside NAME.zarr (zarr.json volanim-plan.json);;All files (*)")
         if path:
             self.view_file(path)
 

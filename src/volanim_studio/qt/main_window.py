@@ -359,7 +359,8 @@ def main_window_for(args) -> MainWindow:
             w.files.open_bones(args.bones)
         if args.connect:
             w.files.open_connect(args.connect)
-        w.doc.undo.mark_clean()  # what the command line named is where the session starts, not an edit
+        w.doc.undo.clear()  # what the command line named is where the session starts, not an edit to undo
+        w.doc.undo.mark_clean()
 
     if worker is not None:
         worker.succeeded.connect(then)

@@ -65,7 +65,7 @@ class SessionController(Controller):
         if ask is None:
             answer = QMessageBox.question(
                 self.window, "Restore unsaved work?", f"volanim studio did not close properly last time.\n"
-                f"Restore the session autosaved at {latest.parent.name}?", QMessageBox.Yes | QMessageBox.No)
+                f"Restore the session autosaved {autosave.describe(latest)}?", QMessageBox.Yes | QMessageBox.No)
             restore = answer == QMessageBox.Yes
         else:
             restore = ask(latest)

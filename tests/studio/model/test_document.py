@@ -7,6 +7,7 @@ import pytest
 
 from volanim_core import io, samples
 from volanim_core.errors import FormatError
+from volanim_studio.model import Document
 from volanim_studio.model.modes import BonesMode, PickEvent, RootOrderMode
 from volanim_studio.model.project import read_project
 
@@ -141,6 +142,29 @@ def test_project_round_trip(tmp_path, doc):
         read_project(tmp_path / "bad.volanim")
 
 
+def test_the_pose_is_saved_with_the_project_and_comes_back(tmp_path, doc):
+    """Issue #37: pose L_UPPERARM to y -44, save, reopen: the angles were 0, 0, 0 (the pose was never saved)."""
+    from volanim_studio.model.project import apply_project
+
+    doc.bone_edits.set_bones(samples.mannequin_bones())
+    arm, hip = doc.bones.index("L_UPPERARM"), doc.bones.index("L_THIGH")
+    doc.pose.set_angles(arm, (0, -44, 0))
+    doc.pose.set_angles(hip, (10, 0, 5))
+    path = doc.save_project(tmp_path / "posed.volanim")
+    fresh = Document()
+    fresh.set_skeleton(doc.skeleton)
+    assert apply_project(fresh, read_project(path), path) == []
+    assert np.allclose(fresh.pose.angles_of(arm), (0, -44, 0)) and np.allclose(fresh.pose.angles_of(hip), (10, 0, 5))
+    assert np.allclose(fresh.pose.matrices(), doc.pose.matrices())
+    assert not fresh.undo.can_undo  # reopening is not an edit
+    # a saved pose of a bone that no longer exists is dropped, and said
+    data = read_project(path)
+    data["pose"][0][("NOPE", "NADA")] = np.array([1.0, 2.0, 3.0])
+    other = Document()
+    other.set_skeleton(doc.skeleton)
+    assert any("NOPE-NADA" in w for w in apply_project(other, data, path))
+
+
 def test_load_connections_sets_bones_in_root_order(tmp_path, doc):
     s = samples.mannequin()
     doc.bone_edits.set_bones(s.bones)
@@ -176,6 +200,9 @@ def test_version_1_projects_read_with_their_defaults(tmp_path):
     ('{"format": "volanim project", "segmentation": {"lo": "x"}}', '"lo" must be a number'),
     ('{"format": "volanim project", "segmentation": {"fill": "yes"}}', '"fill" must be true or false'),
     ('{"format": "volanim project", "segmentation": {"metric": "manhattan"}}', '"metric" must be'),
+    ('{"format": "volanim project", "pose": []}', '"pose" must be an object'),
+    ('{"format": "volanim project", "pose": {"angles": [["A", "B", 1, 2]]}}', r'"pose" "angles": expected'),
+    ('{"format": "volanim project", "pose": {"angles": [["A", "B", 1, 2, "x"]]}}', r'"pose" "angles": expected'),
 ])
 def test_bad_project_fields_are_format_errors_naming_the_file(tmp_path, content, message):
     path = tmp_path / "bad.volanim"

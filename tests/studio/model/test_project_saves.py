@@ -125,6 +125,19 @@ def test_autosave_survives_kill_9_and_is_offered(tmp_path, doc):
     assert generation_on_disk(found[0]) == seen[-1]
 
 
+def test_the_recovery_question_names_the_time_and_what_the_session_holds(tmp_path, doc):
+    """It read "Restore the session autosaved at 8698-1795481871958?" (a process id and milliseconds)."""
+    import re
+
+    saver = autosave.Autosaver(doc, tmp_path / "recovery")
+    make_generation(doc, 7)
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -30, 0))
+    saver.save()
+    text = autosave.describe(saver.path)
+    assert re.fullmatch(r"\w{3} \d{2} \w{3} \d{4} \d{2}:\d{2}: 18 bones, 8 attachments, a pose", text), text
+    assert str(os.getpid()) not in text
+
+
 # spec: docs/formats.md#project
 def test_a_damaged_save_opens_the_previous_one_and_deletes_nothing(tmp_path, doc):
     path = tmp_path / "p.volanim"

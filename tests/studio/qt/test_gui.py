@@ -433,6 +433,13 @@ def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(q
     (tmp_path / "bad.ply").write_text("not a mesh")
     assert window.files.view_file(tmp_path / "bad.ply") is None
     assert "bad.ply" in window.last_error
+    # a sequence: the file dialog picks the zarr.json inside NAME.zarr ("unknown volume format" before)
+    from core.render.test_render import make_sequence
+
+    make_sequence(tmp_path / "walk.zarr", frames=2)
+    viewer = window.files.view_file(tmp_path / "walk.zarr" / "zarr.json")
+    assert viewer is not None and "frame 100" in viewer.what and "body" in viewer.plotter.renderer.actors
+    viewer.close()
 
 
 def test_f1_lists_every_keyboard_shortcut_of_the_menus(window):

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QMessageBox
 
 from paths import ASSETS
@@ -129,6 +130,11 @@ def test_files_named_on_the_command_line_are_not_unsaved_edits(qtbot, tmp_path):
     qtbot.addWidget(w)
     qtbot.waitUntil(lambda: not w.busy and len(w.doc.bones) == 18, timeout=JOB_TIMEOUT_MS)
     assert not w.doc.modified and not w.isWindowModified()
+    # Ctrl+Z right after the start undoes nothing: "Undid: Load bones" took all 18 bones (issue #37)
+    assert not w.doc.undo.can_undo
+    w.activateWindow()
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
+    assert len(w.doc.bones) == 18 and not w.doc.modified
     w.doc.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")  # an edit is one
     assert w.isWindowModified()
     w.doc.undo.mark_clean()
@@ -151,3 +157,22 @@ def test_a_new_volume_after_connecting_and_posing_opens_cleanly(qtbot, window, t
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert window.doc.shape == (40, 30, 30) and len(window.doc.bones) == 0 and window.doc.pose.is_rest
     assert len(window.doc.attachments.bone) == len(window.doc.skeleton) and (window.doc.attachments.bone == -1).all()
+
+
+def test_a_posed_project_reopens_posed_and_opening_is_not_undone(qtbot, window, tmp_path):
+    """Issue #37: pose L_UPPERARM to y -44, Ctrl+S, reopen: the angles were 0, 0, 0; and Ctrl+Z right
+    after opening said "Undid: Load connect" and left 0 points attached."""
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    arm = window.doc.bones.index("L_UPPERARM")
+    window.set_mode(Mode.POSE)
+    window.doc.pose.set_angles(arm, (0, -44, 0), merge=False)
+    path = window.files.save_project(path=tmp_path / "posed.volanim")
+    attached = int((window.doc.attachments.bone >= 0).sum())
+    assert open_project(qtbot, window, path)
+    assert np.allclose(window.doc.pose.angles_of(arm), (0, -44, 0))
+    assert not window.doc.undo.can_undo and not window.isWindowModified()
+    window.activateWindow()
+    qtbot.keyClick(window, Qt.Key_Z, Qt.ControlModifier)
+    assert int((window.doc.attachments.bone >= 0).sum()) == attached and len(window.doc.bones) == 18
+    assert np.allclose(window.doc.pose.angles_of(arm), (0, -44, 0)) and not window.isWindowModified()
