@@ -33,6 +33,16 @@ def recovery_root() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "volanim" / "recovery"
 
 
+def in_recovery_area(path) -> bool:
+    """Whether ``path`` lies in the autosave area, where a declined session is pruned after a week: a
+    project opened from there is saved with Save As, never in place."""
+    try:
+        Path(path).resolve().relative_to(recovery_root().resolve())
+    except ValueError:
+        return False
+    return True
+
+
 def _alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)

@@ -20,6 +20,7 @@ from PySide6.QtWidgets import QFileDialog
 from volanim_core import io
 
 from .. import tasks
+from ..model import autosave
 from ..model.project import apply_project, read_project
 from .controller import FAILED, Controller
 from .threshold_dialog import ThresholdDialog
@@ -267,9 +268,11 @@ class FilesController(Controller):
     def save_project(self, ask: bool = False, path=None) -> Path | None:
         if path is None:
             path = self.doc.project_path
-            if ask or not path:
-                path, _ = QFileDialog.getSaveFileName(self.window, "Save project", self.folder("session.volanim"),
-                                                      "Projects (*.volanim)")
+            cached = bool(path) and autosave.in_recovery_area(path)  # pruned after a week: never saved there
+            if ask or not path or cached:
+                where = str(Path.home() / "session.volanim") if cached else self.folder("session.volanim")
+                title = "Save project (it was opened from the autosave area)" if cached else "Save project"
+                path, _ = QFileDialog.getSaveFileName(self.window, title, where, "Projects (*.volanim)")
                 if not path:
                     return None
         saved = self.attempt("Save project", lambda: self.doc.save_project(path, camera=self.scene.camera()),

@@ -176,3 +176,23 @@ def test_a_posed_project_reopens_posed_and_opening_is_not_undone(qtbot, window, 
     qtbot.keyClick(window, Qt.Key_Z, Qt.ControlModifier)
     assert int((window.doc.attachments.bone >= 0).sum()) == attached and len(window.doc.bones) == 18
     assert np.allclose(window.doc.pose.angles_of(arm), (0, -44, 0)) and not window.isWindowModified()
+
+
+def test_a_project_in_the_autosave_area_is_saved_where_the_user_says(qtbot, window, tmp_path, recovery_dir,
+                                                                      monkeypatch):
+    """Issue #37: Ctrl+S on a project opened from the "-discarded" autosave folder saved into that folder
+    without asking, where it is pruned after a week."""
+    from PySide6.QtWidgets import QFileDialog
+
+    cached = recovery_dir / "123-456-discarded" / "recovery.volanim"
+    cached.parent.mkdir(parents=True)
+    window.files.save_project(path=cached)
+    assert open_project(qtbot, window, cached)
+    window.doc.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")
+    asked = []
+    chosen = tmp_path / "mine.volanim"
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (asked.append(a) or str(chosen), ""))
+    before = cached.read_bytes()
+    assert window.files.save_project() == chosen  # Ctrl+S
+    assert asked and "autosave area" in asked[0][1] and cached.read_bytes() == before
+    assert window.doc.project_path == str(chosen) and not window.isWindowModified()
