@@ -3,6 +3,7 @@ pose events write the widgets back with signals blocked."""
 
 from __future__ import annotations
 
+import numpy as np
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QDoubleSpinBox,
@@ -84,8 +85,12 @@ class PosePanel(QWidget):
 
     def _spin_changed(self) -> None:
         b = self.doc.working_bone
-        if b is not None:
-            self.doc.pose.set_angles(b, [s.value() for s in self.spins], merge=False)
+        typed = [s.value() for s in self.spins]
+        # editingFinished comes on Enter and again on focus-out: an unchanged value is no edit (one typed
+        # angle made three undo steps, and the first Ctrl+Z changed nothing)
+        if b is not None and not np.allclose(typed, self.doc.pose.angles_of(b)):
+            self.doc.pose.set_angles(b, typed, merge=False)
+            self.doc.undo.seal()  # one typed value is one step: the next slider drag is another
             self.drag_finished.emit()
 
     def _released(self) -> None:

@@ -196,3 +196,26 @@ def test_the_axes_the_sliders_turn_about_are_drawn_on_the_selected_bone(qtbot, p
     assert doc.pose.angles_of(fa)[0] == 180 and doc.pose.angles_of(fa)[2] == -180
     qtbot.keyClick(w, Qt.Key_V)  # leaving Pose hides them with the pose stage
     assert not w.scene.xray.renderer.GetDraw()
+
+
+def test_one_typed_angle_is_one_undo_step_and_ctrl_z_reaches_it_from_the_field(qtbot, posed_window):
+    """Issue #37: click the y field, type -90, Enter: the history held three "Pose L_UPPERARM" steps and
+    the first Ctrl+Z changed nothing; and Ctrl+Z in a focused number field undid its text, not the pose."""
+    w = posed_window
+    arm = w.doc.bones.index("L_UPPERARM")
+    w.doc.select_bones([arm])
+    w.panel_tabs.setCurrentWidget(w.pose_panel)
+    spin = w.pose_panel.spins[1]
+    steps = len(w.doc.undo._done)
+    spin.setFocus()
+    spin.selectAll()
+    qtbot.keyClicks(spin, "-90")
+    qtbot.keyClick(spin, Qt.Key_Return)
+    w.plotter.setFocus()  # focus leaves the field: editingFinished once more
+    spin.setFocus()  # and comes back: Ctrl+Z from the field itself
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert np.allclose(w.doc.pose.angles_of(arm), (0, -90, 0))
+    assert len(w.doc.undo._done) == steps + 1
+    qtbot.keyClick(spin, Qt.Key_Z, Qt.ControlModifier)
+    assert np.allclose(w.doc.pose.angles_of(arm), (0, 0, 0)) and spin.value() == 0
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
