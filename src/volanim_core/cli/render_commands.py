@@ -49,7 +49,8 @@ def _render(args):
     import numpy as np
 
     from volanim_core import io
-    from volanim_core.render.run import open_inputs, place_camera, render
+    from volanim_core.render.camera import place_camera
+    from volanim_core.render.run import open_inputs, render
     from volanim_core.render.scene import RenderSettings, transfer_of
 
     inputs = open_inputs(args.inputs, args.range, dims=args.dims)

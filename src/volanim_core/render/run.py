@@ -26,7 +26,7 @@ import numpy as np
 from volanim_core.errors import FormatError
 from volanim_core.parallel import executor
 
-from .camera import Camera, named_view
+from .camera import Camera, union_box
 from .scene import Renderer, RenderSettings
 
 KEY_FILE = "volanim-render.json"
@@ -68,16 +68,6 @@ class RenderInputs:
         world = [None if b is None else ((np.asarray(b[0]) - 0.5) * sp, (np.asarray(b[1]) + 0.5) * sp) for b in boxes]
         cams = follow_cameras(view, world, aspect=aspect, axes=axes, base=base)
         return [replace(f, camera=c) for f, c in zip(self.frames, cams)]
-
-
-def union_box(boxes, lo, hi) -> tuple[tuple, tuple]:
-    """The box holding every known, non-empty box of ``boxes`` (``(lo, hi)`` each); ``lo..hi`` (the grid)
-    when there is none: a camera then frames the grid rather than nothing."""
-    known = [b for b in boxes if b is not None]
-    if not known:
-        return tuple(lo), tuple(hi)
-    return (tuple(int(v) for v in np.min([b[0] for b in known], 0)),
-            tuple(int(v) for v in np.max([b[1] for b in known], 0)))
 
 
 def open_inputs(paths, frames: slice = slice(None), dims=None) -> RenderInputs:
@@ -174,26 +164,6 @@ def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
     lo, hi = union_box(boxes, np.min(los, 0).tolist(), np.max(his, 0).tolist())
     mode = modes.pop() if len(modes) == 1 else None  # the files' recorded mode, when they agree
     return RenderInputs(refs, lo, hi, mode, vmax, None, fingerprint, boxes, spacing)
-
-
-def place_camera(inputs: RenderInputs, view: str = "three-quarter", camera: Camera | str | None = None,
-                 aspect: float = 4 / 3, axes=None) -> tuple[Camera, RenderInputs]:
-    """The camera a render uses and the inputs to draw (every path that renders frames: ``volanim render``
-    and ``view``, the demo, the studio's movie).
-
-    ``camera``: None (the named ``view`` framing every frame's body: the union of their boxes), a
-    :class:`Camera` in world units, or ``"follow"`` (each frame its own camera, :meth:`RenderInputs.follow`;
-    the one returned is the middle frame's, for ``--save-camera``).
-    """
-    if camera == "follow":
-        frames = inputs.follow(view, aspect, axes)
-        return frames[len(frames) // 2].camera, replace(inputs, frames=frames)
-    if isinstance(camera, Camera):
-        return camera, inputs
-    if camera is not None:
-        raise ValueError(f"camera: a Camera or 'follow', got {camera!r}")
-    lo, hi = inputs.world_box()
-    return named_view(view, lo, hi, aspect=aspect, axes=axes, faces=0.0), inputs
 
 
 def _mm(spacing) -> str:
