@@ -146,15 +146,17 @@ def crop(vol: np.ndarray, bounds: Bounds, *, fill: int = 0) -> np.ndarray:
 def tight_bounds(vol: np.ndarray, level: float = 0) -> Bounds | None:
     """Inclusive bounds of the voxels with value > ``level`` (TightBounds); None if there are none."""
     vol = _check3d(vol)
-    lo, hi = [], []
-    for axis in range(3):
-        other = tuple(a for a in range(3) if a != axis)
-        hit = np.flatnonzero((vol > level).any(axis=other))
-        if not len(hit):
-            return None
-        lo.append(int(hit[0]))
-        hi.append(int(hit[-1]))
-    return Bounds(tuple(lo), tuple(hi))
+    # one pass for the (x, y) columns, then z only inside their box: a sequence records every frame's box,
+    # and the mask three times over (once per axis) cost 3x as much
+    def above(v):  # unsigned data above 0 is non-zero: no mask of the whole volume
+        return v if level == 0 and v.dtype.kind in "ub" else v > level
+
+    columns = np.any(above(vol), axis=2)
+    xs, ys = np.flatnonzero(columns.any(axis=1)), np.flatnonzero(columns.any(axis=0))
+    if not len(xs):
+        return None
+    zs = np.flatnonzero(np.any(above(vol[xs[0]:xs[-1] + 1, ys[0]:ys[-1] + 1]), axis=(0, 1)))
+    return Bounds((int(xs[0]), int(ys[0]), int(zs[0])), (int(xs[-1]), int(ys[-1]), int(zs[-1])))
 
 
 def flip(vol: np.ndarray, axis: str | int) -> np.ndarray:

@@ -32,7 +32,7 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
         settings = RenderSettings(named_view(view, lo, hi, aspect=w / h, faces=0.0), size=(w, h))
         renderer = Renderer(settings, off_screen=off_screen, plotter=plotter)
         renderer.plotter.add_mesh(mesh, color=SKIN, smooth_shading=True, name="body", reset_camera=False)
-        settings.camera.apply(renderer.plotter.camera)  # (a volume's draw() applies it itself)
+        settings.camera.apply(renderer.plotter.renderer.GetActiveCamera())  # (a volume's draw() applies it)
         reset_clipping(renderer.plotter.renderer)
         what = f"{mesh.n_points:,} points, {mesh.n_cells:,} faces"
     else:

@@ -53,19 +53,20 @@ class RenderInputs:
     boxes: list | None = None  # per frame: its filled voxels' (lo, hi), None when empty; None: not known
     spacing: tuple = (1.0, 1.0, 1.0)  # world units per voxel (files: their own; sequences: voxels)
 
-    def world_box(self) -> tuple[np.ndarray, np.ndarray]:
-        """The box every frame's body fits in, in world units (voxel x spacing), to the voxels' faces."""
+    def world_box(self, box=None) -> tuple[np.ndarray, np.ndarray]:
+        """``box`` (voxel centres ``(lo, hi)``; default: the one every frame's body fits in) in world units
+        (voxel x spacing), to the voxels' faces."""
+        lo, hi = (self.lo, self.hi) if box is None else box
         sp = np.asarray(self.spacing, np.float64)
-        return (np.asarray(self.lo) - 0.5) * sp, (np.asarray(self.hi) + 0.5) * sp
+        return (np.asarray(lo) - 0.5) * sp, (np.asarray(hi) + 0.5) * sp
 
     def follow(self, view: str, aspect: float, axes=None, base: Camera | None = None) -> list[FrameRef]:
         """The frames, each with a camera that keeps its body in the middle (:func:`follow_cameras`; ``base``:
         a camera whose direction and distance every frame keeps, e.g. the studio's view)."""
         from .camera import follow_cameras
 
-        sp = np.asarray(self.spacing, np.float64)
         boxes = self.boxes or [(self.lo, self.hi)] * len(self.frames)
-        world = [None if b is None else ((np.asarray(b[0]) - 0.5) * sp, (np.asarray(b[1]) + 0.5) * sp) for b in boxes]
+        world = [None if b is None else self.world_box(b) for b in boxes]
         cams = follow_cameras(view, world, aspect=aspect, axes=axes, base=base)
         return [replace(f, camera=c) for f, c in zip(self.frames, cams)]
 

@@ -119,15 +119,14 @@ def transfer_of(settings: RenderSettings) -> TransferFunction:
 
 def crop(volume: np.ndarray, origin, pad: int = 1):
     """The smallest box holding every filled voxel (and ``pad`` empty ones around it), and its origin."""
+    from volanim_core.volume import tight_bounds
+
     origin = np.asarray(origin, np.float64)
-    filled = volume.any(axis=3) if volume.ndim == 4 else volume  # colour: black is empty
-    columns = np.any(filled, axis=2)
-    xs, ys = np.flatnonzero(columns.any(axis=1)), np.flatnonzero(columns.any(axis=0))
-    if not len(xs):
+    box = tight_bounds(volume.any(axis=3) if volume.ndim == 4 else volume)  # colour: black is empty
+    if box is None:
         return volume[:1, :1, :1] * 0, origin
-    zs = np.flatnonzero(np.any(filled[xs[0]:xs[-1] + 1, ys[0]:ys[-1] + 1], axis=(0, 1)))
-    lo = np.maximum([xs[0] - pad, ys[0] - pad, zs[0] - pad], 0)
-    hi = np.minimum([xs[-1] + pad + 1, ys[-1] + pad + 1, zs[-1] + pad + 1], volume.shape[:3])
+    lo = np.maximum(np.array(box.lo) - pad, 0)
+    hi = np.minimum(np.array(box.hi) + pad + 1, volume.shape[:3])
     return volume[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]], origin + lo
 
 
@@ -194,7 +193,7 @@ class Renderer:
         if settings.title:
             self.plotter.add_text(settings.title, position="upper_left", font_size=12, name="title",
                                   color=_contrast(settings.background))
-        settings.camera.apply(self.plotter.camera)
+        settings.camera.apply(self.plotter.renderer.GetActiveCamera())
         self.plotter.camera_set = True  # never reset to fit a frame: the camera is the sequence's
 
     def render(self, volume: np.ndarray, origin, number: int | None = None, camera: Camera | None = None
@@ -227,7 +226,7 @@ class Renderer:
         if s.frame_numbers and number is not None:
             self.plotter.add_text(f"frame {number}", position="upper_right", font_size=12, name="frame",
                                   color=_contrast(s.background), render=False)
-        (camera or s.camera).apply(self.plotter.camera)  # adding actors must not have moved it
+        (camera or s.camera).apply(self.plotter.renderer.GetActiveCamera())  # adding actors must not move it
         reset_clipping(self.plotter.renderer)
 
     def close(self) -> None:

@@ -141,7 +141,7 @@ class PoseLayer:
             labels = style.pop("categories", None)
             self.preview_actor = add_volume_uncopied(plotter, img, "values", name="preview", render=False,
                                                      reset_camera=False, **style,
-                                                     mapper=volume_mapper(self.volume_mapper(), 4 if colour else 1))
+                                                     mapper=self.volume_mapper(4 if colour else 1))
             if labels is not None:
                 apply_labels(self.preview_actor, labels)
             if volume.ndim == 4:
@@ -162,16 +162,17 @@ class PoseLayer:
                              name="slices", render=False, reset_camera=False)
         view.render()
 
-    def volume_mapper(self) -> str:
+    def volume_mapper(self, components: int = 1) -> str:
         """pyvista's name of the mapper full previews use: the CPU ray caster on software OpenGL
-        (2.3x faster there on label volumes, as fast on grey ones), VTK's smart mapper on a GPU."""
+        (2.3x faster there on label volumes, as fast on grey ones), VTK's smart mapper on a GPU; colour
+        (``components`` 4) always the smart mapper (:func:`~volanim_core.render.transfer.volume_mapper`)."""
         if self._mapper is None:
             ren_win = self.view.plotter.ren_win
             renderer = gl_renderer(ren_win) if ren_win is not None else ""
             if not renderer:
                 return "smart"  # no GL context yet (never drawn): decide on a later preview
             self._mapper = "fixed_point" if software_gl(renderer) else "smart"
-        return self._mapper
+        return volume_mapper(self._mapper, components)
 
     def show_surface(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
         """A live preview: the reconstruction's surface coloured by label (software GL draws a

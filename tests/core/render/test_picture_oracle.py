@@ -126,29 +126,27 @@ def walking_sequence(path, frames=6):
     return path
 
 
-@pytest.mark.parametrize("camera", [None, "follow"])
-def test_a_sequence_framed_whole_or_followed(tmp_path, camera):
+def test_a_sequence_framed_whole_and_followed(tmp_path):
+    """The union of every frame's body by default; ``--camera follow`` keeps each frame's body in the
+    middle at one distance, so the ball walking across a grid 5x its size stays large."""
     seq = walking_sequence(tmp_path / "walk.zarr")
-    inputs = open_inputs([seq])
-    assert inputs.boxes[0] == ((25, 25, 25), (55, 55, 55)) and (inputs.lo, inputs.hi) == ((25, 25, 25), (355, 55, 55))
-    cam, inputs = place_camera(inputs, "front", camera, aspect=SIZE[0] / SIZE[1])
-    settings = RenderSettings(cam, preset="binary", vmax=1, size=SIZE)
-    render(inputs, settings, tmp_path / "pics", workers=1)
-    sizes = []
-    for ref in inputs.frames:
-        image = iio.imread(tmp_path / "pics" / f"frame.{ref.number:04d}.png")[..., :3]
-        volume, origin = read_frame(ref)
-        got = check(f"frame {ref.number}", f"sequence ({camera or 'union'})", image, ref.camera or cam, volume > 0,
-                    origin, 1.0, "surface")
-        sizes.append(got["silhouette_px"])
-    if camera == "follow":  # the same distance every frame, the ball in the middle: as large as it is
-        assert max(sizes) - min(sizes) < 0.1 * max(sizes)
-        assert sizes[0] > 4 * TABLE_SIZES.get("union", 1)
-    else:
-        TABLE_SIZES["union"] = sizes[0]
-
-
-TABLE_SIZES: dict = {}
+    sizes = {}
+    for camera in (None, "follow"):
+        inputs = open_inputs([seq])
+        assert inputs.boxes[0] == ((25, 25, 25), (55, 55, 55))
+        assert (inputs.lo, inputs.hi) == ((25, 25, 25), (355, 55, 55))
+        cam, inputs = place_camera(inputs, "front", camera, aspect=SIZE[0] / SIZE[1])
+        render(inputs, RenderSettings(cam, preset="binary", vmax=1, size=SIZE), tmp_path / f"pics-{camera}", workers=1)
+        sizes[camera] = []
+        for ref in inputs.frames:
+            image = iio.imread(tmp_path / f"pics-{camera}" / f"frame.{ref.number:04d}.png")[..., :3]
+            volume, origin = read_frame(ref)
+            got = check(f"frame {ref.number}", f"sequence ({camera or 'union'})", image, ref.camera or cam,
+                        volume > 0, origin, 1.0, "surface")
+            sizes[camera].append(got["silhouette_px"])
+    follow = sizes["follow"]
+    assert max(follow) - min(follow) < 0.1 * max(follow)  # one distance, every frame
+    assert min(follow) > 4 * max(sizes[None])  # as large as the picture allows, not a speck on the path
 
 
 def test_view_screenshot_frames_a_bone_volume_in_bone_colours(tmp_path, files):
