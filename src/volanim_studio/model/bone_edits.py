@@ -182,13 +182,27 @@ class BoneEdits:
         dx = float(self.doc.bones.joints[joint][0]) - self.doc.symmetry_x
         return "" if abs(dx) <= tolerance else ("L_" if dx > 0 else "R_")
 
+    def is_fork(self, joint: str) -> bool:
+        """Whether ``joint`` joins more than one chain (more than two bones meet there)."""
+        return sum((b.proximal == joint) + (b.distal == joint) for b in self.doc.bones.bones) > 2
+
+    def joints_named(self, chain: list[str], count: int) -> list[str]:
+        """The joints of ``chain`` that ``count`` typed names go to, in order: all of them when ``count``
+        covers the chain, else the chain's own joints after a fork at its top (the fork keeps its name)."""
+        own = chain[1:] if count < len(chain) and len(chain) > 1 and self.is_fork(chain[0]) else chain
+        return own[:count]
+
     def rename_chain(self, chain: list[str], names, *, sided: bool = True) -> list[str]:
         """Name the joints of ``chain`` (:meth:`chain_through`, :meth:`chain_from`) in order, one undo
         step; returns the new names.
 
         ``names`` (a list, or one string split at commas and spaces) may be shorter than the chain
-        (the rest keep their names). With ``sided``, a name without ``L_``/``R_`` gets the side of
-        its joint: "SHOULDER, ELBOW, WRIST" on the left arm gives L_SHOULDER, L_ELBOW, L_WRIST.
+        (the rest keep their names). A chain that starts at a fork (the neck of an arm's chain)
+        names the fork only when every joint gets a name: fewer names start after it, since the fork
+        belongs to other chains too ("SHOULDER, ELBOW, WRIST, FINGERS" from the neck renamed the
+        neck and left the fingertip unnamed, issue #37). With ``sided``, a name without
+        ``L_``/``R_`` gets the side of its joint: "SHOULDER, ELBOW, WRIST" on the left arm gives
+        L_SHOULDER, L_ELBOW, L_WRIST.
         """
         if isinstance(names, str):
             names = names.replace(",", " ").split()
@@ -197,6 +211,7 @@ class BoneEdits:
             raise ValueError("type the names of the chain's joints, e.g. SHOULDER, ELBOW, WRIST")
         if len(names) > len(chain):
             raise ValueError(f"{len(names)} names for a chain of {len(chain)} joints ({', '.join(chain)})")
+        chain = self.joints_named(chain, len(names))
         if sided:  # a joint already called so keeps its name (the pelvis that starts a leg's chain)
             names = [n if n[:2] in ("L_", "R_") or n == j else self.side_prefix(j) + n for n, j in zip(names, chain)]
         mapping = {old: new for old, new in zip(chain, names) if old != new}

@@ -54,11 +54,13 @@ class NamingController(Controller):
             self.doc.message("Select a bone of the chain (or click its first joint), then Ctrl+F2.")
             return None
         side = edits.side_prefix(chain[-1])
-        box = self._dialog("Name chain", f"Names for the {len(chain)} joints {' → '.join(chain)}, in order\n"
+        own = edits.joints_named(chain, len(chain) - 1) if edits.is_fork(chain[0]) else chain
+        whole = f" (type {len(chain)} to rename {chain[0]} too)" if len(own) < len(chain) else ""
+        box = self._dialog("Name chain", f"Names for the {len(own)} joints {' → '.join(own)}, in order{whole}\n"
                            f"(commas or spaces; {side or 'no prefix'} is added on this side when left out):")
         box.setComboBoxEditable(True)
-        box.setComboBoxItems([""] + [", ".join(p[:len(chain)]) for p in CHAIN_PRESETS.values()
-                                     if len(p) >= len(chain)])
+        box.setComboBoxItems([""] + [", ".join(p[:n]) for p in CHAIN_PRESETS.values() for n in {len(own), len(chain)}
+                                     if len(p) >= n and (n == len(chain) or p[0] not in ("NECK", "PELVIS"))])
         box.textValueSelected.connect(lambda text: self._apply(
             lambda: edits.rename_chain(chain, text), lambda names: f"Named the chain {', '.join(names)}."))
         box.open()

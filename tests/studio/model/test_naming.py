@@ -44,8 +44,24 @@ def test_one_line_names_a_chain_with_the_side_added_in_one_undo_step(doc):
     assert "R_KNEE" not in doc.bones.joints and a["R_KNEE"] in doc.bones.joints
     neck = doc.bone_edits.chain_through(next(i for i, b in enumerate(doc.bones.bones)
                                              if b.proximal == a["L_SHOULDER"]))
-    assert doc.bone_edits.rename_chain(neck, ["NECK", "SHOULDER"])[:2] == ["NECK", "L_SHOULDER"]  # on the plane:
-    assert doc.bone_edits.chain_from("L_SHOULDER")[1] == a["L_ELBOW"]  # no prefix; the rest keep their names
+    names = ["NECK", "SHOULDER", "ELBOW", "WRIST", "FINGERS"]  # every joint, the fork too
+    assert doc.bone_edits.rename_chain(neck, names)[:2] == ["NECK", "L_SHOULDER"]  # on the plane: no prefix
+
+
+def test_fewer_names_than_joints_leave_the_fork_at_the_top_its_name(doc):
+    """The README's step: the arm's chain from the neck named SHOULDER, ELBOW, WRIST, FINGERS renamed
+    the neck SHOULDER and left the fingertip unnamed (issue #37)."""
+    a = doc.anon
+    edits = doc.bone_edits
+    edits.rename_chain(edits.chain_from(a["PELVIS"]) + [a["NECK"], a["HEAD"]], "PELVIS, NECK, HEAD")
+    arm = edits.chain_through(next(i for i, b in enumerate(doc.bones.bones) if b.proximal == a["L_SHOULDER"]))
+    assert arm[0] == "NECK"
+    assert edits.rename_chain(arm, "SHOULDER, ELBOW, WRIST, FINGERS") == ["L_SHOULDER", "L_ELBOW", "L_WRIST",
+                                                                          "L_FINGERS"]
+    assert "NECK" in doc.bones.joints and a["L_FINGERS"] not in doc.bones.joints
+    assert edits.chain_from("L_SHOULDER") == ["L_SHOULDER", "L_ELBOW", "L_WRIST", "L_FINGERS"]
+    leg = edits.chain_from(a["R_HIP"])  # no fork on top: the names start at its first joint
+    assert edits.rename_chain(leg, "HIP, KNEE") == ["R_HIP", "R_KNEE"]
 
 
 @pytest.mark.parametrize("names, error", [("", "type the names"), ("A B C D E", "5 names for a chain of 4"),
