@@ -45,7 +45,7 @@ def main() -> None:
     for spheres in (False, True):
         for dragging in (False, True):
             w.doc.settings.spheres = spheres
-            w.scene.set_dragging(dragging)
+            w.doc.settings.dragging = dragging
             app.processEvents()
             update, frame, counts = [], [], []
             for v in values:
@@ -95,7 +95,7 @@ def bench_preview(app) -> None:
             bone = w.doc.bones.index("LEGS")
         w.set_mode(Mode.POSE)
         w.doc.select_bones([bone])
-        w.previews.drag_started()  # what pressing a pose slider does
+        w.doc.settings.dragging = True  # what pressing a pose slider does
         w.previews.live_timings.clear()
         t0 = time.perf_counter()
         steps = list(range(0, -46, -3))
@@ -106,7 +106,7 @@ def bench_preview(app) -> None:
         live = statistics.median(w.previews.live_timings) if w.previews.live_timings else float("nan")
         rate = len(w.previews.live_timings) / elapsed
         t0 = time.perf_counter()
-        w.previews.drag_finished()  # the release: a full preview with the report
+        w.doc.settings.dragging = False  # the release: a full preview with the report
         waits = [0.0]
         while w.busy:
             app.processEvents()

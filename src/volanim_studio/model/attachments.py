@@ -169,9 +169,10 @@ class Attachments:
         Points match by integer coordinates; points the cloud lacks are added
         (never dropped). Its bones must be the loaded bone skeleton's, in any
         order (matched by joint coordinates); with no bones loaded, the file's
-        become the bone skeleton. One undo step for the attachments.
+        become the bone skeleton. A load, not an edit: the history starts after it.
         """
-        return self.apply_connectivity(io.read_connect(path), Path(path).name)
+        conn = io.read_connect(path)
+        return self.doc.loading(lambda: self.apply_connectivity(conn, Path(path).name))
 
     def apply_connectivity(self, conn, name: str) -> list[str]:
         """:meth:`load` for a connectivity already read (``name`` is its file's, for messages)."""

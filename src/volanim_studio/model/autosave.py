@@ -5,7 +5,8 @@
     ROOT/<pid>-<start>/recovery.volanim.d/ its data files (this save's and the one before)
 
 A save happens after every ``every_edits`` edits and every ``every_seconds``
-while there are unsaved edits. A clean exit removes the folder; a folder whose
+while there are unsaved edits or the session's state (settings, thinness, the
+frame, the selection, the camera: ``document_state``) differs from the last save. A clean exit removes the folder; a folder whose
 pid is dead on the next start is a crashed session, offered for restore.
 Edits the user discards are first set aside (a declined folder, kept a week).
 A restored session's folder is removed only once the new session has
@@ -114,10 +115,10 @@ def describe(recovery: Path) -> str:
             parts.append(f"{len(io.read_bones(data['bones']))} bones")
         if data.get("connect"):
             parts.append(f"{len(io.read_connect(data['connect'])):,} attachments")
-        angles, shifts = data.get("pose") or ({}, {})
+        angles, shifts = data["state"].get("pose") or ({}, {})
         if angles or shifts:
             parts.append("a pose")
-        timeline = data.get("timeline") or {}
+        timeline = data["state"].get("timeline") or {}
         if timeline.get("keys"):
             parts.append(f"{len(timeline['keys'])} keys")
         if timeline.get("clip"):
@@ -142,6 +143,7 @@ class Autosaver:
         prune(self.root)
         self._new_folder()
         self._saved_edits = doc.undo.edits
+        self._saved_state = self._state()
         self._saved_at = clock()
         self.saves = 0
 
@@ -154,9 +156,16 @@ class Autosaver:
     def path(self) -> Path:
         return self.folder / RECOVERY_FILE
 
+    def _state(self) -> str:
+        """The session's state besides its edits (view state is not undoable, so no edit counts it)."""
+        from .document_state import save_all
+
+        return json.dumps(save_all(self.doc, self.path), sort_keys=True, default=str)
+
     @property
     def dirty(self) -> bool:
-        return self.doc.undo.edits != self._saved_edits
+        """Edits, or a changed view (a slider, the frame, the camera), not autosaved yet."""
+        return self.doc.undo.edits != self._saved_edits or self._state() != self._saved_state
 
     def edited(self) -> bool:
         """After an edit: save when ``every_edits`` edits are unsaved."""
@@ -172,8 +181,9 @@ class Autosaver:
 
     def save(self) -> bool:
         """Autosave now (the skeleton's file is written only when the skeleton changed)."""
+        state = self._state()
         self.doc.write_project(self.path)
-        self._saved_edits = self.doc.undo.edits
+        self._saved_edits, self._saved_state = self.doc.undo.edits, state
         self._saved_at = self.clock()
         self.saves += 1
         return True

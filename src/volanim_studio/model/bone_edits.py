@@ -302,17 +302,18 @@ class BoneEdits:
 
     # ----------------------------------------------------------------- files
     def load_bones(self, path, bones=None) -> None:
-        """Load a ``.bones`` file (or ``bones`` already read from ``path``); one undo step."""
+        """Load a ``.bones`` file (or ``bones`` already read from ``path``): not an undo step, the history
+        starts after it (:meth:`Document.loading`)."""
         bones = io.read_bones(path) if bones is None else bones
         if self.doc.skeleton is not None:  # onto the skeleton's grid: a file's joints may be in other voxels
             bones = bones.on_grid(self.doc.skeleton.geometry)
-        self.set_bones(bones, f"Load {Path(path).name}")
+        self.doc.loading(lambda: self.set_bones(bones, f"Load {Path(path).name}"))
         self.doc.bones_path = str(path)
 
     def load_connections(self, path) -> None:
         """Take the bone list (root order) from a ``.connections`` file over the loaded joints.
 
-        Bones that stay keep their names and attachments. One undo step.
+        Bones that stay keep their names and attachments. A load: the history starts after it.
         """
         pairs = io.read_connections(path)
         missing = sorted({j for pair in pairs for j in pair} - set(self.doc.bones.joints))
@@ -321,7 +322,7 @@ class BoneEdits:
                              "open the .bones file with those joints first")
         names = {(b.proximal, b.distal): b.name for b in self.doc.bones.bones}
         new = BoneSkeleton(copy.deepcopy(self.doc.bones.joints), [Bone(a, b, names.get((a, b), "")) for a, b in pairs])
-        self.set_bones(new, f"Load {Path(path).name}")
+        self.doc.loading(lambda: self.set_bones(new, f"Load {Path(path).name}"))
 
     def save_bones(self, path) -> None:
         io.write_bones(path, self.doc.bones, self.doc.grid)

@@ -11,7 +11,11 @@
     timeline ...................... a clip (BVH, .trans frames) or pose keys  [keys undoable]
     selected_bones, picked_point .. view state (not undoable)
     symmetry_x .................... mirror plane for Symmetrize
-    settings ...................... view and tool settings (colours, preview, lasso, cube, ...)
+    settings ...................... view and tool settings (colours, preview, lasso, cube, mode, ...)
+    camera ........................ the view's camera: the scene lends ``view_camera``; ``set_camera`` puts one back
+
+What a project and an autosave hold of it is defined once, in
+:mod:`~volanim_studio.model.document_state`.
 
 Every setter validates, stores, then emits ``events.<name>``; views never
 write the model except through these methods. Sub-models are handed the
@@ -43,7 +47,7 @@ class Document:
     def __init__(self):
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
-                                   "point_selection", "pose", "preview", "timeline")
+                                   "point_selection", "pose", "pose_settled", "preview", "timeline", "camera")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -74,6 +78,8 @@ class Document:
         self.only_working = False
         self.cube_centre: np.ndarray | None = None
         self.point_selection = np.zeros(0, np.int64)  # the last cube / lasso selection
+        self.camera: dict | None = None  # the last camera set or saved (the view's own when it lends it)
+        self.view_camera = None  # () -> dict: the scene's camera now (a project saves what is on screen)
 
     # ------------------------------------------------------------------ data
     def set_volume(self, volume, mask=None, *, spacing=(1.0, 1.0, 1.0), path=None, segmentation=None, dims=None):
@@ -220,6 +226,15 @@ class Document:
         self.preview = preview
         self.events.preview.emit()
 
+    def set_camera(self, camera: dict | None) -> None:
+        """Look from ``camera`` (a saved view: position, focal_point, view_up); the scene follows."""
+        self.camera = None if camera is None else dict(camera)
+        self.events.camera.emit(camera=self.camera)
+
+    def camera_now(self) -> dict | None:
+        """The camera to save: the view's own when a scene lends it, else the last one set."""
+        return self.view_camera() if self.view_camera is not None else self.camera
+
     def set_point_selection(self, indices) -> None:
         self.point_selection = np.asarray(indices, np.int64)
         self.events.point_selection.emit()
@@ -245,6 +260,17 @@ class Document:
 
     def message(self, text: str) -> None:
         self.events.message.emit(text=text)
+
+    def loading(self, load):
+        """Run ``load()``, which puts a file into the session, as what it is: not an edit (issue #37).
+
+        Ctrl+Z right after opening a file undid the opening. The history starts clean after a
+        load, and the document reads as modified until saved: what was loaded is not in the project
+        yet. A load that fails (raises) leaves the document and its history as they were.
+        """
+        result = load()
+        self.undo.clear()
+        return result
 
     # ------------------------------------------------------ document state
     @property
@@ -275,13 +301,14 @@ class Document:
         self.cube_centre = None
         self.point_selection = np.zeros(0, np.int64)
         self._symmetry_x = None
+        self.camera = None
         self.set_volume(None)
         self.bones_path = self.project_path = self.demo_name = None
         self.undo.clear()
         self.undo.mark_clean()
         self.events.project.emit(path=None)
 
-    def save_project(self, path, camera: dict | None = None) -> Path:
+    def save_project(self, path) -> Path:
         """Save the project as one unit: ``NAME.volanim`` and its data files in ``NAME.volanim.d/``.
 
         The bone skeleton, the attachments (all of them, whatever the slider)
@@ -293,7 +320,7 @@ class Document:
         path = Path(path)
         if path.suffix != ".volanim":
             path = path.with_suffix(".volanim")
-        written = self.write_project(path, camera)
+        written = self.write_project(path)
         self.bones_path = written["bones"]
         self.mskel_path = written["mskel"]
         self.project_path = str(path)
@@ -301,9 +328,9 @@ class Document:
         self.events.project.emit(path=str(path))
         return path
 
-    def write_project(self, path, camera: dict | None = None) -> dict:
+    def write_project(self, path) -> dict:
         """Write the project files without adopting their paths (autosave uses this)."""
         from .project import write_project
 
-        return write_project(self, path, camera)
+        return write_project(self, path)
 

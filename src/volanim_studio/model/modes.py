@@ -10,21 +10,12 @@ mode with plain objects and assert on the document.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import StrEnum
 
 import numpy as np
 
 from . import selection
 from .document import Document
-
-
-class Mode(StrEnum):
-    VIEW = "view"
-    BONES = "bones"
-    ROOT_ORDER = "root_order"
-    CUBE = "cube"
-    LASSO = "lasso"
-    POSE = "pose"
+from .settings import Mode
 
 
 @dataclass(frozen=True)

@@ -26,11 +26,30 @@ class PoseState:
         self.shifts: dict[tuple[str, str], np.ndarray] = {}
         self._rest_parts = None  # (key, breakage.RestParts) of the current attachments
         self.rest_version = 0  # counts attachment changes: a report made before one must not be kept
+        self._rest_preview = None  # (key, Preview) of the rest pose, for Compare (settings.show_rest)
         doc.events.attachments.connect(self._forget_rest_parts)
+        doc.events.bones.connect(self._forget_rest_parts)
 
     def _forget_rest_parts(self, **_) -> None:
         self._rest_parts = None
+        self._rest_preview = None
         self.rest_version += 1
+
+    def rest_preview(self, mode: str):
+        """The rest pose's reconstruction in ``mode`` (Compare shows it instead of the posed one), made
+        once per attachments, bones, thinness and mode; None when nothing is attached."""
+        from volanim_core.rig.tskel import identity_tskel
+
+        from .preview import make_preview
+
+        key = (self.rest_version, self.doc.thinness, mode)
+        if self._rest_preview is None or self._rest_preview[0] != key:
+            tskel = self.tskel()
+            if not len(tskel):
+                return None
+            self._rest_preview = (key, make_preview(identity_tskel(tskel.connectivity), mode=mode,
+                                                    source=self.doc.volume))
+        return self._rest_preview[1]
 
     def _rest_key(self, tskel: Tskel) -> tuple:
         return (self.doc.thinness, len(tskel))
@@ -76,7 +95,17 @@ class PoseState:
     def _push(self, label: str, angles: dict, shifts: dict, merge_key: str | None = None) -> None:
         old = ({k: v.copy() for k, v in self.angles.items()}, {k: v.copy() for k, v in self.shifts.items()})
         new = ({k: np.array(v) for k, v in angles.items()}, {k: np.array(v) for k, v in shifts.items()})
-        self.doc.undo.push(Command(label, lambda: self._write(*new), lambda: self._write(*old), merge_key))
+        timeline, looks = self.doc.timeline, self.doc.timeline.looks
+
+        def undo():
+            """What replaying the session without this edit shows: the pose before it, unless an animation's
+            frame was shown since (scrubbing puts the frame's pose on the bones; so would the replay)."""
+            if timeline.active and timeline.looks != looks:
+                timeline.show_frame()
+            else:
+                self._write(*old)
+
+        self.doc.undo.push(Command(label, lambda: self._write(*new), undo, merge_key))
 
     def set_angles(self, bone: int, angles, *, merge: bool = True) -> None:
         """Rotate ``bone`` about its proximal joint (x, y, z degrees); children follow."""
@@ -97,6 +126,13 @@ class PoseState:
         self._push(f"Reset {self.doc.bones.bones[bone].label}", {a: v for a, v in self.angles.items() if a != k},
                    {a: v for a, v in self.shifts.items() if a != k})
 
+    def settle(self) -> None:
+        """A pose edit is finished (a typed angle, a reset): it ends its undo step and
+        ``doc.events.pose_settled`` asks for the full preview. A held slider settles by its release
+        (``settings.dragging`` back to False)."""
+        self.doc.undo.seal()
+        self.doc.events.pose_settled.emit()
+
     def show(self, matrices: np.ndarray) -> None:
         """Take a frame's matrices as the pose without an undo step (the timeline's current frame:
         scrubbing is looking, not editing); the sliders show the frame's angles."""
@@ -112,9 +148,12 @@ class PoseState:
     # ----------------------------------------------------------------- state
     def to_json(self) -> dict:
         """The pose as a project holds it: ``{"angles": [[PROXIMAL, DISTAL, rx, ry, rz], ...], "shifts": [...]}``
-        (joint names: the pose stays with its bones whatever order they are in)."""
+        (joint names: the pose stays with its bones whatever order they are in). Entries of bones that
+        are gone (removed, until an undo brings them back) move nothing and are not saved."""
+        known = {self._key(i) for i in range(len(self.doc.bones))}
+
         def rows(table):
-            return [[p, d, *(float(v) for v in value)] for (p, d), value in sorted(table.items())]
+            return [[p, d, *(float(v) for v in value)] for (p, d), value in sorted(table.items()) if (p, d) in known]
 
         return {"angles": rows(self.angles), "shifts": rows(self.shifts)}
 
@@ -146,10 +185,11 @@ class PoseState:
 
     # ----------------------------------------------------------------- files
     def load_trans(self, path) -> None:
-        """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order)."""
+        """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order); a load,
+        not an edit: the history starts after it."""
         trans = io.read_trans(path)
         check_root_order(root_bones(self.doc.bones), trans.bones, ".trans")
-        self._push(f"Load pose {path}", *self._from_matrices(trans.matrices))
+        self.doc.loading(lambda: self._write(*self._from_matrices(trans.matrices)))
 
     def save_trans(self, path) -> None:
         io.write_trans(path, Trans(root_bones(self.doc.bones), self.matrices()))

@@ -5,11 +5,8 @@
                      "segmentation": {lo, hi, fill, metric, min_thinness},   how it was segmented
                      "bones", "connect", "mskel": "NAME.volanim.d/<kind>-<hash>.<kind>",
                      "sha256": {"bones": ..., ...},      what each data file must hash to
-                     "thinness", "symmetry_x", "settings", "camera",
-                     "pose": {"angles": [[PROXIMAL, DISTAL, rx, ry, rz], ...], "shifts": [...]},   the current pose
-                     "timeline": {"keys": {FRAME: [[PROXIMAL, DISTAL, rx, ry, rz, tx, ty, tz], ...]},
-                                  "ease", "length", "fps", "clip": {"kind": "bvh"|"trans", "path", "mapping",
-                                  "up", "forward"}}     the animation (a clip is referenced, never copied)
+                     "settings", "thinness", "symmetry_x", "timeline", "pose", "selection", "camera"
+                                                          the session's state: document_state.PARTS
     NAME.volanim.d/ the data files of the current and the previous save (``volanim_core.io.bundle``)
 
 A save is one unit: the data files are written under content names first and
@@ -35,8 +32,8 @@ from volanim_core.io import bundle
 from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
-from .posing import PoseState
-from .timeline import Timeline
+from . import document_state
+from .document_state import _relative
 
 PROJECT_FORMAT = "volanim project"
 PROJECT_VERSION = 3
@@ -60,7 +57,7 @@ def _store_skeleton(path: Path, skeleton) -> tuple[str, str]:
     return rel, digest
 
 
-def write_project(doc, path, camera: dict | None = None) -> dict:
+def write_project(doc, path) -> dict:
     """Write ``doc`` as one project save (see the module docstring); returns the absolute paths written."""
     path = Path(path)
     stored = {}
@@ -79,28 +76,12 @@ def write_project(doc, path, camera: dict | None = None) -> dict:
         "segmentation": doc.segmentation,
         **{key: rel for key, (rel, _) in stored.items()},
         "sha256": {key: digest for key, (_, digest) in stored.items()},
-        "thinness": doc.thinness, "symmetry_x": doc._symmetry_x, "settings": doc.settings.as_dict(),
-        "camera": camera, "timeline": _timeline_json(doc, path), "pose": doc.pose.to_json(),
+        **document_state.save_all(doc, path),
     }
     bundle.commit(path, data)
     written = {"project": str(path), "bones": None, "mskel": None, "connect": None}
     written.update({key: str((path.parent / rel).resolve()) for key, (rel, _) in stored.items()})
     return written
-
-
-def _relative(path: Path, target: str) -> str:
-    """``target`` relative to the project's folder when it is inside it (the pair can move together)."""
-    try:
-        return str(Path(target).resolve().relative_to(path.parent.resolve()))
-    except ValueError:
-        return str(Path(target).resolve())
-
-
-def _timeline_json(doc, path: Path) -> dict:
-    data = doc.timeline.to_json()
-    if data["clip"]:
-        data["clip"]["path"] = _relative(path, data["clip"]["path"])
-    return data
 
 
 def _expect(path, data: dict, key: str, kinds, what: str):
@@ -142,25 +123,9 @@ def _parse(path: Path, text: str) -> dict:
     _expect(path, data, "demo", str, "a sample name")
     for key in ("volume", *DATA_FILES):
         _expect(path, data, key, str, "a file name")
-    for key in ("thinness", "symmetry_x"):
-        value = _expect(path, data, key, int | float, "a number")
-        if value is not None and (isinstance(value, bool) or not math.isfinite(value)):
-            raise FormatError(path, f"\"{key}\" must be a finite number, got {value!r}")
-    for key in ("settings", "camera", "segmentation", "sha256", "timeline", "pose"):
+    for key in ("segmentation", "sha256"):
         _expect(path, data, key, dict, "an object")
-    if data.get("pose") is not None:
-        try:
-            data["pose"] = PoseState.parse(data["pose"], path.name)
-        except ValueError as exc:
-            raise FormatError(path, str(exc).removeprefix(f"{path.name}: ")) from None
-    if data.get("timeline") is not None:
-        try:
-            data["timeline"] = Timeline.parse(data["timeline"], path.name)
-        except ValueError as exc:
-            raise FormatError(path, str(exc).removeprefix(f"{path.name}: ")) from None
-        clip = data["timeline"]["clip"]
-        if clip:
-            clip["path"] = str((path.parent / clip["path"]).resolve())
+    data["state"] = document_state.parse_all(data, path)  # every part checked before anything is applied
     dims = _expect(path, data, "volume_dims", list, "a list of three sizes")
     if dims is not None:  # sizes of a headerless .vol: the same limits as any volume header
         checked_grid(path, dims, what="\"volume_dims\"")
@@ -223,15 +188,7 @@ def apply_project(doc, data: dict, path, *, reset: bool = False) -> list[str]:
         doc.bone_edits.load_bones(data["bones"], bones)
     if conn is not None:
         warnings += doc.attachments.apply_connectivity(conn, Path(data["connect"]).name)
-    if data.get("symmetry_x") is not None:
-        doc.symmetry_x = data["symmetry_x"]
-    if data.get("thinness") is not None:
-        doc.thinness = data["thinness"]
-    if data.get("timeline") is not None:
-        warnings += doc.timeline.restore(data["timeline"], Path(path).name)
-    if data.get("pose") is not None:  # after the timeline: the pose the user saved, not its frame's
-        warnings += [f"{Path(path).name}: {w}" for w in doc.pose.restore(*data["pose"])]
-    warnings += [f"{Path(path).name}: {w}" for w in doc.settings.update(data.get("settings") or {})]
+    warnings += document_state.apply_all(doc, data["state"], path)
     doc.project_path = str(path)
     # opening is not an edit: Ctrl+Z right after it undid "Load connect", then the bones (issue #37)
     doc.undo.clear()

@@ -14,10 +14,23 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Any
 
 from .events import EventEmitter
 from .selection import DEPTH_MODES
+
+
+class Mode(StrEnum):
+    """The interaction mode (``modes.HANDLERS`` has one handler each); a setting, so a project keeps it."""
+
+    VIEW = "view"
+    BONES = "bones"
+    ROOT_ORDER = "root_order"
+    CUBE = "cube"
+    LASSO = "lasso"
+    POSE = "pose"
+
 
 COLOUR_BY = ("thinness", "dt", "bone")
 PREVIEW_MODES = ("bone", "binary", "mottled", "hotspot", "sampled")
@@ -58,11 +71,19 @@ def axis_or_none(name, value):
     return number(0, 2, int)(name, value)
 
 
+def mode(name, value) -> Mode:
+    try:
+        return Mode(value)
+    except ValueError:
+        raise ValueError(f"{name} must be one of {', '.join(Mode)}, got {value!r}") from None
+
+
 @dataclass(frozen=True)
 class Setting:
     default: Any
     check: Callable[[str, Any], Any]
     doc: str
+    saved: bool = True  # False: the moment's state (a slider held), never written to a project
 
 
 SETTINGS: dict[str, Setting] = {
@@ -93,6 +114,10 @@ SETTINGS: dict[str, Setting] = {
     # timeline
     "current_frame": Setting(0, number(0, 10**7, int), "the frame shown (motion and sequences)"),
     "follow_body": Setting(True, flag, "the camera follows the body as the timeline plays or steps, and in movies"),
+    # interaction
+    "mode": Setting(Mode.VIEW, mode, "the interaction mode (View, Bones, Root order, Cube, Lasso, Pose)"),
+    "dragging": Setting(False, flag, "a slider is held: the scene draws light, previews wait for the release",
+                        saved=False),
 }
 
 
@@ -104,14 +129,15 @@ class Settings:
         self._values = {name: s.default for name, s in SETTINGS.items()}
 
     def as_dict(self) -> dict:
-        return dict(self._values)
+        """The settings a project saves (every one but the moment's state, such as a held slider)."""
+        return {name: value for name, value in self._values.items() if SETTINGS[name].saved}
 
     def update(self, values: dict) -> list[str]:
         """Set every known, valid entry of ``values`` (a saved project); returns what was refused."""
         refused = []
         for name, value in values.items():
             try:
-                if name not in SETTINGS:
+                if name not in SETTINGS or not SETTINGS[name].saved:
                     raise ValueError(f"unknown setting {name!r}")
                 setattr(self, name, value)
             except ValueError as exc:

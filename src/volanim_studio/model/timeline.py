@@ -62,7 +62,8 @@ class Timeline:
         self.ease = True
         self.length = DEFAULT_LENGTH  # frames of a keyed animation
         self.fps = DEFAULT_FPS  # of a keyed animation
-        doc.settings.events.current_frame.connect(lambda value: self.show_frame(value))
+        self.looks = 0  # counts frames shown (the current frame set): an undo after one shows the frame
+        doc.settings.events.current_frame.connect(self._on_frame)
         doc.events.bones.connect(self._on_bones)
 
     # ------------------------------------------------------------ queries
@@ -95,6 +96,10 @@ class Timeline:
         return frame
 
     # -------------------------------------------------------------- frames
+    def _on_frame(self, value: int) -> None:
+        self.looks += 1
+        self.show_frame(value)
+
     def show_frame(self, frame: int | None = None) -> None:
         """Put the frame's pose on the bones (view state, like scrubbing: no undo step)."""
         if not self.active or not len(self.doc.bones):
@@ -115,8 +120,19 @@ class Timeline:
         self.show_frame()
 
     def _push_keys(self, label: str, keys: dict[int, KeyPose]) -> None:
+        """One undo step. Its undo gives back what replaying the session without this edit would show:
+        the pose the user keyed, unless a frame was shown since (then that frame of the old keys)."""
         old, new = dict(self.keys), dict(keys)
-        self.doc.undo.push(Command(label, lambda: self._set_keys(new), lambda: self._set_keys(old)))
+        pose = self.doc.pose
+        old_pose = ({k: v.copy() for k, v in pose.angles.items()}, {k: v.copy() for k, v in pose.shifts.items()})
+        looks = self.looks
+
+        def undo():
+            self._set_keys(old)  # shows the current frame of the old keys
+            if self.looks == looks:
+                pose._write(*old_pose)
+
+        self.doc.undo.push(Command(label, lambda: self._set_keys(new), undo))
 
     def _refuse_with_clip(self) -> None:
         if self.clip is not None:
@@ -151,7 +167,12 @@ class Timeline:
     # ---------------------------------------------------------------- clips
     def load_bvh(self, path, mapping: dict[str, str] | None = None, up: str = "auto", forward: str = "auto",
                  motion: Motion | None = None) -> Retarget:
-        """Retarget a BVH clip onto the bones and put it on the timeline (FormatError names the file)."""
+        """Retarget a BVH clip onto the bones and put it on the timeline (FormatError names the file).
+        A load, not an edit: the history starts after it."""
+        return self.doc.loading(lambda: self._retarget(path, mapping, up, forward, motion))
+
+    def _retarget(self, path, mapping, up, forward, motion) -> Retarget:
+        """:meth:`load_bvh` without touching the history (the bones changed: the clip follows them)."""
         if not len(self.doc.bones):
             raise ValueError("build or open the bone skeleton first: the clip drives its bones")
         motion = read_bvh(path) if motion is None else motion
@@ -166,7 +187,11 @@ class Timeline:
         return r
 
     def load_trans(self, paths) -> Clip:
-        """A folder (or list) of ``.trans`` frames of these bones as the clip."""
+        """A folder (or list) of ``.trans`` frames of these bones as the clip; a load: the history starts
+        after it."""
+        return self.doc.loading(lambda: self._take_frames(paths))
+
+    def _take_frames(self, paths) -> Clip:
         if not len(self.doc.bones):
             raise ValueError("build or open the bone skeleton first: the frames move its bones")
         mats, files = read_frames(paths, self.doc.bones)
@@ -195,8 +220,8 @@ class Timeline:
             return
         if c.motion is not None and len(self.doc.bones):
             try:
-                self.load_bvh(c.path, {k: v for k, v in c.mapping.items()
-                                       if k in {b.label for b in self.doc.bones.bones}}, c.up, c.forward, c.motion)
+                self._retarget(c.path, {k: v for k, v in c.mapping.items()
+                                        if k in {b.label for b in self.doc.bones.bones}}, c.up, c.forward, c.motion)
                 return
             except ValueError as exc:
                 self.doc.message(f"The clip {c.name} was unloaded: {exc}")

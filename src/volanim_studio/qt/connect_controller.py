@@ -9,8 +9,6 @@ Owned by the main window.
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QMessageBox
-
 from .controller import Controller
 
 
@@ -39,18 +37,11 @@ class ConnectController(Controller):
         # body): the fallback method attaches those to the nearest bone instead
         text += ("\n\nMost points found no path. The method path-or-nearest connects those to the nearest bone: "
                  "use it now?")
-        box = QMessageBox(QMessageBox.Question, "Auto-connect", text, QMessageBox.Yes | QMessageBox.No, self.window)
-        box.button(QMessageBox.Yes).setText("Use path-or-nearest")
+        def fall_back():
+            st.auto_method = "path-or-nearest"
+            self.auto_connect()
 
-        def answered(_result):
-            if box.standardButton(box.clickedButton()) == QMessageBox.Yes:
-                st.auto_method = "path-or-nearest"
-                self.auto_connect()
-
-        box.finished.connect(answered)
-        self.window.last_error = text
-        self.window._error_box = box
-        box.open()
+        self.ask("Auto-connect", text, "Use path-or-nearest", fall_back)
 
     def mirror_connectivity(self) -> None:
         try:

@@ -19,6 +19,7 @@ class Controller:
         self.scene = window.scene
         self.jobs = window.jobs
         self.show_error = window.show_error
+        self.ask = window.ask
 
     def folder(self, name: str = "") -> str:
         """Where a file dialog opens: the project's folder (else the volume's, the skeleton's, the

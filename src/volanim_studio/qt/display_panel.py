@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -29,7 +29,6 @@ class DisplayPanel(QWidget):
     """Thinness slider, cloud style, hull opacity/visibility and clipping."""
 
     #: the thinness slider is held (True) or released (False): the scene draws a level-of-detail subset
-    dragging = Signal(bool)
 
     def __init__(self, doc: Document, parent=None):
         super().__init__(parent)
@@ -84,8 +83,8 @@ class DisplayPanel(QWidget):
         layout.addStretch(1)
 
         self.thinness_slider.valueChanged.connect(self._slider_moved)
-        self.thinness_slider.sliderPressed.connect(lambda: self.dragging.emit(True))
-        self.thinness_slider.sliderReleased.connect(lambda: self.dragging.emit(False))
+        self.thinness_slider.sliderPressed.connect(lambda: setattr(doc.settings, "dragging", True))
+        self.thinness_slider.sliderReleased.connect(lambda: setattr(doc.settings, "dragging", False))
         # typed values apply on Enter or focus-out, not per key: "0.7" applied while typing "0.75"
         # wrote "0.700" back into the box and the "5" was lost
         self.thinness_spin.setKeyboardTracking(False)

@@ -168,7 +168,7 @@ class FilesController(Controller):
     def open_mskel(self, path) -> bool:
         def load():
             skel = io.read_mskel(path)
-            self.doc.set_skeleton(skel, path)
+            self.doc.loading(lambda: self.doc.set_skeleton(skel, path))
             return skel
 
         return self.attempt("Open skeleton", load,
@@ -202,8 +202,6 @@ class FilesController(Controller):
                 return
             if warnings:
                 self.show_error("Open project", "\n".join(warnings))
-            if data.get("camera"):
-                self.scene.set_camera(data["camera"])
             self.doc.undo.mark_clean()  # as saved: loading its bones is not an edit to save
             self.doc.message(f"Opened {Path(path).name}.")
             done(True)
@@ -275,7 +273,7 @@ class FilesController(Controller):
                 path, _ = QFileDialog.getSaveFileName(self.window, title, where, "Projects (*.volanim)")
                 if not path:
                     return None
-        saved = self.attempt("Save project", lambda: self.doc.save_project(path, camera=self.scene.camera()),
+        saved = self.attempt("Save project", lambda: self.doc.save_project(path),
                              lambda saved: f"Saved {saved}.")
         return None if saved is FAILED else saved
 

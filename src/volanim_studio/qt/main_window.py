@@ -92,7 +92,7 @@ class MainWindow(QMainWindow):
         self.setCentralWidget(self.plotter.interactor if hasattr(self.plotter, "interactor") else self.plotter)
         self.scene = SceneView(self.plotter, self.doc, on_pick=self.handle_pick)
         self.handlers = {m: cls(self.doc) for m, cls in HANDLERS.items()}
-        self.mode = Mode.VIEW
+        self._entered = Mode.VIEW  # the handler entered last (settings.mode is the mode)
         self.jobs = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text),
                               on_idle=self.activateWindow)  # focus back after a job (Xvfb has no WM to do it)
         self.last_error: str | None = None
@@ -102,9 +102,7 @@ class MainWindow(QMainWindow):
         self.previews = PreviewController(self)
         self.naming = NamingController(self)
         self.connecting = ConnectController(self)
-        self.previews.in_pose_mode = lambda: self.mode == Mode.POSE
         self.display_panel = DisplayPanel(self.doc)
-        self.display_panel.dragging.connect(self.scene.set_dragging)
         self.bone_panel = BonePanel(self.doc)
         self.connect_panel = ConnectPanel(self.doc, self.handlers[Mode.CUBE])
         self.pose_panel = PosePanel(self.doc)
@@ -124,8 +122,7 @@ class MainWindow(QMainWindow):
         dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
         self.timeline_panel = TimelinePanel(self.doc)
-        self.timeline = TimelineController(self, self.previews)
-        self.timeline.enter_pose = lambda: self.set_mode(Mode.POSE) if self.mode != Mode.POSE else None
+        self.timeline = TimelineController(self)
         timeline_dock = QDockWidget("Timeline", self)
         timeline_dock.setWidget(self.timeline_panel)
         timeline_dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
@@ -141,7 +138,8 @@ class MainWindow(QMainWindow):
         self.doc.events.bones.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.undo.events.changed.connect(self._on_undo_changed)
         self.session = SessionController(self, every_edits=autosave_every_edits, every_seconds=autosave_seconds)
-        self.set_mode(Mode.VIEW)
+        self.doc.settings.events.mode.connect(lambda value: self._enter_mode(value))
+        self._enter_mode(self.doc.settings.mode)
         self._letters = LettersPastNumberFields(self)
         for box in self.findChildren(QAbstractSpinBox):
             box.installEventFilter(self._letters)
@@ -219,11 +217,20 @@ class MainWindow(QMainWindow):
         self._action("&Shortcuts", self.show_shortcuts, "F1", menu=help_menu)
         self._on_undo_changed()
 
+    @property
+    def mode(self) -> Mode:
+        return self.doc.settings.mode
+
     def set_mode(self, mode: Mode) -> None:
-        self.handlers[self.mode].leave()
-        if self.mode == Mode.POSE and mode != Mode.POSE:
-            self.previews.leave_pose()
-        self.mode = Mode(mode)
+        """Switch the interaction mode (a setting: a project reopens in it); the same mode enters again."""
+        if Mode(mode) == self.doc.settings.mode:
+            self._enter_mode(mode)
+        else:
+            self.doc.settings.mode = mode  # --> _enter_mode
+
+    def _enter_mode(self, mode: Mode) -> None:
+        self.handlers[self._entered].leave()
+        self._entered = Mode(mode)
         self.mode_actions[self.mode].setChecked(True)
         self.scene.lasso.set_enabled(self.mode == Mode.LASSO)
         self.scene.set_posing(self.mode == Mode.POSE)
@@ -321,6 +328,18 @@ class MainWindow(QMainWindow):
         box = QMessageBox(QMessageBox.Warning, title, message, QMessageBox.Ok, self)
         self._error_box = box
         box.open()
+
+    def ask(self, title: str, message: str, yes: str, on_yes) -> QMessageBox:
+        """A non-blocking question after a refusal (the document is untouched): its Yes button reads
+        ``yes`` and runs ``on_yes()``; shown where errors are (``last_error``)."""
+        self.last_error = message
+        box = QMessageBox(QMessageBox.Question, title, message, QMessageBox.Yes | QMessageBox.No, self)
+        box.button(QMessageBox.Yes).setText(yes)
+        box.finished.connect(lambda _: on_yes() if box.standardButton(box.clickedButton()) == QMessageBox.Yes
+                             else None)
+        self._error_box = box
+        box.open()
+        return box
 
     @property
     def busy(self) -> bool:

@@ -4,7 +4,7 @@ pose events write the widgets back with signals blocked."""
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
     QDoubleSpinBox,
     QFormLayout,
@@ -24,9 +24,6 @@ from .verdict_label import VerdictLabel
 class PosePanel(QWidget):
     """Three angle sliders (degrees about x, y, z at the proximal joint) for the working bone."""
 
-    drag_started = Signal()
-    drag_finished = Signal()
-
     def __init__(self, doc: Document, parent=None):
         super().__init__(parent)
         self.doc = doc
@@ -43,7 +40,7 @@ class PosePanel(QWidget):
             row.addWidget(spin)
             form.addRow(QLabel(f"<b style='color:{colour}'>{axis}</b> ° ({name} arrow)"), row)
             slider.valueChanged.connect(self._slider_changed)
-            slider.sliderPressed.connect(self.drag_started.emit)
+            slider.sliderPressed.connect(self._pressed)
             slider.sliderReleased.connect(self._released)
             spin.editingFinished.connect(self._spin_changed)
             self.sliders.append(slider)
@@ -80,8 +77,8 @@ class PosePanel(QWidget):
 
     def _slider_changed(self, _=None) -> None:
         b = self.doc.working_bone
-        if b is not None:
-            self.doc.pose.set_angles(b, self._angles())
+        if b is not None:  # a held slider's moves merge into one step; each arrow key or wheel step is one
+            self.doc.pose.set_angles(b, self._angles(), merge=any(s.isSliderDown() for s in self.sliders))
 
     def _spin_changed(self) -> None:
         b = self.doc.working_bone
@@ -90,17 +87,20 @@ class PosePanel(QWidget):
         # angle made three undo steps, and the first Ctrl+Z changed nothing)
         if b is not None and not np.allclose(typed, self.doc.pose.angles_of(b)):
             self.doc.pose.set_angles(b, typed, merge=False)
-            self.doc.undo.seal()  # one typed value is one step: the next slider drag is another
-            self.drag_finished.emit()
+            self.doc.pose.settle()  # one typed value is one step, previewed in full
+
+    def _pressed(self) -> None:
+        self.doc.undo.seal()  # a drag is a step of its own, whatever came before it
+        self.doc.settings.dragging = True
 
     def _released(self) -> None:
-        self.doc.undo.seal()
-        self.drag_finished.emit()
+        self.doc.undo.seal()  # press to release: one undo step
+        self.doc.settings.dragging = False  # the scene draws in full again; the full preview follows
 
     def _reset_bone(self) -> None:
         if self.doc.working_bone is not None:
             self.doc.pose.reset(self.doc.working_bone)
-            self.drag_finished.emit()
+            self.doc.pose.settle()
 
     def _refresh(self, **_) -> None:
         b = self.doc.working_bone

@@ -1,8 +1,11 @@
 """Posing and previews: live and full previews, compare, slices, export, poses in and out.
 
-    pose slider drag --doc.events.pose--> live_preview (half resolution, GUI thread, coalesced)
-    drag released / F5 --> preview() --> JobRunner(make_preview + breakage report) --> doc.set_preview
-    doc.events.preview, settings.show_rest / slices --> draw() --> scene
+    settings.dragging (a pose slider, the timeline held or playing) + doc.events.pose
+        --> live_preview (half resolution, GUI thread, coalesced) --> doc.set_preview
+    settings.current_frame (a step) --> live_preview
+    dragging back to False in Pose mode, doc.events.pose_settled, F5
+        --> preview() --> JobRunner(make_preview + breakage report) --> doc.set_preview
+    doc.set_preview --> the scene's PoseLayer draws it (this controller draws nothing)
 
 Owned by the main window (composed, not inherited). Preview mode, kernel and
 padding are read from ``doc.settings`` at the moment of use, never from widgets.
@@ -19,6 +22,7 @@ from PySide6.QtWidgets import QFileDialog
 from volanim_core import io
 
 from ..model.preview import make_preview
+from ..model.settings import Mode
 from .controller import FAILED, Controller
 from .worker import Worker
 
@@ -26,21 +30,17 @@ from .worker import Worker
 class PreviewController(Controller):
     def __init__(self, window):
         super().__init__(window)
-        self.in_pose_mode = lambda: False  # the window sets it: full previews follow drags only in Pose mode
         self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
-        self._posing_drag = False
-        self._rest_preview = None
         self._live_timer = QTimer(window)
         self._live_timer.setSingleShot(True)
         self._live_timer.setInterval(0)
         self._live_timer.timeout.connect(self.live_preview)
         ev, st = self.doc.events, self.doc.settings.events
         ev.pose.connect(self._on_pose_changed)
-        ev.preview.connect(lambda **_: self.draw())
-        ev.attachments.connect(self._forget_rest)
-        ev.bones.connect(self._forget_rest)
-        st.show_rest.connect(lambda **_: self.draw())
-        st.slices.connect(lambda **_: self.draw())
+        ev.pose_settled.connect(lambda **_: self._settled())
+        st.dragging.connect(self._on_dragging)
+        st.current_frame.connect(lambda **_: self.live_preview_soon() if self.doc.timeline.active else None)
+        st.mode.connect(lambda value: self._live_timer.stop() if value != Mode.POSE else None)
 
     def fill_menu(self, menu, action) -> None:
         """The Pose menu; ``action(text, slot, shortcut=None, menu=None)`` makes a window action."""
@@ -52,9 +52,7 @@ class PreviewController(Controller):
         action("Export reconstruction…", lambda: self.save_dialog("volume"), menu=menu)
 
     def wire(self, pose_panel, reconstruct_panel) -> None:
-        """Connect the Pose and Reconstruct tabs' buttons and drags to this controller."""
-        pose_panel.drag_started.connect(self.drag_started)
-        pose_panel.drag_finished.connect(self.drag_finished)
+        """Connect the Pose and Reconstruct tabs' buttons to this controller."""
         pose_panel.load_trans.clicked.connect(lambda: self.load_trans_dialog())
         pose_panel.save_trans.clicked.connect(lambda: self.save_dialog("trans"))
         pose_panel.save_tskel.clicked.connect(lambda: self.save_dialog("tskel"))
@@ -62,25 +60,28 @@ class PreviewController(Controller):
         reconstruct_panel.export_button.clicked.connect(lambda: self.save_dialog("volume"))
         reconstruct_panel.joint_clicked.connect(self.jump_to_joint)
 
-    def leave_pose(self) -> None:
-        """Leaving the pose stage drops a live preview still waiting to run."""
-        self._live_timer.stop()
+    @property
+    def _posing(self) -> bool:
+        """In Pose mode with something attached: what full previews follow."""
+        bone = self.doc.attachments.bone
+        return self.doc.settings.mode == Mode.POSE and len(bone) > 0 and bool((bone >= 0).any())
 
-    def drag_started(self) -> None:
-        self._posing_drag = True
-        self.scene.hold_fxaa(True)
-        worker = self.jobs.worker
-        if worker is not None and getattr(worker, "is_preview", False):
-            worker.cancel()  # a newer pose is coming
+    def _on_dragging(self, value: bool) -> None:
+        """Held (a pose slider, the timeline scrubbed or playing): a running full preview is cancelled, a
+        newer pose is coming; released in Pose mode: the full preview with its report."""
+        if value:
+            worker = self.jobs.worker
+            if worker is not None and getattr(worker, "is_preview", False):
+                worker.cancel()
+        elif self._posing:
+            self.preview()
 
-    def drag_finished(self) -> None:
-        self._posing_drag = False
-        self.scene.hold_fxaa(False)
-        if self.in_pose_mode() and len(self.doc.attachments.bone) and (self.doc.attachments.bone >= 0).any():
+    def _settled(self) -> None:
+        if self._posing:
             self.preview()
 
     def _on_pose_changed(self, **_) -> None:
-        if self._posing_drag and self.doc.settings.live_preview:
+        if self.doc.settings.dragging and self.doc.settings.live_preview:
             self._request_live()
 
     def live_preview_soon(self) -> None:
@@ -145,32 +146,6 @@ class PreviewController(Controller):
             rest_parts=rest, progress=progress, cancel=cancel), done)
         worker.is_preview = True
         return worker
-
-    def _forget_rest(self, **_) -> None:
-        self._rest_preview = None
-
-    def draw(self) -> None:
-        """Show the last preview (or the rest pose's, to compare) in the scene."""
-        p = self.doc.preview
-        if self.doc.settings.show_rest:
-            if self._rest_preview is None and len(self.doc.attachments.bone):
-                from volanim_core.rig.tskel import identity_tskel
-
-                try:
-                    rest = identity_tskel(self.doc.pose.tskel().connectivity)
-                    mode = p.mode if p is not None else "bone"
-                    self._rest_preview = make_preview(rest, mode=mode, source=self.doc.volume)
-                except ValueError as exc:
-                    self.doc.message(str(exc))
-                    return
-            p = self._rest_preview
-        if p is None:
-            self.scene.pose_layer.clear()
-            return
-        if p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
-            self.scene.pose_layer.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
-        else:
-            self.scene.pose_layer.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
 
     def jump_to_joint(self, name: str) -> None:
         posed = self.doc.pose.posed_joints()

@@ -25,6 +25,7 @@ from volanim_core.motion.frames import write_frames
 from volanim_core.reconstruct.scan import scan_frames, worst_first
 from volanim_core.render.camera import Camera
 
+from ..model.settings import Mode
 from .controller import FAILED, Controller
 from .mapping_dialog import MappingDialog
 from .movie_dialog import MovieDialog
@@ -32,10 +33,8 @@ from .scan_dialog import ScanDialog
 
 
 class TimelineController(Controller):
-    def __init__(self, window, previews):
+    def __init__(self, window):
         super().__init__(window)
-        self.previews = previews
-        self.enter_pose = lambda: None  # the window sets it: playing shows the posed preview
         self.step_actions = []  # arrows: the window disables them in Cube mode (the cube's nudges)
         self.shown_frames: list[int] = []  # frames drawn while playing (tests, benchmarks)
         self.scan_dialog: ScanDialog | None = None
@@ -80,15 +79,12 @@ class TimelineController(Controller):
         panel.scan.clicked.connect(lambda: self.scan())
         panel.export.clicked.connect(lambda: self.export_dialog(tskel=False))
         panel.movie.clicked.connect(lambda: self.render_movie_dialog())
-        panel.scrub_started.connect(self.previews.drag_started)
-        panel.scrub_finished.connect(self.previews.drag_finished)
 
     # ------------------------------------------------------------ frames
     def _frame_changed(self) -> None:
         if self.doc.timeline.active:
             if self.doc.settings.follow_body and self.scene.posing:  # the posed body is what the view shows
                 self.follow_body(blend=0.35 if self.playing else 1.0)
-            self.previews.live_preview_soon()
 
     def follow_body(self, blend: float = 1.0) -> None:
         """Centre the view on the posed body (the middle of its posed joints' box): a walk's figure, which
@@ -122,8 +118,8 @@ class TimelineController(Controller):
             self.doc.message("Nothing to play: load a BVH clip or .trans frames, or set keys.")
             self._sync_button()
             return
-        self.enter_pose()
-        self.previews.drag_started()  # live previews follow; a running full preview is cancelled
+        self.doc.settings.mode = Mode.POSE  # playing shows the posed preview
+        self.doc.settings.dragging = True  # held while playing: live previews follow, a full one is cancelled
         self.shown_frames = []
         self._start = (time.perf_counter(), self.doc.settings.current_frame)
         self._play.start(max(5, int(1000 / tl.frame_rate)))
@@ -134,7 +130,7 @@ class TimelineController(Controller):
             return
         self._play.stop()
         self._sync_button()
-        self.previews.drag_finished()  # the full preview with its report, of the frame stopped on
+        self.doc.settings.dragging = False  # the full preview with its report, of the frame stopped on
 
     def _tick(self) -> None:
         tl = self.doc.timeline

@@ -7,7 +7,7 @@
 
 from __future__ import annotations
 
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor, QPainter
 from PySide6.QtWidgets import (
     QCheckBox,
@@ -54,8 +54,6 @@ class KeyedSlider(QSlider):
 
 
 class TimelinePanel(QWidget):
-    scrub_started = Signal()
-    scrub_finished = Signal()
 
     def __init__(self, doc: Document, parent=None):
         super().__init__(parent)
@@ -119,8 +117,8 @@ class TimelinePanel(QWidget):
         bind(self.slider, doc.settings, "current_frame", on_error=doc.message)
         bind(self.frame, doc.settings, "current_frame", on_error=doc.message)
         bind(self.follow, doc.settings, "follow_body", on_error=doc.message)
-        self.slider.sliderPressed.connect(self.scrub_started.emit)
-        self.slider.sliderReleased.connect(self.scrub_finished.emit)
+        self.slider.sliderPressed.connect(lambda: setattr(doc.settings, "dragging", True))
+        self.slider.sliderReleased.connect(lambda: setattr(doc.settings, "dragging", False))
         self.ease.toggled.connect(lambda on: self._option(ease=on))
         self.length.editingFinished.connect(lambda: self._option(length=self.length.value()))
         self.fps.editingFinished.connect(lambda: self._option(fps=self.fps.value()))

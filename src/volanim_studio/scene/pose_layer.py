@@ -1,5 +1,9 @@
 """The pose stage of the scene: posed bones and preview reconstructions.
 
+    doc.events.pose --> posed bones and their axes (x-ray layer)
+    doc.events.preview, settings.show_rest / slices --> draw(): the preview (or the rest pose's, to compare)
+    doc.events.preview (with a report) --> the stumps' red boxes
+
 Owned by :class:`~volanim_studio.scene.view.SceneView`. Full previews are
 volumes with a transfer function per mode (``volanim_core.render``); live
 previews are label-coloured surfaces, which software OpenGL draws far faster.
@@ -46,7 +50,10 @@ class PoseLayer:
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
         self._mapper = None  # the volume mapper for full previews, chosen once the GL context exists
         view.doc.events.pose.connect(self.on_pose_changed)
+        view.doc.events.preview.connect(lambda **_: self.draw())
         view.doc.events.preview.connect(self.on_report)
+        view.doc.settings.events.show_rest.connect(lambda **_: self.draw())
+        view.doc.settings.events.slices.connect(lambda **_: self.draw())
         view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
 
     def on_pose_changed(self, **_) -> None:
@@ -91,6 +98,23 @@ class PoseLayer:
                                                             render=False, reset_camera=False, pickable=False))
         view.apply_stage()
         view.render()
+
+    def draw(self) -> None:
+        """Show the last preview (or, with ``settings.show_rest``, the rest pose's, to compare)."""
+        doc = self.view.doc
+        p = doc.preview
+        if doc.settings.show_rest:
+            try:
+                p = doc.pose.rest_preview(p.mode if p is not None else "bone")
+            except ValueError as exc:
+                doc.message(str(exc))
+                return
+        if p is None:
+            self.clear()
+        elif p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
+            self.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+        else:
+            self.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
 
     def on_report(self, **_) -> None:
         """Mark the last full preview's stumps in 3-D (red boxes), where the pose left them; a pose

@@ -56,7 +56,7 @@ class SceneView:
         self._press = None
         self._shown = np.zeros(0, np.int64)
         self.posing = False
-        self.dragging = False  # the thinness slider is held: draw a level-of-detail subset
+        self.dragging = False  # settings.dragging (a slider held): draw a level-of-detail subset
         self._fxaa_after_drag: bool | None = None  # the renderer's FXAA, put back on release
         self._render_pending = False
         self._drawn_once = False
@@ -82,6 +82,9 @@ class SceneView:
         st.colour_by.connect(self._on_colour_by_changed)
         st.point_size.connect(lambda **_: self._update_cloud())
         st.spheres.connect(lambda **_: self._update_cloud())
+        st.dragging.connect(lambda value: self.set_dragging(value))
+        doc.view_camera = self.camera  # a project saves the camera on screen, and doc.set_camera puts one back
+        ev.camera.connect(lambda camera: self.set_camera(camera) if camera is not None else None)
         self.xray = XRayLayer(plotter)  # posed bones and their axes, drawn over the preview
         self.names = NamesLayer(self)  # first: the other layers switch stages, which the labels follow
         self.hull = HullLayer(self)
@@ -286,13 +289,17 @@ class SceneView:
         self._update_cloud()
 
     def set_dragging(self, on: bool) -> None:
-        """While the slider is held draw at most LOD_POINTS and the coarse hull, without FXAA;
-        everything on release. (FXAA is a full-window pass after the translucent hull: on software
-        GL at 1200x800 it is ~16 ms of a held frame's ~42 ms render.)"""
+        """While a slider is held (``settings.dragging``) draw at most LOD_POINTS and the coarse hull,
+        without FXAA; everything on release. (FXAA is a full-window pass after the translucent hull: on
+        software GL at 1200x800 it is ~16 ms of a held frame's ~42 ms render.) In Pose mode the cloud
+        and hull are hidden: only FXAA is held."""
+        if self.dragging == bool(on):
+            return
         self.dragging = bool(on)
         self.hold_fxaa(self.dragging)
-        self.hull.set_dragging(self.dragging)
-        self._update_cloud()
+        if not self.posing:
+            self.hull.set_dragging(self.dragging)
+            self._update_cloud()
 
     def hold_fxaa(self, on: bool) -> None:
         """No FXAA pass while something is held (a slider, a pose joint); the renderer's own setting,

@@ -129,12 +129,14 @@ def test_project_round_trip(tmp_path, doc):
     doc.thinness = 0.7
     doc.settings.cube_size = 31
     doc.settings.preview_mode = "hotspot"
-    path = doc.save_project(tmp_path / "session.volanim", camera={"position": [1, 2, 3]})
+    cam = {"position": [1.0, 2.0, 3.0], "focal_point": [0.0, 0.0, 0.0], "view_up": [0.0, 0.0, 1.0]}
+    doc.set_camera(cam)
+    path = doc.save_project(tmp_path / "session.volanim")
     data = read_project(path)
     assert data["volume"] == str((tmp_path / "m.VOL").resolve())
     assert io.read_bones(data["bones"]) == doc.bones
     assert io.read_mskel(data["mskel"]) == doc.skeleton
-    assert data["thinness"] == 0.7 and data["camera"] == {"position": [1, 2, 3]}
+    assert data["state"]["thinness"] == 0.7 and data["state"]["camera"] == cam
     assert data["segmentation"] == seg  # every segmentation parameter, so reopening segments the same way
     assert data["settings"]["cube_size"] == 31 and data["settings"]["preview_mode"] == "hotspot"
     (tmp_path / "bad.volanim").write_text("{nope")
@@ -159,7 +161,7 @@ def test_the_pose_is_saved_with_the_project_and_comes_back(tmp_path, doc):
     assert not fresh.undo.can_undo  # reopening is not an edit
     # a saved pose of a bone that no longer exists is dropped, and said
     data = read_project(path)
-    data["pose"][0][("NOPE", "NADA")] = np.array([1.0, 2.0, 3.0])
+    data["state"]["pose"][0][("NOPE", "NADA")] = np.array([1.0, 2.0, 3.0])
     other = Document()
     other.set_skeleton(doc.skeleton)
     assert any("NOPE-NADA" in w for w in apply_project(other, data, path))
@@ -176,8 +178,34 @@ def test_load_connections_sets_bones_in_root_order(tmp_path, doc):
     (tmp_path / "b.connections").write_text("L_HIP L_WING\n")
     with pytest.raises(ValueError, match="not loaded: L_WING"):
         doc.bone_edits.load_connections(tmp_path / "b.connections")
-    doc.undo.undo()
-    assert len(doc.bones) == 18
+    assert len(doc.bones) == 2  # a refused file changes nothing
+    assert not doc.undo.can_undo and doc.modified  # a load is not an edit to undo, and not saved yet (issue #37)
+
+
+def test_loading_a_file_is_not_an_edit_but_a_failed_load_keeps_the_history(tmp_path, doc):
+    """Every file put into the session starts the history after it (issue #37: Ctrl+Z undid the
+    opening); a file refused leaves the edits before it undoable."""
+    from volanim_core import io
+
+    s = samples.mannequin()
+    io.write_bones(tmp_path / "m.bones", s.bones)
+    doc.bone_edits.load_bones(tmp_path / "m.bones")
+    assert len(doc.bones) == 18 and not doc.undo.can_undo and doc.modified
+    doc.attachments.assign([0, 1], doc.bones.index("L_THIGH"))
+    io.write_connect(tmp_path / "m.connect", doc.attachments.to_connectivity())
+    doc.pose.set_angles(doc.bones.index("L_THIGH"), [10, 0, 0])
+    doc.pose.save_trans(tmp_path / "m.trans")
+    assert doc.undo.can_undo
+    (tmp_path / "bad.bones").write_text("not bones\n")
+    with pytest.raises(ValueError):
+        doc.bone_edits.load_bones(tmp_path / "bad.bones")
+    assert doc.undo.undo_label == "Pose L_THIGH"  # the refused file took no history
+    for load in (lambda: doc.attachments.load(tmp_path / "m.connect"), lambda: doc.bone_edits.load_bones(
+            tmp_path / "m.bones"), lambda: doc.pose.load_trans(tmp_path / "m.trans")):
+        doc.pose.set_angles(doc.bones.index("L_THIGH"), [20, 0, 0], merge=False)
+        load()
+        assert not doc.undo.can_undo, load
+    assert doc.bone_of_point(0) == "L_THIGH" and np.isclose(doc.pose.angles_of(doc.bones.index("L_THIGH"))[0], 10)
 
 
 def test_version_1_projects_read_with_their_defaults(tmp_path):
@@ -191,7 +219,7 @@ def test_version_1_projects_read_with_their_defaults(tmp_path):
 @pytest.mark.parametrize("content, message", [
     ('{"format": "volanim project", "volume": 7}', '"volume" must be a file name'),
     ('{"format": "volanim project", "volume": ["a"]}', '"volume" must be a file name'),
-    ('{"format": "volanim project", "thinness": "x"}', '"thinness" must be a number'),
+    ('{"format": "volanim project", "thinness": "x"}', '"thinness" must be a finite number'),
     ('{"format": "volanim project", "settings": []}', '"settings" must be an object'),
     ("[" * 100000 + "]" * 100000, "nested too deeply|not a volanim project"),
     ('{"format": "volanim project", "demo": 3}', '"demo" must be a sample name'),
