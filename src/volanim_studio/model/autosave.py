@@ -6,8 +6,8 @@
 
 A save happens after every ``every_edits`` edits and every ``every_seconds``
 while there are unsaved edits or the session's state (settings, thinness, the
-frame, the selection, the camera: ``document_state``) differs from the last save. A clean exit removes the folder; a folder whose
-pid is dead on the next start is a crashed session, offered for restore.
+frame, the selection, the camera: ``document_state``) differs from the last save.
+A clean exit removes the folder; a folder whose pid is dead on the next start is a crashed session, offered for restore.
 Edits the user discards are first set aside (a declined folder, kept a week).
 A restored session's folder is removed only once the new session has
 autosaved what it restored, and never when the restore failed.

@@ -45,11 +45,11 @@ def test_a_held_slider_draws_fewer_points_and_a_coarser_hull(window, monkeypatch
     assert scene.shown_points == doc.visible_count > 1000 and scene.hull.drawn_faces == full_faces
     renderer = window.plotter.renderer
     assert renderer.GetUseFXAA()
-    panel.thinness_slider.sliderPressed.emit()
+    panel.thinness_slider.setSliderDown(True)
     panel.thinness_slider.setValue(100)
     assert scene.shown_points == min(1000, doc.visible_count) and scene.hull.drawn_faces == len(doc.hull_lod[1])
     assert not renderer.GetUseFXAA()
-    panel.thinness_slider.sliderReleased.emit()
+    panel.thinness_slider.setSliderDown(False)
     assert scene.shown_points == doc.visible_count and scene.hull.drawn_faces == full_faces
     assert renderer.GetUseFXAA()
 

@@ -27,11 +27,11 @@ def posed_window(qtbot, window):
 def drag(qtbot, window, axis: int, values) -> None:
     """What a slider drag does: pressed, value changes, released."""
     slider = window.pose_panel.sliders[axis]
-    slider.sliderPressed.emit()
+    slider.setSliderDown(True)  # what a press on the handle does: sliderPressed, and isSliderDown()
     for v in values:
         slider.setValue(v)
         qtbot.wait(1)
-    slider.sliderReleased.emit()
+    slider.setSliderDown(False)  # the release: sliderReleased
 
 
 def test_a_held_pose_slider_draws_without_fxaa_and_the_release_with_it(qtbot, posed_window):
@@ -42,10 +42,10 @@ def test_a_held_pose_slider_draws_without_fxaa_and_the_release_with_it(qtbot, po
     w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
     assert renderer.GetUseFXAA()
     slider = w.pose_panel.sliders[1]
-    slider.sliderPressed.emit()
+    slider.setSliderDown(True)  # what a press on the handle does: sliderPressed, and isSliderDown()
     slider.setValue(-20)
     assert not renderer.GetUseFXAA()
-    slider.sliderReleased.emit()
+    slider.setSliderDown(False)  # the release: sliderReleased
     assert renderer.GetUseFXAA()
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
 
