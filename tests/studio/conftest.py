@@ -136,8 +136,8 @@ def recovery_dir(tmp_path, monkeypatch):
     return folder
 
 
-@pytest.fixture
-def window(qtbot):
+def new_window(qtbot):
+    """A shown MainWindow of 1200x800 with nothing loaded (closed by pytest-qt after the test)."""
     from volanim_studio.qt.main_window import MainWindow
 
     w = MainWindow()
@@ -145,6 +145,12 @@ def window(qtbot):
     w.resize(1200, 800)
     w.show()
     qtbot.waitExposed(w)
+    return w
+
+
+@pytest.fixture
+def window(qtbot):
+    w = new_window(qtbot)
     w.activateWindow()  # window shortcuts need an active window; Xvfb has no window manager to do it
     qtbot.waitUntil(w.isActiveWindow, timeout=5000)
     w.files.load_demo("mannequin")

@@ -15,7 +15,7 @@ import pytest
 
 from volanim_studio.model import autosave
 
-from ..conftest import JOB_TIMEOUT_MS
+from ..conftest import JOB_TIMEOUT_MS, new_window
 from .studio_under_edits import session_state
 
 DRIVER = Path(__file__).with_name("studio_under_edits.py")
@@ -65,12 +65,7 @@ def test_a_killed_studio_recovers_its_last_autosave(qtbot, tmp_path, recovery_di
 
     found = autosave.find_recoveries(recovery_dir)
     assert len(found) == 1
-    from volanim_studio.qt.main_window import MainWindow
-
-    w = MainWindow()
-    qtbot.addWidget(w)
-    w.show()
-    qtbot.waitExposed(w)
+    w = new_window(qtbot)
     try:
         restored = []
         worker = w.session.offer_recovery(ask=lambda path: restored.append(path) or True)

@@ -8,18 +8,7 @@ from PySide6.QtCore import Qt
 from paths import ASSETS
 from volanim_studio.model.modes import Mode
 
-from ..conftest import JOB_TIMEOUT_MS, open_project, rig_and_pose
-
-
-def _second_window(qtbot):
-    from volanim_studio.qt.main_window import MainWindow
-
-    w = MainWindow()
-    qtbot.addWidget(w)
-    w.resize(1200, 800)
-    w.show()
-    qtbot.waitExposed(w)
-    return w
+from ..conftest import JOB_TIMEOUT_MS, new_window, open_project, rig_and_pose
 
 
 def _close(w) -> None:
@@ -57,7 +46,7 @@ def test_the_whole_session_comes_back_on_reopen(qtbot, window, tmp_path):
     path = w.files.save_project(path=tmp_path / "day.volanim")
     assert path is not None and not w.isWindowModified()
 
-    other = _second_window(qtbot)
+    other = new_window(qtbot)
     try:
         assert open_project(qtbot, other, path)
         d = other.doc
