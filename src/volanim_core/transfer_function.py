@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+MAX_POINTS = 4096  # one per grey value of 12 bits; VTK's piecewise functions hung `render` on 100 000
+
 
 @dataclass(frozen=True, eq=False)
 class TransferFunction:
@@ -21,6 +23,8 @@ class TransferFunction:
         c = np.asarray(self.rgba, np.float64).reshape(-1, 4)
         if len(v) == 0 or len(v) != len(c):
             raise ValueError(f"a transfer function needs one RGBA per value, got {len(v)} values, {len(c)} colours")
+        if len(v) > MAX_POINTS:
+            raise ValueError(f"a transfer function has at most {MAX_POINTS} points, got {len(v)}")
         if np.any(np.diff(v) <= 0):
             raise ValueError("transfer function values must be strictly ascending")
         if np.any((c < 0) | (c > 1)) or not np.all(np.isfinite(c)):

@@ -1,35 +1,62 @@
 """The fault corpus, run in a memory-capped worker and as real ``volanim`` processes.
 
-Prints the table (tried / clean / crash / hang / memory / silent per reader and
-CLI command) and fails on anything that is not clean. Cases: the hand-written
-corpus (``cases.hand_written``; the scan readers' in ``scan_cases.scan_cases``), every hostile
-number in every text format, and mutations drawn by hypothesis.
+One test per case, named by its target and case (``test_case[read_sequence: store: two frames' shards
+swapped]``), so a failure names what broke; the corpus runs once (the worker reads cases in batches)
+and ``test_the_table`` prints the table (tried / clean / crash / hang / memory / silent per reader and
+command). Cases: the hand-written corpus (``cases.hand_written``), the scan readers'
+(``scan_cases``), the sequence stores' (``store_cases``), the second round's (``round2_cases``:
+meshes, project values, BVH values, .tskel, transfer functions), every hostile number in every text
+format, and 40 mutations drawn with a fixed seed.
 """
 
 from __future__ import annotations
 
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
+import random
+
+import pytest
 
 from .cases import HOSTILE_NUMBERS, hand_written, mutated
+from .round2_cases import round2_cases
 from .run import run_corpus, table
 from .scan_cases import scan_cases
+from .store_cases import store_cases
 
 KINDS = ("mskel", "bones", "connect", "tskel", "camera", "tf", "palette", "alpha")
-MUTATIONS = st.lists(st.tuples(st.sampled_from(KINDS), st.integers(0, 40), st.sampled_from(HOSTILE_NUMBERS)),
-                     min_size=40, max_size=40, unique=True)
 
 
-@settings(max_examples=1, derandomize=True, deadline=None, database=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow,
-                                 HealthCheck.data_too_large])
-@given(drawn=MUTATIONS)
-def test_fault_corpus_has_no_crash_hang_memory_blowup_or_silent_acceptance(tmp_path_factory, capsys, drawn):
+def corpus():
     sweep = [mutated(kind, k, value) for kind in KINDS for k, value in enumerate(HOSTILE_NUMBERS)]
-    cases = hand_written() + scan_cases() + sweep + [mutated(*m) for m in drawn]
-    rows = run_corpus(cases, tmp_path_factory.mktemp("faults"))
-    report = table(rows)
+    draw = random.Random(2026)
+    drawn = {(draw.choice(KINDS), draw.randrange(41), draw.choice(HOSTILE_NUMBERS)) for _ in range(60)}
+    cases = hand_written() + scan_cases() + store_cases() + round2_cases() + sweep + [mutated(*m)
+                                                                                      for m in sorted(drawn)]
+    seen, unique = set(), []
+    for c in cases:  # a drawn mutation may repeat a swept one
+        key = (c.target, c.name)
+        if key not in seen:
+            seen.add(key)
+            unique.append(c)
+    return unique
+
+
+CASES = corpus()
+
+
+@pytest.fixture(scope="module")
+def outcomes(tmp_path_factory):
+    rows = run_corpus(CASES, tmp_path_factory.mktemp("faults"))
+    return {(case.target, case.name): (outcome, detail) for case, outcome, detail in rows}, rows
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", CASES, ids=[f"{c.target}: {c.name}" for c in CASES])
+def test_case(outcomes, case):
+    outcome, detail = outcomes[0][(case.target, case.name)]
+    assert outcome == "clean", f"{outcome}: {detail}"
+
+
+@pytest.mark.slow
+def test_the_table(outcomes, capsys):
     with capsys.disabled():
-        print("\n" + report)
-    assert all(outcome == "clean" for _, outcome, _ in rows), report
-    assert len(rows) >= 150
+        print("\n" + table(outcomes[1]))
+    assert len(outcomes[1]) >= 250

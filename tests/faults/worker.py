@@ -17,18 +17,29 @@ from pathlib import Path
 MEMORY_CAP = 6 << 30  # address space; VTK and numpy need ~1-2 GB of it just to load
 
 
+def read_sequence(path):
+    """Every finished frame of a sequence store, verified (what a movie reads)."""
+    from volanim_core.sequence.checked import read_store
+
+    s = read_store(path)
+    return [s.read_frame(i) for i in sorted(s.done)]
+
+
 def readers() -> dict:
     from volanim_core import io
     from volanim_core.io.mesh_files import read_mesh
     from volanim_core.io.palette_files import read_alpha_map, read_palette
     from volanim_core.motion.bvh import read_bvh
-    from volanim_studio.model.project import read_project
+    from volanim_studio.model import Document
+    from volanim_studio.model.project import apply_project, read_project
 
     return {"read_volume": io.read_volume, "read_mskel": io.read_mskel, "read_bones": io.read_bones,
             "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
             "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh,
             "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function,
-            "read_mesh": read_mesh, "read_palette": read_palette, "read_alpha_map": read_alpha_map}
+            "read_mesh": read_mesh, "read_palette": read_palette, "read_alpha_map": read_alpha_map,
+            "read_sequence": read_sequence,
+            "open_project": lambda p: apply_project(Document(), read_project(p), p, reset=True)}
 
 
 CHECKS = {
@@ -40,6 +51,10 @@ CHECKS = {
     "first_pair_A_B": lambda r: r[0] == ("A", "B"),
     "len_3000": lambda r: len(r) == 3000,
     "len_frames_1": lambda r: r.frames == 1 and r.names == ["Hips", "Arm"],
+    "warns_dev_zero": lambda r: any("/dev/zero" in w and "not a regular file" in w for w in r),
+    "one_cell": lambda r: r.n_cells == 1 and r.n_points >= 3,
+    "two_cells": lambda r: r.n_cells == 2 and r.n_points == 4,
+    "two_frames": lambda r: len(r) == 2 and r[0].shape == (6, 5, 4) and int(r[1].max()) == 2,
 }
 
 

@@ -54,6 +54,9 @@ def _render(args):
     from volanim_core.render.scene import RenderSettings, transfer_of
 
     inputs = open_inputs(args.inputs, args.range, dims=args.dims)
+    if inputs.unverified:  # every frame of a store with regions is checked against its sha256 as it is read
+        print(f"note: {inputs.unverified} frames were not verified: the store predates frame checksums by region "
+              "(rerun `volanim sequence --force` to record them)", file=sys.stderr)
     preset = args.preset or inputs.mode or "sampled"
     w, h = args.size
     if args.view and args.camera not in (None, "follow"):

@@ -25,12 +25,15 @@ def _check(indices, alphas) -> tuple[np.ndarray, np.ndarray]:
     return v, a
 
 
+MAX_BETWEEN = 100_000  # maps between two looks: a fade over an hour of frames; 10^9 allocated 7 GB first
+
+
 def interpolate_alpha(first, second, n: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """``n`` alpha maps evenly between two (InterpolateAlpha): map k of n is
     ``(1 - t) * first + t * second`` with ``t = k / (n + 1)``, on the union of both maps' indices
     (so a fade from one look to another over ``n`` frames has no jumps)."""
-    if n < 1:
-        raise ValueError(f"the number of maps between two must be at least 1, got {n}")
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= MAX_BETWEEN:
+        raise ValueError(f"the number of maps between two must be a whole number 1..{MAX_BETWEEN}, got {n!r}")
     (v1, a1), (v2, a2) = _check(*first), _check(*second)
     v = np.union1d(v1, v2)
     s1, s2 = np.interp(v, v1, a1), np.interp(v, v2, a2)

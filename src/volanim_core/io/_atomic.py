@@ -135,10 +135,56 @@ def atomic_vtk_save(path: str | Path, dataset) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(path.parent, path.stem, f".tmp{path.suffix}")
     tmp = path.parent / pending_name(path.stem, f".tmp{path.suffix}")
+    _check_room(path, dataset)
     try:
         dataset.save(str(tmp))
         with open(tmp, "rb") as fh:
             os.fsync(fh.fileno())
+        _check_vtk_file(tmp, path, dataset)  # VTK reports a full disk on its error output and returns
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+_XML_SUFFIXES = (".vti", ".vtp", ".vtu", ".vts", ".vtr")
+
+
+def _check_room(path: Path, dataset) -> None:
+    """Refuse (OSError ENOSPC) before VTK writes into too little room: its XML PolyData writer aborts the
+    process on a full disk (free(): invalid pointer). The most a file can take: 1.5x the data in XML
+    (base64), 3x in the text and list formats (.obj, .ply, .stl), plus 1 MB."""
+    import errno
+
+    room = os.statvfs(path.parent)
+    free = min(room.f_bavail, room.f_bfree) * room.f_frsize
+    need = int(dataset.actual_memory_size * 1024 * (1.5 if path.suffix.lower() in _XML_SUFFIXES else 3)) + (1 << 20)
+    if free < need:
+        raise OSError(errno.ENOSPC, f"not enough room to write {path}: {free:,} bytes free, it may take up to "
+                                    f"{need:,}; the file that was there is unchanged")
+
+
+def _check_vtk_file(tmp: Path, path: Path, dataset) -> None:
+    """Refuse (OSError) a file VTK did not finish: an XML file without its closing tag, any other that
+    reads back with fewer points or cells, or any written while the disk ran out (VTK's PLY reader reads
+    a cut binary file back whole, padded with garbage). ``convert`` over an existing .vti replaced it
+    with a 16 KB fragment of the new one on a full disk: VTK's writer failed without raising."""
+    import errno
+
+    room = os.statvfs(tmp.parent)
+    if room.f_bavail == 0 or room.f_bfree == 0:
+        complete = False
+    elif path.suffix.lower() in _XML_SUFFIXES:
+        with open(tmp, "rb") as fh:
+            fh.seek(max(0, os.fstat(fh.fileno()).st_size - 64))
+            complete = fh.read().rstrip().endswith(b"</VTKFile>")
+    else:
+        import pyvista as pv
+
+        try:
+            back = pv.read(str(tmp))
+            complete = (back.n_points, back.n_cells) == (dataset.n_points, dataset.n_cells)
+        except Exception:  # noqa: BLE001 - VTK's readers raise many types; any of them means not written
+            complete = False
+    if not complete:
+        raise OSError(errno.ENOSPC, f"VTK could not finish writing {path} (is the disk full?); "
+                                    "the file that was there is unchanged")

@@ -46,14 +46,10 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
     Header comments of the form ``# key: value`` (e.g. ``# metric: 345``) are
     collected in ``header`` with lower-case keys.
     """
+    from volanim_core.io._files import regular_file_bytes
+
     path = Path(path)
-    try:
-        if path.stat().st_size > MAX_TEXT_BYTES:
-            raise FormatError(path, f"is {path.stat().st_size:,} bytes; text files over {MAX_TEXT_BYTES:,} "
-                                    "bytes are not read")
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise FormatError(path, f"cannot read file: {exc.strerror or exc}") from exc
+    raw = regular_file_bytes(path, MAX_TEXT_BYTES, "text file")  # /dev/zero's size reads 0: it read forever
     if b"\x00" in raw:
         raise FormatError(path, "this is a binary file, expected text")
     try:

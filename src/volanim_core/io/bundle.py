@@ -126,6 +126,8 @@ def verify(manifest: str | Path, data: dict) -> None:
         if not isinstance(rel, str) or not isinstance(digest, str):
             raise FormatError(manifest, f"\"sha256\" names \"{key}\", which is not a saved file")
         path = manifest.parent / rel
+        if not path.is_file():  # a device (/dev/zero) would be hashed forever
+            raise FormatError(manifest, f"its {key} file {path} is missing or not a regular file")
         try:
             actual = file_sha256(path)
         except OSError as exc:

@@ -43,6 +43,12 @@ def read_mesh(path):
     if path.stat().st_size == 0:
         raise FormatError(path, "is empty")
     check_mesh_claims(path)  # VTK allocates whatever a header claims
+    from .mesh_checks import check_ply, read_obj
+
+    if path.suffix.lower() == ".obj":
+        return read_obj(path)  # read here: VTK's reader crashed on indices a face does not have
+    if path.suffix.lower() == ".ply":
+        check_ply(path)  # every count and index, before VTK reads it
     try:
         mesh = pv.read(path)
     except Exception as exc:  # VTK raises many types (and pyvista wraps its error output)

@@ -70,8 +70,13 @@ def write_camera(path: str | Path, cam: Camera) -> None:
 
 
 def read_transfer_function(path: str | Path) -> TransferFunction:
+    from volanim_core.transfer_function import MAX_POINTS
+
     rec = read_records(path)
     values, rgba = [], []
+    if len(rec.records) > MAX_POINTS:
+        raise rec.error(rec.records[MAX_POINTS][0], f"a transfer function has at most {MAX_POINTS} points, "
+                                                    f"this one {len(rec.records)}")
     for line, tokens in rec.records:
         if len(tokens) != 5:
             raise rec.error(line, f"expected VALUE RED GREEN BLUE ALPHA (5 numbers), got {len(tokens)}")

@@ -34,6 +34,9 @@ from volanim_core.io._text import is_number
 from volanim_core.limits import available_bytes, human_bytes
 
 MAX_JOINTS = 10_000
+# Offsets, positions and angles beyond this are no capture (a billion millimetres is 1000 km; a billion
+# degrees turns nothing sensibly): 1e308 overflowed forward kinematics, 1e20 no coordinate can hold
+MAX_VALUE = 1e9
 _AXES = {"xrotation": "X", "yrotation": "Y", "zrotation": "Z"}
 _POSITIONS = {"xposition": 0, "yposition": 1, "zposition": 2}
 
@@ -50,6 +53,33 @@ class Motion:
     values: np.ndarray  # (F, C) float64, C = total channel count
     end_sites: dict[int, np.ndarray] = field(default_factory=dict)  # joint -> End Site offset
 
+    def __post_init__(self) -> None:
+        """A Motion made in code is held to what a file is (ValueError): the API took NaN values, a joint
+        cycle (forward kinematics then returned uninitialised numbers) and a wrong-width value array."""
+        n = len(self.names)
+        self.parents = np.asarray(self.parents, np.int64).reshape(-1)
+        self.offsets = np.asarray(self.offsets, np.float64).reshape(-1, 3) if n else np.zeros((0, 3))
+        self.values = np.asarray(self.values, np.float64)
+        if not 0 < n <= MAX_JOINTS or len(set(self.names)) != n:
+            raise ValueError(f"a motion needs 1..{MAX_JOINTS} joints with distinct names, got {n}")
+        if len(self.parents) != n or len(self.offsets) != n or len(self.channels) != n:
+            raise ValueError(f"{n} joints need {n} parents, offsets and channel lists")
+        if self.parents[0] != -1 or any(not -1 <= p < j for j, p in enumerate(self.parents)):
+            raise ValueError("parents must come before their children (file order): a joint's parent index is "
+                             "-1 (a root) or smaller than its own; a cycle has no such order")
+        for chans in self.channels:
+            unknown = [c for c in chans if c not in _AXES and c not in _POSITIONS]
+            if unknown:
+                raise ValueError(f"unknown channel {unknown[0]!r}: channels are X/Y/Z position and rotation")
+        width = sum(len(c) for c in self.channels)
+        if self.values.ndim != 2 or self.values.shape[1] != width:
+            raise ValueError(f"values must be (frames, {width}) for these channels, got {self.values.shape}")
+        for what, a in (("values", self.values), ("offsets", self.offsets)):
+            if not (np.abs(a) <= MAX_VALUE).all():
+                raise ValueError(f"{what} must be finite numbers of at most {MAX_VALUE:g}")
+        if not (np.isfinite(self.frame_time) and self.frame_time > 0):
+            raise ValueError(f"the frame time must be a positive number, got {self.frame_time!r}")
+
     @property
     def frames(self) -> int:
         return len(self.values)
@@ -59,10 +89,12 @@ class Motion:
         return 1.0 / self.frame_time if self.frame_time > 0 else 0.0
 
     def index(self, name: str) -> int:
+        """The joint's index; ValueError naming the clip's joints when it has none of that name."""
         try:
             return self.names.index(name)
         except ValueError:
-            raise KeyError(f"no joint named {name!r} in the clip") from None
+            shown = ", ".join(self.names[:12]) + (", ..." if len(self.names) > 12 else "")
+            raise ValueError(f"no joint named {name!r} in the clip; it has {shown}") from None
 
     def rest_positions(self) -> np.ndarray:
         """``(J, 3)`` joint positions with every channel zero (the clip's rest pose, often a T-pose)."""
@@ -137,11 +169,14 @@ def _tokens(text: str):
 
 def read_bvh(path: str | Path) -> Motion:
     """Read a BVH file; a bad one is a :class:`FormatError` naming the file and line."""
+    from volanim_core.io._files import regular_file_bytes
+    from volanim_core.io._text import MAX_TEXT_BYTES
+
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise FormatError(path, f"cannot read file: {exc.strerror or exc}") from exc
+    raw = regular_file_bytes(path, MAX_TEXT_BYTES, "BVH file")
+    if b"\0" in raw:
+        line = raw[:raw.index(b"\0")].count(b"\n") + 1
+        raise FormatError(path, "holds a NUL byte: a binary file, expected BVH text", line)
     try:
         text = raw.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError:
@@ -161,8 +196,8 @@ def _number(path, line: int, tok: str, what: str) -> float:
     if not is_number(tok):
         raise FormatError(path, f"expected a number for {what}, got {tok!r}", line)
     value = float(tok)
-    if not np.isfinite(value):
-        raise FormatError(path, f"expected a finite number for {what}, got {tok!r}", line)
+    if not np.isfinite(value) or abs(value) > MAX_VALUE:
+        raise FormatError(path, f"expected a finite number of at most {MAX_VALUE:g} for {what}, got {tok!r}", line)
     return value
 
 
@@ -275,7 +310,7 @@ def _motion(path, text: str, first_line: int, n_channels: int) -> tuple[float, n
             values = np.array([ln.split() for _, ln in data], np.float64).reshape(n_frames, n_channels)
         except ValueError:
             values = None
-    if values is None or not np.isfinite(values).all():  # find the first bad line for the message
+    if values is None or not (np.abs(values) <= MAX_VALUE).all():  # find the first bad line (NaN fails too)
         for line, ln in data:
             toks = ln.split()
             if len(toks) != n_channels:

@@ -23,7 +23,6 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.errors import FormatError
 from volanim_core.parallel import executor
 
 from .camera import Camera, union_box
@@ -52,6 +51,7 @@ class RenderInputs:
     fingerprint: list  # what the pictures depend on besides the settings (for resuming)
     boxes: list | None = None  # per frame: its filled voxels' (lo, hi), None when empty; None: not known
     spacing: tuple = (1.0, 1.0, 1.0)  # world units per voxel (files: their own; sequences: voxels)
+    unverified: int = 0  # sequence frames read without a checksum to compare (stores older than regions)
 
     def world_box(self, box=None) -> tuple[np.ndarray, np.ndarray]:
         """``box`` (voxel centres ``(lo, hi)``; default: the one every frame's body fits in) in world units
@@ -95,41 +95,36 @@ def sequence_folder(path: Path) -> Path:
 
 
 def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
-    import zarr
+    from volanim_core.sequence.checked import read_store
 
-    from volanim_core.sequence import store
-
-    plan = store.read_plan(path)
-    if plan is None:
-        raise FormatError(path, "is not a volanim sequence (no volanim-plan.json): make one with `volanim sequence`")
-    done = store.finished(path)
-    indices = list(range(int(plan["frames"])))[frames]
+    seq = read_store(path)  # every key checked once, sizes before allocation (FormatError names the file)
+    done, numbers = seq.done, seq.numbers
+    indices = list(range(seq.frames))[frames]
     if not indices:
-        raise ValueError(f"{path}: the frame range selects none of its {plan['frames']} frames")
+        raise ValueError(f"{path}: the frame range selects none of its {seq.frames} frames")
     missing = [i for i in indices if i not in done]
     if missing:
         raise ValueError(f"{path}: {len(missing)} of the frames to render are not reconstructed yet (first: frame "
-                         f"{plan['numbers'][missing[0]]}); finish them with `volanim sequence` (rerun it: it resumes)")
-    arr = store.open_frames(path)
-    lo = store.origin(path)
-    hi = tuple(o + n - 1 for o, n in zip(lo, arr.shape[1:][::-1]))
-    mode = plan.get("mode")
+                         f"{numbers[missing[0]]}); finish them with `volanim sequence` (rerun it: it resumes)")
+    lo = seq.origin_xyz
+    hi = tuple(o + n - 1 for o, n in zip(lo, seq.shape_zyx[::-1]))
+    mode, dtype = seq.mode, seq.dtype
     if mode == "hotspot":
         vmax = max(float(done[i].get("hotspot_max") or 1) for i in indices)
     else:
-        vmax = float(np.iinfo(arr.dtype).max) if np.dtype(arr.dtype).kind in "ui" else 1.0
-        if np.dtype(arr.dtype).itemsize > 1 or np.dtype(arr.dtype).kind == "f":
-            vmax = float(np.max(arr[indices[len(indices) // 2]]))  # a middle frame's brightest voxel
-    scale = zarr.open_group(str(path), mode="r").attrs["ome"]["multiscales"][0]["datasets"][0][
-        "coordinateTransformations"][0]["scale"][0]
-    refs = [FrameRef(str(path.resolve()), i, int(plan["numbers"][i])) for i in indices]
+        vmax = float(np.iinfo(dtype).max) if dtype.kind in "ui" else 1.0
+        if dtype.itemsize > 1 or dtype.kind == "f":
+            vmax = float(np.max(seq.read_frame(indices[len(indices) // 2])))  # a middle frame's brightest voxel
+    scale = seq.seconds_per_frame
+    refs = [FrameRef(str(path.resolve()), i, int(numbers[i])) for i in indices]
     boxes = None
     if all("box" in done[i] for i in indices):  # stores written before boxes were recorded: the grid
         boxes = [None if done[i]["box"] is None else (tuple(done[i]["box"][0]), tuple(done[i]["box"][1]))
                  for i in indices]
     body_lo, body_hi = union_box(boxes or [], lo, hi)
     return RenderInputs(refs, body_lo, body_hi, mode, vmax, 1.0 / float(scale),
-                        [plan["key"], *[done[i]["sha256"] for i in indices]], boxes)
+                        [seq.key, *[done[i]["sha256"] for i in indices]], boxes,
+                        unverified=sum(not seq.verified(i) for i in indices))
 
 
 def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
@@ -327,15 +322,20 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     todo, skipped = _plan_folder(folder, key, inputs.frames, force)
     done = total - len(todo)
     label = "nothing to draw"
-    if todo:
-        try:
-            label = _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate)
-        finally:
-            release()
-    if kind in ("mp4", "gif"):
-        encode([frame_path(folder, f.number) for f in inputs.frames], out, fps)
-        if not keep_frames:
+    try:
+        if todo:
+            try:
+                label = _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate)
+            finally:
+                release()
+        if kind in ("mp4", "gif"):
+            encode([frame_path(folder, f.number) for f in inputs.frames], out, fps)
+    except OSError:  # a full disk: a movie's hidden frames are no use to the user (a kill keeps them to resume)
+        if kind in ("mp4", "gif") and not keep_frames:
             shutil.rmtree(folder, ignore_errors=True)
+        raise
+    if kind in ("mp4", "gif") and not keep_frames:
+        shutil.rmtree(folder, ignore_errors=True)
     return RenderReport(out, total, len(todo), skipped, time.perf_counter() - t0, label, fps, settings.mapper)
 
 

@@ -43,6 +43,9 @@ class SequenceReport:
     workers: str = ""
 
 
+MAX_PADDING = 256  # voxels around the bodies; 10^4 made a grid of terabytes before anything refused it
+
+
 def shared_bounds(conn: Connectivity, frames: list[FrameSpec], padding: int = 2,
                   boxes: list[Bounds] | None = None) -> Bounds:
     """One output grid holding every frame (the old ``tskelbounds`` over all of them), and room
@@ -155,6 +158,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
         raise ValueError("a sequence samples a grey source (one value a voxel); for a colour volume make an "
                          "index volume with 'volanim palette build' and 'palette apply', sequence that, and "
                          "render it with the palette's transfer function ('volanim alpha merge', render --tf)")
+    if isinstance(padding, bool) or not isinstance(padding, int | np.integer) or not 0 <= padding <= MAX_PADDING:
+        raise ValueError(f"padding must be a whole number of voxels 0..{MAX_PADDING}, got {padding!r}")
     t0 = time.perf_counter()
     out = Path(out)
     boxes = frame_boxes(conn, frames)  # each frame posed once, here

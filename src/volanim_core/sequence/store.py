@@ -6,7 +6,11 @@
                                   into one shard silently lose data); chunks outside the box a frame's
                                   body reaches are never written (a walk's shared grid is mostly empty)
     OUT.zarr/volanim-plan.json    what was asked (the plan's key), written once, atomically
-    OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes, stats
+    OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes and the
+                                  region it hashed (z, y, x), stats
+
+Reading for pictures goes through :mod:`~volanim_core.sequence.checked`, which checks this
+metadata once and verifies each frame against its sha256.
 
 A task's frames are appended to the manifest only after their shards are
 written, by the one process that runs the sequence, in one ``write`` +
@@ -28,9 +32,18 @@ PLAN_FILE, FRAMES_FILE = "volanim-plan.json", "volanim-frames.jsonl"
 
 def frame_checksum(part_zyx: np.ndarray, region=None) -> str:
     """sha256 of a frame: the part its body reaches (and where that is); the rest is zero by construction."""
-    h = hashlib.sha256(repr([(s.start, s.stop) for s in region or ()]).encode())
+    # plain ints: NumPy 2 writes np.int64(3) where Python writes 3, and a reader's slices are Python's
+    h = hashlib.sha256(repr([(int(s.start), int(s.stop)) for s in region or ()]).encode())
     h.update(np.ascontiguousarray(part_zyx).data)
     return h.hexdigest()
+
+
+def frame_record(index: int, number: int, part_zyx: np.ndarray, region=None, **stats) -> dict:
+    """The manifest record of frame ``index`` whose ``part_zyx`` was written at ``region`` (``[z, y, x]``
+    slices; default: the whole frame): its checksum and the region it covers, which a reader verifies."""
+    region = region or tuple(slice(0, n) for n in part_zyx.shape)
+    return {"index": int(index), "number": int(number), "sha256": frame_checksum(part_zyx, region),
+            "region": [[int(s.start), int(s.stop)] for s in region], **stats}
 
 
 # 128, not 64: zarr spends ~0.4 ms per chunk written, whatever its size -- a frog frame's 168 chunks
@@ -92,13 +105,18 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
 
 
 def read_plan(path: str | Path) -> dict | None:
+    """The plan of the store at ``path``, or None when there is none or it is not a plan (a rerun replaces it)."""
+    from volanim_core.errors import FormatError
+    from volanim_core.io._files import load_json
+
     p = Path(path) / PLAN_FILE
     if not p.is_file():
         return None
     try:
-        return json.loads(p.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError):
+        plan = load_json(p, what="sequence plan")
+    except FormatError:
         return None
+    return plan if isinstance(plan, dict) else None
 
 
 def finished(path: str | Path) -> dict[int, dict]:
@@ -136,12 +154,15 @@ def open_frames(path: str | Path, mode: str = "r"):
 
 
 def read_frame(path: str | Path, index: int) -> np.ndarray:
-    """Frame ``index`` as a ``[x, y, z]`` volume (like every volanim volume)."""
-    return np.asarray(open_frames(path)[index]).T
+    """Frame ``index`` as a ``[x, y, z]`` volume (like every volanim volume), its metadata checked and the
+    frame verified against its sha256 (:func:`~volanim_core.sequence.checked.read_store`)."""
+    from .checked import read_store
+
+    return read_store(path).read_frame(index)
 
 
 def origin(path: str | Path) -> tuple[int, int, int]:
-    import zarr
+    """The grid's voxel ``[0, 0, 0]`` in the frames' voxel indices (checked metadata)."""
+    from .checked import read_store
 
-    o = zarr.open_group(str(path), mode="r").attrs["volanim"]["origin_xyz"]
-    return tuple(int(v) for v in o)
+    return read_store(path).origin_xyz

@@ -25,7 +25,7 @@ from volanim_core.rig.connectivity import Connectivity
 from volanim_core.volume import Bounds, tight_bounds
 
 from .frames import FrameSpec
-from .store import CHUNK_EDGE, frame_checksum, open_frames
+from .store import CHUNK_EDGE, frame_record, open_frames
 
 
 @dataclass
@@ -122,14 +122,14 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
         io.write_output(frame_file(p.every_frame_as, spec.number), whole.T, p.conn.geometry.shifted(p.bounds.lo),
                         p.mode)
     s = r.stats
-    return {"index": int(index), "number": int(spec.number), "sha256": frame_checksum(part, region),
-            "filled": int(s["filled"]), "box": None if box is None else _in_grid(box, grid.lo),
-            "clipped": int(s.get("clipped", 0)),
-            "hotspot_max": int(s["hotspot_max"]) if "hotspot_max" in s else None,
-            "dt_scale": round(float(np.mean(spec.dt_scale)), 6), "crumble": spec.crumble,
-            "seconds": round(time.perf_counter() - t0, 4), "finished": round(time.time(), 4),
-            "worker": f"{socket.gethostname()}:{os.getpid()}",
-            "peak_rss": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
+    return frame_record(  # its checksum and the region it hashed: a reader verifies the frame
+        index, spec.number, part, region, filled=int(s["filled"]),
+        box=None if box is None else _in_grid(box, grid.lo), clipped=int(s.get("clipped", 0)),
+        hotspot_max=int(s["hotspot_max"]) if "hotspot_max" in s else None,
+        dt_scale=round(float(np.mean(spec.dt_scale)), 6), crumble=spec.crumble,
+        seconds=round(time.perf_counter() - t0, 4), finished=round(time.time(), 4),
+        worker=f"{socket.gethostname()}:{os.getpid()}",
+        peak_rss=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
 
 
 def _in_grid(box, lo) -> list[list[int]]:

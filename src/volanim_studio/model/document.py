@@ -330,7 +330,13 @@ class Document:
 
     def write_project(self, path) -> dict:
         """Write the project files without adopting their paths (autosave uses this)."""
+        from volanim_core.io import bundle
+
         from .project import write_project
 
-        return write_project(self, path)
+        try:
+            return write_project(self, path)
+        except BaseException:  # a full disk: the files this save stored, which no manifest names, go
+            bundle.collect_garbage(path)
+            raise
 

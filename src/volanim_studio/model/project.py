@@ -29,6 +29,7 @@ from pathlib import Path
 from volanim_core import io
 from volanim_core.errors import FormatError
 from volanim_core.io import bundle
+from volanim_core.io._files import CHECKED_NUMBERS
 from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
@@ -109,11 +110,13 @@ def read_project(path) -> dict:
 
 def _parse(path: Path, text: str) -> dict:
     try:
-        data = json.loads(text)
+        data = json.loads(text, **CHECKED_NUMBERS)  # one number parser: a 401-digit angle raised OverflowError
     except json.JSONDecodeError as exc:
         raise FormatError(path, f"not a volanim project (JSON error: {exc.msg})", exc.lineno) from exc
     except RecursionError:
         raise FormatError(path, "not a volanim project: nested too deeply") from None
+    except ValueError as exc:  # the number hooks
+        raise FormatError(path, f"holds {exc}") from None
     if not isinstance(data, dict) or data.get("format") != PROJECT_FORMAT:
         raise FormatError(path, f"not a volanim project: expected \"format\": \"{PROJECT_FORMAT}\"")
     version = _expect(path, data, "version", int, "a whole number")
@@ -175,9 +178,16 @@ def apply_project(doc, data: dict, path, *, reset: bool = False) -> list[str]:
     """
     warnings = list(data.get("warnings") or [])
     fresh = reset or doc.skeleton is None
-    skeleton = io.read_mskel(data["mskel"]) if data.get("mskel") and fresh else None
-    bones = io.read_bones(data["bones"]) if data.get("bones") else None
-    conn = io.read_connect(data["connect"]) if data.get("connect") else None
+
+    def data_file(key, read):
+        try:
+            return read(data[key])
+        except FormatError as exc:  # the project is what the user opened: name it, then the file
+            raise FormatError(path, f"its {key} file: {exc}") from None
+
+    skeleton = data_file("mskel", io.read_mskel) if data.get("mskel") and fresh else None
+    bones = data_file("bones", io.read_bones) if data.get("bones") else None
+    conn = data_file("connect", io.read_connect) if data.get("connect") else None
     if reset:  # a new document, once every file has been read
         doc.reset()
     if skeleton is not None:

@@ -121,8 +121,8 @@ def walking_sequence(path, frames=6):
         c = (40 + 60 * i, 40, 40)
         zyx = (((xx - c[0]) ** 2 + (yy - c[1]) ** 2 + (zz - c[2]) ** 2) <= 15**2).astype(np.uint8)
         arr[i] = zyx
-        store.record(path, {"index": i, "number": i, "sha256": f"s{i}", "filled": int(zyx.sum()),
-                            "box": [[c[0] - 15, 25, 25], [c[0] + 15, 55, 55]]})
+        store.record(path, store.frame_record(i, i, zyx, filled=int(zyx.sum()),
+                                              box=[[c[0] - 15, 25, 25], [c[0] + 15, 55, 55]]))
     return path
 
 

@@ -95,7 +95,7 @@ def make_sequence(path, frames: int = 4):
         vol = ball(shape, centre=(30 + 12 * i, 32, 32), radius=10, value=2)
         vol[2:10, 2:10, 2:10] = 1
         arr[i] = vol.T
-        store.record(path, {"index": i, "number": 100 + 2 * i, "sha256": f"s{i}", "filled": int((vol > 0).sum())})
+        store.record(path, store.frame_record(i, 100 + 2 * i, vol.T, filled=int((vol > 0).sum())))
     return path
 
 

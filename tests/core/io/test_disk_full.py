@@ -1,0 +1,38 @@
+"""A full disk: every writer raises, leaves the file that was there byte for byte and leaves no litter (#38).
+
+The writers run in a tmpfs of 2 MB mounted in a mount namespace of their own (``unshare``: no root
+needed, nothing to unmount if the test dies), whose disk is filled to 24 kB before each write.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+DRIVER = Path(__file__).with_name("disk_full_writers.py")
+
+
+@pytest.mark.slow
+def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
+    full, spare = tmp_path / "full", tmp_path / "spare"
+    full.mkdir()
+    spare.mkdir()
+    assert shutil.which("unshare"), "util-linux's unshare makes the small disk"
+    script = f'mount -t tmpfs -o size=2m tmpfs "{full}" && exec "{sys.executable}" "{DRIVER}" "{full}" "{spare}"'
+    out = subprocess.run(["unshare", "--user", "--map-root-user", "--mount", "sh", "-c", script],
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    rows = [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
+    table = "\n".join(f"{r['writer']:<24} raised: {bool(r['raised'])!s:<6} old intact: {r['old_intact']!s:<6} "
+                      f"litter: {r['litter']}" for r in rows)
+    print("\n" + table)
+    assert len(rows) == 15, out.stderr[-2000:]
+    for r in rows:
+        assert r["raised"] and not r.get("traceback"), r
+        assert r["old_intact"], r
+        assert r["litter"] == [], r
