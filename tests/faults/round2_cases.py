@@ -40,6 +40,8 @@ def mesh_cases() -> list[Case]:
         case("a PLY claiming 3000 vertices holding 4 (padded with a comment)",
              {"m.ply": ply_ascii("3 0 1 2\n", n=3000).replace(b"end_header", b"comment " + b"x" * 40000 +
                                                               b"\nend_header")}, "m.ply"),
+        case("an ASCII PLY face of words", {"m.ply": ply_ascii("three a b c\n")}, "m.ply"),
+        case("an ASCII PLY face list count of NaN", {"m.ply": ply_ascii("nan 0 1 2\n")}, "m.ply"),
         case("a PLY without faces", {"m.ply": ply_ascii("", n_faces=0)}, "m.ply"),
         case("an OBJ of vertices only", {"m.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"}, "m.obj"),
         case("an OBJ face naming vertex 99999999", {"m.obj": b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999\n"},

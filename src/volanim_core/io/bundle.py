@@ -161,10 +161,10 @@ def load(manifest: str | Path, parse: Callable[[Path, str], dict]) -> tuple[dict
 
 
 def read_manifest_text(path: Path) -> str:
+    """A manifest's text: a regular file of at most MAX_MANIFEST_BYTES (``/dev/zero`` read forever)."""
+    from ._files import regular_file_bytes
+
     try:
-        if path.stat().st_size > MAX_MANIFEST_BYTES:
-            raise FormatError(path, f"is {path.stat().st_size} bytes; a project file is a few kB "
-                                    f"(limit {MAX_MANIFEST_BYTES} bytes)")
-        return path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FormatError(path, f"cannot read: {getattr(exc, 'strerror', None) or exc}") from exc
+        return regular_file_bytes(path, MAX_MANIFEST_BYTES, "project file").decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise FormatError(path, f"cannot read: {exc}") from exc

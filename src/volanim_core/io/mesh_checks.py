@@ -78,6 +78,16 @@ def _check_face(path, count: int, indices, n_vertices: int, record: int, line: i
         raise FormatError(path, f"face {record} names vertex {bad[0]}; the file has {n_vertices} vertices", line)
 
 
+def _whole(path, word: str, what: str) -> int:
+    try:
+        value = float(word)
+    except ValueError:
+        raise FormatError(path, f"{what}: expected a number, got {word[:20]!r}") from None
+    if not value.is_integer():
+        raise FormatError(path, f"{what}: expected a whole number, got {word[:20]!r}")
+    return int(value)
+
+
 def _walk_ascii(path, body: bytes, elements, n_vertices: int) -> None:
     lines = [ln for ln in body.decode("latin-1").splitlines() if ln.strip() and not ln.startswith("comment")]
     at = 0
@@ -91,11 +101,12 @@ def _walk_ascii(path, body: bytes, elements, n_vertices: int) -> None:
                 if count_type is None:
                     pos += 1
                     continue
-                n = int(float(words[pos])) if pos < len(words) else -1
+                n = _whole(path, words[pos], f"{name} {k}'s list count") if pos < len(words) else -1
                 if not 0 <= n <= MAX_CORNERS or pos + 1 + n > len(words):
                     raise FormatError(path, f"{name} {k}: a list of {n} values does not fit its line")
                 if name == "face" and prop in ("vertex_indices", "vertex_index"):
-                    _check_face(path, n, (int(float(w)) for w in words[pos + 1:pos + 1 + n]), n_vertices, k)
+                    _check_face(path, n, [_whole(path, w, f"face {k}'s index") for w in words[pos + 1:pos + 1 + n]],
+                                n_vertices, k)
                 pos += 1 + n
             if pos > len(words):
                 raise FormatError(path, f"{name} {k} has {len(words)} values; its properties need {pos}")

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.io._files import load_json, regular_file_bytes
+from volanim_core.io._files import load_json, parse_json, regular_file_bytes
 from volanim_core.limits import MAX_AXIS, checked_grid
 from volanim_core.modes import MODES
 
@@ -184,8 +184,6 @@ def _manifest(path: Path, frames: int, shape_zyx) -> dict:
     for number, raw in enumerate(lines[:-1], start=1):  # lines[-1]: after the last newline (torn, or empty)
         if not raw.strip():
             continue
-        from volanim_core.io._files import parse_json
-
         rec = parse_json(file, raw)
         index = rec.get("index") if isinstance(rec, dict) else None
         _need(file, _int(index) and 0 <= index < frames, f"a record's \"index\" must be 0..{frames - 1}", number)

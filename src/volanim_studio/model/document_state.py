@@ -44,7 +44,7 @@ class Part:
     apply: Callable[[Any, Any, Path], list[str]]  # (doc, checked value, project path) -> warnings
 
 
-def _relative(path: Path, target: str) -> str:
+def relative_path(path: Path, target: str) -> str:
     """``target`` relative to the project's folder when it is inside it (the pair can move together)."""
     try:
         return str(Path(target).resolve().relative_to(path.parent.resolve()))
@@ -83,7 +83,7 @@ def _apply_settings(doc, values: dict, path: Path) -> list[str]:
 def _save_timeline(doc, path: Path) -> dict:
     data = doc.timeline.to_json()
     if data["clip"]:
-        data["clip"]["path"] = _relative(path, data["clip"]["path"])
+        data["clip"]["path"] = relative_path(path, data["clip"]["path"])
     return data
 
 

@@ -34,7 +34,7 @@ from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
 from . import document_state
-from .document_state import _relative
+from .document_state import relative_path
 
 PROJECT_FORMAT = "volanim project"
 PROJECT_VERSION = 3
@@ -70,7 +70,7 @@ def write_project(doc, path) -> dict:
         conn = doc.attachments.to_connectivity()
         stored["connect"] = bundle.store_file(path, "connect", ".connect", lambda p: io.write_connect(p, conn))
 
-    volume = _relative(path, doc.volume_path) if doc.volume_path else None
+    volume = relative_path(path, doc.volume_path) if doc.volume_path else None
     data = {
         "format": PROJECT_FORMAT, "version": PROJECT_VERSION, "demo": doc.demo_name,
         "volume": volume, "volume_dims": list(doc.volume_dims) if doc.volume_dims else None,

@@ -238,3 +238,11 @@ def test_bad_project_fields_are_format_errors_naming_the_file(tmp_path, content,
     with pytest.raises(FormatError, match=message) as info:
         read_project(path)
     assert str(path) in str(info.value)
+
+
+def test_a_project_that_is_a_device_is_refused_not_read_forever(tmp_path):
+    """#38 review: the manifest reader took a size of 0 for /dev/zero and read until memory ran out."""
+    link = tmp_path / "zero.volanim"
+    link.symlink_to("/dev/zero")
+    with pytest.raises(FormatError, match="zero.volanim: is not a regular file"):
+        read_project(link)
