@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import struct
 
+import numpy as np
+
 from paths import ASSETS
 
 from .cases import BONES, BVH, IDENTITY, Case
@@ -100,8 +102,12 @@ def bvh_cases() -> list[Case]:
 def tskel_cases() -> list[Case]:
     three_rows = "\n".join(IDENTITY.splitlines()[:3]) + "\n"
     text = f"# metric: euclid\nRoot: 0 0 0 :: 0 0 10\n{three_rows}10 10 10 3 0.9\n11 10 10 2.5 0.7\n"
+    counted = (f"# volanim tskel 1\n# points: 2\nRoot: 0 0 0 :: 0 0 10\n{three_rows}"
+               "10 10 10 1\n11 10 10 2.5\n")
     return [Case("tskel: a 3-row matrix followed by a point line", "read_tskel", {"m.tskel": text.encode()},
-                 "m.tskel")]
+                 "m.tskel"),
+            Case("tskel: a 3-row matrix followed by a point of dt 1, counted", "read_tskel",
+                 {"m.tskel": counted.encode()}, "m.tskel")]
 
 
 def tf_cases() -> list[Case]:
@@ -110,5 +116,26 @@ def tf_cases() -> list[Case]:
                  "m.tf")]
 
 
+def png(pixels: np.ndarray, mode: str) -> bytes:
+    from io import BytesIO
+
+    from PIL import Image
+
+    out = BytesIO()
+    Image.fromarray(pixels, mode).save(out, format="PNG")
+    return out.getvalue()
+
+
+def alpha_cases() -> list[Case]:
+    rgba = np.full((6, 5, 4), 200, np.uint8)
+    rgba[0, 0, 3] = 0  # one pixel masked out, its colour left as painted
+    la = np.full((4, 5, 2), 200, np.uint8)
+    la[..., 1] = 128
+    return [Case("slices: RGBA with a transparent pixel", "read_volume",
+                 {"s/a0.png": png(rgba, "RGBA"), "s/a1.png": png(rgba, "RGBA")}, "s"),
+            Case("slices: grey+alpha half transparent, 4 rows high", "read_volume",
+                 {"s/a0.png": png(la, "LA"), "s/a1.png": png(la, "LA")}, "s")]
+
+
 def round2_cases() -> list[Case]:
-    return mesh_cases() + project_cases() + bvh_cases() + tskel_cases() + tf_cases()
+    return mesh_cases() + project_cases() + bvh_cases() + tskel_cases() + tf_cases() + alpha_cases()

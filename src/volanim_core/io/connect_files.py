@@ -65,6 +65,24 @@ def _parse_matrix(rec: TextRecords, records, start: int, root_line: int) -> np.n
     return m
 
 
+def _check_point_count(rec: TextRecords, found: int) -> None:
+    """Compare with the ``# points: N`` header volanim writes, when the file has one.
+
+    Why: in a ``.tskel`` a 3-row matrix followed by a point ``x y z 1`` reads
+    exactly like a 4-row matrix whose translation is (x, y, z); only a count
+    written beside the points tells the two apart (docs/formats.md, ``.tskel``).
+    """
+    text = rec.header.get("points")
+    if text is None:
+        return
+    line = rec.header_lines.get("points")
+    if not text.strip().isdigit() or len(text.strip()) > 12:
+        raise rec.error(line, f"bad '# points: {text.strip()}' header, expected a whole number")
+    if int(text) != found:
+        raise rec.error(line, f"the header says {int(text)} points but the file has {found} point lines; "
+                              "a line is missing or extra (a matrix of 3 rows takes the next point as its 4th)")
+
+
 def _read_rooted(path, *, matrices: bool, points: bool):
     rec = read_records(path)
     records = rec.records
@@ -97,6 +115,7 @@ def _read_rooted(path, *, matrices: bool, points: bool):
     if not bones:
         raise rec.error(None, f"no {ROOT_SYNTAX} line, expected at least one bone")
     arr = parse_point_rows(rec, rows, (4, 5), "x y z dt [thinness]")
+    _check_point_count(rec, len(rows))
     if len(arr):
         coords = arr[:, :3].astype(np.int64)
         _, first, counts = np.unique(coords, axis=0, return_index=True, return_counts=True)
@@ -161,7 +180,7 @@ def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | Non
     if thinness is not None:
         keep = ~(conn.thinness < thinness)  # NaN thinness (unknown) is kept
     th = thinness if thinness is not None else conn.thinness_threshold
-    lines = ["# volanim connect 1"]
+    lines = ["# volanim connect 1", f"# points: {int(keep.sum())}"]
     if th is not None:
         lines.append(f"# thinness: {th:.2f}" if round(th, 2) == th else f"# thinness: {fmt_float(th)}")
     lines.append(f"# metric: {conn.metric}")
@@ -181,7 +200,8 @@ def write_trans(path: str | Path, trans: Trans) -> None:
 
 def write_tskel(path: str | Path, tskel: Tskel) -> None:
     """Write a ``.tskel`` file atomically, points grouped under their bone."""
-    lines = ["# volanim tskel 1", f"# metric: {tskel.metric}", *_geometry_header(tskel.geometry)]
+    lines = ["# volanim tskel 1", f"# points: {len(tskel.points)}", f"# metric: {tskel.metric}",
+             *_geometry_header(tskel.geometry)]
     lines += _bone_blocks(tskel.bones, tskel.bone, tskel.points, tskel.dt, tskel.thinness, tskel.matrices)
     atomic_write_text(path, "\n".join(lines) + "\n")
 

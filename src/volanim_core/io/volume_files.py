@@ -156,9 +156,10 @@ def _read_vtk(path: Path):
         raise FormatError(path, f"bad geometry: {exc}") from None
     mode = _recorded_mode(img.field_data[MODE_KEY][0] if MODE_KEY in img.field_data else None)
     scalars = np.asarray(img.point_data.active_scalars)
-    if scalars.ndim > 1 and scalars.shape[1] in (3, 4) and scalars.dtype == np.uint8:  # RGB(A): drop alpha
+    if scalars.ndim > 1 and scalars.shape[1] in (3, 4) and scalars.dtype == np.uint8:  # RGB(A)
         nx, ny, nz = img.dimensions
-        data = scalars[:, :3].reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
+        rgb = _without_alpha(scalars, path) if scalars.shape[1] == 4 else scalars
+        data = rgb.reshape(nz, ny, nx, 3).transpose(2, 1, 0, 3)
         return data, geometry, mode
     if scalars.ndim > 1:  # other vector data: take the first component
         scalars = scalars[:, 0]
@@ -191,19 +192,40 @@ def slice_files(folder: str | Path) -> list[Path]:
     return files
 
 
+def _without_alpha(img: np.ndarray, path: Path) -> np.ndarray:
+    """Drop the alpha channel (the last of 2 or 4 on the last axis) when it is
+    opaque everywhere; refuse it when it is not.
+
+    Why refuse: a transparent pixel's RGB is whatever the painter left there
+    (often white or the tissue colour), and whether it means "background" or
+    "ignore the mask" is the user's to say. Reading the RGB as if opaque
+    silently put masked-out pixels in the volume (docs/formats.md, slices).
+    """
+    alpha = img[..., -1]
+    opaque = np.iinfo(img.dtype).max if np.issubdtype(img.dtype, np.integer) else 1.0
+    seethrough = int(np.count_nonzero(alpha != opaque))
+    if seethrough:
+        raise FormatError(path, f"{seethrough} of {alpha.size} pixels are transparent (alpha below {opaque}); "
+                                "volanim reads slices as opaque and will not guess what a transparent pixel "
+                                "holds: flatten the images onto a background, or save them without alpha")
+    return img[..., 0] if img.shape[-1] == 2 else img[..., :3]
+
+
 def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.ndarray:
     """One slice image as ``[x, y]``, or ``[x, y, 3]`` with ``colour`` (grey images then repeat in
     R, G, B). ``colour=None`` keeps the image as it is: ``[x, y, 3]`` for a colour image, else ``[x, y]``.
 
     ``expect`` is the first slice's ``(X, Y)``: every slice must have it.
     """
-    from skimage import io as skio
+    import imageio.v3 as iio  # not skimage.io.imread: it moves the axes of a grey+alpha image 3 or 4 rows high
 
     try:
-        img = np.asarray(skio.imread(path))
+        img = np.asarray(iio.imread(path))
     except Exception as exc:  # imageio/PIL raise many types
         raise FormatError(path, f"cannot read image: {exc}") from exc
-    is_rgb = img.ndim == 3 and img.shape[2] in (3, 4)
+    if img.ndim == 3 and img.shape[2] in (2, 4):  # grey+alpha or RGBA
+        img = _without_alpha(img, path)
+    is_rgb = img.ndim == 3 and img.shape[2] == 3
     if colour is None:
         colour = is_rgb
     if is_rgb:

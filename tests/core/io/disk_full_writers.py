@@ -26,7 +26,7 @@ def writers(spare: Path):
     from volanim_core.io.mesh_files import write_mesh
     from volanim_core.render.run import encode, write_png
     from volanim_core.rig.bones import Bone, BoneSkeleton
-    from volanim_core.rig.connectivity import Connectivity, RootBone
+    from volanim_core.rig.connectivity import Connectivity, RootBone, Tskel
     from volanim_core.skeleton.points import Skeleton
 
     rng = np.random.default_rng(0)
@@ -60,6 +60,8 @@ def writers(spare: Path):
     out.update({
         "skeleton .mskel": ("s.mskel", lambda p: io.write_mskel(p, skel)),
         "connectivity .connect": ("c.connect", lambda p: io.write_connect(p, conn)),
+        "posed .tskel": ("t.tskel", lambda p: io.write_tskel(p, Tskel(roots, np.stack([np.eye(4)] * 2), conn.points,
+                                                                  conn.dt, conn.thinness, conn.bone))),
         "picture .png": ("o.png", lambda p: write_png(p, picture)),
         "movie .gif": ("o.gif", lambda p: encode(pngs * 4, p, 12.0)),
         "project .volanim": ("p.volanim", project),
@@ -67,14 +69,57 @@ def writers(spare: Path):
     return out
 
 
+def fill(full: Path, leave: int) -> Path:
+    """Fill the disk of ``full`` but ``leave`` bytes; the ballast file to delete for room."""
+    ballast = full / "ballast"
+    free = os.statvfs(full).f_bavail * os.statvfs(full).f_frsize
+    with open(ballast, "wb") as fh:
+        fh.write(b"\0" * max(0, free - leave))
+    return ballast
+
+
+def sequence_store(full: Path, spare: Path) -> dict:
+    """A sequence store is a resumable cache, not a file replaced whole: on a full disk the run must
+    raise, every frame it recorded complete must verify, and the same run must finish it after room is
+    made, frame for frame equal to a run that had room."""
+    sys.path.insert(0, str(Path(__file__).parents[2]))  # tests/: run as a script, not under pytest
+    from paths import ASSETS, WALK
+    from volanim_core import io
+    from volanim_core.samples import mannequin_bones
+    from volanim_core.sequence import store
+    from volanim_core.sequence.frames import frames_from_files
+    from volanim_core.sequence.run import run_sequence
+
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
+    walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))
+    run_sequence(conn, walk, spare / "roomy.zarr", mode="bone", workers=1)
+    size = sum(f.stat().st_size for f in (spare / "roomy.zarr").rglob("*") if f.is_file())
+    ballast = fill(full, size // 2)
+    result = {"writer": "sequence .zarr", "store_bytes": size}
+    try:
+        run_sequence(conn, walk, full / "s.zarr", mode="bone", workers=1)
+        result["raised"] = None
+    except OSError as exc:
+        result["raised"] = f"{type(exc).__name__}: {exc}"[:300]
+    recorded = sorted(store.finished(full / "s.zarr"))
+    result["recorded"] = len(recorded)
+    result["frames"] = len(walk)
+    want = store.open_frames(spare / "roomy.zarr")
+    result["recorded_verify"] = all(np.array_equal(store.read_frame(full / "s.zarr", i),
+                                                   store.read_frame(spare / "roomy.zarr", i)) for i in recorded)
+    ballast.unlink()
+    again = run_sequence(conn, walk, full / "s.zarr", mode="bone", workers=1)
+    result["skipped_on_resume"] = again.skipped
+    got = store.open_frames(full / "s.zarr")
+    result["resumed_equal"] = bool(np.array_equal(got[:], want[:]))
+    return result
+
+
 def main(full: Path, spare: Path) -> None:
     for name, (rel, write) in writers(spare).items():
         target = full / rel
         target.write_bytes(OLD)
-        ballast = full / "ballast"
-        free = os.statvfs(full).f_bavail * os.statvfs(full).f_frsize
-        with open(ballast, "wb") as fh:  # leave 24 kB: more than the old file, less than any new one
-            fh.write(b"\0" * max(0, free - 24 * 1024))
+        ballast = fill(full, 24 * 1024)  # more than the old file, less than any new one
         result = {"writer": name}
         try:
             write(target)
@@ -90,6 +135,7 @@ def main(full: Path, spare: Path) -> None:
         for p in sorted(full.rglob("*"), reverse=True):  # the next writer starts on an empty disk
             p.unlink() if p.is_file() else p.rmdir()
         print(json.dumps(result), flush=True)
+    print(json.dumps(sequence_store(full, spare)), flush=True)
 
 
 if __name__ == "__main__":

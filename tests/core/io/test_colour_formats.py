@@ -53,11 +53,54 @@ def test_counting_a_colour_file_says_why_not(tmp_path, rgb):
         io.histogram_file(tmp_path / "c.VOL")
 
 
-def test_a_4_component_vti_reads_as_rgb(tmp_path, rgb):
+def _rgba_vti(path, rgb, alpha):
     import pyvista as pv
 
     img = pv.ImageData(dimensions=(7, 5, 4))
-    rgba = np.concatenate([rgb, np.full((7, 5, 4, 1), 9, np.uint8)], axis=3)
+    rgba = np.concatenate([rgb, np.broadcast_to(np.asarray(alpha, np.uint8), (7, 5, 4))[..., None]], axis=3)
     img.point_data["rgba"] = np.ascontiguousarray(rgba.transpose(2, 1, 0, 3)).reshape(-1, 4)
-    img.save(tmp_path / "a.vti")
+    img.save(path)
+
+
+# spec: docs/formats.md (colour volumes, alpha)
+def test_an_opaque_4_component_vti_reads_as_rgb(tmp_path, rgb):
+    _rgba_vti(tmp_path / "a.vti", rgb, 255)
     assert np.array_equal(io.read_volume(tmp_path / "a.vti", colour=True), rgb)
+
+
+# spec: docs/formats.md (colour volumes, alpha)
+def test_a_vti_with_transparent_voxels_is_refused(tmp_path, rgb):
+    alpha = np.full((7, 5, 4), 255, np.uint8)
+    alpha[1, 2, 3] = alpha[0, 0, 0] = 0
+    _rgba_vti(tmp_path / "a.vti", rgb, alpha)
+    with pytest.raises(FormatError, match=r"a\.vti.*2 of 140 pixels are transparent"):
+        io.read_volume(tmp_path / "a.vti", colour=True)
+
+
+# spec: docs/formats.md (colour volumes, alpha)
+@pytest.mark.parametrize("colour", [True, False])
+def test_rgba_slice_folders_opaque_read_transparent_refused(tmp_path, rgb, colour):
+    from PIL import Image  # the images a paint program writes, not our own writer
+
+    for name, alpha in (("opaque", 255), ("masked", 0)):
+        folder = tmp_path / name
+        folder.mkdir()
+        for z in range(rgb.shape[2]):
+            a = np.full(rgb.shape[:2], 255, np.uint8)
+            a[:2, :2] = alpha  # a corner masked out, its colour left as painted
+            rgba = np.concatenate([rgb[:, :, z], a[..., None]], axis=2).swapaxes(0, 1)
+            Image.fromarray(np.ascontiguousarray(rgba), "RGBA").save(folder / f"s{z}.png")
+    got = io.read_volume(tmp_path / "opaque", colour=colour)
+    luma = np.rint(rgb @ [0.2125, 0.7154, 0.0721]).astype(np.uint8)  # docs/formats.md: Rec. 709
+    assert np.array_equal(got, rgb if colour else luma)
+    with pytest.raises(FormatError, match=r"s0\.png: 4 of 35 pixels are transparent"):
+        io.read_volume(tmp_path / "masked", colour=colour)
+
+
+def test_a_grey_and_alpha_slice_4_rows_high_reads_as_grey_when_opaque(tmp_path):
+    from PIL import Image
+
+    grey = np.arange(20, dtype=np.uint8).reshape(4, 5)
+    for z in range(2):
+        Image.fromarray(np.stack([grey, np.full_like(grey, 255)], axis=2), "LA").save(tmp_path / f"s{z}.png")
+    assert np.array_equal(io.read_volume(tmp_path), np.stack([grey.T, grey.T], axis=2))

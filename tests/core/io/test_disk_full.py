@@ -28,11 +28,18 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
                          capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]
     rows = [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
+    assert rows and rows[-1]["writer"] == "sequence .zarr", out.stderr[-2000:]
+    seq = rows.pop()
+    print(f"\nsequence .zarr: {seq}")
     table = "\n".join(f"{r['writer']:<24} raised: {bool(r['raised'])!s:<6} old intact: {r['old_intact']!s:<6} "
                       f"litter: {r['litter']}" for r in rows)
     print("\n" + table)
-    assert len(rows) == 15, out.stderr[-2000:]
+    assert len(rows) == 16, out.stderr[-2000:]
     for r in rows:
         assert r["raised"] and not r.get("traceback"), r
         assert r["old_intact"], r
         assert r["litter"] == [], r
+    # a store is resumable: it stops with the error, what it recorded verifies, the rerun finishes it
+    assert seq["raised"] and 0 <= seq["recorded"] < seq["frames"], seq
+    assert seq["recorded_verify"] and seq["skipped_on_resume"] == seq["recorded"], seq
+    assert seq["resumed_equal"], seq

@@ -149,6 +149,35 @@ def test_tskel_round_trip(tmp_path, small_connect, rng):
 
 
 # spec: docs/formats.md#tskel
+def test_tskel_three_row_matrix_before_a_point_with_dt_1_is_refused_by_the_count(tmp_path):
+    # "x y z 1" is a valid translation row: without the count this file reads as
+    # one bone translated by (10, 10, 10) holding one point, silently.
+    body = "Root: 0 0 0 :: 0 0 10\n1 0 0 0\n0 1 0 0\n0 0 1 0\n10 10 10 1\n11 10 10 2\n"
+    (tmp_path / "seed.tskel").write_text(body)
+    assert len(io.read_tskel(tmp_path / "seed.tskel")) == 1  # the seed's files: ambiguous, documented
+    (tmp_path / "m.tskel").write_text("# volanim tskel 1\n# points: 2\n" + body)
+    with pytest.raises(io.FormatError, match=r"m.tskel:2: the header says 2 points but the file has 1"):
+        io.read_tskel(tmp_path / "m.tskel")
+
+
+# spec: docs/formats.md#connect
+@pytest.mark.parametrize("count", ["3", "x", "-1", "9" * 13])
+def test_point_count_header_must_match(tmp_path, count):
+    (tmp_path / "a.connect").write_text(f"# points: {count}\nRoot: 0 0 0 :: 0 0 10\n1 1 1 2\n")
+    with pytest.raises(io.FormatError, match="a.connect:1: .*points"):
+        io.read_connect(tmp_path / "a.connect")
+
+
+# spec: docs/formats.md#tskel
+def test_volanim_writes_the_point_count(tmp_path, small_connect, rng):
+    c = small_connect
+    io.write_connect(tmp_path / "a.connect", c, thinness=0.5)
+    assert f"# points: {int((c.thinness >= 0.5).sum())}\n" in (tmp_path / "a.connect").read_text()
+    io.write_tskel(tmp_path / "a.tskel", Tskel(c.bones, _trans(c, rng), c.points, c.dt, c.thinness, c.bone))
+    assert f"# points: {len(c)}\n" in (tmp_path / "a.tskel").read_text()
+
+
+# spec: docs/formats.md#tskel
 def test_tskel_with_zero_points(tmp_path, small_connect):
     t = Tskel(small_connect.bones, np.tile(np.eye(4), (2, 1, 1)), np.zeros((0, 3)), [], None, [])
     io.write_tskel(tmp_path / "z.tskel", t)
