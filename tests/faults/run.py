@@ -1,6 +1,6 @@
 """Run a fault corpus and tabulate it: tried / clean / crash / hang / memory / silent per target.
 
-    python tests/faults/run.py          # the hand-written corpus, table on stdout
+    python tests/faults/run.py          # the whole corpus (as test_fault_corpus.py runs it), table on stdout
 
 Outcomes:
     clean   refused with FormatError/OSError (CLI: exit 2, no traceback) naming the file,
@@ -159,7 +159,8 @@ def table(rows) -> str:
 
 if __name__ == "__main__":
     sys.path.insert(0, str(HERE.parents[1]))
-    from tests.faults.cases import hand_written
+    sys.path.insert(0, str(HERE.parent))  # tests/: paths.py
+    from tests.faults.test_fault_corpus import CASES
 
     with tempfile.TemporaryDirectory() as tmp:
-        print(table(run_corpus(hand_written(), Path(tmp))))
+        print(table(run_corpus(CASES, Path(tmp))))
