@@ -135,16 +135,45 @@ class Motion:
         column = 0
         for j, chans in enumerate(self.channels):
             axes, cols = "", []
+            moves = [(column + k, _POSITIONS[c]) for k, c in enumerate(chans) if c not in _AXES]
+            if moves and j in self.absolute_positions():
+                for col, axis in moves:
+                    pos[:, j, axis] = vals[:, col]
+                moves = []
+            for col, axis in moves:
+                pos[:, j, axis] += vals[:, col]
             for k, c in enumerate(chans):
                 if c in _AXES:
                     axes += _AXES[c]
                     cols.append(column + k)
-                else:
-                    pos[:, j, _POSITIONS[c]] += vals[:, column + k]
             if axes:
                 rot[:, j] = Rotation.from_euler(axes, vals[:, cols], degrees=True).as_matrix()
             column += len(chans)
         return rot, pos
+
+    def absolute_positions(self) -> frozenset[int]:
+        """Non-root joints whose position channels hold their whole local position, not a move from it.
+
+        **Decided here** (docs/formats.md, BVH): BVH leaves a child's position channels undefined.
+        Blender writes them as the joint's local position (equal to its OFFSET while it does not
+        move) and reads them so; three.js adds them to the OFFSET. Read both ways, a Blender clip
+        with 6-channel joints doubles every bone that has them. So a joint's channels replace its
+        OFFSET when they lie nearer the OFFSET than zero (median over the frames), and add to it
+        otherwise. The root is always a move (only its displacement is used).
+        """
+        if getattr(self, "_absolute", None) is None:
+            found, column = set(), 0
+            for j, chans in enumerate(self.channels):
+                cols = [(column + k, _POSITIONS[c]) for k, c in enumerate(chans) if c in _POSITIONS]
+                column += len(chans)
+                if j == 0 or not cols or not len(self.values):
+                    continue
+                v = self.values[:, [c for c, _ in cols]]
+                off = self.offsets[j, [a for _, a in cols]]
+                if np.median(np.linalg.norm(v - off, axis=1)) < np.median(np.linalg.norm(v, axis=1)):
+                    found.add(j)
+            self._absolute = frozenset(found)
+        return self._absolute
 
     def forward_kinematics(self, frames=slice(None), scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """World ``(rotations (F, J, 3, 3), positions (F, J, 3))`` of every joint, positions times ``scale``."""

@@ -13,13 +13,20 @@ Spine2) are absorbed. Positions come from *our* hierarchy: each bone turns
 about its own proximal joint, which its parent has moved (bone lengths are
 ours and never change). Unmapped bones follow their parent rigidly. The root
 moves by the BVH root's displacement from the first frame, scaled by the ratio
-of hip heights.
+of leg lengths (thigh + shin: OFFSET lengths, true whatever the rest pose).
+
+Which joint drives which bone (:func:`match`) is read from the names in the
+scheme that explains most of them (``presets.py``) and from the clip's shape
+and motion (``body.py``); each line says which of the two placed it. Up and
+facing come from the motion (feet lowest, feet pointing forward), so a clip
+whose rest pose is not a T-pose (LAFAN's lies along x) lands upright; such a
+clip's rest differences are measured at its most upright sampled frame
+instead of at its OFFSET pose.
 """
 
 from __future__ import annotations
 
-import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -28,53 +35,89 @@ from volanim_core.errors import FormatError
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.pose import parents_first
 
+from .body import (
+    Sampled,
+    chain_length,
+    facing_at,
+    nearest_axis,
+    read_body,
+    sample,
+    units_of,
+    up_over,
+    upright,
+)
 from .bvh import Motion
+from .presets import best_preset, part_key, part_of
 
 AXES = {"x": 0, "y": 1, "z": 2}
 OUR_UP, OUR_FORWARD = np.array([0.0, 0.0, 1.0]), np.array([0.0, -1.0, 0.0])  # volanim's figures: z up, facing -y
 
-# Suggestions: our bone name -> BVH joint names to try, in order (Mixamo and CMU share most of them).
-SUGGESTIONS = {
-    "SPINE": ["Spine", "LowerBack", "Spine1", "Chest"], "NECK": ["Neck", "Neck1"], "HEAD": ["Head", "Neck"],
-    "PELVIS": ["Hips"], "HIPS": ["Hips"],
-    "CLAVICLE": ["{S}Shoulder", "{S}Collar"], "UPPERARM": ["{S}Arm", "{S}UpArm", "{S}UpperArm"],
-    "FOREARM": ["{S}ForeArm", "{S}LowArm", "{S}LowerArm"], "HAND": ["{S}Hand", "{S}Wrist"],
-    "THIGH": ["{S}UpLeg", "{S}Thigh", "{S}UpperLeg"], "SHIN": ["{S}Leg", "{S}Shin", "{S}LowLeg", "{S}Knee"],
-    "CALF": ["{S}Leg", "{S}Shin"], "FOOT": ["{S}Foot", "{S}Ankle"], "TOE": ["{S}ToeBase", "{S}Toe"],
-}
-SIDES = {"L": "Left", "R": "Right"}
-ARM_PARTS = {"CLAVICLE", "SHOULDER", "UPPERARM", "ARM", "FOREARM", "ELBOW", "HAND", "WRIST"}
-
-
-def _plain(name: str) -> str:
-    return re.sub(r"^.*[:|]", "", name).lower()  # mixamorig:LeftArm -> leftarm
+ARM_PARTS = {"CLAVICLE", "UPPERARM", "FOREARM", "HAND"}
 
 
 def _part(label: str) -> str:
     """``L_UPPERARM`` -> ``UPPERARM``: the body part of one of our bone labels."""
-    return re.sub(r"^[LR]_", "", label.upper())
+    return part_of(label)[1]
+
+
+@dataclass
+class Match:
+    """Our bone label -> BVH joint name, with how each was placed and by which naming scheme."""
+
+    mapping: dict[str, str]
+    how: dict[str, str]  # label -> "name and shape", "name", "shape", or "name (shape says X)"
+    scheme: str
+    notes: list[str]
+
+
+def match(bones: BoneSkeleton, motion: Motion, sampled: Sampled | None = None) -> Match:
+    """Which BVH joint drives each of our bones, from names and shape together (module docstring).
+
+    Pelvis bones (``L_PELVIS``, from the root joint sideways) follow the BVH root. Where the name
+    and the shape disagree, the name wins when its joint lies in the limb the shape found (a
+    scheme's finer choice inside a limb), the shape wins otherwise (a name that means another limb).
+    """
+    preset, named = best_preset(motion.names)
+    s = sampled if sampled is not None else sample(motion)
+    body = read_body(motion, s)
+    shaped = body.parts
+    limb_of = _limbs(shaped)
+    mapping, how = {}, {}
+    for b in bones.bones:
+        side, part = part_of(b.label)
+        if part in ("PELVIS", "HIPS"):
+            mapping[b.label], how[b.label] = motion.names[0], "the root"
+            continue
+        key = part_key(side, part)
+        n, sh = named.get(key), shaped.get(key)
+        if n is not None and sh is not None and n != sh:
+            same_limb = limb_of.get(key) is not None and limb_of[key] == limb_of.get(_key_of(shaped, n))
+            pick = n if same_limb or motion.is_descendant(n, sh) or motion.is_descendant(sh, n) else sh
+            mapping[b.label] = motion.names[pick]
+            how[b.label] = (f"name (shape says {motion.names[sh]})" if pick == n
+                            else f"shape (name says {motion.names[n]})")
+        elif n is not None or sh is not None:
+            mapping[b.label] = motion.names[n if n is not None else sh]
+            how[b.label] = "name and shape" if n == sh else ("name" if n is not None else "shape")
+    return Match(mapping, how, preset.name if named else "none", body.notes)
+
+
+def _limbs(parts: dict[str, int]) -> dict[str, str]:
+    """Part key -> its limb (``L_arm``, ``R_leg``, ``trunk``)."""
+    out = {}
+    for key in parts:
+        side, part = part_of(key)
+        out[key] = f"{side}_{'arm' if part in ARM_PARTS else 'leg'}" if side else "trunk"
+    return out
+
+
+def _key_of(parts: dict[str, int], joint: int) -> str | None:
+    return next((k for k, j in parts.items() if j == joint), None)
 
 
 def suggest_mapping(bones: BoneSkeleton, motion: Motion) -> dict[str, str]:
-    """Our bone label -> BVH joint, from common naming schemes (``L_UPPERARM`` -> ``LeftArm``).
-
-    Pelvis bones (``L_PELVIS``, from the root joint sideways) follow the BVH root.
-    """
-    plain = {_plain(n): n for n in motion.names}
-    out = {}
-    for b in bones.bones:
-        label = b.label.upper()
-        m = re.fullmatch(r"(?:([LR])_)?(\w+?)", label)
-        side, part = (m.group(1), m.group(2)) if m else (None, label)
-        if part == "PELVIS" and side:
-            out[b.label] = motion.names[0]
-            continue
-        for pattern in SUGGESTIONS.get(part, [part.capitalize()]):
-            name = pattern.format(S=SIDES.get(side, "")).lower()
-            if name in plain:
-                out[b.label] = plain[name]
-                break
-    return out
+    """Our bone label -> BVH joint (:func:`match`'s mapping)."""
+    return match(bones, motion).mapping
 
 
 def read_mapping(path: str | Path) -> dict[str, str]:
@@ -92,9 +135,12 @@ def read_mapping(path: str | Path) -> dict[str, str]:
     return out
 
 
-def format_mapping(mapping: dict[str, str], bones: BoneSkeleton) -> str:
+def format_mapping(mapping: dict[str, str], bones: BoneSkeleton, how: dict[str, str] | None = None) -> str:
+    """The mapping file's text; ``how`` adds to each line, as a comment, what placed it."""
+    how = how or {}
     lines = ["# volanim bone mapping: BONE BVH_JOINT (the BVH joint whose rotation drives the bone)"]
-    lines += [f"{b.label} {mapping[b.label]}" for b in bones.bones if b.label in mapping]
+    lines += [f"{b.label} {mapping[b.label]}" + (f"  # {how[b.label]}" if b.label in how else "")
+              for b in bones.bones if b.label in mapping]
     lines += [f"# {b.label} (unmapped: follows its parent)" for b in bones.bones if b.label not in mapping]
     return "\n".join(lines) + "\n"
 
@@ -135,19 +181,32 @@ def _align(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return Rotation.from_rotvec(axis / s * np.arctan2(s, c)).as_matrix()
 
 
-def rest_directions(bones: BoneSkeleton, motion: Motion, index: dict[int, int]) -> dict[int, tuple]:
-    """Per mapped bone: (our rest direction, the clip's rest direction in BVH axes), both unit vectors.
+def rest_pose(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+    """``(joints, tips)`` at the OFFSET pose: each joint and where its bone points to (longest child,
+    else End Site, else itself)."""
+    joints = motion.rest_positions()
+    tips = joints.copy()
+    for j in range(len(joints)):
+        dirs = motion.child_directions(j)
+        if dirs:
+            tips[j] = joints[j] + dirs[0]
+    return joints, tips
 
-    The clip's direction points from the bone's joint towards the joints that
-    drive its child bones (or its own children when none is mapped).
+
+def rest_directions(bones: BoneSkeleton, motion: Motion, index: dict[int, int], pose=None) -> dict[int, tuple]:
+    """Per mapped bone: (our rest direction, the clip's direction in BVH axes at ``pose``), unit vectors.
+
+    ``pose``: ``(joints, tips)`` of the clip's reference (its OFFSET pose by default). The clip's
+    direction points from the bone's joint towards the joints that drive its child bones (or to
+    its tip when none is mapped).
     """
-    rest = motion.rest_positions()
+    joints, tips = pose if pose is not None else rest_pose(motion)
     out = {}
     for b, k in index.items():
         ours = bones.joints[bones.bones[b].distal] - bones.joints[bones.bones[b].proximal]
         targets = [index[c] for c in range(len(bones)) if c in index and
                    bones.bones[c].proximal == bones.bones[b].distal and motion.is_descendant(index[c], k)]
-        clip_dirs = [rest[t] - rest[k] for t in targets] or motion.child_directions(k)
+        clip_dirs = [joints[t] - joints[k] for t in targets] or [tips[k] - joints[k]]
         clip_dirs = [d / np.linalg.norm(d) for d in clip_dirs if np.linalg.norm(d) > 1e-9]
         if clip_dirs and np.linalg.norm(ours) > 1e-9:
             clip = np.mean(clip_dirs, axis=0)
@@ -157,15 +216,41 @@ def rest_directions(bones: BoneSkeleton, motion: Motion, index: dict[int, int]) 
 
 
 def detect_axes(bones: BoneSkeleton, motion: Motion, index: dict[int, int], up: str = "auto",
-                forward: str = "auto") -> tuple[str, str]:
-    """The clip's up and forward axes: of the 24 axis-aligned frames, the one under which the
-    mapped bones' rest directions agree best with ours.
+                forward: str = "auto", sampled: Sampled | None = None):
+    """The clip's up and forward axes, what decided them, and the pose the rest differences are
+    measured at: ``(up, forward, how, reference, pose)``.
 
-    Arm bones do not vote (a T-pose clip and our arms-down rest disagree
-    there); the spine, neck, legs, hips and feet do. With no such bone mapped,
-    or when they leave forward undetermined, BVH's usual y up, z forward wins.
-    A given ``up`` or ``forward`` (not ``"auto"``) is kept.
+    Up from the motion (feet lowest over the sampled frames). The reference pose is the clip's
+    OFFSET pose when it stands upright in it, else its most upright sampled frame (LAFAN's
+    OFFSET pose lies along x). Forward is where that pose faces (:func:`~.body.facing_at`).
+    A given ``up`` or ``forward`` (not ``"auto"``) is kept. When the motion cannot tell (no head
+    or feet mapped), of the 24 axis-aligned frames the one under which the mapped non-arm bones'
+    rest directions agree best with ours; then BVH's usual y up, z forward.
     """
+    s = sampled if sampled is not None else sample(motion)
+    parts = {part_key(*part_of(bones.bones[b].label)): k for b, k in index.items()}
+    up_v = up_over(s, parts)
+    if up == "auto" and up_v is not None:
+        up = nearest_axis(up_v)[0]
+    if up == "auto":
+        up, forward = _axes_from_rest(bones, motion, index, up, forward)
+        return up, forward, "from the rest pose (no head and feet mapped)", None, None
+    up_clip = axes_matrix(up, "x" if up.lstrip("+-") != "x" else "y").T @ OUR_UP
+    reference, pose = None, rest_pose(motion)
+    if upright(*pose, parts, up_clip) < 0.7:  # not standing at rest: LAFAN lies along x
+        best = int(np.argmax([upright(s.joints[i], s.tips[i], parts, up_clip) for i in range(len(s.frames))]))
+        reference, pose = int(s.frames[best]), (s.joints[best], s.tips[best])
+    at = "its rest pose" if reference is None else f"frame {reference}"
+    if forward != "auto":
+        return up, forward, f"up from the motion, forward given (rest measured at {at})", reference, pose
+    fwd_v, told = facing_at(*pose, parts, up_clip)
+    if fwd_v is None:
+        forward = _axes_from_rest(bones, motion, index, up, "auto")[1]
+        return up, forward, f"up from the motion, forward from the rest directions ({told})", reference, pose
+    return up, nearest_axis(fwd_v, exclude=up)[0], f"from the motion (facing from {told} at {at})", reference, pose
+
+
+def _axes_from_rest(bones, motion, index, up, forward) -> tuple[str, str]:
     pairs = {b: d for b, d in rest_directions(bones, motion, index).items()
              if _part(bones.bones[b].label) not in ARM_PARTS}  # a T-pose and arms-down disagree there
     default = ("y" if up == "auto" else up), ("z" if forward == "auto" else forward)
@@ -187,6 +272,25 @@ def detect_axes(bones: BoneSkeleton, motion: Motion, index: dict[int, int], up: 
     return best
 
 
+def _bone_of(bones: BoneSkeleton, side: str, part: str) -> int | None:
+    return next((b for b in range(len(bones)) if part_of(bones.bones[b].label) == (side, part)), None)
+
+
+def _legs(bones: BoneSkeleton, motion: Motion, index: dict[int, int]) -> list[tuple[float, float]]:
+    """Per leg mapped in both: (our thigh + shin, the clip's hip-to-ankle length in its units)."""
+    out = []
+    for side in "LR":
+        thigh, shin, foot = (_bone_of(bones, side, p) for p in ("THIGH", "SHIN", "FOOT"))
+        if None in (thigh, shin, foot) or thigh not in index or foot not in index:
+            continue
+        clip = chain_length(motion, index[thigh], index[foot])
+        ours = sum(float(np.linalg.norm(bones.joints[bones.bones[b].distal] - bones.joints[bones.bones[b].proximal]))
+                   for b in (thigh, shin))
+        if clip > 1e-9 and ours > 0:
+            out.append((ours, clip))
+    return out
+
+
 @dataclass
 class Retarget:
     """A clip bound to our bones; :meth:`matrices` gives each frame's ``.trans`` matrices."""
@@ -199,36 +303,50 @@ class Retarget:
     rest_align: np.ndarray  # (B, 3, 3) Q_b
     up: str = "y"  # the clip's axes, as given or detected
     forward: str = "z"
+    reference: int | None = None  # the clip frame taken as its rest (None: its OFFSET pose)
+    report: dict = field(default_factory=dict)  # how axes, units and mapping were found (printed)
 
     @classmethod
     def build(cls, bones: BoneSkeleton, motion: Motion, mapping: dict[str, str] | None = None,
               up: str = "auto", forward: str = "auto") -> Retarget:
-        mapping = suggest_mapping(bones, motion) if mapping is None else mapping
+        s = sample(motion)
+        found = match(bones, motion, s) if mapping is None else Match(
+            mapping, dict.fromkeys(mapping, "given"), "given", [])
         index = {}
-        for label, joint in mapping.items():
+        for label, joint in found.mapping.items():
             try:
                 b = bones.index(label)
             except KeyError:
                 raise ValueError(f"the mapping names bone {label!r}, which the bone skeleton lacks") from None
             index[b] = motion.index(joint)
-        if up == "auto" or forward == "auto":
-            up, forward = detect_axes(bones, motion, index, up, forward)
+        up, forward, axes_how, reference, pose = detect_axes(bones, motion, index, up, forward, s)
         axes = axes_matrix(up, forward)
-        rest = motion.rest_positions()
+        up_clip = axes.T @ OUR_UP  # the clip's up, in its own axes
         align = np.tile(np.eye(3), (len(bones), 1, 1))
-        for b, (ours, clip) in rest_directions(bones, motion, index).items():
+        for b, (ours, clip) in rest_directions(bones, motion, index, pose).items():
             align[b] = _align(ours, axes @ clip)
-        up_axis = axes.T @ OUR_UP  # the clip's up, in its own axes
-        clip_height = rest[0] @ up_axis - min(p @ up_axis for p in motion.rest_points())
-        roots = [b for b, p in enumerate(bones.parents()) if p is None]
-        our_root = bones.joints[bones.bones[roots[0]].proximal] if roots else np.zeros(3)
-        our_height = our_root @ OUR_UP - min(j @ OUR_UP for j in bones.joints.values())
-        scale = our_height / clip_height if clip_height > 1e-9 and our_height > 0 else 1.0
-        return cls(bones, motion, index, axes, float(scale), align, up, forward)
+        legs = _legs(bones, motion, index)
+        if legs:
+            scale = float(np.mean([ours / clip for ours, clip in legs]))
+            scale_how, units = "leg length (hip to ankle)", units_of(float(np.mean([c for _, c in legs])))
+        else:
+            rest = motion.rest_positions()
+            clip_height = rest[0] @ up_clip - min(p @ up_clip for p in motion.rest_points())
+            roots = [b for b, p in enumerate(bones.parents()) if p is None]
+            our_root = bones.joints[bones.bones[roots[0]].proximal] if roots else np.zeros(3)
+            our_height = our_root @ OUR_UP - min(j @ OUR_UP for j in bones.joints.values())
+            scale = our_height / clip_height if clip_height > 1e-9 and our_height > 0 else 1.0
+            scale_how, units = "hip height at rest", "unknown"
+        report = {"scheme": found.scheme, "how": found.how, "notes": found.notes, "axes": axes_how,
+                  "scale": scale_how, "reference": reference, "units": units}
+        return cls(bones, motion, index, axes, float(scale), align, up, forward, reference, report)
 
     def matrices(self, frames=slice(None)) -> np.ndarray:
         """``(F, B, 4, 4)`` row-vector matrices, rest voxel coordinates -> posed, one set per frame."""
         world_rot, world_pos = self.motion.forward_kinematics(frames)
+        if self.reference is not None:  # rotations from the reference frame, not from the OFFSET pose
+            ref_rot, _ = self.motion.forward_kinematics([self.reference])
+            world_rot = world_rot @ np.swapaxes(ref_rot, -1, -2)
         n, bones = len(world_rot), self.bones
         a = self.axes
         shift = (world_pos[:, 0] - world_pos[:1, 0]) @ a.T * self.scale  # root displacement, our axes
