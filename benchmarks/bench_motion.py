@@ -139,8 +139,37 @@ def bench_playback(seconds: float = 6.0) -> None:
     print("targets: >= 10 drawn/s; clip time kept ~1 (frames dropped, never slowed down)")
 
 
+def bench_real_clip() -> None:
+    """#39: mapping and detection (names, shape, axes from the motion, plausibility) on LAFAN's
+    7184-frame test.bvh, against parsing it, measured in the same run. Target: at most +20 %."""
+    sys.path.insert(0, str(ROOT / "tests"))
+    from real_clips import clip
+
+    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.motion.plausible import check_clip
+    from volanim_core.motion.retarget import Retarget
+    from volanim_core.samples import mannequin_bones
+
+    path, bones = clip("lafan_test"), mannequin_bones()
+    motion = read_bvh(path)
+    parse = best_of(lambda: read_bvh(path))
+    build = best_of(lambda: Retarget.build(bones, motion))
+    retarget = Retarget.build(bones, motion)
+    check = best_of(lambda: check_clip(retarget))
+    frames = best_of(lambda: retarget.matrices(), repeats=3)
+    rows = [["parse (read_bvh)", f"{1000 * parse:.0f}", "1.00"],
+            ["map + detect axes, units, reference (Retarget.build)", f"{1000 * build:.1f}", f"{build / parse:.3f}"],
+            ["plausibility check (64 sampled frames)", f"{1000 * check:.1f}", f"{check / parse:.3f}"],
+            ["mapping and detection together", f"{1000 * (build + check):.1f}", f"{(build + check) / parse:.3f}"],
+            ["retarget all 7184 frames (matrices)", f"{1000 * frames:.0f}", f"{frames / parse:.2f}"]]
+    print(f"\nLAFAN test.bvh ({motion.frames} frames, {len(motion.names)} joints) onto the mannequin")
+    print(table(rows, ["step", "ms (best of 5)", "ratio to parse"]))
+    print("target: mapping and detection add at most 0.20 of the parse time")
+
+
 if __name__ == "__main__":
     bench_clip()
+    bench_real_clip()
     if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
         bench_playback()
     else:

@@ -8,6 +8,7 @@ from pathlib import Path
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frames import write_frames
+from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget, check_mapping_file, format_mapping, read_mapping
 from volanim_core.progress import TextProgress
 from volanim_core.rig.tskel import connect_to_tskel
@@ -39,9 +40,24 @@ def _bvh2trans(args):
         raise ValueError(f"{args.clip}: --frames {args.frames.start}:{args.frames.stop}:{args.frames.step} "
                          f"selects no frame of {motion.frames}")
     used = {retarget.bones.bones[b].label: motion.names[k] for b, k in retarget.mapping.items()}
-    print(format_mapping(used, bones), end="")
+    report = retarget.report
+    print(f"# naming scheme: {report['scheme']}; each line says what placed it (name, shape or both)")
+    print(format_mapping(used, bones, report["how"]), end="")
+    for note in report["notes"]:
+        print(f"# note: {note}")
     for label, angle in retarget.absorbed_degrees().items():
         print(f"# {label}: rest poses differ by {angle:.1f} degrees (absorbed)")
+    print(f"# axes: up {retarget.up}, forward {retarget.forward} ({report['axes']})")
+    print(f"# units: {report['units']}; scale {retarget.scale:.3g} voxels per BVH unit ({report['scale']})")
+    checks, sampled = check_clip(retarget)
+    for c in checks:
+        print(f"# {c.line(sampled)}")
+    failed = [c for c in checks if not c.ok]
+    if failed and not args.no_check:
+        raise ValueError(f"{args.clip}: the retargeted clip does not look like a person standing: "
+                         + "; ".join(f"{c.name} in only {100 * c.held:.0f}% of frames (suspect {c.suspect})"
+                                     for c in failed)
+                         + ". Nothing was written; give --up/--forward/--map, or --no-check to write it anyway")
     conn = read_connect(args.connect) if args.connect else None
     mats = retarget.matrices(args.frames)
     write_frames(args.output, Path(args.clip).stem, bones, mats, frames, connect=conn,
@@ -68,9 +84,12 @@ def register(sub) -> None:
     p.add_argument("--map", help="BONE BVH_JOINT per line (default: suggested from the names; printed)")
     p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
     p.add_argument("--up", default="auto", help="the clip's up axis: x, y, z, -x, ... (default: detected "
-                                                "from the mapped bones' rest directions; BVH is usually y)")
-    p.add_argument("--forward", default="auto", help="the way the clip's figure faces at rest (default: detected)")
+                                                "from the motion: the feet are lowest)")
+    p.add_argument("--forward", default="auto", help="the way the clip's figure faces at rest (default: detected "
+                                                     "from where the feet point)")
     p.add_argument("--connect", help="also write each frame's .tskel for this .connect")
+    p.add_argument("--no-check", action="store_true",
+                   help="write the frames even when the retargeted figure fails the plausibility checks")
     p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
 
     p = add_command(sub, "trans2tskel", "A .connect plus many .trans frames -> one .tskel each.",

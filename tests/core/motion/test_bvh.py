@@ -145,3 +145,13 @@ def test_deep_hierarchies_do_not_recurse(tmp_path):
     m = read_bvh(write(tmp_path, text))
     _, pos = m.forward_kinematics()
     assert np.allclose(pos[0, -1], [0, n - 1, 0])
+
+
+def test_six_channel_child_holding_its_local_position_replaces_its_offset(tmp_path):
+    """Blender writes a child's position channels as its whole local position (equal to its OFFSET
+    while it does not move); adding them doubled such bones (#39, bvhtools' test3.bvh)."""
+    text = clip("ZXY", ["0 0 0 0 0 0 0 10 0 0 0 0 0 0 0", "0 0 0 0 0 0 0 10.5 0 0 0 0 0 0 0"],
+                child_channels="Xposition Yposition Zposition Zrotation Xrotation Yrotation")
+    m = read_bvh(write(tmp_path, text))
+    _, pos = m.forward_kinematics()
+    assert np.allclose(pos[:, 1], [[0, 10, 0], [0, 10.5, 0]])  # not (0, 20, 0)

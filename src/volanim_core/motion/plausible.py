@@ -1,0 +1,85 @@
+"""Is a retargeted clip a person? Checks on our posed joints at sampled frames, before anything is written.
+
+    Retarget.matrices(sampled frames) -> our joints posed (z up) -> per check: the share of frames it holds
+        head above pelvis        the spine's top over its bottom: not on its back, not upside down
+        feet near the floor      the lowest joint within half a leg of our rest floor (scale, up)
+        knees and elbows bend    a limb's lower bone never folds back more than 165 degrees onto the upper
+
+A check that holds in fewer than ``MOST`` of the frames names what is suspect
+(the up axis, the scale, a bone's mapping), so ``bvh2trans`` refuses instead of
+writing a figure on its back; ``--no-check`` writes it anyway.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .presets import part_of
+
+MOST = 0.8  # a check must hold in this share of the sampled frames (a jump leaves the floor, a bow dips the head)
+FOLD_DEGREES = 165.0
+
+
+@dataclass(frozen=True)
+class Check:
+    name: str
+    held: float  # share of the sampled frames in which it held
+    suspect: str  # what to look at when it fails
+
+    @property
+    def ok(self) -> bool:
+        return self.held >= MOST
+
+    def line(self, frames: int) -> str:
+        state = "ok" if self.ok else f"FAILS: suspect {self.suspect}"
+        return f"{self.name}: {100 * self.held:.0f}% of {frames} sampled frames ({state})"
+
+
+def _posed(bones, mats: np.ndarray, joint: str) -> np.ndarray:
+    b = next(i for i, bone in enumerate(bones.bones) if joint in (bone.proximal, bone.distal))
+    return bones.joints[joint] @ mats[:, b, :3, :3] + mats[:, b, 3, :3]
+
+
+def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
+    """The checks that apply to this skeleton, at up to ``samples`` frames spread over the clip."""
+    motion, bones = retarget.motion, retarget.bones
+    frames = np.unique(np.linspace(0, motion.frames - 1, min(samples, motion.frames)).round().astype(int))
+    mats = retarget.matrices(frames)
+    checks = []
+    by_part = {part_of(b.label): k for k, b in enumerate(bones.bones)}
+    spine = by_part.get((None, "SPINE"))
+    if spine is not None:
+        bone = bones.bones[spine]
+        top, bottom = _posed(bones, mats, bone.distal), _posed(bones, mats, bone.proximal)
+        held = float(np.mean(top[:, 2] > bottom[:, 2]))
+        checks.append(Check("head above pelvis", held, f"the up axis (detected: {retarget.up}; try --up)"))
+    legs = [by_part[(s, "SHIN")] for s in "LR" if (s, "SHIN") in by_part]
+    if legs:
+        rest_floor = min(j[2] for j in bones.joints.values())
+        leg = max(np.linalg.norm(bones.joints[bones.bones[b].distal] - bones.joints[bones.bones[b].proximal])
+                  for b in legs)
+        lowest = np.min([_posed(bones, mats, j)[:, 2] for j in bones.joints], axis=0)
+        held = float(np.mean(np.abs(lowest - rest_floor) <= 0.5 * leg))  # a crouch keeps a foot down; a jump is brief
+        checks.append(Check("feet near the floor", held, f"the scale ({retarget.scale:.3g} voxels per BVH unit, "
+                                                         f"{retarget.report.get('scale', '')}) or the up axis"))
+    for upper, lower, name in (("THIGH", "SHIN", "knee"), ("UPPERARM", "FOREARM", "elbow")):
+        for side in "LR":
+            a, b = by_part.get((side, upper)), by_part.get((side, lower))
+            if a is None or b is None or b not in retarget.mapping:
+                continue
+            da = _direction(bones, mats, a)
+            db = _direction(bones, mats, b)
+            angle = np.degrees(np.arccos(np.clip(np.einsum("fi,fi->f", da, db), -1, 1)))
+            held = float(np.mean(angle < FOLD_DEGREES))
+            label = bones.bones[b].label
+            checks.append(Check(f"{side} {name} bends less than {FOLD_DEGREES:.0f} degrees", held,
+                                f"the mapping of {label} ({motion.names[retarget.mapping[b]]})"))
+    return checks, len(frames)
+
+
+def _direction(bones, mats, b: int) -> np.ndarray:
+    bone = bones.bones[b]
+    d = _posed(bones, mats, bone.distal) - _posed(bones, mats, bone.proximal)
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
