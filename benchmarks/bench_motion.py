@@ -144,7 +144,6 @@ def bench_real_clip() -> None:
     7184-frame test.bvh, against parsing it, measured in the same run. Target: at most +20 %."""
     sys.path.insert(0, str(ROOT / "tests"))
     from real_clips import clip
-
     from volanim_core.motion.bvh import read_bvh
     from volanim_core.motion.plausible import check_clip
     from volanim_core.motion.retarget import Retarget
