@@ -65,11 +65,11 @@ class FigureView(QWidget):
         scale = min(half, self.height()) / size
         p.setPen(QPen(QColor(230, 200, 120), 2))
         for view, (h, sign) in enumerate(((0, 1.0), (1, -1.0))):  # front: x across; side: -y across
-            def at(v):
-                return QPointF(half * view + half / 2 + sign * (v[h] - centre[h]) * scale,
-                               self.height() / 2 - (v[2] - centre[2]) * scale)
+            left = half * view + half / 2
             for bone in self.bones.bones:
-                p.drawLine(at(self.joints[bone.proximal]), at(self.joints[bone.distal]))
+                a, b = self.joints[bone.proximal], self.joints[bone.distal]
+                p.drawLine(*(QPointF(left + sign * (v[h] - centre[h]) * scale,
+                                     self.height() / 2 - (v[2] - centre[2]) * scale) for v in (a, b)))
         p.setPen(QColor(160, 160, 160))
         p.drawText(6, 14, "front")
         p.drawText(int(half) + 6, 14, "side")
