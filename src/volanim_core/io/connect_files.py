@@ -76,8 +76,9 @@ def _check_point_count(rec: TextRecords, found: int) -> None:
     if text is None:
         return
     line = rec.header_lines.get("points")
-    if not text.strip().isdigit() or len(text.strip()) > 12:
-        raise rec.error(line, f"bad '# points: {text.strip()}' header, expected a whole number")
+    text = text.strip()
+    if not (text.isascii() and text.isdigit()) or len(text) > 12:  # "²".isdigit() is True; int() refuses it
+        raise rec.error(line, f"bad '# points: {text}' header, expected a whole number")
     if int(text) != found:
         raise rec.error(line, f"the header says {int(text)} points but the file has {found} point lines; "
                               "a line is missing or extra (a matrix of 3 rows takes the next point as its 4th)")

@@ -104,7 +104,6 @@ class Body:
     """What the shape and motion say, in the clip's axes."""
 
     parts: dict[str, int]  # part key ("L_UPPERARM") -> joint index
-    upper: int | None  # the upper body's first joint
     notes: list[str]
 
 
@@ -117,7 +116,7 @@ def read_body(motion: Motion, s: Sampled) -> Body:
         root = kids[root][0]
     branches = kids[root]
     if len(branches) < 2:
-        return Body({}, None, ["the hierarchy does not fork at the hips"])
+        return Body({}, ["the hierarchy does not fork at the hips"])
     count = {b: _subtree_size(kids, b) for b in branches}
     upper = max(branches, key=lambda b: (count[b], far[b]))
     others = sorted((b for b in branches if b != upper), key=lambda b: -(far[b] + np.linalg.norm(motion.offsets[b])))
@@ -160,7 +159,7 @@ def read_body(motion: Motion, s: Sampled) -> Body:
             continue
         for side, limb in sided:
             parts.update({part_key(side, p): j for p, j in limb.items()})
-    return Body(parts, upper, notes)
+    return Body(parts, notes)
 
 
 def _subtree_size(kids, j: int) -> int:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -136,7 +137,7 @@ class Motion:
         for j, chans in enumerate(self.channels):
             axes, cols = "", []
             moves = [(column + k, _POSITIONS[c]) for k, c in enumerate(chans) if c not in _AXES]
-            if moves and j in self.absolute_positions():
+            if moves and j in self.absolute_positions:
                 for col, axis in moves:
                     pos[:, j, axis] = vals[:, col]
                 moves = []
@@ -151,6 +152,7 @@ class Motion:
             column += len(chans)
         return rot, pos
 
+    @cached_property
     def absolute_positions(self) -> frozenset[int]:
         """Non-root joints whose position channels hold their whole local position, not a move from it.
 
@@ -161,19 +163,17 @@ class Motion:
         OFFSET when they lie nearer the OFFSET than zero (median over the frames), and add to it
         otherwise. The root is always a move (only its displacement is used).
         """
-        if getattr(self, "_absolute", None) is None:
-            found, column = set(), 0
-            for j, chans in enumerate(self.channels):
-                cols = [(column + k, _POSITIONS[c]) for k, c in enumerate(chans) if c in _POSITIONS]
-                column += len(chans)
-                if j == 0 or not cols or not len(self.values):
-                    continue
-                v = self.values[:, [c for c, _ in cols]]
-                off = self.offsets[j, [a for _, a in cols]]
-                if np.median(np.linalg.norm(v - off, axis=1)) < np.median(np.linalg.norm(v, axis=1)):
-                    found.add(j)
-            self._absolute = frozenset(found)
-        return self._absolute
+        found, column = set(), 0
+        for j, chans in enumerate(self.channels):
+            cols = [(column + k, _POSITIONS[c]) for k, c in enumerate(chans) if c in _POSITIONS]
+            column += len(chans)
+            if j == 0 or not cols or not len(self.values):
+                continue
+            v = self.values[:, [c for c, _ in cols]]
+            off = self.offsets[j, [a for _, a in cols]]
+            if np.median(np.linalg.norm(v - off, axis=1)) < np.median(np.linalg.norm(v, axis=1)):
+                found.add(j)
+        return frozenset(found)
 
     def forward_kinematics(self, frames=slice(None), scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         """World ``(rotations (F, J, 3, 3), positions (F, J, 3))`` of every joint, positions times ``scale``."""

@@ -54,7 +54,7 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
         bone = bones.bones[spine]
         top, bottom = _posed(bones, mats, bone.distal), _posed(bones, mats, bone.proximal)
         held = float(np.mean(top[:, 2] > bottom[:, 2]))
-        checks.append(Check("head above pelvis", held, f"the up axis (detected: {retarget.up}; try --up)"))
+        checks.append(Check("head above pelvis", held, f"the up axis (up {retarget.up}; give another with --up)"))
     legs = [by_part[(s, "SHIN")] for s in "LR" if (s, "SHIN") in by_part]
     if legs:
         rest_floor = min(j[2] for j in bones.joints.values())

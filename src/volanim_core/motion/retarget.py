@@ -145,19 +145,21 @@ def format_mapping(mapping: dict[str, str], bones: BoneSkeleton, how: dict[str, 
     return "\n".join(lines) + "\n"
 
 
+def axis_vector(text: str) -> np.ndarray:
+    """``"-z"`` -> (0, 0, -1): a signed axis name as a unit vector."""
+    text = text.strip().lower()
+    sign = -1.0 if text.startswith("-") else 1.0
+    key = text.lstrip("+-")
+    if key not in AXES:
+        raise ValueError(f"an axis must be x, y or z (optionally signed), got {text!r}")
+    v = np.zeros(3)
+    v[AXES[key]] = sign
+    return v
+
+
 def axes_matrix(up: str = "y", forward: str = "z") -> np.ndarray:
     """A: BVH world -> ours, from the clip's up and forward axes (``"y"``, ``"-z"``, ...)."""
-    def axis(text):
-        text = text.strip().lower()
-        sign = -1.0 if text.startswith("-") else 1.0
-        key = text.lstrip("+-")
-        if key not in AXES:
-            raise ValueError(f"an axis must be x, y or z (optionally signed), got {text!r}")
-        v = np.zeros(3)
-        v[AXES[key]] = sign
-        return v
-
-    u, f = axis(up), axis(forward)
+    u, f = axis_vector(up), axis_vector(forward)
     if abs(u @ f) > 0.5:
         raise ValueError(f"up ({up}) and forward ({forward}) must be different axes")
     source = np.column_stack([u, f, np.cross(f, u)])  # up, forward, right in BVH axes
@@ -235,7 +237,7 @@ def detect_axes(bones: BoneSkeleton, motion: Motion, index: dict[int, int], up: 
     if up == "auto":
         up, forward = _axes_from_rest(bones, motion, index, up, forward)
         return up, forward, "from the rest pose (no head and feet mapped)", None, None
-    up_clip = axes_matrix(up, "x" if up.lstrip("+-") != "x" else "y").T @ OUR_UP
+    up_clip = axis_vector(up)
     reference, pose = None, rest_pose(motion)
     if upright(*pose, parts, up_clip) < 0.7:  # not standing at rest: LAFAN lies along x
         best = int(np.argmax([upright(s.joints[i], s.tips[i], parts, up_clip) for i in range(len(s.frames))]))

@@ -119,7 +119,7 @@ class MappingDialog(QDialog):
         axes.addStretch(1)
         self.frame = QSlider(Qt.Horizontal)
         self.frame.setRange(0, max(motion.frames - 1, 0))
-        self.frame.valueChanged.connect(self.refresh)
+        self.frame.valueChanged.connect(self.show_frame)  # a frame re-poses; only an edit re-retargets
         self.frame_label = QLabel()
         self.detected = QLabel()
         self.detected.setWordWrap(True)
@@ -153,16 +153,19 @@ class MappingDialog(QDialog):
     def axes(self) -> tuple[str, str]:
         return self.up.currentText(), self.forward.currentText()
 
-    def refresh(self) -> None:
-        """Retarget with what the dialog shows now: the detected axes, units and checks, and the figure."""
+    def show_frame(self) -> None:
         frame = self.frame.value()
         self.frame_label.setText(f"{frame} / {self.motion.frames - 1}")
+        self.figure.show_pose(None if self.retarget is None else self.retarget.matrices([frame])[0])
+
+    def refresh(self) -> None:
+        """Retarget with what the dialog shows now: the detected axes, units and checks, and the figure."""
         try:
             r = Retarget.build(self.bones, self.motion, self.mapping(), *self.axes())
         except ValueError as exc:  # e.g. up and facing on one axis: said, not raised
             self.retarget = None
             self.detected.setText(f"Cannot retarget this way: {exc}")
-            self.figure.show_pose(None)
+            self.show_frame()
             return
         self.retarget = r
         checks, n = check_clip(r)
@@ -171,4 +174,4 @@ class MappingDialog(QDialog):
         lines += [c.line(n) for c in checks]
         self.detected.setText("\n".join(lines))
         self.detected.setStyleSheet("" if all(c.ok for c in checks) else "color: #d04040")
-        self.figure.show_pose(r.matrices([frame])[0])
+        self.show_frame()

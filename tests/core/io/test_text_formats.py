@@ -161,7 +161,7 @@ def test_tskel_three_row_matrix_before_a_point_with_dt_1_is_refused_by_the_count
 
 
 # spec: docs/formats.md#connect
-@pytest.mark.parametrize("count", ["3", "x", "-1", "9" * 13])
+@pytest.mark.parametrize("count", ["3", "x", "-1", "9" * 13, "²"])
 def test_point_count_header_must_match(tmp_path, count):
     (tmp_path / "a.connect").write_text(f"# points: {count}\nRoot: 0 0 0 :: 0 0 10\n1 1 1 2\n")
     with pytest.raises(io.FormatError, match="a.connect:1: .*points"):

@@ -85,7 +85,12 @@ def test_lafan_lies_along_x_at_rest_and_is_measured_at_a_standing_frame(bones):
     assert np.ptp(rest[:, 0]) > np.ptp(rest[:, 1])  # the OFFSET pose: not standing up y
     r = Retarget.build(bones, motion)
     assert r.reference is not None and "frame" in r.report["axes"]
-    assert 1.2 < r.scale < 1.7  # our 122-voxel leg over LAFAN's ~85 cm (the issue: 32.8 before)
+    # our thigh + shin over the clip's, both read off the files here (the issue: 32.8 before)
+    ours = sum(np.linalg.norm(np.subtract(bones.joints[a], bones.joints[b]))
+               for a, b in (("L_HIP", "L_KNEE"), ("L_KNEE", "L_ANKLE")))
+    theirs = sum(np.linalg.norm(motion.offsets[motion.index(j)]) for j in ("LeftLeg", "LeftFoot"))
+    assert r.scale == pytest.approx(ours / theirs, rel=0.02)  # the mean of both legs: within 2 % of the left
+    assert abs(r.scale - 32.8) > 30
 
 
 def test_a_wrong_up_axis_is_refused_with_the_suspect_named(tmp_path, bones, capsys):
