@@ -20,23 +20,35 @@ from volanim_core.io import (
 )
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
-from volanim_core.rig.attach import connect_nearest
+from volanim_core.rig.attach import METHODS
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
 from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
 
-from ._common import add_command, add_dims, ascii_int, bounds_arg, finite_float, load_source
+from ._common import add_command, add_dims, ascii_int, bounds_arg, finite_float, load_source, parse_range
 
 
 def _connect(args):
+    from volanim_core.rig.attach import connect
+
     skel = read_mskel(args.mskel)
     if args.thinness is not None:
         skel = skel.at(args.thinness)
-    conn = connect_nearest(skel, read_bones(args.bones).on_grid(skel.geometry))
+    mask = None
+    if args.volume:
+        from volanim_core.io import read_scan
+        from volanim_core.volume import isotropic_mask
+
+        from .skeleton_commands import segment
+
+        scan = read_scan(args.volume, dims=args.dims)
+        mask = segment(scan.data, args.threshold, args.fill_cavities)
+        # on the skeleton's grid: skeletonize made it on cubes of this size
+        mask, _ = isotropic_mask(mask, scan.geometry, min(skel.geometry.spacing))
+    conn, report = connect(skel, read_bones(args.bones).on_grid(skel.geometry), method=args.method, mask=mask)
     write_connect(args.output, conn, thinness=args.thinness)
     counts = np.bincount(conn.bone, minlength=len(conn.bones))
-    print(f"attached {len(conn)} points to {len(conn.bones)} bones (nearest segment); "
-          f"fewest on one bone: {counts.min()} -> {args.output}")
+    print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")
 
 
 def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
@@ -131,12 +143,23 @@ def _reconstruct(args):
 
 
 def register(sub) -> None:
-    p = add_command(sub, "connect", "Attach every skeleton point to its nearest bone -> .connect.",
-                    "volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
+    p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
+                    ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
+                     "volanim connect mannequin.mskel mannequin.bones --method path --volume mannequin.VOL "
+                     "-o mannequin.path.connect"),
                     _connect)
     p.add_argument("mskel")
     p.add_argument("bones")
     p.add_argument("--thinness", type=finite_float, help="only points with thinness >= this")
+    p.add_argument("--method", choices=METHODS, default="nearest",
+                   help="nearest segment (default); path: the nearest bone reachable by a straight path inside "
+                        "the object; path-or-nearest: path, else nearest; geodesic: along the skeleton inside "
+                        "the object (all but nearest need --volume)")
+    p.add_argument("--volume", help="the scan the skeleton was made from (segmented like skeletonize)")
+    add_dims(p)
+    p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
+                   help="object = LO <= v <= HI (default: every non-zero voxel)")
+    p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background first")
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "pose", "Write a .trans frame: rotate bones about their proximal joints (FK).",

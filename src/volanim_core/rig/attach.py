@@ -186,3 +186,28 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     report.attached = int((~missing).sum())
     report.unattached = int(missing.sum())
     return current, report
+
+
+METHODS = ("nearest", "path", "path-or-nearest", "geodesic")
+
+
+def connect(skeleton: Skeleton, bones: BoneSkeleton, *, method: str = "nearest",
+            mask: np.ndarray | None = None) -> tuple[Connectivity, AutoConnectReport]:
+    """Attach a skeleton's points to bones by ``method`` (the studio's auto-connect, all points).
+
+    ``mask`` (the segmented object on the skeleton's voxel grid) is needed by every method but
+    ``nearest``: a path must run inside it. Unattached points are left out of the connectivity
+    (a ``.connect`` lists attached points only) and counted in the report.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if method != "nearest" and mask is None:
+        raise ValueError(f"the {method!r} method needs the segmented volume (a path must run inside it)")
+    if mask is not None and len(skeleton) and (skeleton.points.max(axis=0) >= np.array(mask.shape)).any():
+        raise ValueError(f"the segmented volume ({'x'.join(map(str, mask.shape))} voxels) does not hold the "
+                         "skeleton's points: give the scan the skeleton was made from")
+    bone, report = auto_connect(skeleton.points, bones, mask, method=method)
+    keep = bone != UNATTACHED
+    conn = Connectivity(root_bones(bones), skeleton.points[keep], skeleton.dt[keep], skeleton.thinness[keep],
+                        bone[keep], skeleton.metric, geometry=skeleton.geometry)
+    return conn.grouped(), report
