@@ -349,6 +349,22 @@ def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
     return [folder / "mannequin-ct", folder / "mannequin-ct.bones"]
 
 
+def write_mannequin_keys(path: str | Path, bones: BoneSkeleton) -> None:
+    """A one-second wave of the mannequin's left arm as a ``.keys`` file (docs/formats.md, "Keys")."""
+    from volanim_core.motion.keyframes import KeyPose
+    from volanim_core.motion.keys_files import Keys, write_keys
+
+    def key(**angles) -> KeyPose:
+        k = KeyPose()
+        for label, a in angles.items():
+            b = bones.bones[bones.index(label)]
+            k.angles[(b.proximal, b.distal)], k.shifts[(b.proximal, b.distal)] = np.array(a, float), np.zeros(3)
+        return k
+
+    write_keys(path, Keys({0: key(), 12: key(L_UPPERARM=(0, -80, 0), L_FOREARM=(0, -40, 0), SPINE=(0, 0, 8)),
+                           24: key()}, fps=24.0, length=25, ease=True), bones)
+
+
 def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     """Write a sample's files into ``folder``: ``NAME.VOL`` (+ ``.bones``/``.connections``), or for
     ``walk`` the clip ``walk.bvh`` and its licence. ``progress(done, total)`` is reported for
@@ -380,6 +396,9 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         written += [folder / f"{name}.bones", folder / f"{name}.connections"]
         write_bones(written[1], sample.bones)
         write_connections(written[2], sample.bones)
+    if name == "mannequin":  # keyframes for `volanim keys`: the left arm waves once, the spine leans
+        written.append(folder / f"{name}.keys")
+        write_mannequin_keys(written[-1], sample.bones)
     if name == "mannequin-large":  # ready to reconstruct at the thesis's scale: its Table 2.2 skeleton
         from volanim_core.io import write_connect
 

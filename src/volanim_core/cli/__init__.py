@@ -15,6 +15,7 @@ from pathlib import Path
 from volanim_core.errors import Cancelled, FormatError
 
 from . import (
+    check_commands,
     colour_commands,
     demo_command,
     motion_commands,
@@ -22,6 +23,7 @@ from . import (
     render_commands,
     sequence_commands,
     skeleton_commands,
+    slicer_commands,
     view_command,
     volume_commands,
 )
@@ -47,8 +49,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (volume_commands, skeleton_commands, reconstruct_commands, motion_commands, sequence_commands,
-                   render_commands, colour_commands, view_command, demo_command):
+    for module in (volume_commands, skeleton_commands, reconstruct_commands, check_commands, motion_commands,
+                   sequence_commands, render_commands, colour_commands, slicer_commands, view_command, demo_command):
         module.register(sub)
     return parser
 

@@ -336,7 +336,10 @@ def _flatten_layers(path: Path, layers: np.ndarray, pairs: dict) -> np.ndarray:
 
 
 def write_nrrd(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY, pairs: dict | None = None) -> None:
-    """Write a 3-D NRRD (raw encoding, little endian, LPS space) atomically; ``pairs``: ``key:=value`` lines."""
+    """Write a 3-D NRRD (raw encoding, little endian, LPS space) atomically; ``pairs``: ``key:=value`` lines.
+
+    ``[x, y, z, 3]``: uint8 is RGB colour; floats are a vector per voxel in LPS (a displacement field,
+    which 3D Slicer opens as a grid transform and ITK as a DisplacementFieldTransform)."""
     name = _WRITE_TYPES.get(vol.dtype.str[1:])
     if name is None:
         raise ValueError(f"cannot write {vol.dtype} to .nrrd")
@@ -344,12 +347,13 @@ def write_nrrd(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY,
     dirs = " ".join("(" + ",".join(repr(float(v)) for v in cols[:, k]) + ")" for k in range(3))
     o = ",".join(repr(float(v)) for v in geometry.origin)
     rgb = vol.ndim == 4  # [x, y, z, 3]: written with the colour axis first, as NRRD readers expect
+    kind = "RGB-color " if vol.dtype == np.uint8 else "vector "
     header = (
         "NRRD0004\n# written by volanim\n"
         f"type: {name}\ndimension: {4 if rgb else 3}\nspace: left-posterior-superior\n"
         f"sizes: {'3 ' if rgb else ''}{vol.shape[0]} {vol.shape[1]} {vol.shape[2]}\n"
         f"space directions: {'none ' if rgb else ''}{dirs}\n"
-        f"kinds: {'RGB-color ' if rgb else ''}domain domain domain\nendian: little\nencoding: raw\n"
+        f"kinds: {kind if rgb else ''}domain domain domain\nendian: little\nencoding: raw\n"
         f"space origin: ({o})\n"
         + "".join(f"{k}:={v}\n" for k, v in (pairs or {}).items()) + "\n"
     )

@@ -94,3 +94,24 @@ def interpolate(bones: BoneSkeleton, keys: dict[int, KeyPose], frames, *, ease: 
         rot[:, i] = (Slerp(at, r)(t) if len(at) > 1 else r[np.zeros(len(t), int)]).as_matrix()
         shift[:, i] = np.column_stack([np.interp(t, at, shifts[:, c]) for c in range(3)])
     return pose_frames(bones, rot, shift)
+
+
+def keys(keys: dict[int, KeyPose], bones: BoneSkeleton, *, length: int | None = None, fps: float | None = None,
+         key_fps: float = 24.0, ease: bool = False) -> np.ndarray:
+    """The frames of a keyed animation (``volanim keys``): ``(F, B, 4, 4)`` pose matrices.
+
+    Keys sit at frames counted at ``key_fps`` (a ``.keys`` file's ``fps``, else 24); the output has
+    ``fps`` frames per second (default ``key_fps``), so ``fps=12`` makes half as many frames of the same
+    motion. ``length``: output frames (default: through the last key). ``ease``: slow in and out.
+    """
+    if not keys:
+        raise ValueError("no key to animate")
+    fps = key_fps if fps is None else fps
+    for what, v in (("fps", fps), ("key_fps", key_fps)):
+        if not 1 <= v <= 1000:
+            raise ValueError(f"{what} must be 1 to 1000 frames per second, got {v:g}")
+    if length is None:
+        length = int(np.floor(max(keys) * fps / key_fps + 1e-9)) + 1
+    if not 1 <= length <= 100_000:
+        raise ValueError(f"length must be 1 to 100000 frames, got {length}")
+    return interpolate(bones, keys, np.arange(length) * (key_fps / fps), ease=ease)

@@ -61,6 +61,7 @@ class BreakageReport:
     pieces: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid) of torn-off parts
     stumps: list = field(default_factory=list)  # Stump, largest first
     rest_pieces: int = 1  # the body's pieces at rest: pieces the pose keeps apart are not breakage
+    source_coverage: tuple[int, int] | None = None  # (covered at rest, object voxels) of the scan, when given
 
     @property
     def loss_percent(self) -> float:
@@ -96,6 +97,10 @@ class BreakageReport:
                f"({self.lost_voxels} rest voxels not covered in the pose)",
                f"{self.cracks} cracks (sphere pairs of different bones that touched at rest and part in the pose)",
                f"hotspot: up to {self.hotspot_max} spheres on one voxel, mean {self.hotspot_mean:.1f}"]
+        if self.source_coverage is not None:
+            covered, total = self.source_coverage
+            out.append(f"the rest pose re-grows {covered} of the scan's {total} object voxels "
+                       f"({100 * covered / max(total, 1):.2f} %): the rest is the skeleton's loss, not the pose's")
         return out
 
 

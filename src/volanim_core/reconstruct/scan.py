@@ -40,6 +40,12 @@ class FrameVerdict:
     def healthy(self) -> bool:
         return self.pieces <= self.rest_pieces and self.cracks == 0 and self.stump == 0
 
+    @property
+    def broken(self) -> bool:
+        """A piece torn off or a stump left behind: what the report calls broken (cracks alone open at
+        every bent joint and are no verdict)."""
+        return self.pieces > self.rest_pieces or self.stump > 0
+
     def badness(self) -> tuple:
         """Sort key, worst first: detached pieces outrank stumps, stumps outrank cracks, then how much."""
         return (-min(max(self.pieces - self.rest_pieces, 0), 1), -self.detached, -min(self.stump, 1), -self.stump,

@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core import io
+from volanim_core.rig import symmetry
 from volanim_core.rig.attach import UNATTACHED, auto_connect
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity, RootBone
 from volanim_core.skeleton.points import Skeleton
 
-from . import symmetry
 from .undo import Command
 
 MATCH_TOLERANCE = 1e-3  # voxels: Root: joints must match the bone skeleton's to this
@@ -119,25 +119,8 @@ class Attachments:
         bones = doc.selected_bones if bones is None else bones
         if not bones:
             raise ValueError("select the bones whose connectivity to mirror")
-        from scipy.spatial import cKDTree
-
-        pts = doc.skeleton.points
-        tree = cKDTree(pts)
-        targets, values, lonely = [], [], 0
-        for b in bones:
-            bone = doc.bones.bones[b]
-            twin = (symmetry.mirror_name(bone.proximal), symmetry.mirror_name(bone.distal))
-            k = [i for i, x in enumerate(doc.bones.bones) if (x.proximal, x.distal) == twin]
-            if not k or k[0] == b:
-                raise ValueError(f"bone {bone.label} has no L_/R_ twin; symmetrize the bones first")
-            src = np.flatnonzero(self.bone == b)
-            d, j = tree.query(symmetry.mirror_point(pts[src], doc.symmetry_x))
-            ok = d <= 1.5
-            lonely += int((~ok).sum())
-            targets.append(j[ok])
-            values.append(np.full(int(ok.sum()), k[0], np.int32))
-        idx = np.concatenate(targets) if targets else np.zeros(0, np.int64)
-        vals = np.concatenate(values) if values else np.zeros(0, np.int32)
+        idx, vals, lonely = symmetry.mirrored_attachments(doc.skeleton.points, self.bone, doc.bones, bones,
+                                                          doc.symmetry_x)
         copied = self.assign_many(idx, vals, f"Mirror connectivity of {len(bones)} bone(s)")
         return copied, lonely
 

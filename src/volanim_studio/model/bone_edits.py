@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core import io
+from volanim_core.rig import symmetry
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
-from . import symmetry
 from .undo import Command
 
 SNAP_DISTANCE = 0.5  # voxels: a click this close to a joint reuses it
@@ -281,7 +281,7 @@ class BoneEdits:
         written = []
         for i in indices:
             b = new.bones[i]
-            if symmetry.side(b.proximal) is None and symmetry.side(b.distal) is None:
+            if symmetry.side_of(b.proximal) is None and symmetry.side_of(b.distal) is None:
                 raise ValueError(f"bone {b.label} has no L_/R_ joint to mirror; rename its joints first")
             twin_ends = []
             for j in (b.proximal, b.distal):
