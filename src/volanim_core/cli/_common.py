@@ -54,14 +54,14 @@ def load_source(args, frame, *, colour: bool = False):
     from volanim_core.reconstruct.source_space import check_source_overlap, source_geometry_for
 
     if not args.source:
-        if args.mode == "sampled":
+        if getattr(args, "mode", None) == "sampled":
             raise ValueError("sampled mode needs --source VOLUME")
         return None, None
     source, geometry, _ = load_scan(args.source, args, colour=colour)
     frame.geometry, note = source_geometry_for(frame.geometry, geometry)
     if note:
         print(f"note: {note}")
-    if args.mode == "sampled":
+    if getattr(args, "mode", None) == "sampled":
         check_source_overlap(frame, source.shape, geometry)
     return source, geometry
 

@@ -229,6 +229,26 @@ class Timeline:
             self.doc.message(f"The clip {c.name} was unloaded: its .trans frames were made for the old bones.")
         self._put_clip(None)
 
+    # ------------------------------------------------------------ .keys
+    def export_keys(self, path) -> int:
+        """Write the keys and their options as a ``.keys`` file (``volanim keys`` makes the same frames)."""
+        from volanim_core.motion.keys_files import Keys, write_keys
+
+        if not self.keys:
+            raise ValueError("no keys to export: set keys on the timeline first (S)")
+        write_keys(path, Keys(dict(self.keys), self.fps, self.length, self.ease), self.doc.bones)
+        return len(self.keys)
+
+    def import_keys(self, path) -> int:
+        """Replace the keys (and the options the file gives) by a ``.keys`` file's; one undo step."""
+        from volanim_core.motion.keys_files import read_keys
+
+        self._refuse_with_clip()
+        k = read_keys(path, self.doc.bones)
+        self.set_options(ease=k.ease, length=k.length, fps=k.fps)
+        self._push_keys(f"Import {len(k.keys)} keys", k.keys)
+        return len(k.keys)
+
     # ------------------------------------------------------------- project
     def to_json(self) -> dict:
         data = {"keys": {str(f): k.to_json() for f, k in sorted(self.keys.items())}, "ease": self.ease,

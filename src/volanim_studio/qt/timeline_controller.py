@@ -58,6 +58,8 @@ class TimelineController(Controller):
         menu.addSeparator()
         action("Set key", lambda: self.set_key(), "S", menu=menu)
         action("Delete key", lambda: self.delete_key(), "Shift+S", menu=menu)
+        action("Import keys (.keys)…", lambda: self.keys_dialog(save=False), menu=menu)
+        action("Export keys (.keys)…", lambda: self.keys_dialog(save=True), menu=menu)
         menu.addSeparator()
         action("Scan clip for breakage…", lambda: self.scan(), menu=menu)
         action("Export frames (.trans)…", lambda: self.export_dialog(tskel=False), menu=menu)
@@ -154,6 +156,22 @@ class TimelineController(Controller):
         self.attempt("Delete key", lambda: self.doc.timeline.delete_key(), "Deleted the key.")
 
     # ------------------------------------------------------------- clips
+    def export_keys(self, path) -> None:
+        """The keys as a ``.keys`` file: ``volanim keys`` makes the same frames from it."""
+        self.attempt("Export keys", lambda: self.doc.timeline.export_keys(path),
+                     f"Saved the keys to {path} (volanim keys {Path(path).name} --bones … makes their frames).")
+
+    def import_keys(self, path) -> None:
+        self.stop()
+        self.attempt("Import keys", lambda: self.doc.timeline.import_keys(path), f"Loaded the keys of {path}.")
+
+    def keys_dialog(self, *, save: bool) -> None:
+        pick = QFileDialog.getSaveFileName if save else QFileDialog.getOpenFileName
+        path, _ = pick(self.window, "Export keys" if save else "Import keys", self.folder("animation.keys"),
+                       "Keys (*.keys);;All files (*)")
+        if path:
+            (self.export_keys if save else self.import_keys)(path)
+
     def load_bvh(self, path, *, ask=None) -> bool:
         """Read a clip, let the user confirm the mapping (``ask(dialog) -> bool``; None: the suggestions)
         and retarget it onto the bones."""
