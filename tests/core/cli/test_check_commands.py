@@ -148,6 +148,7 @@ def test_report_refuses_a_frame_of_other_bones(made, tmp_path):
     assert r.returncode == 2 and "frog.trans" in r.stderr and "bones" in r.stderr
 
 
+# spec: docs/formats.md#keys
 def test_keys_write_the_timeline_frames_and_scan_finds_the_torn_one(made, tmp_path):
     d = made
     r = run("keys", d / "mannequin.keys", "--bones", d / "mannequin.bones", "-o", tmp_path / "wave")
