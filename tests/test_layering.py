@@ -118,7 +118,7 @@ LAYERS = [
     # one layer, which never imports the renderer
     {"volume", "io", "skeleton", "colour", "rig"},
     {"reconstruct", "motion"},
-    {"sequence", "render", "samples", "warmup"},
+    {"sequence", "render", "samples", "ant_sample", "warmup"},
     {"pipeline_demo"},
     {"cli", "__main__"},
 ]

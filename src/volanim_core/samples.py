@@ -28,7 +28,8 @@ from volanim_core.rig.bones import Bone, BoneSkeleton
 NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog")
 #: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence;
 #: ``mannequin-ct`` writes the mannequin as a CT scan arrives, a DICOM series (:func:`write_mannequin_ct`);
-#: ``ant`` copies the closed ant mesh pyvista's wheel ships (``ant.ply``), a model to voxelize.
+#: ``ant`` copies the closed ant mesh pyvista's wheel ships (``ant.ply``), a model to voxelize, with joints
+#: placed on it as Slicer markups (``ant.mrk.json``) and a gait (``ant.keys``): :mod:`volanim_core.ant_sample`.
 FILE_SAMPLES = ("walk", "mannequin-ct", "ant")
 
 # Tissue values: distinct so sampled reconstruction shows the interior moving.
@@ -379,9 +380,11 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     if name == "ant":
         from pyvista import examples  # lazy: VTK only here
 
+        from volanim_core.ant_sample import write_ant_rig
+
         written = [folder / "ant.ply"]
         atomic_write_bytes(written[0], Path(examples.antfile).read_bytes())
-        return written
+        return written + write_ant_rig(folder)  # its joints as Slicer markups, and a gait
     if name == "walk":
         clip = walk_clip()
         written = [folder / clip.name, folder / f"{clip.name}.LICENSE"]

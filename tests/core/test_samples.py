@@ -63,9 +63,15 @@ def test_frog_body_points_at_the_head_and_legs_at_the_legs():
 
 def test_write_sample_files(tmp_path):
     paths = samples.write_sample("mannequin", tmp_path)
-    assert [p.name for p in paths] == ["mannequin.VOL", "mannequin.bones", "mannequin.connections"]
+    assert [p.name for p in paths] == ["mannequin.VOL", "mannequin.bones", "mannequin.connections", "mannequin.keys"]
     assert np.array_equal(io.read_volume(paths[0]), samples.mannequin().volume)
     assert io.read_bones(paths[1]) == samples.mannequin_bones()
+    from volanim_core.motion.keys_files import read_keys
+
+    keys = read_keys(paths[3], samples.mannequin_bones())
+    assert sorted(keys.keys) == [0, 12, 24] and (keys.fps, keys.length, keys.ease) == (24.0, 25, True)
+    arm = ("L_SHOULDER", "L_ELBOW")
+    assert np.array_equal(keys.keys[12].angles[arm], [0, -80, 0]) and not keys.keys[0].angles
 
 
 def test_colour_mannequin_is_the_mannequin_in_colour():

@@ -98,7 +98,7 @@ def test_transform_files_move_the_joints_where_ours_go(scan, tmp_path, fmt):
     assert main(["transforms", str(scan / "ct.connect"), str(frame), "--format", fmt, "-o", str(tmp_path)]) == 0
     bones = io.read_bones(scan / "mannequin.bones")
     ours = posed_joints(bones, io.read_trans(frame).matrices)  # voxels of the scan's grid
-    for i, b in enumerate(bones.bones):
+    for b in bones.bones:
         tx = sitk.ReadTransform(str(tmp_path / f"{b.label}.{fmt}"))
         for name in (b.proximal, b.distal):  # both ends of the bone move with it
             rest = GEOMETRY.to_physical(bones.joints[name][None])[0]

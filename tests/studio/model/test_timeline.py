@@ -127,3 +127,35 @@ def test_a_missing_clip_is_a_warning_and_a_bad_timeline_names_the_project(doc, t
         with pytest.raises(FormatError, match="bad.volanim"):
             read_project(tmp_path / "bad.volanim")
     assert KeyPose.from_json([], "k").angles == {}
+
+
+def test_exported_keys_make_the_timeline_frames_on_the_command_line(doc, tmp_path):
+    from volanim_core import io
+    from volanim_core.cli import main
+
+    tl, st = doc.timeline, doc.settings
+    tl.set_key(0)
+    st.current_frame = 9
+    doc.pose.set_angles(arm(doc), (10, -70, 5))
+    doc.pose.set_angles(doc.bones.index("SPINE"), (0, 0, 12))
+    tl.set_key()
+    st.current_frame = 15
+    tl.set_key()  # a hold
+    tl.set_options(ease=True, length=20, fps=30)
+    assert tl.export_keys(tmp_path / "a.keys") == 3
+    io.write_bones(tmp_path / "m.bones", doc.bones)
+    assert main(["keys", str(tmp_path / "a.keys"), "--bones", str(tmp_path / "m.bones"), "-o",
+                 str(tmp_path / "out")]) == 0
+    files = sorted((tmp_path / "out").glob("*.trans"))
+    assert len(files) == 20  # the timeline's length, at its own rate
+    written = np.stack([io.read_trans(f).matrices for f in files])
+    assert np.allclose(written, tl.matrices(), atol=1e-6)
+    # and back into a fresh timeline: the same keys and options, one undo step
+    other = Document()
+    other.bone_edits.set_bones(samples.mannequin_bones())
+    other.undo.clear()
+    assert other.timeline.import_keys(tmp_path / "a.keys") == 3
+    assert (other.timeline.ease, other.timeline.length, other.timeline.fps) == (True, 20, 30.0)
+    assert np.allclose(other.timeline.matrices(), tl.matrices(), atol=1e-9)
+    other.undo.undo()
+    assert not other.timeline.keys
