@@ -65,6 +65,12 @@ def help_examples(parser: argparse.ArgumentParser) -> list[tuple[str, str]]:
     return found
 
 
+def volanim(*args, cwd=None, timeout: float = 300) -> subprocess.CompletedProcess:
+    """``volanim ARGS`` as its own process (this interpreter's), output captured: the CLI tests' runner."""
+    return subprocess.run([sys.executable, "-m", "volanim_core", *map(str, args)], capture_output=True, text=True,
+                          timeout=timeout, cwd=cwd)
+
+
 def shell_blocks(markdown: str) -> list[str]:
     """The text of every ```sh fenced block, in order."""
     return re.findall(r"^```sh\n(.*?)^```", markdown, flags=re.S | re.M)

@@ -34,10 +34,7 @@ def _keys(args):
     k = read_keys(args.keys, bones)
     key_fps = k.fps or 24.0
     ease = args.ease if args.ease is not None else bool(k.ease)
-    # the file's length spans (length - 1) / fps seconds: the same span at the output's rate
-    length = args.length if args.length is not None else (
-        None if k.length is None else int((k.length - 1) * (args.fps or key_fps) / key_fps + 1e-9) + 1)
-    mats = keys(k.keys, bones, length=length, fps=args.fps, key_fps=key_fps, ease=ease)
+    mats = keys(k.keys, bones, length=args.length, fps=args.fps, key_fps=key_fps, key_length=k.length, ease=ease)
     conn = read_connect(args.connect) if args.connect else None
     write_frames(args.output, args.name or Path(args.keys).stem, bones, mats, range(len(mats)), connect=conn,
                  progress=TextProgress(f"writing {len(mats)} frames"))

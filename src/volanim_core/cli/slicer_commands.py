@@ -34,11 +34,13 @@ def _markups(args):
     if not out.endswith(".json"):
         raise ValueError(f"cannot write {out}: a .bones file in, so the output is a .mrk.json file")
     bones = read_bones(args.inputs[0])
-    geometry = load_scan(args.like, args).geometry if args.like else bones.geometry
+    geometry = bones.geometry  # the grid the file records wins; --like places a file that records none
+    if geometry.is_identity and args.like:
+        geometry = load_scan(args.like, args).geometry
     if geometry.is_identity:
         print(f"note: {args.inputs[0]} records no voxel grid: its voxels are written as 1 mm cubes at the origin "
               "(give --like SCAN to place them in the scan)")
-    write_markups(out, bones, geometry if bones.geometry.is_identity else bones.geometry)
+    write_markups(out, bones, geometry)
     print(f"{len(bones.joints)} joints, {len(bones)} bones -> {out} (LPS mm)")
 
 
@@ -86,7 +88,8 @@ def register(sub) -> None:
                      "volanim markups mannequin.mrk.json --like mannequin.VOL -o from-slicer.bones"), _markups)
     p.add_argument("inputs", nargs="+", help="a .bones file, or .mrk.json files (one chain of bones per point "
                                              "list; a label seen before is the same joint)")
-    p.add_argument("--like", help="the scan whose grid the joints are on")
+    p.add_argument("--like", help="the scan whose grid the joints are on (markups in; a .bones file that records "
+                                  "no grid)")
     add_dims(p)
     p.add_argument("-o", "--output", required=True, help=".mrk.json or .bones")
 

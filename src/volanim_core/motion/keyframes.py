@@ -97,12 +97,13 @@ def interpolate(bones: BoneSkeleton, keys: dict[int, KeyPose], frames, *, ease: 
 
 
 def keys(keys: dict[int, KeyPose], bones: BoneSkeleton, *, length: int | None = None, fps: float | None = None,
-         key_fps: float = 24.0, ease: bool = False) -> np.ndarray:
+         key_fps: float = 24.0, key_length: int | None = None, ease: bool = False) -> np.ndarray:
     """The frames of a keyed animation (``volanim keys``): ``(F, B, 4, 4)`` pose matrices.
 
     Keys sit at frames counted at ``key_fps`` (a ``.keys`` file's ``fps``, else 24); the output has
     ``fps`` frames per second (default ``key_fps``), so ``fps=12`` makes half as many frames of the same
-    motion. ``length``: output frames (default: through the last key). ``ease``: slow in and out.
+    motion. ``length``: output frames (default: the span of ``key_length`` frames at ``key_fps``, a
+    ``.keys`` file's ``length``; else through the last key). ``ease``: slow in and out.
     """
     if not keys:
         raise ValueError("no key to animate")
@@ -110,8 +111,9 @@ def keys(keys: dict[int, KeyPose], bones: BoneSkeleton, *, length: int | None = 
     for what, v in (("fps", fps), ("key_fps", key_fps)):
         if not 1 <= v <= 1000:
             raise ValueError(f"{what} must be 1 to 1000 frames per second, got {v:g}")
-    if length is None:
-        length = int(np.floor(max(keys) * fps / key_fps + 1e-9)) + 1
+    if length is None:  # n frames span (n - 1) / fps seconds: the same span at the output's rate
+        last = max(keys) if key_length is None else key_length - 1
+        length = int(np.floor(last * fps / key_fps + 1e-9)) + 1
     if not 1 <= length <= 100_000:
         raise ValueError(f"length must be 1 to 100000 frames, got {length}")
     return interpolate(bones, keys, np.arange(length) * (key_fps / fps), ease=ease)

@@ -5,8 +5,8 @@
     .connect + many .trans --stack, check root order--> scan_frames --worst first--> [FrameVerdict]
 
 The same functions the studio's preview report and Scan for breakage call
-(:mod:`.breakage`, :mod:`.scan`); these only gather the joints and the frames
-the files give. Without a ``.bones`` file the joints are named after the bones
+(:mod:`.breakage`, :mod:`.scan`); these only gather the joints (:func:`rig_of`)
+and the frames the files give. Without a ``.bones`` file the joints are named after the bones
 that hang from them (``near L_UPPERARM``: at the upper arm's proximal end).
 """
 
@@ -16,9 +16,10 @@ from dataclasses import asdict
 
 import numpy as np
 
-from volanim_core.reconstruct.breakage import BreakageReport, breakage_report
+from volanim_core.reconstruct.breakage import BreakageReport, RestParts, breakage_report
+from volanim_core.reconstruct.engine import Reconstruction
 from volanim_core.reconstruct.scan import FrameVerdict, scan_frames, worst_first
-from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity, Trans
 from volanim_core.rig.pose import posed_joints
 from volanim_core.rig.tskel import check_root_order, connect_to_tskel
@@ -26,30 +27,22 @@ from volanim_core.rig.tskel import check_root_order, connect_to_tskel
 SLAB_VOXELS = 8_000_000  # source voxels looked at per step of the coverage count (bounded memory)
 
 
-def joints_of(conn: Connectivity, bones: BoneSkeleton | None = None) -> dict[str, np.ndarray]:
-    """Joint name -> rest position on the connectivity's grid: the bones' joints, or one per bone."""
+def rig_of(conn: Connectivity, bones: BoneSkeleton | None = None) -> BoneSkeleton:
+    """The bone skeleton of a connectivity on its grid: ``bones`` (checked to be its bones), or one made
+    from its segments, each joint named after the bone that hangs from it (``LABEL.end`` at a limb's end)."""
     if bones is not None:
         from volanim_core.rig.symmetry import check_same_bones
 
         check_same_bones(conn, bones)
-        return dict(bones.on_grid(conn.geometry).joints)
-    out = {b.label: b.proximal for b in conn.bones}
-    starts = {tuple(b.proximal) for b in conn.bones}
+        return bones.on_grid(conn.geometry)
+    names: dict[tuple, str] = {}
     for b in conn.bones:
-        if tuple(b.distal) not in starts:  # a limb's end: nothing hangs from it
-            out[f"{b.label}.end"] = b.distal
-    return out
-
-
-def _posed(conn: Connectivity, matrices: np.ndarray, bones: BoneSkeleton | None) -> dict[str, np.ndarray]:
-    if bones is not None:
-        return posed_joints(bones.on_grid(conn.geometry), matrices)
-    out = {b.label: np.append(b.proximal, 1.0) @ m for b, m in zip(conn.bones, matrices)}
-    for name, rest in joints_of(conn).items():
-        if name.endswith(".end"):
-            i = next(i for i, b in enumerate(conn.bones) if f"{b.label}.end" == name)
-            out[name] = np.append(rest, 1.0) @ matrices[i]
-    return {k: np.asarray(v)[:3] for k, v in out.items()}
+        names.setdefault(tuple(b.proximal), b.label)
+    for b in conn.bones:
+        names.setdefault(tuple(b.distal), f"{b.label}.end")  # nothing hangs from it
+    return BoneSkeleton({n: np.array(p) for p, n in names.items()},
+                        [Bone(names[tuple(b.proximal)], names[tuple(b.distal)], b.label) for b in conn.bones],
+                        conn.geometry)
 
 
 def report(conn: Connectivity, trans: Trans, *, bones: BoneSkeleton | None = None, source: np.ndarray | None = None,
@@ -61,20 +54,19 @@ def report(conn: Connectivity, trans: Trans, *, bones: BoneSkeleton | None = Non
     re-grows (``report.source_coverage``), so a loss that is the skeleton's, not the pose's, shows.
     """
     tskel = connect_to_tskel(conn, trans)
-    joints = joints_of(conn, bones)
-    out = breakage_report(tskel, joints, _posed(conn, tskel.matrices, bones), cancel=cancel)
+    rig = rig_of(conn, bones)
+    rest = RestParts.of(conn, cancel)  # made once: the report's rest pose is also the coverage's
+    out = breakage_report(tskel, rig.joints, posed_joints(rig, tskel.matrices), rest=rest, cancel=cancel)
     if source is not None:
-        out.source_coverage = source_coverage(conn, source, source_geometry)
+        out.source_coverage = source_coverage(rest.rest_bone, source, source_geometry)
     return out
 
 
-def source_coverage(conn: Connectivity, source: np.ndarray, source_geometry=None) -> tuple[int, int]:
-    """``(covered, object)``: the scan's object voxels (non-zero) and how many the rest pose re-grows."""
-    from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.rig.tskel import identity_tskel
-
-    rest = reconstruct(identity_tskel(conn), mode="binary", padding=1)
-    to_grid = (source_geometry or conn.geometry).index_map(conn.geometry)
+def source_coverage(rest: Reconstruction, source: np.ndarray, source_geometry=None) -> tuple[int, int]:
+    """``(covered, object)``: the scan's object voxels (non-zero) and how many the rest reconstruction
+    ``rest`` (any mode; on the frame's grid) covers."""
+    frame = rest.geometry.shifted(-np.asarray(rest.origin))  # the grid the reconstruction's origin counts on
+    to_grid = (source_geometry or frame).index_map(rest.geometry)  # source indices -> rest.volume's
     body = np.asarray(source)
     body = body.any(axis=3) if body.ndim == 4 else body != 0
     covered = total = 0
@@ -82,7 +74,6 @@ def source_coverage(conn: Connectivity, source: np.ndarray, source_geometry=None
     for z0 in range(0, body.shape[2], step):
         idx = np.argwhere(body[:, :, z0:z0 + step]) + (0, 0, z0)
         where = np.rint(np.column_stack([idx, np.ones(len(idx))]) @ to_grid)[:, :3].astype(np.int64)
-        where -= np.asarray(rest.origin)
         inside = np.all((where >= 0) & (where < rest.volume.shape), axis=1)
         covered += int(np.count_nonzero(rest.volume[tuple(where[inside].T)]))
         total += len(idx)
@@ -116,7 +107,7 @@ def scan(conn: Connectivity, frames: list[Trans], *, bones: BoneSkeleton | None 
     for n, t in enumerate(frames):
         check_root_order(conn.bones, t.bones, f"frame {n if numbers is None else numbers[n]}")
     matrices = np.stack([t.matrices for t in frames])
-    verdicts = scan_frames(conn, matrices, numbers, joints=joints_of(conn, bones), factor=factor,
+    verdicts = scan_frames(conn, matrices, numbers, joints=rig_of(conn, bones).joints, factor=factor,
                            progress=progress, cancel=cancel)
     return worst_first(verdicts)
 

@@ -138,8 +138,6 @@ def mirror(conn: Connectivity, bones: BoneSkeleton, *, side: str = "L", only=Non
 def check_same_bones(conn: Connectivity, bones: BoneSkeleton) -> None:
     """ValueError unless ``conn``'s bones are ``bones``' segments in the same order (on its grid)."""
     from volanim_core.rig.pose import root_bones
+    from volanim_core.rig.tskel import check_root_order
 
-    ours = root_bones(bones.on_grid(conn.geometry))
-    if len(ours) != len(conn.bones) or not all(a.same_segment(b, 1e-3) for a, b in zip(ours, conn.bones)):
-        raise ValueError(f"the connectivity's {len(conn.bones)} bones are not these {len(ours)} bones in the same "
-                         "order (connect with these bones first)")
+    check_root_order(conn.bones, root_bones(bones.on_grid(conn.geometry)), ".bones")

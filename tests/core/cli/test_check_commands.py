@@ -7,12 +7,11 @@ nothing written), and its answer checked against a count made another way.
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
+from runnable import volanim
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.reconstruct.engine import reconstruct
@@ -25,9 +24,7 @@ from volanim_core.volume import Bounds
 ARM = ("L_UPPERARM", "L_FOREARM", "L_HAND")
 
 
-def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "volanim_core", *map(str, args)], capture_output=True, text=True,
-                          timeout=300, cwd=cwd)
+run = volanim  # volanim ARGS as a process
 
 
 @pytest.fixture(scope="module")
@@ -109,7 +106,7 @@ def test_mirror_gives_the_right_arm_back_from_the_left(made, tmp_path):
 def test_mirror_with_other_bones_is_refused_and_writes_nothing(made, tmp_path):
     write_sample("frog", tmp_path)
     r = run("mirror", made / "m.connect", "--bones", tmp_path / "frog.bones", "-o", tmp_path / "out.connect")
-    assert r.returncode == 2 and "m.connect" in r.stderr and "not these" in r.stderr
+    assert r.returncode == 2 and "m.connect" in r.stderr and "bones but the .bones has" in r.stderr
     assert not (tmp_path / "out.connect").exists()
 
 

@@ -3,20 +3,15 @@ sorted palette + remap -> transfer function -> picture, and their refusals."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
+from runnable import volanim
 from volanim_core import io, samples
 from volanim_core.colour.palette import NearestColour
 from volanim_core.io.palette_files import read_alpha_map, read_palette
 
-
-def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "volanim_core", *map(str, args)], capture_output=True, text=True,
-                          timeout=300, cwd=cwd)
+run = volanim  # volanim ARGS as a process
 
 
 @pytest.fixture(scope="module")

@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
+from runnable import volanim
 from volanim_core import io
 from volanim_core.cli import build_parser, main, subcommands
 
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "volanim_core", *map(str, args)],
-                          capture_output=True, text=True, timeout=120)
+run = volanim  # volanim ARGS as a process
 
 
 def test_help_lists_every_subcommand_and_each_has_an_example():
