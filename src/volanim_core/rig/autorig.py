@@ -1,0 +1,277 @@
+"""Auto-rig: a bone skeleton proposed from the volume's own skeleton.
+
+    Skeleton (.mskel) --at(thinness)--> points, dt
+      --curve_tree-->    CurveTree: nodes, radii, tree edges (rig/curve_skeleton.py)
+      --template-->      humanoid / quadruped: ends matched by symmetry, joints at the template's
+                         forks, bends and narrowings, named as the template names them (rig/templates.py)
+      --or chains-->     none: a joint at every fork and end, and where a branch bends or its
+                         thickness changes (a split of the branch as a curve in x, y, z and 2 x radius,
+                         Douglas-Peucker); chains named by side and direction from the root
+      --root order-->    from the root (the template's, or the thickest fork), parents before children
+      Proposal (BoneSkeleton on the skeleton's grid, the template used, notes)
+
+Left and right follow the scanner's convention: ``L_`` is the side towards +x in physical (LPS)
+space, the patient's left, whatever the voxel axes are.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volanim_core.rig.bones import Bone, BoneSkeleton
+from volanim_core.rig.curve_skeleton import CurveTree, NotRiggable, curve_tree
+from volanim_core.skeleton.points import Skeleton
+
+TEMPLATES = ("auto", "humanoid", "quadruped", "none")
+THICKNESS_WEIGHT = 2.0  # a radius change of 1 voxel counts as a bend of 2 voxels
+BEND = 0.35  # a branch is split where it strays more than this x its radius from its chord (at least 2 voxels)
+
+
+@dataclass
+class Proposal:
+    """A proposed bone skeleton, the template that named it, and what the user should know."""
+
+    bones: BoneSkeleton
+    template: str
+    notes: list[str] = field(default_factory=list)
+
+    def __str__(self) -> str:
+        return (f"{len(self.bones.bones)} bones, {len(self.bones.joints)} joints ({self.template})"
+                + "".join(f"\n  {n}" for n in self.notes))
+
+
+class Tree:
+    """A CurveTree with the walks autorig needs: paths between nodes, ends, forks."""
+
+    def __init__(self, curve: CurveTree, left: np.ndarray):
+        self.p, self.r = curve.points, curve.radius
+        self.adj = curve.neighbours()
+        self.left = left / np.linalg.norm(left)  # +x physical, in voxel index space
+
+    def degree(self, i: int) -> int:
+        return len(self.adj[i])
+
+    def ends(self) -> list[int]:
+        return [i for i in range(len(self.p)) if self.degree(i) == 1]
+
+    def parents(self, root: int) -> np.ndarray:
+        parent = np.full(len(self.p), -2)
+        parent[root] = -1
+        todo = deque([root])
+        while todo:
+            a = todo.popleft()
+            for b in self.adj[a]:
+                if parent[b] == -2:
+                    parent[b] = a
+                    todo.append(b)
+        return parent
+
+    def path(self, a: int, b: int) -> list[int]:
+        """Node indices from ``a`` to ``b`` along the tree."""
+        parent = self.parents(a)
+        out = [b]
+        while out[-1] != a:
+            out.append(int(parent[out[-1]]))
+        return out[::-1]
+
+    def length(self, path) -> np.ndarray:
+        """Arc length at each node of ``path``."""
+        steps = np.linalg.norm(np.diff(self.p[path], axis=0), axis=1)
+        return np.concatenate([[0.0], np.cumsum(steps)])
+
+    def median(self, a: int, b: int, c: int) -> int:
+        """The node where the paths between three nodes meet."""
+        on_ab = set(self.path(a, b))
+        for n in self.path(c, a):
+            if n in on_ab:
+                return n
+        return a
+
+    def tip(self, end: int) -> np.ndarray:
+        """An end extended by its radius along the branch: the body's tip, where thinning stopped short."""
+        back = self.path(end, self._fork_or_far(end))
+        s = self.length(back)
+        k = int(np.searchsorted(s, max(self.r[end], 2.0)))
+        k = min(k, len(back) - 1)
+        direction = self.p[end] - self.p[back[k]]
+        norm = np.linalg.norm(direction)
+        return self.p[end] + (self.r[end] * direction / norm if norm > 0 else 0)
+
+    def _fork_or_far(self, end: int) -> int:
+        prev, cur = end, self.adj[end][0] if self.adj[end] else end
+        while self.degree(cur) == 2:
+            prev, cur = cur, next(k for k in self.adj[cur] if k != prev)
+        return cur
+
+
+def splits(xyz: np.ndarray, r: np.ndarray, *, tolerance: float | None = None, count: int | None = None) -> list[int]:
+    """Interior indices where a branch should bend: Douglas-Peucker on the curve (x, y, z, 2 r).
+
+    With ``count``, exactly that many splits (the largest deviations first); otherwise every split whose
+    deviation exceeds ``tolerance`` (default: BEND x the branch's mean radius, at least 2 voxels).
+    """
+    curve = np.column_stack([xyz, THICKNESS_WEIGHT * np.asarray(r)])
+    tol = tolerance if tolerance is not None else max(2.0, BEND * float(np.mean(r)))
+    chosen: list[int] = []
+    spans = [(0, len(curve) - 1)]
+    while spans:
+        best = None
+        for a, b in spans:
+            if b - a < 2:
+                continue
+            dev = _deviation(curve[a:b + 1])
+            k = int(np.argmax(dev))
+            if best is None or dev[k] > best[0]:
+                best = (dev[k], a, b, a + k)
+        if best is None or (count is None and best[0] <= tol) or (count is not None and len(chosen) >= count):
+            break
+        _, a, b, k = best
+        chosen.append(k)
+        spans.remove((a, b))
+        spans += [(a, k), (k, b)]
+    return sorted(chosen)
+
+
+def _deviation(curve: np.ndarray) -> np.ndarray:
+    a, b = curve[0], curve[-1]
+    ab = b - a
+    n2 = float(ab @ ab)
+    if n2 == 0:
+        return np.linalg.norm(curve - a, axis=1)
+    t = np.clip((curve - a) @ ab / n2, 0, 1)
+    return np.linalg.norm(curve - (a + t[:, None] * ab), axis=1)
+
+
+def _keys(tree: Tree) -> list[int]:
+    return [i for i in range(len(tree.p)) if tree.degree(i) != 2]
+
+
+def _branches(tree: Tree, root: int) -> list[list[int]]:
+    """The tree cut at forks and ends into branches (node paths), each from the root's side outwards,
+    in breadth-first order from the root."""
+    parent = tree.parents(root)
+    keys = set(_keys(tree)) | {root}
+    out, todo = [], deque([root])
+    while todo:
+        start = todo.popleft()
+        for nxt in tree.adj[start]:
+            if parent[nxt] != start:
+                continue
+            path = [start, nxt]
+            while path[-1] not in keys:
+                path.append(next(k for k in tree.adj[path[-1]] if parent[k] == path[-1]))
+            out.append(path)
+            todo.append(path[-1])
+    return out
+
+
+def _direction_name(v: np.ndarray, tree: Tree, geometry) -> str:
+    """SUP/INF/ANT/POST for the larger of a branch's vertical and front-back runs (LPS)."""
+    d = np.asarray(geometry.direction, float).reshape(3, 3) @ (np.asarray(geometry.spacing) * v)
+    if abs(d[2]) >= abs(d[1]):
+        return "SUP" if d[2] > 0 else "INF"
+    return "POST" if d[1] > 0 else "ANT"
+
+
+def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None = None) -> BoneSkeleton:
+    """Bones with no template: joints at forks and ends, and where branches bend or thin."""
+    if root is None:
+        forks = [i for i in range(len(tree.p)) if tree.degree(i) >= 3]
+        root = max(forks or range(len(tree.p)), key=lambda i: tree.r[i])
+    branches = _branches(tree, root)
+    if bones is not None and bones < len(branches):
+        raise NotRiggable(f"--bones {bones} is fewer than the skeleton's {len(branches)} branches")
+    # split points per branch, the largest deviations first when a count is asked for
+    cuts = {k: splits(tree.p[b], tree.r[b]) for k, b in enumerate(branches)}
+    if bones is not None:
+        cuts = _share(tree, branches, bones - len(branches))
+    joints: dict[str, np.ndarray] = {"ROOT": tree.p[root]}
+    name_of = {root: "ROOT"}
+    out: list[Bone] = []
+    used: dict[str, int] = {}
+    for k, path in enumerate(branches):
+        start = name_of[path[0]]
+        rel = tree.p[path[-1]] - tree.p[path[0]]
+        side = rel @ tree.left
+        prefix = "L_" if side > tree.r[root] else "R_" if side < -tree.r[root] else ""
+        label = prefix + _direction_name(rel, tree, geometry)
+        used[label] = used.get(label, 0) + 1
+        label += str(used[label]) if used[label] > 1 else ""
+        stops = [path[i] for i in cuts[k]] + [path[-1]]
+        prev = start
+        for n, node in enumerate(stops, 1):
+            name = f"{label}_{n}"
+            is_end = node == path[-1] and tree.degree(node) == 1
+            joints[name] = tree.tip(node) if is_end else tree.p[node]
+            if node == path[-1]:
+                name_of[node] = name
+            out.append(Bone(prev, name, name))
+            prev = name
+    return BoneSkeleton(joints, out)
+
+
+def _share(tree: Tree, branches, extra: int) -> dict[int, list[int]]:
+    """``extra`` splits shared among branches by largest deviation relative to radius."""
+    cuts: dict[int, list[int]] = {k: [] for k in range(len(branches))}
+    for _ in range(extra):
+        best = None
+        for k, b in enumerate(branches):
+            trial = splits(tree.p[b], tree.r[b], count=len(cuts[k]) + 1)
+            if len(trial) > len(cuts[k]):
+                gain = len(b) / (len(cuts[k]) + 1)
+                if best is None or gain > best[0]:
+                    best = (gain, k, trial)
+        if best is None:
+            break
+        cuts[best[1]] = best[2]
+    return cuts
+
+
+def left_axis(geometry) -> np.ndarray:
+    """Physical +x (the patient's left, LPS) as a direction in the grid's voxel index space."""
+    d = np.asarray(geometry.direction, float).reshape(3, 3)
+    return d[0] / np.asarray(geometry.spacing, float)
+
+
+def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str = "auto",
+            bones: int | None = None) -> Proposal:
+    """A bone skeleton for ``skeleton`` (at ``thinness``; default: all its points).
+
+    ``template``: ``humanoid`` and ``quadruped`` name joints and bones as those rigs do (the humanoid's
+    are the mannequin's); ``none`` names chains by position; ``auto`` takes the template that fits.
+    ``bones`` (template ``none`` only) asks for that many bones, split where branches bend most.
+    Raises :class:`NotRiggable` with where and why when the skeleton cannot be rigged.
+    """
+    from volanim_core.rig import templates
+
+    if template not in TEMPLATES:
+        raise ValueError(f"template must be one of {', '.join(TEMPLATES)}, got {template!r}")
+    if bones is not None and template not in ("none", "auto"):
+        raise ValueError("--bones sets the number of bones without a template: use --template none")
+    skel = skeleton.at(thinness) if thinness is not None else skeleton
+    curve = curve_tree(skel)
+    notes = []
+    if curve.dropped:
+        n = sum(c for c, _ in curve.dropped)
+        notes.append(f"left out {len(curve.dropped)} small piece(s) apart from the body ({n} points)")
+    tree = Tree(curve, left_axis(skel.geometry))
+    if len(tree.ends()) < 2:
+        raise NotRiggable("the skeleton has no branches: nothing to bend (is the object a ball?)")
+    if template == "auto" and bones is None:
+        fit = templates.best_fit(tree)
+        if fit is not None:
+            result, name, why = fit
+            return Proposal(_on(result, skel), name, notes + [why])
+        notes.append("no template fits (humanoid: 5 limbs, legs away from the head; quadruped: 4 legs "
+                     "across the spine): chains named by position")
+    elif template in ("humanoid", "quadruped"):
+        result = templates.fit(tree, template)
+        return Proposal(_on(result, skel), template, notes)
+    return Proposal(_on(chains(tree, skel.geometry, bones=bones), skel), "none", notes)
+
+
+def _on(bones: BoneSkeleton, skel: Skeleton) -> BoneSkeleton:
+    return BoneSkeleton(bones.joints, bones.bones, skel.geometry)

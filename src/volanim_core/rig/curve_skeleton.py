@@ -1,0 +1,198 @@
+"""The curve skeleton: a skeleton's thick points linked into one tree, spurs pruned.
+
+    Skeleton (points, dt at thinness T)
+      --cover-->  balls: the thickest point of each neighbourhood (a point suppresses the
+                  points within half its radius), so a limb is a string of beads
+      --link-->   an edge where two balls overlap: the segment between their centres lies
+                  inside the body (every point of it is inside one ball or the other)
+      --pieces--> the largest piece by volume; small ones (specks, loose organs) are left out
+                  and counted; a second large piece is refused (the object is not one body)
+      --tree-->   the minimum spanning tree, an edge costing length / (sum of radii), so the
+                  tree runs along the thick middle of a flat part rather than its rim
+      --prune-->  leaf branches shorter than twice the radius at their fork are surface
+                  noise, not limbs (Pinocchio's rule, Baran & Popovic 2007); removed until none is left
+      CurveTree (nodes, radii, edges)
+
+A medial axis computed from voxels is a surface in flat parts (a torso) and grows a spur at
+every bump; linking its thick points and pruning by thickness leaves the body's curve skeleton,
+which :mod:`volanim_core.rig.autorig` cuts into chains and bones.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volanim_core.skeleton.points import Skeleton
+
+COVER = 0.5  # a ball suppresses the points within this fraction of its radius
+SPUR = 3.0
+LARGE_PIECE = 0.2
+FLOOR = 2.0
+
+
+class NotRiggable(ValueError):
+    """The skeleton cannot be rigged (no points, or a body in pieces); the message says where."""
+
+
+@dataclass
+class CurveTree:
+    """Tree nodes (skeleton voxel coordinates), their radii and the tree's edges."""
+
+    points: np.ndarray  # (M, 3) float64
+    radius: np.ndarray  # (M,)
+    edges: np.ndarray  # (M - 1, 2) int
+    dropped: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (points, centre) of pieces left out
+
+    def neighbours(self) -> list[list[int]]:
+        adj: list[list[int]] = [[] for _ in range(len(self.points))]
+        for a, b in self.edges:
+            adj[a].append(int(b))
+            adj[b].append(int(a))
+        return adj
+
+
+def cover(points: np.ndarray, dt: np.ndarray, fraction: float = COVER) -> np.ndarray:
+    """Indices of the balls that cover the points: thickest first, each suppressing its neighbours
+    within ``fraction`` of its radius (at least the 26 neighbouring voxels)."""
+    from scipy.spatial import cKDTree
+
+    order = np.argsort(-dt, kind="stable")
+    tree = cKDTree(points)
+    alive = np.ones(len(points), bool)
+    keep = []
+    reach = np.maximum(fraction * dt, 1.8)
+    for i in order:
+        if alive[i]:
+            keep.append(i)
+            alive[tree.query_ball_point(points[i], reach[i])] = False
+    return np.asarray(keep, dtype=np.int64)
+
+
+GAP = 3.0
+
+
+def _link(p: np.ndarray, r: np.ndarray, k: int = 24):
+    """Sparse graph of overlapping balls among each ball's ``k`` nearest, cost length / (r_a + r_b)."""
+    from scipy.sparse import coo_matrix
+    from scipy.spatial import cKDTree
+
+    n = len(p)
+    k = min(k, n - 1)
+    d, j = cKDTree(p).query(p, k + 1)
+    i = np.repeat(np.arange(n), k + 1)
+    d, j = d.ravel(), j.ravel()
+    ok = (j != i) & (j < n) & (d <= r[i] + r[np.minimum(j, n - 1)] + GAP)
+    i, j, d = i[ok], j[ok], d[ok]
+    cost = np.maximum(d, 1e-9) / (r[i] + r[j])
+    return coo_matrix((cost, (i, j)), shape=(n, n)).tocsr()
+
+
+def _where(p: np.ndarray) -> str:
+    return "(" + ", ".join(f"{v:.0f}" for v in p) + ")"
+
+
+def _largest_piece(graph, p, r):
+    from scipy.sparse.csgraph import connected_components
+
+    count, label = connected_components(graph, directed=False)
+    volume = np.bincount(label, weights=r**3, minlength=count)
+    order = np.argsort(-volume)
+    main = order[0]
+    big = [c for c in order[1:] if volume[c] >= LARGE_PIECE * volume[main]]
+    if big:
+        where = "; ".join(f"{np.count_nonzero(label == c)} balls around {_where(p[label == c].mean(axis=0))}"
+                          for c in [main, *big])
+        raise NotRiggable(f"the skeleton is in {count} pieces, {1 + len(big)} of them large ({where}): rig each "
+                          "body separately, or lower --thinness so that thin parts join them")
+    dropped = [(int(np.count_nonzero(label == c)), p[label == c].mean(axis=0)) for c in order[1:]]
+    return label == main, dropped
+
+
+def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float, floor: float) -> None:
+    """Remove leaf branches shorter than ``factor`` x their fork's radius, in place, round by round.
+    A fork keeps at least two branches (its longest short ones), so a limb ending in a Y keeps one tip."""
+    while True:
+        at_fork: dict[int, list[tuple[float, list[int]]]] = {}
+        for leaf in [i for i in range(len(adj)) if len(adj[i]) == 1]:
+            path, prev, cur, length = [leaf], leaf, next(iter(adj[leaf])), 0.0
+            length += float(np.linalg.norm(p[cur] - p[prev]))
+            while len(adj[cur]) == 2:
+                prev, cur = cur, next(k for k in adj[cur] if k != prev)
+                path.append(prev)
+                length += float(np.linalg.norm(p[cur] - p[prev]))
+            if len(adj[cur]) >= 3 and length < max(factor * r[cur], floor):
+                at_fork.setdefault(cur, []).append((length, path))
+        removed = False
+        for fork, branches in at_fork.items():
+            branches.sort(key=lambda b: b[0])
+            keep = max(0, 2 - (len(adj[fork]) - len(branches)))  # branches that must stay
+            for _, path in branches[: len(branches) - keep]:
+                for a in path:
+                    for b in adj[a]:
+                        adj[b].discard(a)
+                    adj[a].clear()
+                removed = True
+        if not removed:
+            return
+
+
+COARSE_VOXELS = 2_000_000  # the solid body is remade on a grid of at most this many voxels
+
+
+def solid(skeleton: Skeleton, *, close: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """The medial points ``(points, radii)`` of the body the skeleton's balls make, remade solid.
+
+    The balls are painted on a grid coarse enough to hold at most ``COARSE_VOXELS`` voxels, closed by
+    ``close`` voxels and filled, then skeletonized again: a porous segmentation (the frog's tissues,
+    with unlabelled gaps between muscles) becomes one body whose thickness means something.
+    """
+    from scipy import ndimage
+
+    from volanim_core.rig._curve_kernels import paint_balls
+    lo = skeleton.points.min(axis=0) - skeleton.dt.max() - 1
+    hi = skeleton.points.max(axis=0) + skeleton.dt.max() + 1
+    h = max(1, int(np.ceil((np.prod(hi - lo) / COARSE_VOXELS) ** (1 / 3))))
+    pad = close + 1
+    shape = tuple(int(v) for v in np.ceil((hi - lo) / h) + 1 + 2 * pad)
+    grid = np.zeros(shape, bool)
+    centres = (skeleton.points - lo) / h + pad
+    paint_balls(centres, np.maximum(skeleton.dt, 0.5) / h + 0.5, grid)
+    if close:
+        grid = ndimage.binary_closing(grid, ndimage.generate_binary_structure(3, 1), iterations=close)
+    grid = ndimage.binary_fill_holes(grid)
+    from skimage.morphology import skeletonize as thin
+    import edt
+    curve = thin(grid)
+    dist = edt.edt(grid)
+    idx = np.argwhere(curve)
+    return (idx - pad) * h + lo, dist[curve] * h
+
+
+def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
+    """The curve skeleton of ``skeleton`` (all its points: pass ``skeleton.at(thinness)``)."""
+    from scipy.sparse.csgraph import minimum_spanning_tree
+
+    if len(skeleton) == 0:
+        raise NotRiggable("the skeleton has no points at this thinness: lower --thinness")
+    pts, dt = solid(skeleton)
+    keep = np.arange(len(pts))
+    p, r = pts[keep], dt[keep]
+    if len(p) == 1:
+        return CurveTree(p, r, np.zeros((0, 2), np.int64))
+    graph = _link(p, r)
+    main, dropped = _largest_piece(graph, p, r)
+    p, r = p[main], r[main]
+    sub = graph[main][:, main]
+    mst = minimum_spanning_tree(sub + sub.T).tocoo()
+    adj = [set() for _ in range(len(p))]
+    for a, b in zip(mst.row, mst.col):
+        adj[a].add(int(b))
+        adj[b].add(int(a))
+    _prune(adj, p, r, spur, FLOOR * r.max())
+    alive = np.array([len(a) > 0 for a in adj]) if len(p) > 1 else np.ones(1, bool)
+    renum = np.cumsum(alive) - 1
+    edges = np.array(sorted((renum[a], renum[b]) for a in range(len(adj)) for b in adj[a] if a < b),
+                     np.int64).reshape(-1, 2)
+    return CurveTree(p[alive], r[alive], edges, dropped)
