@@ -11,6 +11,7 @@ __version__ = "0.1.0"
 # imported on first use so that ``import volanim_core`` stays light (numba compiles on first call anyway).
 _API = {
     "connect": "volanim_core.rig.attach",
+    "autorig": "volanim_core.rig.autorig",
     "mirror": "volanim_core.rig.symmetry",
     "keys": "volanim_core.motion.keyframes",
     "report": "volanim_core.reconstruct.checks",

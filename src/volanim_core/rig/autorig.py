@@ -27,7 +27,8 @@ from volanim_core.skeleton.points import Skeleton
 
 TEMPLATES = ("auto", "humanoid", "quadruped", "none")
 THICKNESS_WEIGHT = 2.0  # a radius change of 1 voxel counts as a bend of 2 voxels
-BEND = 0.35  # a branch is split where it strays more than this x its radius from its chord (at least 2 voxels)
+FORK_BALL = 1.5  # no joint within this x the fork's radius of a fork: the limb is leaving the fork's ball
+BEND = 0.6  # a branch is split where it strays more than this x its radius from its chord (at least 2 voxels)
 
 
 @dataclass
@@ -49,6 +50,7 @@ class Tree:
     def __init__(self, curve: CurveTree, left: np.ndarray):
         self.p, self.r = curve.points, curve.radius
         self.adj = curve.neighbours()
+        self.curve = curve
         self.left = left / np.linalg.norm(left)  # +x physical, in voxel index space
 
     def degree(self, i: int) -> int:
@@ -90,15 +92,20 @@ class Tree:
                 return n
         return a
 
-    def tip(self, end: int) -> np.ndarray:
-        """An end extended by its radius along the branch: the body's tip, where thinning stopped short."""
+    def tip(self, end: int, inset: bool = False) -> np.ndarray:
+        """An end extended along its branch to the body's surface: thinning stops short of the tip.
+        With ``inset``, one end radius short of the surface, where a limb's last ball is centred
+        (the end of a finger's or a toe's axis), but never behind the end itself."""
         back = self.path(end, self._fork_or_far(end))
         s = self.length(back)
         k = int(np.searchsorted(s, max(self.r[end], 2.0)))
         k = min(k, len(back) - 1)
         direction = self.p[end] - self.p[back[k]]
-        norm = np.linalg.norm(direction)
-        return self.p[end] + (self.r[end] * direction / norm if norm > 0 else 0)
+        surface = self.curve.surface(self.p[end], direction)
+        if not inset:
+            return surface
+        reach = np.linalg.norm(surface - self.p[end])
+        return self.p[end] + (surface - self.p[end]) * max(0.0, reach - self.r[end]) / (reach or 1)
 
     def _fork_or_far(self, end: int) -> int:
         prev, cur = end, self.adj[end][0] if self.adj[end] else end
@@ -107,22 +114,43 @@ class Tree:
         return cur
 
 
-def splits(xyz: np.ndarray, r: np.ndarray, *, tolerance: float | None = None, count: int | None = None) -> list[int]:
-    """Interior indices where a branch should bend: Douglas-Peucker on the curve (x, y, z, 2 r).
+def smooth(xyz: np.ndarray, width: int = 2) -> np.ndarray:
+    """A moving average over ``2 width + 1`` nodes (ends kept): the thinned curve's voxel stairs are not bends."""
+    if len(xyz) <= 2 * width + 1:
+        return xyz
+    kernel = np.ones(2 * width + 1) / (2 * width + 1)
+    out = xyz.astype(np.float64).copy()
+    for axis in range(xyz.shape[1]):
+        out[width:-width, axis] = np.convolve(xyz[:, axis], kernel, mode="valid")
+    return out
 
-    With ``count``, exactly that many splits (the largest deviations first); otherwise every split whose
-    deviation exceeds ``tolerance`` (default: BEND x the branch's mean radius, at least 2 voxels).
+
+def splits(xyz: np.ndarray, r: np.ndarray, *, tolerance: float | None = None, count: int | None = None,
+           skip: float = 0.0) -> list[int]:
+    """Interior indices where a branch should bend: Douglas-Peucker on the smoothed curve (x, y, z, 2 r).
+
+    With ``count``, up to that many splits (the largest deviations first); otherwise every split whose
+    deviation exceeds ``tolerance`` (default: BEND x the branch's mean radius, at least 2 voxels). No
+    piece is made shorter than the branch's mean radius (a bone is longer than it is thick), and none
+    within ``skip`` of the start: a limb thins where it leaves its fork's ball, which is not a joint.
     """
-    curve = np.column_stack([xyz, THICKNESS_WEIGHT * np.asarray(r)])
+    curve = smooth(np.column_stack([xyz, THICKNESS_WEIGHT * np.asarray(r)]))
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))])
+    shortest = float(np.mean(r))
     tol = tolerance if tolerance is not None else max(2.0, BEND * float(np.mean(r)))
     chosen: list[int] = []
-    spans = [(0, len(curve) - 1)]
+    first = min(int(np.searchsorted(arc, skip)), len(curve) - 1)  # the chord starts out of the fork's ball
+    spans = [(first, len(curve) - 1)]
     while spans:
         best = None
         for a, b in spans:
             if b - a < 2:
                 continue
             dev = _deviation(curve[a:b + 1])
+            room = (arc[a:b + 1] - arc[a] >= shortest) & (arc[b] - arc[a:b + 1] >= shortest)
+            if not room.any():
+                continue
+            dev = np.where(room, dev, -1.0)
             k = int(np.argmax(dev))
             if best is None or dev[k] > best[0]:
                 best = (dev[k], a, b, a + k)
@@ -185,7 +213,7 @@ def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None =
     if bones is not None and bones < len(branches):
         raise NotRiggable(f"--bones {bones} is fewer than the skeleton's {len(branches)} branches")
     # split points per branch, the largest deviations first when a count is asked for
-    cuts = {k: splits(tree.p[b], tree.r[b]) for k, b in enumerate(branches)}
+    cuts = {k: splits(tree.p[b], tree.r[b], skip=FORK_BALL * tree.r[b[0]]) for k, b in enumerate(branches)}
     if bones is not None:
         cuts = _share(tree, branches, bones - len(branches))
     joints: dict[str, np.ndarray] = {"ROOT": tree.p[root]}
@@ -194,6 +222,12 @@ def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None =
     used: dict[str, int] = {}
     for k, path in enumerate(branches):
         start = name_of[path[0]]
+        span = float(tree.length(path)[-1])
+        if tree.degree(path[-1]) >= 3 and span < max(2.0, tree.r[path[0]], tree.r[path[-1]]):
+            name_of[path[-1]] = start  # two forks a voxel or two apart are one junction
+            continue
+        if tree.degree(path[-1]) == 1 and span + tree.r[path[-1]] < FORK_BALL * tree.r[path[0]]:
+            continue  # the far side of the root's own ball, not a limb
         rel = tree.p[path[-1]] - tree.p[path[0]]
         side = rel @ tree.left
         prefix = "L_" if side > tree.r[root] else "R_" if side < -tree.r[root] else ""
@@ -210,6 +244,8 @@ def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None =
                 name_of[node] = name
             out.append(Bone(prev, name, name))
             prev = name
+    if not out:
+        raise NotRiggable("the skeleton has no branches longer than it is thick: nothing to bend (a ball?)")
     return BoneSkeleton(joints, out)
 
 
@@ -219,7 +255,7 @@ def _share(tree: Tree, branches, extra: int) -> dict[int, list[int]]:
     for _ in range(extra):
         best = None
         for k, b in enumerate(branches):
-            trial = splits(tree.p[b], tree.r[b], count=len(cuts[k]) + 1)
+            trial = splits(tree.p[b], tree.r[b], count=len(cuts[k]) + 1, skip=FORK_BALL * tree.r[b[0]])
             if len(trial) > len(cuts[k]):
                 gain = len(b) / (len(cuts[k]) + 1)
                 if best is None or gain > best[0]:

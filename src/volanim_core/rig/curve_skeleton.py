@@ -32,6 +32,26 @@ LARGE_PIECE = 0.2
 FLOOR = 2.0
 
 
+@dataclass
+class Body:
+    """The skeleton's balls painted solid on a coarse grid: voxel ``i`` is at ``(i - pad) * step + lo``."""
+
+    grid: np.ndarray
+    lo: np.ndarray
+    step: int
+    pad: int
+
+    def exit(self, start: np.ndarray, direction: np.ndarray) -> np.ndarray:
+        d = direction / (np.linalg.norm(direction) or 1)
+        t = np.arange(0, 4 * max(self.grid.shape) * self.step, 0.5 * self.step)
+        ray = start + t[:, None] * d
+        idx = np.rint((ray - self.lo) / self.step + self.pad).astype(int)
+        inside = (idx >= 0).all(axis=1) & (idx < self.grid.shape).all(axis=1)
+        inside[inside] = self.grid[tuple(idx[inside].T)]
+        out = np.flatnonzero(~inside)
+        return ray[out[0] - 1] if len(out) and out[0] > 0 else start
+
+
 class NotRiggable(ValueError):
     """The skeleton cannot be rigged (no points, or a body in pieces); the message says where."""
 
@@ -44,6 +64,13 @@ class CurveTree:
     radius: np.ndarray  # (M,)
     edges: np.ndarray  # (M - 1, 2) int
     dropped: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (points, centre) of pieces left out
+    body: Body | None = None  # the solid body the tree was thinned from
+
+    def surface(self, start: np.ndarray, direction: np.ndarray) -> np.ndarray:
+        """Where the ray from ``start`` along ``direction`` leaves the body (``start`` without a body)."""
+        if self.body is None:
+            return start
+        return self.body.exit(start, direction)
 
     def neighbours(self) -> list[list[int]]:
         adj: list[list[int]] = [[] for _ in range(len(self.points))]
@@ -138,36 +165,41 @@ def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float, floor: f
             return
 
 
-COARSE_VOXELS = 2_000_000  # the solid body is remade on a grid of at most this many voxels
+COARSE_VOXELS = 8_000_000  # the solid body is remade on a grid of at most this many voxels
+CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues)
 
 
-def solid(skeleton: Skeleton, *, close: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def solid(skeleton: Skeleton, *, close: float = CLOSE) -> tuple[np.ndarray, np.ndarray, Body]:
     """The medial points ``(points, radii)`` of the body the skeleton's balls make, remade solid.
 
-    The balls are painted on a grid coarse enough to hold at most ``COARSE_VOXELS`` voxels, closed by
-    ``close`` voxels and filled, then skeletonized again: a porous segmentation (the frog's tissues,
-    with unlabelled gaps between muscles) becomes one body whose thickness means something.
+    The balls are painted on a grid coarse enough to hold at most ``COARSE_VOXELS`` voxels, gaps
+    narrower than ``close`` voxels are closed, cavities filled, and the solid is thinned to a curve
+    (scikit-image's ``skeletonize``, Lee's 3-D thinning) with its distance transform as radius: a
+    porous segmentation (the frog's tissues, unlabelled seams between muscles) becomes one body
+    whose thickness means something, and a flat part (a torso) a curve rather than a sheet.
     """
+    import edt
     from scipy import ndimage
+    from skimage.morphology import skeletonize as thin
 
     from volanim_core.rig._curve_kernels import paint_balls
-    lo = skeleton.points.min(axis=0) - skeleton.dt.max() - 1
+
+    lo = np.floor(skeleton.points.min(axis=0) - skeleton.dt.max() - 1)
     hi = skeleton.points.max(axis=0) + skeleton.dt.max() + 1
     h = max(1, int(np.ceil((np.prod(hi - lo) / COARSE_VOXELS) ** (1 / 3))))
-    pad = close + 1
+    steps = max(1, int(round(close / 2 / h)))  # a closing by k steps bridges gaps of about 2 k
+    pad = steps + 1
     shape = tuple(int(v) for v in np.ceil((hi - lo) / h) + 1 + 2 * pad)
     grid = np.zeros(shape, bool)
     centres = (skeleton.points - lo) / h + pad
     paint_balls(centres, np.maximum(skeleton.dt, 0.5) / h + 0.5, grid)
     if close:
-        grid = ndimage.binary_closing(grid, ndimage.generate_binary_structure(3, 1), iterations=close)
+        grid = ndimage.binary_closing(grid, ndimage.generate_binary_structure(3, 1), iterations=steps)
     grid = ndimage.binary_fill_holes(grid)
-    from skimage.morphology import skeletonize as thin
-    import edt
     curve = thin(grid)
     dist = edt.edt(grid)
     idx = np.argwhere(curve)
-    return (idx - pad) * h + lo, dist[curve] * h
+    return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad)
 
 
 def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
@@ -176,11 +208,11 @@ def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
 
     if len(skeleton) == 0:
         raise NotRiggable("the skeleton has no points at this thinness: lower --thinness")
-    pts, dt = solid(skeleton)
+    pts, dt, body = solid(skeleton)
     keep = np.arange(len(pts))
     p, r = pts[keep], dt[keep]
     if len(p) == 1:
-        return CurveTree(p, r, np.zeros((0, 2), np.int64))
+        return CurveTree(p, r, np.zeros((0, 2), np.int64), body=body)
     graph = _link(p, r)
     main, dropped = _largest_piece(graph, p, r)
     p, r = p[main], r[main]
@@ -195,4 +227,16 @@ def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
     renum = np.cumsum(alive) - 1
     edges = np.array(sorted((renum[a], renum[b]) for a in range(len(adj)) for b in adj[a] if a < b),
                      np.int64).reshape(-1, 2)
-    return CurveTree(p[alive], r[alive], edges, dropped)
+    return CurveTree(p[alive], r[alive], edges, dropped, body)
+
+
+def balls(skeleton: Skeleton) -> np.ndarray:
+    """The union of the skeleton's balls on its own voxel grid: the body its rest pose re-grows."""
+    from volanim_core.rig._curve_kernels import paint_balls
+
+    if len(skeleton) == 0:
+        return np.zeros((1, 1, 1), bool)
+    shape = tuple(int(v) for v in np.ceil(skeleton.points.max(axis=0) + skeleton.dt.max()) + 2)
+    out = np.zeros(shape, bool)
+    paint_balls(skeleton.points.astype(np.float64), np.maximum(skeleton.dt, 0.5), out)
+    return out

@@ -33,7 +33,7 @@ def trimmed(tree: Tree, ends: int) -> Tree:
     """The tree with its shortest leaf branches removed until ``ends`` ends are left."""
     adj = [list(a) for a in tree.adj]
     t = Tree.__new__(Tree)
-    t.p, t.r, t.adj, t.left = tree.p, tree.r, adj, tree.left
+    t.p, t.r, t.adj, t.left, t.curve = tree.p, tree.r, adj, tree.left, tree.curve
     while len(t.ends()) > ends:
         best = None
         for e in t.ends():
@@ -135,7 +135,7 @@ def _limb(tree: Tree, start: int, end: int, fractions, last_bend: bool, thin_at:
     n = len(path)
     first = _bend(tree, path, 0, max(2, int(0.45 * n)))
     s = tree.length(path)
-    tip = tree.tip(end)
+    tip = tree.tip(end, inset=True)
     total = s[-1] + np.linalg.norm(tip - tree.p[end])
     inner = [_at(tree, path, f, s[first], total) for f in fractions]
     if last_bend:
@@ -144,7 +144,28 @@ def _limb(tree: Tree, start: int, end: int, fractions, last_bend: bool, thin_at:
     if thin_at is not None:
         inner[thin_at] = _thinning(tree, path, _at(tree, path, 0.65, s[first], total),
                                    _at(tree, path, 0.92, s[first], total), inner[thin_at])
-    return [tree.p[path[first]]] + [tree.p[path[k]] for k in inner] + [tip]
+    return [_corner(tree.p[path], first)] + [tree.p[path[k]] for k in inner] + [tip]
+
+
+def _line(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    centre = pts.mean(axis=0)
+    return centre, np.linalg.svd(pts - centre)[2][0]
+
+
+def _corner(xyz: np.ndarray, k: int) -> np.ndarray:
+    """Where the straight runs before and after node ``k`` meet (the midpoint of their closest points):
+    a shoulder where the clavicle's line meets the upper arm's, not on the rounded curve between."""
+    before, after = xyz[max(0, k - max(3, k)): k + 1], xyz[k: k + max(3, (len(xyz) - k) // 3)]
+    if len(before) < 3 or len(after) < 3:
+        return xyz[k]
+    (a, u), (b, v) = _line(before), _line(after)
+    w, uv = a - b, u @ v
+    if abs(1 - uv * uv) < 1e-3:  # parallel runs: no corner
+        return xyz[k]
+    s = (uv * (w @ v) - (w @ u)) / (1 - uv * uv)
+    t = ((w @ v) - uv * (w @ u)) / (1 - uv * uv)
+    point = (a + s * u + b + t * v) / 2
+    return point if np.linalg.norm(point - xyz[k]) < 0.5 * np.linalg.norm(xyz[-1] - xyz[0]) else xyz[k]
 
 
 def _at_level(tree: Tree, start: int, end: int, level: np.ndarray, up: np.ndarray) -> np.ndarray:

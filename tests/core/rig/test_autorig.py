@@ -1,0 +1,190 @@
+"""Auto-rig against creatures with known answers, the mannequins' hand-made bones, and the frog.
+
+The synthetic creatures are capsules (tubes with round ends) joined at known points and angles, so
+the number of chains and where each joint belongs are exact: a star's limbs leave one centre, a
+chain bends where its segments meet, a T has one junction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from volanim_core import samples
+from volanim_core.reconstruct.checks import report
+from volanim_core.rig.attach import connect
+from volanim_core.rig.autorig import autorig, splits
+from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.connectivity import Trans
+from volanim_core.rig.curve_skeleton import NotRiggable, balls
+from volanim_core.rig.pose import pose_matrices, root_bones
+from volanim_core.skeleton.skeletonize import skeletonize
+
+
+def capsules(shape, parts) -> np.ndarray:
+    """A mask of capsules ``(a, b, radius)`` (voxel coordinates), computed directly from distances."""
+    x, y, z = np.meshgrid(*(np.arange(n, dtype=float) for n in shape), indexing="ij")
+    grid = np.stack([x, y, z], axis=-1)
+    mask = np.zeros(shape, bool)
+    for a, b, r in parts:
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        ab = b - a
+        t = np.clip(((grid - a) @ ab) / max(ab @ ab, 1e-12), 0, 1)
+        mask |= np.linalg.norm(grid - (a + t[..., None] * ab), axis=-1) <= r
+    return mask
+
+
+def star(limbs: int, length: float = 40, radius: float = 4.5):
+    """``limbs`` tubes from a central ball, evenly spread in the x-z plane (tilted out of it in turn)."""
+    c = np.array([60.0, 60.0, 60.0])
+    tips = []
+    for k in range(limbs):
+        angle = 2 * np.pi * k / limbs
+        d = np.array([np.cos(angle), 0.25 * (-1) ** k, np.sin(angle)])
+        tips.append(c + length * d / np.linalg.norm(d))
+    parts = [(c, c, 9.0)] + [(c, t, radius) for t in tips]
+    return capsules((121, 121, 121), parts), c, tips, radius
+
+
+def rig(mask, **kw):
+    return autorig(skeletonize(mask), template="none", **kw)
+
+
+def children(bones, joint):
+    return [b for b in bones.bones if b.proximal == joint]
+
+
+@pytest.mark.parametrize("limbs", [3, 4, 5, 6, 7, 8])
+def test_a_star_has_one_chain_per_limb_from_its_centre(limbs):
+    mask, centre, tips, r = star(limbs)
+    bones = rig(mask).bones
+    assert len(children(bones, "ROOT")) == limbs
+    assert np.linalg.norm(bones.joints["ROOT"] - centre) < 3.0
+    # every limb is one straight bone, ending at the surface of its tip (the capsule's end + radius)
+    assert len(bones.bones) == limbs
+    ends = np.array([bones.joints[b.distal] for b in bones.bones])
+    for t in tips:
+        surface = t + r * (t - centre) / np.linalg.norm(t - centre)
+        assert np.min(np.linalg.norm(ends - surface, axis=1)) < 3.0
+
+
+def test_a_bent_chain_gets_a_joint_at_each_bend():
+    body = np.array([25.0, 40.0, 40.0])
+    bends = [np.array([55.0, 40.0, 40.0]), np.array([75.0, 40.0, 74.6])]  # 60 degrees up, then back level
+    end = np.array([105.0, 40.0, 74.6])
+    mask = capsules((125, 81, 100), [(body, body, 12.0), (body, bends[0], 4.5), (bends[0], bends[1], 4.5),
+                                     (bends[1], end, 4.5)])
+    bones = rig(mask).bones
+    chain = [j for j in bones.joints if j != "ROOT"]
+    assert len(bones.bones) == 3 and len(chain) == 3
+    placed = np.array([bones.joints[j] for j in chain])
+    for b in bends:
+        assert np.min(np.linalg.norm(placed - b, axis=1)) < 3.5
+    assert np.linalg.norm(placed[-1] - (end + [4.5, 0, 0])) < 3.0
+    assert np.linalg.norm(bones.joints["ROOT"] - body) < 3.0
+
+
+def test_a_t_has_one_junction_and_three_branches():
+    j = np.array([60.0, 30.0, 70.0])
+    left, right, foot = j + [-45, 0, 0], j + [45, 0, 0], j + [0, 0, -55]
+    mask = capsules((121, 61, 131), [(left, right, 5.0), (j, foot, 5.0)])
+    bones = rig(mask).bones
+    assert np.linalg.norm(bones.joints["ROOT"] - j) < 4.0
+    assert len(children(bones, "ROOT")) == 3 and len(bones.bones) == 3
+    names = {b.name for b in bones.bones}
+    assert {"L_INF_1", "R_INF_1"} & names == set() and {"INF_1"} <= names  # the stem points down (SUP is +z)
+    ends = {b.name: bones.joints[b.distal] for b in bones.bones}
+    assert ends["INF_1"][2] == pytest.approx(foot[2] - 5, abs=3)
+    sides = sorted(n for n in names if n != "INF_1")
+    assert sides[0].startswith("L_") and sides[1].startswith("R_")  # +x is the left (LPS)
+    assert ends[sides[0]][0] > j[0] > ends[sides[1]][0]
+
+
+def test_bones_n_splits_where_branches_bend_most():
+    mask, centre, tips, r = star(3)
+    bones = rig(mask, bones=7).bones
+    assert len(bones.bones) == 7
+    with pytest.raises(NotRiggable, match="fewer than"):
+        rig(mask, bones=2)
+
+
+def test_douglas_peucker_splits_at_the_corner():
+    t = np.linspace(0, 1, 41)[:, None]
+    xyz = np.concatenate([t[:-1] * [40, 0, 0], [40, 0, 0] + t * [0, 0, 40]])
+    assert splits(xyz, np.full(len(xyz), 3.0)) == [40]
+    assert splits(xyz[:41], np.full(41, 3.0)) == []  # straight: nothing to split
+
+
+def test_what_cannot_be_rigged_is_refused_with_where():
+    ball = capsules((41, 41, 41), [((20, 20, 20), (20, 20, 20), 12.0)])
+    with pytest.raises(NotRiggable, match="no branches"):
+        rig(ball)
+    two = capsules((140, 60, 60), [((20, 30, 30), (50, 30, 30), 8.0), ((90, 30, 30), (120, 30, 30), 8.0)])
+    with pytest.raises(NotRiggable, match=r"2 pieces, 2 of them large .*around \((\d+), 30, 30\)"):
+        rig(two)
+    skel = skeletonize(two)
+    with pytest.raises(NotRiggable, match="no points at this thinness"):
+        autorig(skel, thinness=99.0)
+
+
+def _mean_error(proposal, reference):
+    assert [b.name for b in proposal.bones] == [b.name for b in reference.bones]
+    return np.mean([np.linalg.norm(proposal.joints[k] - v) for k, v in reference.joints.items()])
+
+
+def test_the_mannequin_gets_its_own_bones_back():
+    s = samples.mannequin()
+    skel = skeletonize(s.mask)
+    proposal = autorig(skel, template="auto")
+    assert proposal.template == "humanoid"
+    assert _mean_error(proposal.bones, s.bones) < 5.0
+    # every limb bent 60 degrees after auto-connect (path method, inside the skeleton's own balls): one piece
+    conn, _ = connect(skel, proposal.bones, method="path", mask=balls(skel))
+    for bone in ("HEAD", "L_UPPERARM", "R_FOREARM", "L_THIGH", "R_SHIN", "L_HAND", "R_FOOT"):
+        trans = Trans(root_bones(proposal.bones), pose_matrices(proposal.bones, {bone: (0.0, 60.0, 0.0)}))
+        rep = report(conn, trans, bones=proposal.bones)
+        assert len(rep.components) == 1 and not rep.stumps, (bone, rep.verdict)
+
+
+def test_mannequin_large_humanoid():
+    s = samples.mannequin_large()
+    proposal = autorig(skeletonize(s.mask))
+    assert proposal.template == "humanoid"
+    # the same body on a grid 1.8 x 1.7 x 3.1 times finer: in the mannequin's own voxels the error is the
+    # small one's; in the large voxels, where the torso's top is stretched 3.1 times upwards and the
+    # thinned curve leaves it below the clavicles, it is twice the issue's 5 (see the issue's note)
+    scale = np.array(samples.LARGE_SHAPE, float) / samples.MANNEQUIN_SHAPE
+    body = _mean_error(BoneSkeleton({k: v / scale for k, v in proposal.bones.joints.items()}, proposal.bones.bones),
+                       BoneSkeleton({k: v / scale for k, v in s.bones.joints.items()}, s.bones.bones))
+    assert body < 5.0
+    assert _mean_error(proposal.bones, s.bones) < 10.5
+
+
+def test_the_frog_legs_are_separate_chains():
+    s = samples.frog()
+    bones = autorig(skeletonize(s.mask)).bones
+    parent = {b.distal: b.proximal for b in bones.bones}
+
+    def ancestry(j):
+        out = [j]
+        while out[-1] in parent:
+            out.append(parent[out[-1]])
+        return out
+
+    # the four feet: the object's voxels farthest out along y (the hind feet), and among the front half's
+    # (x 250..350) those farthest out (the front feet)
+    pts = np.argwhere(s.mask[::2, ::2, ::2]) * 2.0
+    front = pts[(pts[:, 0] > 250) & (pts[:, 0] < 350)]
+    feet = [pts[np.argmax(pts[:, 1])], pts[np.argmin(pts[:, 1])], front[np.argmax(front[:, 1])],
+            front[np.argmin(front[:, 1])]]
+    centre = pts.mean(axis=0)
+    names = list(bones.joints)
+    pos = np.array([bones.joints[n] for n in names])
+    tips = [names[int(np.argmin(np.linalg.norm(pos - f, axis=1)))] for f in feet]
+    assert all(np.min(np.linalg.norm(pos - f, axis=1)) < 40 for f in feet)
+    # two feet share no joint outside the trunk: each leg is its own chain
+    lines = [set(ancestry(t)) for t in tips]
+    for i in range(4):
+        for k in range(i + 1, 4):
+            shared = lines[i] & lines[k]
+            assert all(np.linalg.norm(bones.joints[j][:2] - centre[:2]) < 130 for j in shared), (tips[i], tips[k])
