@@ -36,6 +36,7 @@ from .attachments import Attachments
 from .bone_edits import BoneEdits
 from .events import EventEmitter
 from .posing import PoseState
+from .proposal import BoneProposal
 from .settings import Settings
 from .timeline import Timeline
 from .undo import UndoStack
@@ -70,6 +71,7 @@ class Document:
         self.demo_name: str | None = None  # a session opened on a demo dataset reopens it
         self.settings = Settings()
         self.bone_edits = BoneEdits(self)
+        self.proposal = BoneProposal(self)
         self.attachments = Attachments(self)
         self.pose = PoseState(self)
         self.timeline = Timeline(self)

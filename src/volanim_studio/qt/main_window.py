@@ -28,6 +28,7 @@ from ..model.modes import HANDLERS, Mode, PickEvent
 from ..scene.view import SceneView
 from .bone_panel import BonePanel
 from .connect_controller import ConnectController
+from .propose_dialog import ProposeController
 from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .files_controller import FilesController
@@ -102,6 +103,7 @@ class MainWindow(QMainWindow):
         self.previews = PreviewController(self)
         self.naming = NamingController(self)
         self.connecting = ConnectController(self)
+        self.proposing = ProposeController(self)
         self.display_panel = DisplayPanel(self.doc)
         self.bone_panel = BonePanel(self.doc)
         self.connect_panel = ConnectPanel(self.doc, self.handlers[Mode.CUBE])
@@ -193,6 +195,7 @@ class MainWindow(QMainWindow):
             for name, key in (("Left", "Left"), ("Right", "Right"), ("Up", "Up"), ("Down", "Down"),
                               ("PageUp", "PgUp"), ("PageDown", "PgDown"), ("Plus", "+"), ("Minus", "-"),
                               ("C", "C"), ("X", "X"))]
+        self.proposing.fill_menu(bar.addMenu("&Bones"), self._action)
         connect_menu = bar.addMenu("&Connect")
         self.connecting.fill_menu(connect_menu, self._action)
         self._action("Save .connect…", lambda: self.files.save_dialog("connect"), menu=connect_menu)
