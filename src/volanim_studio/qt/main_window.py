@@ -28,7 +28,6 @@ from ..model.modes import HANDLERS, Mode, PickEvent
 from ..scene.view import SceneView
 from .bone_panel import BonePanel
 from .connect_controller import ConnectController
-from .propose_dialog import ProposeController
 from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .files_controller import FilesController
@@ -38,6 +37,7 @@ from .mode_keys import LettersPastNumberFields
 from .naming_controller import NamingController
 from .pose_panel import PosePanel
 from .preview_controller import PreviewController
+from .propose_dialog import ProposeController
 from .reconstruct_panel import ReconstructPanel
 from .session_controller import SessionController
 from .timeline_controller import TimelineController
