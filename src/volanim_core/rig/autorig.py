@@ -209,7 +209,14 @@ def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None =
     if root is None:
         forks = [i for i in range(len(tree.p)) if tree.degree(i) >= 3]
         root = max(forks or range(len(tree.p)), key=lambda i: tree.r[i])
-    branches = _branches(tree, root)
+    alias: dict[int, int] = {}  # a fork a voxel or two from its parent fork is the same junction
+    branches = []
+    for path in _branches(tree, root):
+        span = float(tree.length(path)[-1])
+        if tree.degree(path[-1]) >= 3 and span < max(2.0, tree.r[path[0]], tree.r[path[-1]]):
+            alias[path[-1]] = alias.get(path[0], path[0])
+        elif not (tree.degree(path[-1]) == 1 and span + tree.r[path[-1]] < FORK_BALL * tree.r[path[0]]):
+            branches.append(path)  # (else the far side of the root's own ball, not a limb)
     if bones is not None and bones < len(branches):
         raise NotRiggable(f"--bones {bones} is fewer than the skeleton's {len(branches)} branches")
     # split points per branch, the largest deviations first when a count is asked for
@@ -221,13 +228,7 @@ def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None =
     out: list[Bone] = []
     used: dict[str, int] = {}
     for k, path in enumerate(branches):
-        start = name_of[path[0]]
-        span = float(tree.length(path)[-1])
-        if tree.degree(path[-1]) >= 3 and span < max(2.0, tree.r[path[0]], tree.r[path[-1]]):
-            name_of[path[-1]] = start  # two forks a voxel or two apart are one junction
-            continue
-        if tree.degree(path[-1]) == 1 and span + tree.r[path[-1]] < FORK_BALL * tree.r[path[0]]:
-            continue  # the far side of the root's own ball, not a limb
+        start = name_of[alias.get(path[0], path[0])]
         rel = tree.p[path[-1]] - tree.p[path[0]]
         side = rel @ tree.left
         prefix = "L_" if side > tree.r[root] else "R_" if side < -tree.r[root] else ""
@@ -250,7 +251,8 @@ def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None =
 
 
 def _share(tree: Tree, branches, extra: int) -> dict[int, list[int]]:
-    """``extra`` splits shared among branches by largest deviation relative to radius."""
+    """``extra`` splits, each to the branch whose pieces are longest, where it bends most (Douglas-Peucker
+    with a count); refused when the branches have no room left (no piece shorter than it is thick)."""
     cuts: dict[int, list[int]] = {k: [] for k in range(len(branches))}
     for _ in range(extra):
         best = None
@@ -261,7 +263,9 @@ def _share(tree: Tree, branches, extra: int) -> dict[int, list[int]]:
                 if best is None or gain > best[0]:
                     best = (gain, k, trial)
         if best is None:
-            break
+            made = len(branches) + sum(len(c) for c in cuts.values())
+            raise NotRiggable(f"--bones {len(branches) + extra}: only {made} bones fit this skeleton "
+                              "(no bone shorter than it is thick)")
         cuts[best[1]] = best[2]
     return cuts
 

@@ -30,6 +30,7 @@ COVER = 0.5  # a ball suppresses the points within this fraction of its radius
 SPUR = 3.0
 LARGE_PIECE = 0.2
 FLOOR = 2.0
+BRIDGE = 0.08  # a bridge may cross background this fraction of the body's length (at least 6 voxels)
 
 
 @dataclass
@@ -118,6 +119,47 @@ def _link(p: np.ndarray, r: np.ndarray, k: int = 24):
 
 def _where(p: np.ndarray) -> str:
     return "(" + ", ".join(f"{v:.0f}" for v in p) + ")"
+
+
+def _bridge(graph, p, r):
+    """The graph with each piece joined to the body by its shortest gap when that gap is at most BRIDGE
+    of the body's length: a segmentation (or a mesh made of parts, like pyvista's ant) that cuts a limb
+    off at a thin joint still gives the limb to the body, its nearest end to the nearest ball."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    count, label = connected_components(graph, directed=False)
+    if count == 1:
+        return graph
+    volume = np.bincount(label, weights=r**3, minlength=count)
+    body = label == int(np.argmax(volume))
+    rows, cols, costs = [], [], []
+    reach = max(6.0, BRIDGE * float(np.ptp(p, axis=0).max()))
+    changed = True
+    while changed:
+        changed = False
+        tree = cKDTree(p[body])
+        index = np.flatnonzero(body)
+        for c in np.argsort(-volume):
+            members = np.flatnonzero(label == c)
+            if body[members[0]]:
+                continue
+            d, k = tree.query(p[members], k=min(8, len(index)))
+            d, k = np.atleast_2d(d.T).T, np.atleast_2d(k.T).T
+            gap = d - r[members][:, None] - r[index[k]]
+            i, j = np.unravel_index(int(np.argmin(gap)), gap.shape)
+            if gap[i, j] <= reach:
+                a, b = members[i], index[k[i, j]]
+                rows.append(a)
+                cols.append(b)
+                costs.append(max(d[i, j], 1e-9) / (r[a] + r[b]))
+                body[members] = True
+                changed = True
+    if not rows:
+        return graph
+    extra = coo_matrix((costs, (rows, cols)), shape=graph.shape).tocsr()
+    return graph + extra
 
 
 def _largest_piece(graph, p, r):
@@ -213,7 +255,7 @@ def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
     p, r = pts[keep], dt[keep]
     if len(p) == 1:
         return CurveTree(p, r, np.zeros((0, 2), np.int64), body=body)
-    graph = _link(p, r)
+    graph = _bridge(_link(p, r), p, r)
     main, dropped = _largest_piece(graph, p, r)
     p, r = p[main], r[main]
     sub = graph[main][:, main]

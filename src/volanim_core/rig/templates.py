@@ -27,10 +27,12 @@ from volanim_core.rig.curve_skeleton import NotRiggable
 SYMMETRY = 0.15  # a pairing is symmetric when its mirror error is below this fraction of the body's size
 ELBOW, WRIST = 0.42, 0.76  # upper arm 0.186 H, forearm 0.146 H, hand 0.108 H (Drillis & Contini)
 KNEE = 0.5  # thigh 0.245 H, shank 0.246 H
+EXTRA = 0.5  # auto: ends beyond the template's are spurs only if shorter than this x its shortest limb
 
 
-def trimmed(tree: Tree, ends: int) -> Tree:
-    """The tree with its shortest leaf branches removed until ``ends`` ends are left."""
+def trimmed(tree: Tree, ends: int, removed: list[float] | None = None) -> Tree:
+    """The tree with its shortest leaf branches removed until ``ends`` ends are left (their lengths are
+    appended to ``removed``)."""
     adj = [list(a) for a in tree.adj]
     t = Tree.__new__(Tree)
     t.p, t.r, t.adj, t.left, t.curve = tree.p, tree.r, adj, tree.left, tree.curve
@@ -44,6 +46,8 @@ def trimmed(tree: Tree, ends: int) -> Tree:
             length = float(t.length(path + [cur])[-1])
             if best is None or length < best[0]:
                 best = (length, path)
+        if removed is not None:
+            removed.append(best[0])
         for a in best[1]:
             for b in adj[a]:
                 adj[b].remove(a)
@@ -282,7 +286,11 @@ def best_fit(tree: Tree) -> tuple[BoneSkeleton, str, str] | None:
     for template, singles in (("humanoid", 1), ("quadruped", 2), ("quadruped", 1)):
         if template == "quadruped" and singles == 2 and ends < 6:
             continue
-        t = trimmed(tree, 4 + singles)
+        removed: list[float] = []
+        t = trimmed(tree, 4 + singles, removed)
+        limbs = [float(t.length(t.path(e, t._fork_or_far(e)))[-1]) for e in t.ends()]
+        if removed and max(removed) > EXTRA * min(limbs):
+            continue  # a limb the template has no place for (an ant's third pair of legs): not this template
         match = _match(t, singles)
         if match[0] > SYMMETRY:
             continue

@@ -1,0 +1,81 @@
+"""``volanim autorig`` as a process: the mannequin's names and an auto-connect posable without breakage;
+the ant (a mesh of separate parts nobody here rigged) gets one chain per leg; refusals exit 2."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from runnable import volanim
+from volanim_core import io
+from volanim_core.cli import main
+from volanim_core.samples import mannequin_bones, write_sample
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    d = tmp_path_factory.mktemp("autorig")
+    write_sample("mannequin", d)
+    assert main(["skeletonize", str(d / "mannequin.VOL"), "-o", str(d / "m.mskel")]) == 0
+    return d
+
+
+def test_autorig_writes_the_humanoids_bones_and_a_posable_connect(made):
+    out = volanim("autorig", made / "m.mskel", "--template", "humanoid", "-o", made / "p.bones",
+                  "--connect", made / "p.connect", "--volume", made / "mannequin.VOL")
+    assert out.returncode == 0, out.stderr
+    assert "18 bones, 19 joints (humanoid)" in out.stdout and "attached 4380 points" in out.stdout
+    bones = io.read_bones(made / "p.bones")
+    assert [b.name for b in bones.bones] == [b.name for b in mannequin_bones().bones]
+    conn = io.read_connect(made / "p.connect")
+    assert conn.bones[0].label == "SPINE" and len(conn.points) == 4380
+    # the left upper arm and the right thigh bent 60 degrees: volanim report says one piece (exit 0)
+    for bone in ("L_UPPERARM", "R_THIGH"):
+        posed = volanim("pose", made / "p.bones", "--rotate", f"{bone}=0,60,0", "-o", made / f"{bone}.trans")
+        assert posed.returncode == 0, posed.stderr
+        rep = volanim("report", made / "p.connect", made / f"{bone}.trans", "--bones", made / "p.bones", "--json")
+        assert rep.returncode == 0, rep.stdout + rep.stderr
+        assert '"components": [' in rep.stdout and rep.stdout.count('"voxels"') == 0  # no piece torn off
+
+
+def test_template_none_with_a_bone_count(made):
+    out = volanim("autorig", made / "m.mskel", "--template", "none", "--bones", "12", "-o", made / "c.bones")
+    assert out.returncode == 0, out.stderr
+    bones = io.read_bones(made / "c.bones")
+    assert len(bones.bones) == 12 and "ROOT" in bones.joints
+
+
+def test_refusals_exit_2_and_write_nothing(made):
+    out = volanim("autorig", made / "m.mskel", "--thinness", "5", "-o", made / "none.bones")
+    assert out.returncode == 2 and "no points at this thinness" in out.stderr
+    out = volanim("autorig", made / "m.mskel", "--template", "humanoid", "--bones", "4", "-o", made / "x.bones")
+    assert out.returncode == 2 and "--template none" in out.stderr
+    assert not (made / "none.bones").exists() and not (made / "x.bones").exists()
+
+
+def test_the_ant_gets_one_chain_per_leg(tmp_path):
+    """pyvista's ant: legs are separate parts of the mesh, so its voxels are in 13 pieces; autorig bridges
+    the gaps and proposes each leg as one chain from the thorax, ending at the leg's tip."""
+    assert main(["samples", "ant", "-o", str(tmp_path)]) == 0
+    assert main(["voxelize", str(tmp_path / "ant.ply"), str(tmp_path / "ant.nrrd"), "--size", "160"]) == 0
+    assert main(["skeletonize", str(tmp_path / "ant.nrrd"), "--min-thinness", "0",
+                 "-o", str(tmp_path / "a.mskel")]) == 0
+    assert main(["markups", str(tmp_path / "ant.mrk.json"), "--like", str(tmp_path / "ant.nrrd"),
+                 "-o", str(tmp_path / "hand.bones")]) == 0
+    out = volanim("autorig", tmp_path / "a.mskel", "-o", tmp_path / "auto.bones")
+    assert out.returncode == 0, out.stderr
+    auto = io.read_bones(tmp_path / "auto.bones")
+    hand = io.read_bones(tmp_path / "hand.bones").on_grid(auto.geometry)
+    children = {}
+    for b in auto.bones:
+        children.setdefault(b.proximal, []).append(b.distal)
+    tips = [j for j in auto.joints if j not in children]
+    # each hand-placed foot (L_FOOT1 ... R_FOOT3, where a leg's chain ends) has a proposed chain end near it,
+    # and no two feet share one: one chain per leg
+    leg_tips = [j for j in hand.joints if "FOOT" in j]
+    assert len(leg_tips) == 6, leg_tips
+    tip_pos = np.array([auto.joints[t] for t in tips])
+    nearest = [int(np.argmin(np.linalg.norm(tip_pos - hand.joints[t], axis=1))) for t in leg_tips]
+    assert len(set(nearest)) == 6
+    # the proposal ends a chain at the surface, the markups at the cross-section's centre: within 10 voxels
+    assert all(np.linalg.norm(tip_pos[n] - hand.joints[t]) < 10 for n, t in zip(nearest, leg_tips))
