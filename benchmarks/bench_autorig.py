@@ -43,16 +43,24 @@ def main(argv=None) -> int:
         autorig(skel)  # warm: numba, imports
         ratios, seconds = [], []
         for k in range(args.rounds):
+            def skeleton(m=mask):
+                return skeletonize(m)
+
+            def rig(s=skel):
+                return autorig(s)
+
             if k % 2 == 0:
-                a, skel = timed(lambda: skeletonize(mask))
-                b, prop = timed(lambda: autorig(skel))
+                a, _ = timed(skeleton)
+                b, prop = timed(rig)
             else:
-                b, prop = timed(lambda: autorig(skel))
-                a, skel = timed(lambda: skeletonize(mask))
+                b, prop = timed(rig)
+                a, _ = timed(skeleton)
             ratios.append(b / a)
             seconds.append(b)
-            print(f"| {name} | {k + 1} | {a:.2f} | {b:.2f} | {b / a:.2f} | {len(prop.bones)} bones ({prop.template}) |")
-        print(f"| **{name}** | median | | **{statistics.median(seconds):.2f}** | **{statistics.median(ratios):.2f}** | |")
+            print(f"| {name} | {k + 1} | {a:.2f} | {b:.2f} | {b / a:.2f} | "
+                  f"{len(prop.bones)} bones ({prop.template}) |")
+        sec, ratio = statistics.median(seconds), statistics.median(ratios)
+        print(f"| **{name}** | median | | **{sec:.2f}** | **{ratio:.2f}** | |")
         if name == "frog":
             frog_seconds = statistics.median(seconds)
     print(f"\nfrog: autorig {frog_seconds:.2f} s (target 2 s)")
