@@ -171,6 +171,7 @@ PARTS: tuple[Part, ...] = (
 #: it is not (the test walks ``vars(Document())``: an attribute added without a place here fails it).
 ATTRIBUTES = {
     "events": "wiring", "undo": "history: a reopened project starts a new one", "bone_edits": "an editor of bones",
+    "proposal": "a preview being looked at: the bones it applied are saved, the preview itself is not",
     "attachments": "saved as the .connect data file", "bones": "saved as the .bones data file",
     "skeleton": "saved as the .mskel data file", "pose": "the pose part", "timeline": "the timeline part",
     "settings": "the settings part", "_thinness": "the thinness part", "_symmetry_x": "the symmetry_x part",

@@ -60,6 +60,7 @@ SHORTCUTS = [
     ("Right click", "End the bone chain"),
     ("Del", "Remove the selected bones (the Delete key)"),
     ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
+    ("Ctrl+Shift+B", "Propose bones (auto-rig): a template, a preview, accept or discard"),
     ("F2", "Rename the joint clicked last"),
     ("Ctrl+F2", "Name the selected bone's chain in one line: SHOULDER, ELBOW, WRIST (L_/R_ added by side)"),
     ("Space", "Play / pause the timeline (a BVH clip, .trans frames or keys)"),
