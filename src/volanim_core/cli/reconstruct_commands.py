@@ -36,15 +36,9 @@ def _connect(args):
         skel = skel.at(args.thinness)
     mask = None
     if args.volume:
-        from volanim_core.io import read_scan
-        from volanim_core.volume import isotropic_mask
+        from .skeleton_commands import mask_like_skeleton
 
-        from .skeleton_commands import segment
-
-        scan = read_scan(args.volume, dims=args.dims)
-        mask = segment(scan.data, args.threshold, args.fill_cavities)
-        # on the skeleton's grid: skeletonize made it on cubes of this size
-        mask, _ = isotropic_mask(mask, scan.geometry, min(skel.geometry.spacing))
+        mask = mask_like_skeleton(args, skel)
     conn, report = connect(skel, read_bones(args.bones).on_grid(skel.geometry), method=args.method, mask=mask)
     write_connect(args.output, conn, thinness=args.thinness)
     counts = np.bincount(conn.bone, minlength=len(conn.bones))

@@ -17,7 +17,7 @@ from ._common import add_command, add_dims, finite_float, parse_range, positive_
 
 def _autorig(args):
     from volanim_core.rig.attach import connect
-    from volanim_core.rig.autorig import TEMPLATES, autorig  # noqa: F401  (TEMPLATES: the choices below)
+    from volanim_core.rig.autorig import autorig
 
     skel = read_mskel(args.mskel)
     if args.thinness is not None:
@@ -38,14 +38,9 @@ def _mask(args, skel):
     """The object on the skeleton's grid: the scan's, segmented as skeletonize does, or else the union
     of the skeleton's own balls (the rest pose it re-grows)."""
     if args.volume:
-        from volanim_core.io import read_scan
-        from volanim_core.volume import isotropic_mask
+        from .skeleton_commands import mask_like_skeleton
 
-        from .skeleton_commands import segment
-
-        scan = read_scan(args.volume, dims=args.dims, series=args.series)
-        mask = segment(scan.data, args.threshold, args.fill_cavities)
-        return isotropic_mask(mask, scan.geometry, min(skel.geometry.spacing))[0]
+        return mask_like_skeleton(args, skel)
     from volanim_core.rig.curve_skeleton import balls
 
     return balls(skel)

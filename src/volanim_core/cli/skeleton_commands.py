@@ -23,6 +23,14 @@ def segment(vol: np.ndarray, threshold, fill: bool) -> np.ndarray:
     return volume.segment(vol, lo, hi, fill=fill)
 
 
+def mask_like_skeleton(args, skeleton):
+    """``args.volume`` segmented as skeletonize did (``--threshold``, ``--fill-cavities``) on the skeleton's
+    grid: the cubes skeletonize resampled the scan to. What connect's and autorig's paths run inside."""
+    scan = read_scan(args.volume, dims=args.dims, series=args.series)
+    mask = segment(scan.data, args.threshold, args.fill_cavities)
+    return volume.isotropic_mask(mask, scan.geometry, min(skeleton.geometry.spacing))[0]
+
+
 def _skeletonize(args):
     scan = read_scan(args.volume, dims=args.dims, series=args.series)
     mask = segment(scan.data, args.threshold, args.fill_cavities)

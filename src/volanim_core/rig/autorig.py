@@ -47,11 +47,16 @@ class Proposal:
 class Tree:
     """A CurveTree with the walks autorig needs: paths between nodes, ends, forks."""
 
-    def __init__(self, curve: CurveTree, left: np.ndarray):
+    def __init__(self, curve: CurveTree, left: np.ndarray, adj: list[list[int]] | None = None):
         self.p, self.r = curve.points, curve.radius
-        self.adj = curve.neighbours()
+        self.adj = curve.neighbours() if adj is None else adj
         self.curve = curve
         self.left = left / np.linalg.norm(left)  # +x physical, in voxel index space
+        self._parents: dict[int, np.ndarray] = {}  # one breadth-first walk per root, however many paths
+
+    def with_adjacency(self, adj: list[list[int]]) -> Tree:
+        """The same nodes with other edges (a trimmed copy)."""
+        return Tree(self.curve, self.left, adj)
 
     def degree(self, i: int) -> int:
         return len(self.adj[i])
@@ -60,6 +65,9 @@ class Tree:
         return [i for i in range(len(self.p)) if self.degree(i) == 1]
 
     def parents(self, root: int) -> np.ndarray:
+        """Each node's parent walking from ``root`` (-1 at the root, -2 where unreachable)."""
+        if root in self._parents:
+            return self._parents[root]
         parent = np.full(len(self.p), -2)
         parent[root] = -1
         todo = deque([root])
@@ -69,6 +77,7 @@ class Tree:
                 if parent[b] == -2:
                     parent[b] = a
                     todo.append(b)
+        self._parents[root] = parent
         return parent
 
     def path(self, a: int, b: int) -> list[int]:
@@ -96,7 +105,7 @@ class Tree:
         """An end extended along its branch to the body's surface: thinning stops short of the tip.
         With ``inset``, one end radius short of the surface, where a limb's last ball is centred
         (the end of a finger's or a toe's axis), but never behind the end itself."""
-        back = self.path(end, self._fork_or_far(end))
+        back = self.branch(end)
         s = self.length(back)
         k = int(np.searchsorted(s, max(self.r[end], 2.0)))
         k = min(k, len(back) - 1)
@@ -107,12 +116,15 @@ class Tree:
         reach = np.linalg.norm(surface - self.p[end])
         return self.p[end] + (surface - self.p[end]) * max(0.0, reach - self.r[end]) / (reach or 1)
 
-    def _fork_or_far(self, end: int) -> int:
+    def branch(self, end: int) -> list[int]:
+        """Nodes from ``end`` along its branch to the first node that is not a plain link (a fork, or
+        the far end of a lone chain), both included. Walks the edges as they are now (no cache)."""
+        out = [end]
         prev, cur = end, self.adj[end][0] if self.adj[end] else end
         while self.degree(cur) == 2:
+            out.append(cur)
             prev, cur = cur, next(k for k in self.adj[cur] if k != prev)
-        return cur
-
+        return out + [cur] if cur != end else out
 
 def smooth(xyz: np.ndarray, width: int = 2) -> np.ndarray:
     """A moving average over ``2 width + 1`` nodes (ends kept): the thinned curve's voxel stairs are not bends."""
@@ -125,19 +137,18 @@ def smooth(xyz: np.ndarray, width: int = 2) -> np.ndarray:
     return out
 
 
-def splits(xyz: np.ndarray, r: np.ndarray, *, tolerance: float | None = None, count: int | None = None,
-           skip: float = 0.0) -> list[int]:
+def splits(xyz: np.ndarray, r: np.ndarray, *, count: int | None = None, skip: float = 0.0) -> list[int]:
     """Interior indices where a branch should bend: Douglas-Peucker on the smoothed curve (x, y, z, 2 r).
 
     With ``count``, up to that many splits (the largest deviations first); otherwise every split whose
-    deviation exceeds ``tolerance`` (default: BEND x the branch's mean radius, at least 2 voxels). No
+    deviation exceeds BEND x the branch's mean radius (at least 2 voxels). No
     piece is made shorter than the branch's mean radius (a bone is longer than it is thick), and none
     within ``skip`` of the start: a limb thins where it leaves its fork's ball, which is not a joint.
     """
     curve = smooth(np.column_stack([xyz, THICKNESS_WEIGHT * np.asarray(r)]))
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))])
     shortest = float(np.mean(r))
-    tol = tolerance if tolerance is not None else max(2.0, BEND * float(np.mean(r)))
+    tol = max(2.0, BEND * float(np.mean(r)))
     chosen: list[int] = []
     first = min(int(np.searchsorted(arc, skip)), len(curve) - 1)  # the chord starts out of the fork's ball
     spans = [(first, len(curve) - 1)]
@@ -204,11 +215,11 @@ def _direction_name(v: np.ndarray, tree: Tree, geometry) -> str:
     return "POST" if d[1] > 0 else "ANT"
 
 
-def chains(tree: Tree, geometry, *, root: int | None = None, bones: int | None = None) -> BoneSkeleton:
-    """Bones with no template: joints at forks and ends, and where branches bend or thin."""
-    if root is None:
-        forks = [i for i in range(len(tree.p)) if tree.degree(i) >= 3]
-        root = max(forks or range(len(tree.p)), key=lambda i: tree.r[i])
+def chains(tree: Tree, geometry, *, bones: int | None = None) -> BoneSkeleton:
+    """Bones with no template: joints at forks and ends, and where branches bend or thin; the root is the
+    thickest fork (the thickest node of a lone chain)."""
+    forks = [i for i in range(len(tree.p)) if tree.degree(i) >= 3]
+    root = max(forks or range(len(tree.p)), key=lambda i: tree.r[i])
     alias: dict[int, int] = {}  # a fork a voxel or two from its parent fork is the same junction
     branches = []
     for path in _branches(tree, root):

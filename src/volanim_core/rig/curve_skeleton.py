@@ -1,21 +1,24 @@
-"""The curve skeleton: a skeleton's thick points linked into one tree, spurs pruned.
+"""The curve skeleton: a skeleton's balls made one solid body, thinned to a tree, spurs pruned.
 
     Skeleton (points, dt at thinness T)
-      --cover-->  balls: the thickest point of each neighbourhood (a point suppresses the
-                  points within half its radius), so a limb is a string of beads
-      --link-->   an edge where two balls overlap: the segment between their centres lies
-                  inside the body (every point of it is inside one ball or the other)
+      --solid-->  the union of its balls painted on a coarse grid (at most COARSE_VOXELS),
+                  gaps under CLOSE voxels closed, cavities filled: a porous segmentation
+                  (the frog's tissues) becomes one body whose thickness means something
+      --thin-->   scikit-image's 3-D thinning: a curve, radius = the solid's distance
+                  transform (a flat torso is a curve, not the medial sheet voxels give)
+      --link-->   an edge where two curve balls overlap: the segment between their centres
+                  lies inside the body (every point of it is inside one ball or the other)
+      --bridge--> a piece cut off by a small gap (a mesh made of parts, like the ant's legs)
+                  joined to the body by its shortest gap, up to BRIDGE of the body's length
       --pieces--> the largest piece by volume; small ones (specks, loose organs) are left out
                   and counted; a second large piece is refused (the object is not one body)
       --tree-->   the minimum spanning tree, an edge costing length / (sum of radii), so the
-                  tree runs along the thick middle of a flat part rather than its rim
-      --prune-->  leaf branches shorter than twice the radius at their fork are surface
-                  noise, not limbs (Pinocchio's rule, Baran & Popovic 2007); removed until none is left
-      CurveTree (nodes, radii, edges)
+                  tree runs along thick routes
+      --prune-->  leaf branches shorter than SPUR x their fork's radius (or FLOOR x the largest
+                  radius) are surface noise, not limbs (Pinocchio's rule, Baran & Popovic 2007)
+      CurveTree (nodes, radii, edges, the solid body for rays to the surface)
 
-A medial axis computed from voxels is a surface in flat parts (a torso) and grows a spur at
-every bump; linking its thick points and pruning by thickness leaves the body's curve skeleton,
-which :mod:`volanim_core.rig.autorig` cuts into chains and bones.
+:mod:`volanim_core.rig.autorig` cuts the tree into chains and bones.
 """
 
 from __future__ import annotations
@@ -26,11 +29,13 @@ import numpy as np
 
 from volanim_core.skeleton.points import Skeleton
 
-COVER = 0.5  # a ball suppresses the points within this fraction of its radius
-SPUR = 3.0
-LARGE_PIECE = 0.2
-FLOOR = 2.0
+SPUR = 3.0  # a leaf branch shorter than this x its fork's radius is pruned ...
+FLOOR = 2.0  # ... and so is one shorter than this x the body's largest radius
+LARGE_PIECE = 0.2  # a second piece with this fraction of the largest one's volume is refused
 BRIDGE = 0.08  # a bridge may cross background this fraction of the body's length (at least 6 voxels)
+GAP = 3.0  # balls this many voxels apart still link (a coarse voxel's slack)
+COARSE_VOXELS = 8_000_000  # the solid body is remade on a grid of at most this many voxels
+CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues)
 
 
 @dataclass
@@ -79,26 +84,6 @@ class CurveTree:
             adj[a].append(int(b))
             adj[b].append(int(a))
         return adj
-
-
-def cover(points: np.ndarray, dt: np.ndarray, fraction: float = COVER) -> np.ndarray:
-    """Indices of the balls that cover the points: thickest first, each suppressing its neighbours
-    within ``fraction`` of its radius (at least the 26 neighbouring voxels)."""
-    from scipy.spatial import cKDTree
-
-    order = np.argsort(-dt, kind="stable")
-    tree = cKDTree(points)
-    alive = np.ones(len(points), bool)
-    keep = []
-    reach = np.maximum(fraction * dt, 1.8)
-    for i in order:
-        if alive[i]:
-            keep.append(i)
-            alive[tree.query_ball_point(points[i], reach[i])] = False
-    return np.asarray(keep, dtype=np.int64)
-
-
-GAP = 3.0
 
 
 def _link(p: np.ndarray, r: np.ndarray, k: int = 24):
@@ -207,10 +192,6 @@ def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float, floor: f
             return
 
 
-COARSE_VOXELS = 8_000_000  # the solid body is remade on a grid of at most this many voxels
-CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues)
-
-
 def solid(skeleton: Skeleton, *, close: float = CLOSE) -> tuple[np.ndarray, np.ndarray, Body]:
     """The medial points ``(points, radii)`` of the body the skeleton's balls make, remade solid.
 
@@ -250,9 +231,7 @@ def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
 
     if len(skeleton) == 0:
         raise NotRiggable("the skeleton has no points at this thinness: lower --thinness")
-    pts, dt, body = solid(skeleton)
-    keep = np.arange(len(pts))
-    p, r = pts[keep], dt[keep]
+    p, r, body = solid(skeleton)
     if len(p) == 1:
         return CurveTree(p, r, np.zeros((0, 2), np.int64), body=body)
     graph = _bridge(_link(p, r), p, r)

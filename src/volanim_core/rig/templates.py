@@ -27,6 +27,8 @@ from volanim_core.rig.curve_skeleton import NotRiggable
 SYMMETRY = 0.15  # a pairing is symmetric when its mirror error is below this fraction of the body's size
 ELBOW, WRIST = 0.42, 0.76  # upper arm 0.186 H, forearm 0.146 H, hand 0.108 H (Drillis & Contini)
 KNEE = 0.5  # thigh 0.245 H, shank 0.246 H
+ARM_JOINTS, LEG_JOINTS = ("SHOULDER", "ELBOW", "WRIST", "FINGERS"), ("HIP", "KNEE", "ANKLE", "TOE")
+FORELEG_JOINTS, HINDLEG_JOINTS = ("SHOULDER", "ELBOW", "WRIST", "FRONT_TOE"), ("HIP", "KNEE", "HOCK", "HIND_TOE")
 EXTRA = 0.5  # auto: ends beyond the template's are spurs only if shorter than this x its shortest limb
 
 
@@ -34,18 +36,14 @@ def trimmed(tree: Tree, ends: int, removed: list[float] | None = None) -> Tree:
     """The tree with its shortest leaf branches removed until ``ends`` ends are left (their lengths are
     appended to ``removed``)."""
     adj = [list(a) for a in tree.adj]
-    t = Tree.__new__(Tree)
-    t.p, t.r, t.adj, t.left, t.curve = tree.p, tree.r, adj, tree.left, tree.curve
+    t = tree.with_adjacency(adj)  # edited in place below, before any path is walked on it
     while len(t.ends()) > ends:
         best = None
         for e in t.ends():
-            path, prev, cur = [e], e, adj[e][0]
-            while len(adj[cur]) == 2:
-                path.append(cur)
-                prev, cur = cur, next(k for k in adj[cur] if k != prev)
-            length = float(t.length(path + [cur])[-1])
+            branch = t.branch(e)
+            length = float(t.length(branch)[-1])
             if best is None or length < best[0]:
-                best = (length, path)
+                best = (length, branch[:-1])  # the fork stays
         if removed is not None:
             removed.append(best[0])
         for a in best[1]:
@@ -64,7 +62,7 @@ def _samples(tree: Tree, end: int, other: int, count: int = 8) -> np.ndarray:
     return np.array([tree.p[path[int(np.argmin(np.abs(s - f * s[-1])))]] for f in np.linspace(0, 1, count)])
 
 
-def _mirror_cost(tree: Tree, pairs, singles) -> tuple[float, np.ndarray, np.ndarray]:
+def _mirror_cost(tree: Tree, pairs, singles) -> tuple[float, np.ndarray]:
     p = tree.p
     limbs = [(_samples(tree, a, b), _samples(tree, b, a)) for a, b in pairs]
     diffs = np.concatenate([la - lb for la, lb in limbs])
@@ -81,11 +79,11 @@ def _mirror_cost(tree: Tree, pairs, singles) -> tuple[float, np.ndarray, np.ndar
 
     err = [np.linalg.norm(mirror(la) - lb, axis=1).mean() for la, lb in limbs] + \
         [2 * abs((p[s] - centre) @ n) for s in singles]
-    return float(np.mean(err)), n, centre
+    return float(np.mean(err)), n
 
 
 def _match(tree: Tree, singles: int):
-    """The best (cost, singles, pairs, normal, centre) with ``singles`` unpaired ends and two pairs."""
+    """The best (cost, singles, pairs, mirror normal) with ``singles`` unpaired ends and two pairs."""
     ends = tree.ends()
     size = max(np.linalg.norm(tree.p[a] - tree.p[b]) for a, b in combinations(ends, 2))
     best = None
@@ -95,9 +93,9 @@ def _match(tree: Tree, singles: int):
         for b in rest[1:]:
             other = [e for e in rest[1:] if e != b]
             pairs = [(a, b), (other[0], other[1])]
-            cost, n, centre = _mirror_cost(tree, pairs, single)
+            cost, n = _mirror_cost(tree, pairs, single)
             if best is None or cost / size < best[0]:
-                best = (cost / size, single, pairs, n, centre)
+                best = (cost / size, single, pairs, n)
     return best
 
 
@@ -180,16 +178,24 @@ def _at_level(tree: Tree, start: int, end: int, level: np.ndarray, up: np.ndarra
     pts = tree.p[path][(s >= 0.2 * s[-1]) & (s <= 0.5 * s[-1])]
     if len(pts) < 2:
         return tree.p[path[len(path) // 4]]
-    centre = pts.mean(axis=0)
-    axis = np.linalg.svd(pts - centre)[2][0]
+    centre, axis = _line(pts)
     up = up / np.linalg.norm(up)
     if abs(axis @ up) < 0.3:  # a limb across the spine never reaches that level
         return tree.p[path[len(path) // 4]]
     return centre + ((level - centre) @ up) / (axis @ up) * axis
 
 
+def _limb_bones(parent: str, joints, names) -> list[Bone]:
+    """The left limb's chain from ``parent`` through ``joints``, bone k named ``names[k]``, then the right's."""
+    out = []
+    for side in ("L_", "R_"):
+        ends = [parent] + [side + j for j in joints]
+        out += [Bone(a, b, side + n) for a, b, n in zip(ends, ends[1:], names)]
+    return out
+
+
 def _humanoid(tree: Tree, match) -> BoneSkeleton:
-    _, (head,), pairs, n, centre = match
+    _, (head,), pairs, n = match
     meets = [tree.median(a, b, head) for a, b in pairs]
     arms_first = _hops(tree, meets[0], head) <= _hops(tree, meets[1], head)
     (arms, m_arms), (legs, m_legs) = ((pairs[0], meets[0]), (pairs[1], meets[1])) if arms_first \
@@ -209,21 +215,17 @@ def _humanoid(tree: Tree, match) -> BoneSkeleton:
         arm = _limb(tree, m_arms, hand, (ELBOW, WRIST), last_bend=False, thin_at=1)
         leg = _limb(tree, m_legs, foot, (KNEE, 1.0), last_bend=True)
         leg[0] = _at_level(tree, m_legs, foot, j["PELVIS"], j["NECK"] - j["PELVIS"])
-        leg[1] = (leg[0] + leg[2]) / 2 if KNEE == 0.5 else leg[1]
-        j.update(zip((side + k for k in ("SHOULDER", "ELBOW", "WRIST", "FINGERS")), arm))
-        j.update(zip((side + k for k in ("HIP", "KNEE", "ANKLE", "TOE")), leg))
-    bones = [Bone("PELVIS", "NECK", "SPINE"), Bone("NECK", "HEAD", "HEAD")]
-    for s in ("L_", "R_"):
-        bones += [Bone("NECK", s + "SHOULDER", s + "CLAVICLE"), Bone(s + "SHOULDER", s + "ELBOW", s + "UPPERARM"),
-                  Bone(s + "ELBOW", s + "WRIST", s + "FOREARM"), Bone(s + "WRIST", s + "FINGERS", s + "HAND")]
-    for s in ("L_", "R_"):
-        bones += [Bone("PELVIS", s + "HIP", s + "PELVIS"), Bone(s + "HIP", s + "KNEE", s + "THIGH"),
-                  Bone(s + "KNEE", s + "ANKLE", s + "SHIN"), Bone(s + "ANKLE", s + "TOE", s + "FOOT")]
+        leg[1] = leg[0] + KNEE * (leg[2] - leg[0])  # between the moved hip and the ankle
+        j.update(zip((side + k for k in ARM_JOINTS), arm))
+        j.update(zip((side + k for k in LEG_JOINTS), leg))
+    bones = [Bone("PELVIS", "NECK", "SPINE"), Bone("NECK", "HEAD", "HEAD"),
+             *_limb_bones("NECK", ARM_JOINTS, ("CLAVICLE", "UPPERARM", "FOREARM", "HAND")),
+             *_limb_bones("PELVIS", LEG_JOINTS, ("PELVIS", "THIGH", "SHIN", "FOOT"))]
     return BoneSkeleton(j, bones)
 
 
 def _quadruped(tree: Tree, match) -> BoneSkeleton:
-    _, singles, pairs, n, centre = match
+    _, singles, pairs, n = match
     # the head is the unpaired end nearest a pair's meeting point; the tail, if any, the other
     meets = [[tree.median(a, b, s) for s in singles] for a, b in pairs]
     dist = [[_hops(tree, meets[i][k], singles[k]) for k in range(len(singles))] for i in range(2)]
@@ -239,16 +241,12 @@ def _quadruped(tree: Tree, match) -> BoneSkeleton:
     for side, pick in (("L_", 0), ("R_", 1)):
         paw = sorted(front, key=lambda e: -(tree.p[e] @ n))[pick]
         foot = sorted(hind, key=lambda e: -(tree.p[e] @ n))[pick]
-        j.update(zip((side + k for k in ("SHOULDER", "ELBOW", "WRIST", "FRONT_TOE")),
+        j.update(zip((side + k for k in FORELEG_JOINTS),
                      _limb(tree, m_front, paw, (0.45, 1.0), last_bend=True)))
-        j.update(zip((side + k for k in ("HIP", "KNEE", "HOCK", "HIND_TOE")),
+        j.update(zip((side + k for k in HINDLEG_JOINTS),
                      _limb(tree, m_hind, foot, (0.45, 1.0), last_bend=True)))
-    for s in ("L_", "R_"):
-        bones += [Bone("CHEST", s + "SHOULDER", s + "SCAPULA"), Bone(s + "SHOULDER", s + "ELBOW", s + "HUMERUS"),
-                  Bone(s + "ELBOW", s + "WRIST", s + "RADIUS"), Bone(s + "WRIST", s + "FRONT_TOE", s + "FRONT_FOOT")]
-    for s in ("L_", "R_"):
-        bones += [Bone("PELVIS", s + "HIP", s + "PELVIS"), Bone(s + "HIP", s + "KNEE", s + "FEMUR"),
-                  Bone(s + "KNEE", s + "HOCK", s + "TIBIA"), Bone(s + "HOCK", s + "HIND_TOE", s + "HIND_FOOT")]
+    bones += _limb_bones("CHEST", FORELEG_JOINTS, ("SCAPULA", "HUMERUS", "RADIUS", "FRONT_FOOT"))
+    bones += _limb_bones("PELVIS", HINDLEG_JOINTS, ("PELVIS", "FEMUR", "TIBIA", "HIND_FOOT"))
     if len(singles) == 2:
         tail = singles[1 - k_head]
         j["TAIL"] = tree.tip(tail)
@@ -288,7 +286,7 @@ def best_fit(tree: Tree) -> tuple[BoneSkeleton, str, str] | None:
             continue
         removed: list[float] = []
         t = trimmed(tree, 4 + singles, removed)
-        limbs = [float(t.length(t.path(e, t._fork_or_far(e)))[-1]) for e in t.ends()]
+        limbs = [float(t.length(t.branch(e))[-1]) for e in t.ends()]
         if removed and max(removed) > EXTRA * min(limbs):
             continue  # a limb the template has no place for (an ant's third pair of legs): not this template
         match = _match(t, singles)

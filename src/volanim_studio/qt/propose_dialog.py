@@ -29,7 +29,7 @@ class ProposeDialog(QDialog):
         self.template.addItems(TEMPLATES)
         self.hint = QLabel(HINTS["auto"])
         self.hint.setWordWrap(True)
-        self.template.currentTextChanged.connect(lambda t: self.hint.setText(HINTS[t]))
+        self.template.currentTextChanged.connect(lambda t: (self.hint.setText(HINTS[t]), self.adjustSize()))
         self.summary = QLabel("Preview shows the proposal in the scene; nothing is kept until you accept.")
         self.summary.setWordWrap(True)
         self.preview_button = QPushButton("Preview")
@@ -41,9 +41,9 @@ class ProposeDialog(QDialog):
         self.buttons.button(QDialogButtonBox.Discard).clicked.connect(self.reject)
         form = QFormLayout()
         form.addRow("Template", self.template)
-        form.addRow("", self.hint)
         layout = QVBoxLayout(self)
         layout.addLayout(form)
+        layout.addWidget(self.hint)  # in the box, not a form row: a wrapped label there was clipped
         layout.addWidget(self.preview_button)
         layout.addWidget(self.summary)
         layout.addWidget(self.buttons)
@@ -54,8 +54,10 @@ class ProposeDialog(QDialog):
 
     def shown(self, proposal) -> None:
         self.summary.setText(f"{proposal}\nThe proposal is in the scene: accept to keep it (Undo takes it back), "
-                             "or try another template.")
+                             "or try another template. Its bones are new: connect the points next "
+                             "(Connect → Auto-connect, Ctrl+A).")
         self.buttons.button(QDialogButtonBox.Ok).setEnabled(True)
+        self.adjustSize()  # the dialog grows with the text (it was clipped at its first size)
 
     def accept(self) -> None:
         self.controller.doc.proposal.accept()

@@ -31,6 +31,8 @@ def test_propose_preview_accept_and_undo(qtbot, window):
     hand_made = window.doc.bones
     dialog = _propose(qtbot, window, "none")
     assert "ROOT" in window.doc.bones.joints and "(none)" in dialog.summary.text()
+    for label in (dialog.hint, dialog.summary):  # wrapped text shown whole (the dialog grows; it was clipped)
+        assert label.height() >= label.heightForWidth(label.width()), label.text()
     dialog.template.setCurrentText("humanoid")
     qtbot.mouseClick(dialog.preview_button, Qt.LeftButton)
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
