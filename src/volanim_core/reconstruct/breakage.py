@@ -32,10 +32,11 @@ from numba import njit
 
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct import _labels as L
-from volanim_core.reconstruct.engine import Reconstruction, reconstruct
+from volanim_core.reconstruct.engine import OWNER, Reconstruction, posed_centres, reconstruct
 from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
-from volanim_core.rig.pose import apply_matrices
+from volanim_core.rig.pose import apply_matrices, apply_rows
+from volanim_core.rig.skinning import transform_table
 from volanim_core.rig.tskel import identity_tskel
 
 
@@ -142,7 +143,8 @@ def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
 
 def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[Stump]:
     """Misplaced points the pose carries more than a sphere's diameter from where the bone they lie
-    along went, grouped by (their bone, that bone); largest first.
+    along went, grouped by (their bone, that bone); largest first. With smooth joints, a point blended
+    with the bone it lies along is not left behind (:func:`_blended_with`).
 
     ``misplaced``: :func:`misplaced_points` of the same connectivity, when scanning many frames.
     """
@@ -151,9 +153,10 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
         return []
     p = tskel.points[idx].astype(np.float64)
     own = tskel.bone[idx].astype(np.int64)
-    went = apply_matrices(p, own, tskel.matrices)
+    table, row = transform_table(tskel)  # smooth joints: a point near its bone's joint moves by the blend
+    went = apply_rows(p, row[idx], table, len(tskel.bones))
     should = apply_matrices(p, along, tskel.matrices)
-    behind = np.linalg.norm(went - should, axis=1) > 2.0 * tskel.dt[idx]
+    behind = (np.linalg.norm(went - should, axis=1) > 2.0 * tskel.dt[idx]) & ~_blended_with(tskel, idx, along)
     names = list(joints)
     pos = np.array([joints[n] for n in names], np.float64) if names else np.zeros((0, 3))
     label = [b.name or f"bone {k}" for k, b in enumerate(tskel.bones)]
@@ -165,6 +168,21 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
         out.append(Stump(len(k), joint, label[o], label[n], went[k], float((tskel.dt[idx[k]] ** 3).sum()),
                          float(tskel.dt[idx[k]].max())))
     return sorted(out, key=lambda s: -s.weight)
+
+
+def _blended_with(tskel: Tskel, idx: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """Whether smooth joints give point ``idx[k]`` some weight on bone ``along[k]``: then it is part of
+    that joint's bend, the body stretching continuously between the two bones, not a piece left behind."""
+    out = np.zeros(len(idx), bool)
+    if not tskel.joints.smooth or not len(tskel.skin):
+        return out
+    skin = tskel.skin
+    row = np.full(len(tskel), -1, np.int64)
+    row[skin.index] = np.arange(len(skin))
+    r = row[idx]
+    has = r >= 0
+    out[has] = (skin.influence[r[has]][:, 1:] == along[has, None]).any(axis=1)
+    return out
 
 
 def components(volume: np.ndarray) -> list[int]:
@@ -293,10 +311,11 @@ def _piece_voxels(labels, counts, skip):
 
 
 def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
-    """Every filled voxel of a rest reconstruction in bone mode: its rest coordinates ``(K, 3)`` and
-    its bone ``(K,)``, grouped by bone (so :func:`~volanim_core.rig.pose.apply_matrices` moves
-    them slice by slice: 0.3 s less per report on the frog than a mask per bone), in x-fastest
-    order within a bone. Pose-independent, so a caller reporting on many poses makes them once."""
+    """Every filled voxel of a rest reconstruction in bone (or owner) mode: its rest coordinates ``(K, 3)``
+    and its label - 1 ``(K,)`` (the bone; the owner's row of the transform table), grouped by it (so
+    :func:`~volanim_core.rig.pose.apply_matrices` moves them slice by slice: 0.3 s less per report
+    on the frog than a mask per bone), in x-fastest order within a label. Pose-independent, so a
+    caller reporting on many poses makes them once."""
     zyx = np.asarray(rest_bone.volume).T  # C-contiguous for a reconstruction
     counts, _ = _label_stats(zyx, int(zyx.max()) if zyx.size else 0)
     _, voxels = _piece_voxels(zyx, counts, 0)  # two passes, no grid-sized temporaries
@@ -304,10 +323,12 @@ def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
     return voxels[:, ::-1] + np.asarray(rest_bone.origin), bone
 
 
-def posed_images(points: np.ndarray, owner: np.ndarray, posed: Reconstruction, matrices: np.ndarray) -> np.ndarray:
-    """Where rest voxels ``points`` (bones ``owner``) land in the pose: ``(K, 3)`` array coordinates of
-    ``posed``'s grid (possibly outside it)."""
-    moved = apply_matrices(points, owner, matrices)
+def posed_images(points: np.ndarray, owner: np.ndarray, posed: Reconstruction, matrices: np.ndarray,
+                 n_bones: int | None = None) -> np.ndarray:
+    """Where rest voxels ``points`` land in the pose: ``(K, 3)`` array coordinates of ``posed``'s grid
+    (possibly outside it). ``owner``: each voxel's row of ``matrices`` (bone matrices, then with smooth
+    joints the blended ones from row ``n_bones`` on, :func:`~volanim_core.rig.skinning.transform_table`)."""
+    moved = apply_rows(points, owner, matrices, len(matrices) if n_bones is None else n_bones)
     return np.floor(moved + 0.5).astype(np.int64) - np.asarray(posed.origin)
 
 
@@ -357,8 +378,6 @@ def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, 
     Returns the pairs' rest midpoints ``(K, 3)`` and their gaps ``(K,)`` in voxels.
     ``pairs``: :func:`touching_pairs` of the same points, when the caller scans many frames.
     """
-    from volanim_core.reconstruct.engine import posed_centres
-
     i, j, touch = touching_pairs(tskel) if pairs is None else pairs
     if not len(i):
         return np.zeros((0, 3)), np.zeros(0)
@@ -372,8 +391,9 @@ def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, 
 @dataclass
 class RestParts:
     """What the report needs that no pose changes, made once per connectivity: the rest frame's
-    bone volume, its voxels' rest coordinates and bones (:func:`rest_voxels`), and the sphere
-    pairs that touch at rest (:func:`touching_pairs`). The studio keeps them between previews."""
+    owner volume (bone + 1 per voxel; with smooth joints, the owner's row of the transform table + 1),
+    its voxels' rest coordinates and rows (:func:`rest_voxels`), and the sphere pairs that touch at
+    rest (:func:`touching_pairs`). The studio keeps them between previews."""
 
     rest_bone: Reconstruction
     voxels: tuple[np.ndarray, np.ndarray]
@@ -384,7 +404,7 @@ class RestParts:
     @classmethod
     def of(cls, conn: Connectivity, cancel=None) -> RestParts:
         rest = identity_tskel(conn)
-        rest_bone = reconstruct(rest, mode="bone", cancel=cancel)
+        rest_bone = reconstruct(rest, mode=OWNER, cancel=cancel)
         voxels = rest_voxels(rest_bone)
         parts, labels = _components(rest_bone.volume)
         piece = pieces_at(labels, rest_bone.volume, voxels[0] - np.asarray(rest_bone.origin))
@@ -412,7 +432,8 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
         rest = RestParts.of(tskel.connectivity, cancel)
     hot = reconstruct(tskel, mode="hotspot", bounds=posed.bounds, cancel=cancel)
     check(0, 1)
-    images = posed_images(*rest.voxels, posed, tskel.matrices)
+    table, _ = transform_table(tskel)
+    images = posed_images(*rest.voxels, posed, table, len(tskel.bones))
     lost = lost_voxels(rest.rest_bone, posed, tskel.matrices, rest.voxels, images)
     where, gaps = cracks(tskel, pairs=rest.pairs)
     check(0, 1)

@@ -43,10 +43,16 @@ from volanim_core.reconstruct.neighbours import (
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.sampling import sample_source
 from volanim_core.rig.connectivity import Tskel
-from volanim_core.rig.pose import apply_matrices
+from volanim_core.rig.pose import apply_rows
+from volanim_core.rig.skinning import transform_table
 from volanim_core.volume import Bounds
 
-_MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT}
+#: Not a user's mode: bone mode's pass labelling each voxel with its owner's row of the transform table
+#: (:func:`~volanim_core.rig.skinning.transform_table`; the bone + 1 with rigid joints). The breakage
+#: report moves rest voxels by it.
+OWNER = "owner"
+_MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT,
+              OWNER: K.BONE}
 SNAP = 2.0**20
 LAUNCH_SECONDS = 0.25  # aimed length of one parallel launch: the progress and cancel granularity
 CLIP_ROW_BUDGET = 4_000_000  # rows counted exactly per clipped sphere (radius ~1000); beyond, estimated
@@ -139,15 +145,18 @@ def check_output_grid(shape, bytes_per_voxel: int) -> None:
     check_allocation(shape, bytes_per_voxel, "the output grid", "give smaller --bounds or check the radii")
 
 
-def posed_centres(tskel: Tskel) -> np.ndarray:
-    """Each point's centre moved by its bone's matrix, ``[x y z 1] @ M`` (snapped; 345: rounded).
+def posed_centres(tskel: Tskel, transforms: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    """Each point's centre moved by its bone's matrix, ``[x y z 1] @ M`` (snapped; 345: rounded); with
+    smooth joints, a point in a blend zone by its blended matrix.
 
     In the 3-4-5 metric the posed centre is rounded to the nearest voxel
-    (half-way rounds up), as docs/formats.md says.
+    (half-way rounds up), as docs/formats.md says. ``transforms``: the frame's
+    :func:`~volanim_core.rig.skinning.transform_table`, when the caller has it.
     """
     if len(tskel) == 0:
         return np.zeros((0, 3))
-    c = apply_matrices(tskel.points, tskel.bone, tskel.matrices)
+    table, row = transform_table(tskel) if transforms is None else transforms
+    c = apply_rows(tskel.points, row, table, len(tskel.bones))
     # floor(c * SNAP + 0.5) / SNAP, in place: no temporaries of the frog's 3.3 MB each
     c *= SNAP
     c += 0.5
@@ -275,7 +284,8 @@ def reconstruct(
     if neighbours is not None and neighbours is not False:
         check_neighbours(neighbours, len(tskel))
     tskel, order = file_ordered(tskel)
-    posed = posed_centres(tskel)
+    table, rows = transform_table(tskel)
+    posed = posed_centres(tskel, (table, rows))
     own_bounds = bounds is None
     if own_bounds:  # grid_bounds checks the posed reach itself
         bounds = grid_bounds(tskel, padding, centres=[posed]) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
@@ -289,7 +299,7 @@ def reconstruct(
     r2s = radius_squared(tskel.dt)
     radii = np.ascontiguousarray(tskel.dt, np.float64)
     metric = K.CHAMFER if tskel.metric == "345" else K.EUCLID
-    out_dtype, values = _labels(mode, tskel, value)
+    out_dtype, values = _labels(mode, tskel, value, rows, len(table))
     final_dtype = source.dtype if mode == "sampled" else out_dtype
     relax = mode not in ("hotspot", "binary")  # binary is a union and hotspot a count: no stencil
     per_voxel = np.dtype(out_dtype).itemsize + \
@@ -338,7 +348,8 @@ def reconstruct(
             z0, chunk = z1, max(nthreads * 4, int(pace * LAUNCH_SECONDS))
         if mode == "sampled":
             to_source = np.eye(4) if source_geometry is None else tskel.geometry.index_map(source_geometry)
-            out = sample_source(out, source, _grid_to_source(minv_rest, origin, to_source), kernel,
+            minv = np.concatenate([minv_rest, np.linalg.inv(table[len(minv_rest):])])  # blended: rigid, invertible
+            out = sample_source(out, source, _grid_to_source(minv, origin, to_source), kernel,
                                 (row_lo, row_hi), nthreads, chunk, lambda done: report(nz + done, total))
     finally:
         numba.set_num_threads(previous)
@@ -355,7 +366,7 @@ def reconstruct(
 
 
 def _check_arguments(mode, kernel, source, value) -> None:
-    if mode not in MODES:
+    if mode not in MODES and mode != OWNER:
         raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
     if kernel not in (1, 3, 5):
         raise ValueError(f"kernel must be 1, 3 or 5, got {kernel!r}")
@@ -381,20 +392,24 @@ def output_dtype(mode: str, n_bones: int, source_dtype=None) -> np.dtype:
     if mode == "hotspot":
         return np.dtype(np.uint16)
     if mode == "bone":
-        return np.dtype(np.uint8 if n_bones < 256 else np.uint16)
+        return np.dtype(np.uint8 if n_bones < 256 else np.uint16 if n_bones < 65536 else np.uint32)
     return np.dtype(np.uint8)
 
 
-def _labels(mode: str, tskel: Tskel, value: int) -> tuple[type, np.ndarray]:
+def _labels(mode: str, tskel: Tskel, value: int, rows: np.ndarray, n_rows: int) -> tuple[type, np.ndarray]:
     """The kernel's output dtype and the value each sphere writes.
 
-    Sampled relaxes like bone mode (owner = bone + 1) and then samples
-    (``K.sample_rows``); hotspot counts, so its values are unused.
+    Sampled relaxes like the owner pass (each sphere writes its row of the transform table + 1: its
+    bone + 1 with rigid joints) and then samples (``K.sample_rows``); hotspot counts, so its values
+    are unused.
     """
-    dtype = output_dtype("bone" if mode == "sampled" else mode, len(tskel.bones)).type
+    if mode in ("sampled", OWNER):
+        dtype = output_dtype("bone", n_rows).type
+        return dtype, (rows + 1).astype(dtype)
+    dtype = output_dtype(mode, len(tskel.bones)).type
     if mode == "hotspot":
         return dtype, np.zeros(len(tskel), dtype)
-    if mode in ("bone", "sampled"):
+    if mode == "bone":
         return dtype, (tskel.bone + 1).astype(dtype)
     if mode == "mottled":
         return dtype, mottled_values(len(tskel))

@@ -21,7 +21,7 @@ import numpy as np
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct.breakage import components, cracks, misplaced_points, stumps, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
-from volanim_core.rig.connectivity import Connectivity, Tskel
+from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.tskel import coarse_tskel, identity_tskel
 
 
@@ -69,8 +69,7 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
     out = []
     for n, (frame, mats) in enumerate(zip(frames, matrices)):
         report(n, len(frames))
-        posed = Tskel(conn.bones, np.asarray(mats), conn.points, conn.dt, conn.thinness, conn.bone, conn.metric,
-                      conn.geometry)
+        posed = conn.posed(np.asarray(mats))
         where, gaps = cracks(posed, pairs=pairs)
         worst = ""
         if len(gaps) and near is not None:

@@ -18,6 +18,7 @@ import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.limits import voxel_points
+from volanim_core.rig.skinning import RIGID, Joints, Skin, cached_skin
 from volanim_core.skeleton.points import check_metric
 
 
@@ -80,6 +81,7 @@ class Connectivity:
     metric: str = "euclid"
     thinness_threshold: float | None = None
     geometry: Geometry = IDENTITY  # the voxel grid of the coordinates (volanim_core.geometry)
+    joints: Joints = RIGID  # how bones meet: rigid, or smooth with a blend width (rig/skinning.py)
 
     def __post_init__(self):
         self.points, self.dt, self.thinness, self.bone = _points_fields(
@@ -101,12 +103,23 @@ class Connectivity:
             and np.array_equal(self.dt, other.dt)
             and np.array_equal(self.thinness, other.thinness, equal_nan=True)
             and np.array_equal(self.bone, other.bone)
+            and self.joints == other.joints
         )
 
     def take(self, order: np.ndarray) -> Connectivity:
         """A copy holding the points in ``order`` (a permutation or a subset)."""
         return Connectivity(self.bones, self.points[order], self.dt[order], self.thinness[order],
-                            self.bone[order], self.metric, self.thinness_threshold, self.geometry)
+                            self.bone[order], self.metric, self.thinness_threshold, self.geometry, self.joints)
+
+    def posed(self, matrices, joints: Joints | None = None) -> Tskel:
+        """A frame of these points: one matrix per bone, the joints of the connectivity (or ``joints``)."""
+        return Tskel(self.bones, matrices, self.points, self.dt, self.thinness, self.bone, self.metric,
+                     self.geometry, joints=self.joints if joints is None else joints)
+
+    def with_joints(self, joints: Joints) -> Connectivity:
+        """The same points with other joints."""
+        return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
+                            self.thinness_threshold, self.geometry, joints)
 
     def is_grouped(self) -> bool:
         """Whether points are grouped by bone in root order, as files list them."""
@@ -150,9 +163,20 @@ class Tskel(Connectivity):
     """
 
     def __init__(self, bones, matrices, points, dt, thinness, bone, metric: str = "euclid",
-                 geometry: Geometry = IDENTITY):
-        super().__init__(bones, points, dt, thinness, bone, metric, None, geometry)
+                 geometry: Geometry = IDENTITY, *, joints: Joints = RIGID, skin: Skin | None = None):
+        super().__init__(bones, points, dt, thinness, bone, metric, None, geometry, joints)
         self.matrices = _check_matrices(matrices, len(self.bones))
+        self._skin = skin
+
+    @property
+    def skin(self) -> Skin:
+        """The blend weights of smooth joints (made from the points once, remembered; rig/skinning.py)."""
+        if self._skin is None:
+            self._skin = cached_skin(self)
+        return self._skin
+
+    def with_joints(self, joints: Joints) -> Tskel:
+        return self.connectivity.with_joints(joints).posed(self.matrices)
 
     def __eq__(self, other) -> bool:
         return super().__eq__(other) and np.array_equal(self.matrices, other.matrices)
@@ -161,10 +185,11 @@ class Tskel(Connectivity):
         return f"Tskel({len(self.bones)} bones, {len(self)} points, metric={self.metric!r})"
 
     def take(self, order: np.ndarray) -> Tskel:
+        skin = self.skin.take(order, len(self)) if self.joints.smooth else None
         return Tskel(self.bones, self.matrices, self.points[order], self.dt[order], self.thinness[order],
-                     self.bone[order], self.metric, self.geometry)
+                     self.bone[order], self.metric, self.geometry, joints=self.joints, skin=skin)
 
     @property
     def connectivity(self) -> Connectivity:
         return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
-                            geometry=self.geometry)
+                            geometry=self.geometry, joints=self.joints)

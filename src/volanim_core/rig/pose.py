@@ -43,6 +43,22 @@ def apply_matrices(points: np.ndarray, bone: np.ndarray, matrices: np.ndarray) -
     return out
 
 
+def apply_rows(points: np.ndarray, row: np.ndarray, table: np.ndarray, n_bones: int) -> np.ndarray:
+    """Each point moved by its row of ``table``: the first ``n_bones`` rows are bone matrices shared by
+    many points (:func:`apply_matrices`), later ones a point's own (smooth joints' blended motions)."""
+    row = np.asarray(row, np.int64)
+    own = row >= n_bones
+    if not own.any():
+        return apply_matrices(points, row, table)
+    p = np.asarray(points, np.float64).reshape(-1, 3)
+    out = np.empty_like(p)
+    shared = ~own
+    out[shared] = apply_matrices(p[shared], row[shared], table)
+    m = table[row[own]]
+    out[own] = np.einsum("ni,nij->nj", p[own], m[:, :3, :3]) + m[:, 3, :3]
+    return out
+
+
 def euler(degrees) -> np.ndarray:
     """3x3 rotation from x, y, z angles in degrees (extrinsic, applied x then y then z)."""
     return Rotation.from_euler("xyz", np.asarray(degrees, np.float64), degrees=True).as_matrix()

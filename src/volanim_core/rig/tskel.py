@@ -31,25 +31,25 @@ def _coords(b) -> str:
 def connect_to_tskel(conn: Connectivity, trans: Trans) -> Tskel:
     """One frame ready to reconstruct: the connectivity with the frame's matrices."""
     check_root_order(conn.bones, trans.bones)
-    return Tskel(conn.bones, trans.matrices, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric,
-                 conn.geometry)
+    return conn.posed(trans.matrices)
 
 
 def identity_tskel(conn: Connectivity) -> Tskel:
     """The rest frame: every matrix the identity (reconstructs the original shape)."""
-    mats = np.tile(np.eye(4), (len(conn.bones), 1, 1))
-    return Tskel(conn.bones, mats, conn.points, conn.dt, conn.thinness, conn.bone, conn.metric, conn.geometry)
+    return conn.posed(np.tile(np.eye(4), (len(conn.bones), 1, 1)))
 
 
 def coarse_tskel(tskel: Tskel, factor: int) -> Tskel:
     """The frame on a ``factor``-times coarser grid: matrices followed by a 1/factor scale, radii alike
-    (live previews and the clip scan: factor^3 fewer voxels, the same shape)."""
+    (live previews and the clip scan: factor^3 fewer voxels, the same shape). Smooth joints keep the
+    fine frame's blend weights: the coarse frame bends exactly as the full one does."""
     if factor == 1:
         return tskel
     from volanim_core.rig.pose import scaled
 
     return Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
-                 tskel.bone, tskel.metric, tskel.geometry.with_spacing(np.multiply(tskel.geometry.spacing, factor)))
+                 tskel.bone, tskel.metric, tskel.geometry.with_spacing(np.multiply(tskel.geometry.spacing, factor)),
+                 joints=tskel.joints, skin=tskel.skin if tskel.joints.smooth else None)
 
 
 def sort_tskel(tskel: Tskel) -> Tskel:

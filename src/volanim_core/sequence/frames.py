@@ -33,8 +33,12 @@ class FrameSpec:
 
     def tskel(self, conn: Connectivity) -> Tskel:
         plain = np.isscalar(self.dt_scale) and self.dt_scale == 1.0
-        dt = conn.dt if plain else conn.dt * np.asarray(self.dt_scale, np.float64)
-        return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric, conn.geometry)
+        if plain:
+            return conn.posed(self.matrices)
+        dt = conn.dt * np.asarray(self.dt_scale, np.float64)
+        skin = conn.posed(self.matrices).skin if conn.joints.smooth else None  # blend as the unscaled body does
+        return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric, conn.geometry,
+                     joints=conn.joints, skin=skin)
 
     def key(self) -> bytes:
         """Everything that decides this frame's voxels besides the connectivity (for plan keys)."""
