@@ -37,6 +37,28 @@ def add_volume_in(p: argparse.ArgumentParser, name: str = "volume", help: str = 
                    ".mha/.mhd, .mgz, a 3-D .tif, a DICOM folder or file, or a folder of slices)")
 
 
+def add_joints(p: argparse.ArgumentParser, what: str = "the file's") -> None:
+    """``--joints rigid|smooth`` and ``--blend W`` (rig/skinning.py); :func:`joints_of` reads them."""
+    p.add_argument("--joints", choices=("rigid", "smooth"),
+                   help=f"how bones meet: rigid (each point follows its bone) or smooth (points near a joint blend "
+                        f"their bones' motions, dual quaternions); default {what}")
+    p.add_argument("--blend", metavar="W",
+                   help="smooth joints' blend half-width: times the joint's radius (default 1), or millimetres "
+                        "like 12mm")
+
+
+def joints_of(args, conn):
+    """``conn`` (a connectivity or frame) with the joints ``--joints``/``--blend`` ask for; as it is without them."""
+    from volanim_core.rig.skinning import Joints
+
+    if args.joints is None and args.blend is None:
+        return conn
+    kind = args.joints or ("smooth" if args.blend is not None else conn.joints.kind)
+    if kind == "rigid" and args.blend is not None:
+        raise ValueError("--blend is the width of smooth joints; it means nothing with --joints rigid")
+    return conn.with_joints(Joints.parse(kind, args.blend))
+
+
 def add_dims(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="dimensions of a headerless .vol")
     p.add_argument("--series", help="the DICOM series to read from a folder holding several (its UID or number)")

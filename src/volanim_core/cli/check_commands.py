@@ -13,7 +13,16 @@ from pathlib import Path
 from volanim_core.io import read_bones, read_connect, read_trans, write_connect
 from volanim_core.progress import TextProgress
 
-from ._common import add_command, add_dims, finite_float, load_source, positive_float, positive_int
+from ._common import (
+    add_command,
+    add_dims,
+    add_joints,
+    finite_float,
+    joints_of,
+    load_source,
+    positive_float,
+    positive_int,
+)
 
 
 def _mirror(args):
@@ -45,7 +54,7 @@ def _keys(args):
 def _report(args):
     from volanim_core.reconstruct.checks import report, report_json
 
-    conn = read_connect(args.connect)
+    conn = joints_of(args, read_connect(args.connect))
     source, geometry = load_source(args, conn) if args.source else (None, None)
     rep = report(conn, read_trans(args.trans), bones=read_bones(args.bones) if args.bones else None,
                  source=source, source_geometry=geometry)
@@ -64,7 +73,7 @@ def _scan(args):
     from volanim_core.motion.frames import frame_number
     from volanim_core.reconstruct.checks import scan, scan_json
 
-    conn = read_connect(args.connect)
+    conn = joints_of(args, read_connect(args.connect))
     frames = [read_trans(p) for p in args.frames]
     numbers = [frame_number(p) for p in args.frames]
     if None in numbers or len(set(numbers)) < len(numbers):
@@ -111,18 +120,23 @@ def register(sub) -> None:
 
     p = add_command(sub, "report", "The breakage report of one frame; exit 0 healthy, 1 broken, 2 bad input.",
                     ("volanim report mannequin.0.50.connect arm.trans",
-                     "volanim report mannequin.0.50.connect arm.trans --bones mannequin.bones --json"), _report)
+                     "volanim report mannequin.0.50.connect arm.trans --bones mannequin.bones --json",
+                     "volanim report mannequin.0.50.connect arm.trans --joints smooth   # the same frame, blended"),
+                    _report)
     p.add_argument("connect")
     p.add_argument("trans")
     p.add_argument("--bones", help="name the joints as this .bones file does (default: after their bones)")
     p.add_argument("--source", help="the scan: also how much of its object the rest pose re-grows")
     add_dims(p)
     p.add_argument("--json", action="store_true", help="the report as JSON on stdout")
+    add_joints(p, "the .connect's (rigid when it records none)")
 
     p = add_command(sub, "scan", "Scan frames for breakage, worst first; exit 0 none broken, 1 any broken.",
-                    "volanim scan mannequin.0.50.connect wave/*.trans --top 5", _scan)
+                    ("volanim scan mannequin.0.50.connect wave/*.trans --top 5",
+                     "volanim scan mannequin.0.50.connect wave/*.trans --joints smooth"), _scan)
     p.add_argument("connect")
     p.add_argument("frames", nargs="+", help=".trans files")
     p.add_argument("--bones", help="name the joints as this .bones file does")
     p.add_argument("--top", type=positive_int, default=10, help="frames to list (default 10)")
     p.add_argument("--json", action="store_true", help="every frame's verdict as JSON, worst first")
+    add_joints(p, "the .connect's (rigid when it records none)")

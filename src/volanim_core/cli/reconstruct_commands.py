@@ -23,9 +23,20 @@ from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
 from volanim_core.rig.attach import METHODS
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
+from volanim_core.rig.skinning import transform_table
 from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
 
-from ._common import add_command, add_dims, ascii_int, bounds_arg, finite_float, load_source, parse_range
+from ._common import (
+    add_command,
+    add_dims,
+    add_joints,
+    ascii_int,
+    bounds_arg,
+    finite_float,
+    joints_of,
+    load_source,
+    parse_range,
+)
 
 
 def _connect(args):
@@ -73,9 +84,10 @@ def _pose(args):
 
 
 def _connect2tskel(args):
-    t = connect_to_tskel(read_connect(args.connect), read_trans(args.trans))
+    t = connect_to_tskel(joints_of(args, read_connect(args.connect)), read_trans(args.trans))
+    transform_table(t)  # a frame smooth joints cannot blend (a sheared bone) is refused now, not at reconstruct
     write_tskel(args.output, t)
-    print(f"{len(t)} points, {len(t.bones)} bones -> {args.output}")
+    print(f"{len(t)} points, {len(t.bones)} bones, {t.joints.text()} joints -> {args.output}")
 
 
 def _connect2identity(args):
@@ -103,7 +115,7 @@ def _check_output(path: str) -> None:
 
 def _reconstruct(args):
     _check_output(args.output)
-    t = read_tskel(args.tskel)
+    t = joints_of(args, read_tskel(args.tskel))
     source, source_geometry = load_source(args, t, colour=True)
     bounds = bounds_arg(args.bounds) if args.bounds else None
     bar = TextProgress("reconstruct")
@@ -164,9 +176,12 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "connect2tskel", "A .connect plus one .trans frame -> .tskel (root orders must match).",
-                    "volanim connect2tskel mannequin.0.50.connect arm.trans -o arm.tskel", _connect2tskel)
+                    ("volanim connect2tskel mannequin.0.50.connect arm.trans -o arm.tskel",
+                     "volanim connect2tskel mannequin.0.50.connect arm.trans --joints smooth -o arm-smooth.tskel"),
+                    _connect2tskel)
     p.add_argument("connect")
     p.add_argument("trans")
+    add_joints(p, "the .connect's (rigid when it records none)")
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "connect2identitytskel", "The identity (rest) .tskel of a .connect.",
@@ -187,6 +202,7 @@ def register(sub) -> None:
     p = add_command(sub, "reconstruct", "Re-grow a volume from a .tskel frame (numba, parallel).",
                     ("volanim reconstruct arm.tskel --source mannequin.VOL --mode sampled -o arm.vti",
                      "volanim reconstruct arm.tskel --mode hotspot -o arm-hot.nrrd",
+                     "volanim reconstruct arm.tskel --joints smooth --blend 1.5 --mode bone -o arm-smooth.vti",
                      "volanim reconstruct arm.tskel --mode bone -o arm-bone.vol   # written as arm-bone.XxYxZ.vol"),
                     _reconstruct)
     p.add_argument("tskel")
@@ -199,4 +215,5 @@ def register(sub) -> None:
     group.add_argument("--padding", type=ascii_int, default=2, help="voxels around the posed spheres (default 2)")
     p.add_argument("--threads", type=ascii_int, help="numba threads (default: all cores)")
     p.add_argument("--loss", action="store_true", help="also report voxel loss against the identity frame")
+    add_joints(p, "the .tskel's (rigid when it records none)")
     p.add_argument("-o", "--output", required=True, help=".vti/.nrrd keep the origin; .vol/.VOL: it is printed")

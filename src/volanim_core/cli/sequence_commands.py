@@ -8,8 +8,10 @@ from ._common import (
     FrameProgress,
     add_command,
     add_dims,
+    add_joints,
     ascii_int,
     checked_by,
+    joints_of,
     load_source,
     local_workers,
     positive_float,
@@ -21,6 +23,7 @@ EXAMPLE = (
     "volanim sequence mannequin.0.50.connect walk.bvh --bones mannequin.bones --frames 0:240:8 \\\n"
     "--mode bone --melt 12 --workers 2 -o melt.zarr",
     "volanim sequence mannequin.0.50.connect walk/*.trans --mode bone --crumble 12 -o crumble.zarr   # into a heap",
+    "volanim sequence mannequin.0.50.connect walk/*.trans --joints smooth --mode bone -o smooth.zarr",
     "volanim sequence mannequin.0.50.connect walk/*.trans --source mannequin.VOL --mode sampled -o walk.zarr"
     "   # again: done frames are skipped",
 )
@@ -33,7 +36,7 @@ def _sequence(args):
     from volanim_core.sequence.frames import frames_from_files
     from volanim_core.sequence.run import run_sequence
 
-    conn = read_connect(args.connect)
+    conn = joints_of(args, read_connect(args.connect))
     bones = read_bones(args.bones) if args.bones else None
     frames = frames_from_files(conn, args.frames, bones=bones, mapping=read_mapping(args.map) if args.map else None,
                                frames=args.range, up=args.up, forward=args.forward)
@@ -81,6 +84,7 @@ def register(sub) -> None:
     p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     p.add_argument("--padding", type=ascii_int, default=2, help="voxels around every frame's spheres (default 2)")
+    add_joints(p, "the .connect's (rigid when it records none)")
     p.add_argument("-o", "--output", required=True, help="the .zarr store (a folder)")
     p.add_argument("--every-frame-as", metavar="DIR/NAME.%%04d.vti",
                    type=checked_by("volanim_core.sequence.task:check_frame_pattern", "--every-frame-as {text!r} "),

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.rig.connectivity import Connectivity, RootBone, Trans, Tskel
+from volanim_core.rig.skinning import RIGID, Joints
 
 from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
@@ -135,7 +136,7 @@ def read_connect(path: str | Path) -> Connectivity:
     if threshold is not None:
         threshold = parse_float(rec, None, threshold, "'# thinness:' header")
     return Connectivity(bones, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), threshold,
-                        parse_geometry(rec))
+                        parse_geometry(rec), _parse_joints(rec))
 
 
 def read_trans(path: str | Path) -> Trans:
@@ -147,7 +148,25 @@ def read_trans(path: str | Path) -> Trans:
 def read_tskel(path: str | Path) -> Tskel:
     """Read a ``.tskel`` file: per bone ``Root:``, 4 matrix rows, then points."""
     rec, bones, mats, arr, owner = _read_rooted(path, matrices=True, points=True)
-    return Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), parse_geometry(rec))
+    return Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), parse_geometry(rec),
+                 joints=_parse_joints(rec))
+
+
+# spec: joints
+def _parse_joints(rec: TextRecords) -> Joints:
+    """The ``# joints:`` header: ``rigid`` (also when absent: the seed's files) or ``smooth [WIDTH]``."""
+    text = rec.header.get("joints")
+    if text is None:
+        return RIGID
+    try:
+        return Joints.from_header(text)
+    except ValueError as exc:
+        raise rec.error(rec.header_lines.get("joints"), f"bad '# joints:' header: {exc}") from None
+
+
+def _joints_header(joints: Joints) -> list[str]:
+    """Written only for smooth joints: a rigid file stays byte for byte what it was."""
+    return [f"# joints: {joints.text()}"] if joints.smooth else []
 
 
 def _format_matrix(m: np.ndarray) -> list[str]:
@@ -185,7 +204,7 @@ def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | Non
     if th is not None:
         lines.append(f"# thinness: {th:.2f}" if round(th, 2) == th else f"# thinness: {fmt_float(th)}")
     lines.append(f"# metric: {conn.metric}")
-    lines += _geometry_header(conn.geometry)
+    lines += _geometry_header(conn.geometry) + _joints_header(conn.joints)
     lines += _bone_blocks(conn.bones, conn.bone[keep], conn.points[keep], conn.dt[keep], conn.thinness[keep])
     atomic_write_text(path, "\n".join(lines) + "\n")
 
@@ -202,7 +221,7 @@ def write_trans(path: str | Path, trans: Trans) -> None:
 def write_tskel(path: str | Path, tskel: Tskel) -> None:
     """Write a ``.tskel`` file atomically, points grouped under their bone."""
     lines = ["# volanim tskel 1", f"# points: {len(tskel.points)}", f"# metric: {tskel.metric}",
-             *_geometry_header(tskel.geometry)]
+             *_geometry_header(tskel.geometry), *_joints_header(tskel.joints)]
     lines += _bone_blocks(tskel.bones, tskel.bone, tskel.points, tskel.dt, tskel.thinness, tskel.matrices)
     atomic_write_text(path, "\n".join(lines) + "\n")
 

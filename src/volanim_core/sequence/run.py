@@ -103,6 +103,8 @@ def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int
     h.update(f"{mode}|{kernel}|{padding}|{conn.metric}".encode())
     if not conn.geometry.is_identity:  # keys of stores made before geometry was recorded stay the same
         h.update(conn.geometry.header_value().encode())
+    if conn.joints.smooth:  # likewise for stores made before smooth joints
+        h.update(f"joints {conn.joints.text()}".encode())
     if source_geometry is not None and not source_geometry.is_identity:
         h.update(source_geometry.header_value().encode())
     if source is not None:
