@@ -18,6 +18,7 @@ from volanim_core.rig import symmetry
 from volanim_core.rig.attach import UNATTACHED, auto_connect
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.rig.skinning import Joints
 from volanim_core.skeleton.points import Skeleton
 
 from .undo import Command
@@ -133,7 +134,7 @@ class Attachments:
         keep = self.bone >= 0
         roots = [RootBone(*doc.bones.segment(i), b.label) for i, b in enumerate(doc.bones.bones)]
         conn = Connectivity(roots, s.points[keep], s.dt[keep], s.thinness[keep], self.bone[keep], s.metric,
-                            thinness, s.geometry)
+                            thinness, s.geometry, Joints(doc.settings.joints, doc.settings.blend))
         return conn.grouped()
 
     def save(self, path, thinness: float | None = None) -> int:
@@ -155,7 +156,15 @@ class Attachments:
         become the bone skeleton. A load, not an edit: the history starts after it.
         """
         conn = io.read_connect(path)
-        return self.doc.loading(lambda: self.apply_connectivity(conn, Path(path).name))
+        warnings = self.doc.loading(lambda: self.apply_connectivity(conn, Path(path).name))
+        if conn.joints.smooth:  # the file's joints become the Reconstruct tab's
+            self.doc.settings.joints = "smooth"
+            if conn.joints.mm:
+                warnings.append(f"{Path(path).name}: smooth joints {conn.joints.text()}: the studio sets the "
+                                f"blend as a multiple of the joint's radius, kept at {self.doc.settings.blend:g}")
+            else:
+                self.doc.settings.blend = min(max(conn.joints.blend, 0.1), 10.0)
+        return warnings
 
     def apply_connectivity(self, conn, name: str) -> list[str]:
         """:meth:`load` for a connectivity already read (``name`` is its file's, for messages)."""

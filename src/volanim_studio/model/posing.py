@@ -52,7 +52,7 @@ class PoseState:
         return self._rest_preview[1]
 
     def _rest_key(self, tskel: Tskel) -> tuple:
-        return (self.doc.thinness, len(tskel))
+        return (self.doc.thinness, len(tskel), tskel.joints)  # smooth joints label the rest voxels by blend
 
     def rest_parts(self, tskel: Tskel):
         """The kept :class:`~volanim_core.reconstruct.breakage.RestParts` of this frame's attachments, or None."""
@@ -198,9 +198,7 @@ class PoseState:
         """The posed frame of the attached points with thinness >= ``thinness`` (default: the slider)."""
         conn = self.doc.attachments.to_connectivity()
         t = self.doc.thinness if thinness is None else thinness
-        keep = ~(conn.thinness < t)
-        return Tskel(conn.bones, self.matrices(), conn.points[keep], conn.dt[keep], conn.thinness[keep],
-                     conn.bone[keep], conn.metric, conn.geometry)
+        return conn.take(np.flatnonzero(~(conn.thinness < t))).posed(self.matrices())
 
     def posed_box(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The voxel box the posed spheres of every attached point fill (None: nothing attached): where the

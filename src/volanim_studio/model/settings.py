@@ -4,7 +4,7 @@
         --validate, store--> settings.events.NAME(value=...) --> scene, panels, controllers
 
 Everything a panel used to keep in its widgets (colour-by, point size, hull,
-clipping, slices, preview mode/kernel/padding, lasso and cube tools,
+clipping, slices, preview mode/kernel/padding/joints, lasso and cube tools,
 auto-connect options, the current frame) lives here, so the +/- keys and the
 cube-size slider, or a saved project and the Display tab, can never disagree.
 Settings are not undoable (they are view state), and a project saves them.
@@ -101,6 +101,8 @@ SETTINGS: dict[str, Setting] = {
     "preview_mode": Setting("bone", one_of(*PREVIEW_MODES), "reconstruction mode of the preview"),
     "preview_kernel": Setting(1, one_of(1, 3, 5), "sampled mode's kernel"),
     "preview_padding": Setting(2, number(0, 64, int), "voxels around the posed spheres"),
+    "joints": Setting("rigid", one_of("rigid", "smooth"), "how bones meet: rigid, or smooth (blended near joints)"),
+    "blend": Setting(1.0, number(0.1, 10), "smooth joints' blend half-width, times the joint's radius"),
     "live_preview": Setting(True, flag, "half-resolution preview while a pose slider moves"),
     "show_rest": Setting(False, flag, "show the rest pose's reconstruction instead (compare)"),
     # connect tools

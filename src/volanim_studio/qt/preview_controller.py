@@ -41,6 +41,8 @@ class PreviewController(Controller):
         st.dragging.connect(self._on_dragging)
         st.current_frame.connect(lambda **_: self.live_preview_soon() if self.doc.timeline.active else None)
         st.mode.connect(lambda value: self._live_timer.stop() if value != Mode.POSE else None)
+        st.joints.connect(lambda **_: self._settled())  # the pose is shown again the new way at once
+        st.blend.connect(lambda **_: self._settled() if self.doc.settings.joints == "smooth" else None)
 
     def fill_menu(self, menu, action) -> None:
         """The Pose menu; ``action(text, slot, shortcut=None, menu=None)`` makes a window action."""

@@ -7,6 +7,7 @@ from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
+    QDoubleSpinBox,
     QFormLayout,
     QGroupBox,
     QLabel,
@@ -37,13 +38,21 @@ class ReconstructPanel(QWidget):
         self.kernel = QComboBox()
         self.kernel.addItems(["1", "3", "5"])
         self.padding = QSpinBox(minimum=0, maximum=64)
+        self.joint_kind = QComboBox()
+        self.joint_kind.addItems(["rigid", "smooth"])
+        self.joint_kind.setToolTip("rigid: each skeleton point follows its bone (a bent joint may crack);\n"
+                                   "smooth: points near a joint blend the two bones' motions (dual quaternions),\n"
+                                   "so shoulders, hips, elbows and knees bend without breaking")
+        self.blend = QDoubleSpinBox(minimum=0.1, maximum=10.0, singleStep=0.25, decimals=2)
+        self.blend.setToolTip("smooth joints: how far from a joint the blend reaches, times the joint's radius")
         self.live = QCheckBox("Live preview while posing (half resolution)")
         self.slices = QCheckBox("Orthogonal slices")
         self.show_rest = QCheckBox("Show the rest pose instead (compare)")
         s = doc.settings
         for widget, name, conv in ((self.mode, "preview_mode", None), (self.kernel, "preview_kernel", int),
                                    (self.padding, "preview_padding", None), (self.live, "live_preview", None),
-                                   (self.slices, "slices", None), (self.show_rest, "show_rest", None)):
+                                   (self.slices, "slices", None), (self.show_rest, "show_rest", None),
+                                   (self.joint_kind, "joints", None), (self.blend, "blend", None)):
             bind(widget, s, name, to_value=conv, on_error=doc.message)
         self.metric_label = QLabel("euclid")
         self.metric_label.setToolTip("The distance metric of the skeleton's DT (set when skeletonizing); "
@@ -58,6 +67,8 @@ class ReconstructPanel(QWidget):
         form.addRow("Mode", self.mode)
         form.addRow("Kernel (sampled)", self.kernel)
         form.addRow("Padding", self.padding)
+        form.addRow("Joints", self.joint_kind)
+        form.addRow("Blend (× joint radius)", self.blend)
         form.addRow("Metric (from the skeleton)", self.metric_label)
         form.addRow(self.live)
         form.addRow(self.preview_button)
@@ -78,6 +89,8 @@ class ReconstructPanel(QWidget):
         doc.events.skeleton.connect(
             lambda **_: self.metric_label.setText(doc.skeleton.metric if doc.skeleton is not None else "euclid"))
         doc.events.preview.connect(self._on_preview_changed)
+        s.events.joints.connect(lambda value: self.blend.setEnabled(value == "smooth"))
+        self.blend.setEnabled(s.joints == "smooth")
 
     def _on_preview_changed(self, **_) -> None:
         p = self.doc.preview
