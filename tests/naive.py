@@ -131,3 +131,53 @@ def reconstruct(tskel, bounds, *, mode="binary", source=None, source_origin=(0, 
                 vals = np.floor(acc + 0.5)
             out[tuple(qw)] = vals
     return out, best, ties
+
+
+def _quaternion_of(rot):
+    """Unit quaternion (w, x, y, z) of a 3x3 rotation, Shepperd's method, one branch at a time."""
+    m = np.asarray(rot, np.float64)
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = np.sqrt(tr + 1.0) * 2
+        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        q = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s]
+    elif m[1, 1] > m[2, 2]:
+        s = np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        q = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s]
+    else:
+        s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
+    return np.array(q)
+
+
+def _qmul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def dual_quaternion_blend(point, matrices, influence, weight):
+    """Kavan et al. 2007, one point: sum w_k (q_k, 0.5 t_k q_k) (each q_k on q_0's side), normalise,
+    then p' = R(q) p + t with t = 2 d q*. ``matrices`` are row-vector rigid 4x4."""
+    real, dual = np.zeros(4), np.zeros(4)
+    first = None
+    for b, w in zip(influence, weight):
+        if b < 0 or w == 0:
+            continue
+        m = np.asarray(matrices[b], np.float64)
+        q = _quaternion_of(m[:3, :3].T)
+        if first is None:
+            first = q
+        if np.dot(q, first) < 0:
+            q = -q
+        d = 0.5 * _qmul(np.array([0.0, *m[3, :3]]), q)
+        real += w * q
+        dual += w * d
+    n = np.linalg.norm(real)
+    real, dual = real / n, dual / n
+    t = 2 * _qmul(dual, real * np.array([1, -1, -1, -1]))[1:]
+    v = _qmul(_qmul(real, np.array([0.0, *point])), real * np.array([1, -1, -1, -1]))[1:]
+    return v + t

@@ -5,7 +5,8 @@
       --per joint (two bones a, b with linked points): a graph over a's and b's points near
         the other bone;
         geodesic distance d from the other bone's points (Dijkstra)
-      --w_other = (1 - smoothstep(d / h)) / 2, h = blend x the joint's radius (or blend mm)
+      --closeness f = 1 - smoothstep(d / h) per other bone, 1 for its own; h = blend x the joint's
+        radius (or blend mm); weights f / sum f
       --> Skin: the blended points, their bones (own first) and weights (summing to 1)
     Skin + a frame's matrices --dual_quaternion.blended_matrices--> one matrix per blended point
       --transform_table--> bone matrices + blended ones, and each point's row in it
@@ -133,9 +134,9 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
         h = joints.blend / spacing if joints.mm else joints.blend * float(meet.max())
         near = np.concatenate([ia[da < h], ib[db < h]])
         on_b = bone[near] == b
-        w = 0.5 * (1.0 - _smoothstep(_geodesic(points[near], dt[near], on_b) / h))
-        for k in np.flatnonzero(w > 0):
-            others.setdefault(int(near[k]), []).append((int(a if on_b[k] else b), float(w[k])))
+        f = 1.0 - _smoothstep(_geodesic(points[near], dt[near], on_b) / h)
+        for k in np.flatnonzero(f > 0):
+            others.setdefault(int(near[k]), []).append((int(a if on_b[k] else b), float(f[k])))
     return _skin(others, bone)
 
 
@@ -181,16 +182,20 @@ def _geodesic(points: np.ndarray, dt: np.ndarray, side: np.ndarray) -> np.ndarra
 
 
 def _skin(others: dict[int, list[tuple[int, float]]], bone: np.ndarray) -> Skin:
+    """Weights from closeness: the own bone counts 1, another bone ``1 - smoothstep(d / h)``, normalised.
+
+    Two bones meet 50/50 at their seam and a point ``h`` away is its own bone's alone; where three
+    meet (the armpit: torso, clavicle, upper arm) each seam point is a third of each, so neighbouring
+    points of different bones get nearly the same blend from every side."""
     index = np.array(sorted(others), np.int64)
     influence = np.full((len(index), INFLUENCES), -1, np.int64)
     weight = np.zeros((len(index), INFLUENCES))
     for r, i in enumerate(index):
         pairs = sorted(others[int(i)], key=lambda p: -p[1])[:INFLUENCES - 1]
-        total = sum(w for _, w in pairs)
-        scale = 1.0 / total if total > 1.0 else 1.0  # two joints close together: share, never go negative
-        influence[r, 0], weight[r, 0] = bone[i], 1.0 - total * scale
-        for c, (o, w) in enumerate(pairs, start=1):
-            influence[r, c], weight[r, c] = o, w * scale
+        total = 1.0 + sum(f for _, f in pairs)
+        influence[r, 0], weight[r, 0] = bone[i], 1.0 / total
+        for c, (o, f) in enumerate(pairs, start=1):
+            influence[r, c], weight[r, c] = o, f / total
     return Skin(index, influence, weight)
 
 

@@ -1,0 +1,159 @@
+"""Smooth joints: blend weights (rig/skinning.py) and dual-quaternion blending (rig/dual_quaternion.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from tests import naive
+from volanim_core.reconstruct.breakage import components
+from volanim_core.reconstruct.engine import posed_centres, reconstruct
+from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.rig.dual_quaternion import blended_matrices
+from volanim_core.rig.pose import euler
+from volanim_core.rig.skinning import Joints, skin_weights, transform_table
+
+SMOOTH = Joints("smooth")
+
+
+def rotation_about(centre, rot) -> np.ndarray:
+    """Row-vector 4x4: rotate by ``rot`` (3x3, column convention) about ``centre``."""
+    m = np.eye(4)
+    m[:3, :3] = rot.T
+    m[3, :3] = centre - centre @ rot.T
+    return m
+
+
+def cylinder(length=60, radius=4.0, joint=30) -> Connectivity:
+    """A straight rod along x: two bones meeting at x = ``joint``, one medial point per voxel."""
+    x = np.arange(5, 5 + length)
+    points = np.column_stack([x, np.full_like(x, 20), np.full_like(x, 20)])
+    bones = [RootBone((5, 20, 20), (joint, 20, 20), "UPPER"), RootBone((joint, 20, 20), (5 + length, 20, 20), "LOWER")]
+    return Connectivity(bones, points, np.full(len(x), radius), None, (x >= joint).astype(int), joints=SMOOTH)
+
+
+def test_blended_centres_match_the_naive_dual_quaternion_reference():
+    rng = np.random.default_rng(4)
+    mats = np.stack([rotation_about(rng.uniform(-20, 20, 3), Rotation.random(random_state=k).as_matrix())
+                     for k in range(5)])
+    mats[:, 3, :3] += rng.uniform(-5, 5, (5, 3))
+    influence = np.array([[0, 1, -1, -1], [2, 0, 4, -1], [3, 1, 2, 4], [4, -1, -1, -1]])
+    weight = np.array([[0.7, 0.3, 0, 0], [0.5, 0.25, 0.25, 0], [0.4, 0.3, 0.2, 0.1], [1.0, 0, 0, 0]])
+    points = rng.uniform(0, 50, (4, 3))
+    ours = blended_matrices(mats, influence, weight)
+    moved = np.einsum("ni,nij->nj", points, ours[:, :3, :3]) + ours[:, 3, :3]
+    for k in range(4):
+        expect = naive.dual_quaternion_blend(points[k], mats, influence[k], weight[k])
+        np.testing.assert_allclose(moved[k], expect, atol=1e-9)
+    np.testing.assert_allclose(ours[3], mats[4], atol=1e-12)  # one bone at weight 1: exactly its motion
+
+
+def test_a_blend_of_turns_about_one_joint_keeps_every_distance_to_it():
+    """Two bones turning about the same joint by 0 and 120 degrees: any blend is a turn about that
+    joint (dual quaternions never shrink it, as a linear blend of matrices does)."""
+    joint = np.array([10.0, -3.0, 7.0])
+    mats = np.stack([np.eye(4), rotation_about(joint, euler((0, 0, 120)))])
+    w = np.linspace(0, 1, 11)
+    out = blended_matrices(mats, np.tile([0, 1], (11, 1)), np.column_stack([1 - w, w]))
+    p = joint + np.array([6.0, 2.0, -1.0])
+    moved = np.einsum("i,nij->nj", p, out[:, :3, :3]) + out[:, 3, :3]
+    np.testing.assert_allclose(np.linalg.norm(moved - joint, axis=1), np.linalg.norm(p - joint), atol=1e-9)
+    linear = (1 - w)[:, None] * (p @ mats[0][:3, :3] + mats[0][3, :3]) + w[:, None] * (p @ mats[1][:3, :3] + mats[1][3, :3])
+    assert np.linalg.norm(linear[5] - joint) < 0.6 * np.linalg.norm(p - joint)  # the candy wrapper we avoid
+
+
+def test_a_shared_uniform_scale_is_kept_and_a_shear_is_refused():
+    joint = np.array([3.0, 4.0, 5.0])
+    mats = np.stack([np.eye(4), rotation_about(joint, euler((40, 0, 0)))])
+    half = mats @ np.diag([0.5, 0.5, 0.5, 1.0])  # a coarse preview's 1/2
+    a = blended_matrices(mats, np.array([[0, 1]]), np.array([[0.5, 0.5]]))
+    b = blended_matrices(half, np.array([[0, 1]]), np.array([[0.5, 0.5]]))
+    np.testing.assert_allclose(b[0], a[0] @ np.diag([0.5, 0.5, 0.5, 1.0]), atol=1e-12)
+    sheared = mats.copy()
+    sheared[1, 0, 1] = 0.3
+    with pytest.raises(ValueError, match="bone 1: its matrix is not a rotation"):
+        blended_matrices(sheared, np.array([[0, 1]]), np.array([[0.5, 0.5]]))
+
+
+def test_weights_are_a_partition_of_unity_falling_off_from_the_joint():
+    conn = cylinder()
+    skin = skin_weights(conn.points, conn.dt, conn.bone, conn.bones, Joints("smooth", 1.0))
+    assert np.all(skin.weight >= 0)
+    np.testing.assert_allclose(skin.weight.sum(1), 1.0, atol=1e-12)
+    x = conn.points[skin.index, 0]
+    # blend half-width h: 1 x the radius (4), from the other bone's nearest point; bones meet at x 29 | 30,
+    # so x 26 and 33 are h away: weight 0, rigid
+    assert x.min() == 27 and x.max() == 32
+    own = skin.weight[:, 0]
+    lower = conn.bone[skin.index] == 1
+    assert np.all(np.diff(own[~lower]) < 0) and np.all(np.diff(own[lower]) > 0)  # 1 far away, 1/2 at the seam
+    f = 1 - (1 / 4) ** 2 * (3 - 2 / 4)  # the other bone's closeness one voxel from the seam: 1 - smoothstep(1/4)
+    assert own[x == 29][0] == pytest.approx(1 / (1 + f))
+    np.testing.assert_array_equal(skin.influence[:, 1], 1 - conn.bone[skin.index])
+
+
+def test_weights_are_zero_across_a_gap():
+    """A third bone's points touch the rod's LOWER end at rest (a hand on the hip): they are not linked to
+    it, so neither gets weight from the other, though they are nearer than the blend width."""
+    rod = cylinder()
+    x = np.arange(50, 65)
+    hand = np.column_stack([x, np.full_like(x, 28), np.full_like(x, 20)])  # 8 voxels over the rod: spheres touch
+    bones = [*rod.bones, RootBone((70, 28, 20), (50, 28, 20), "HAND")]
+    points = np.vstack([rod.points, hand])
+    bone = np.concatenate([rod.bone, np.full(len(x), 2)])
+    dt = np.full(len(points), 4.0)
+    skin = skin_weights(points, dt, bone, bones, Joints("smooth", 3.0))
+    touched = bone[skin.index] == 2
+    assert not touched.any()
+    assert not (skin.influence == 2).any()
+    assert len(skin) > 0  # the rod's own joint still blends
+
+
+@pytest.mark.parametrize("angle", [0, 30, 60, 90, 120, 150])
+def test_a_bent_cylinder_stays_one_piece_with_its_radius(angle):
+    conn = cylinder(radius=4.0)
+    joint = np.array([30.0, 20.0, 20.0])
+    mats = np.stack([np.eye(4), rotation_about(joint, euler((0, 0, angle)))])
+    smooth = conn.posed(mats)
+    r = reconstruct(smooth, mode="binary", padding=1)
+    assert len(components(r.volume)) == 1
+    c = posed_centres(smooth)
+    # centres keep their distance to the joint (each turned about it), and the medial curve stretches
+    # little through the bend (1 voxel apart at rest): neighbouring spheres still overlap deeply
+    np.testing.assert_allclose(np.linalg.norm(c - joint, axis=1), np.linalg.norm(conn.points - joint, axis=1),
+                               atol=1e-5)
+    assert np.linalg.norm(np.diff(c, axis=0), axis=1).max() < 2.0  # half the radius
+    # the radius stays: every posed centre's voxels within 3.5 of it are filled, nothing beyond 4 + 1
+    filled = np.argwhere(r.volume > 0) + r.origin
+    d = np.sqrt(((filled[:, None, :] - c[None]) ** 2).sum(2)).min(1)
+    assert d.max() < 4.0
+    grid = np.argwhere(np.ones(r.volume.shape, bool)) + r.origin
+    near = np.sqrt(((grid[:, None, :] - c[None]) ** 2).sum(2)).min(1) < 3.5
+    assert r.volume.reshape(-1)[near].all()
+    if angle >= 60:
+        rigid = reconstruct(conn.with_joints(Joints()).posed(mats), mode="binary", padding=1)
+        assert rigid.stats["filled"] < r.stats["filled"]  # the rigid bend's outside opens
+
+
+def test_sampled_mode_reads_each_voxel_through_its_owners_blended_motion():
+    conn = cylinder(radius=3.0)
+    joint = np.array([30.0, 20.0, 20.0])
+    mats = np.stack([np.eye(4), rotation_about(joint, euler((0, 0, 90)))])
+    t = conn.posed(mats)
+    source = np.zeros((80, 40, 40), np.uint16)
+    source[...] = np.arange(80)[:, None, None] * 100 + np.arange(40)[None, :, None]  # position-coded
+    ours = reconstruct(t, mode="sampled", source=source, padding=1)
+    table, row = transform_table(t)
+    owner = reconstruct(t, mode="owner", padding=1)
+    assert owner.origin == ours.origin
+    q = np.argwhere(owner.volume > 0)
+    rows = owner.volume[tuple(q.T)].astype(int) - 1
+    back = np.einsum("ni,nij->nj", np.column_stack([q + ours.origin, np.ones(len(q))]), np.linalg.inv(table[rows]))
+    idx = np.floor(back[:, :3] + 0.5).astype(int)
+    inside = ((idx >= 0) & (idx < source.shape)).all(1)
+    expect = np.zeros(len(q), np.uint16)
+    expect[inside] = source[tuple(idx[inside].T)]
+    np.testing.assert_array_equal(ours.volume[tuple(q.T)], expect)
+    assert (rows >= len(mats)).sum() > 50  # many voxels are read through a blended motion
+    assert set(row[conn.points[:, 0] < 20]) == {0}  # far from the joint: the bone's own matrix
