@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
-
 from tests import naive
+
 from volanim_core.reconstruct.breakage import components
 from volanim_core.reconstruct.engine import posed_centres, reconstruct
 from volanim_core.rig.connectivity import Connectivity, RootBone
