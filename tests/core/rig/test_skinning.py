@@ -59,7 +59,8 @@ def test_a_blend_of_turns_about_one_joint_keeps_every_distance_to_it():
     p = joint + np.array([6.0, 2.0, -1.0])
     moved = np.einsum("i,nij->nj", p, out[:, :3, :3]) + out[:, 3, :3]
     np.testing.assert_allclose(np.linalg.norm(moved - joint, axis=1), np.linalg.norm(p - joint), atol=1e-9)
-    linear = (1 - w)[:, None] * (p @ mats[0][:3, :3] + mats[0][3, :3]) + w[:, None] * (p @ mats[1][:3, :3] + mats[1][3, :3])
+    ends = [p @ m[:3, :3] + m[3, :3] for m in mats]
+    linear = (1 - w)[:, None] * ends[0] + w[:, None] * ends[1]
     assert np.linalg.norm(linear[5] - joint) < 0.6 * np.linalg.norm(p - joint)  # the candy wrapper we avoid
 
 
