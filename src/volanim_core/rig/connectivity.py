@@ -90,6 +90,15 @@ class Connectivity:
         check_metric(self.metric)
         if len(self.bone) and (self.bone.min() < 0 or self.bone.max() >= len(self.bones)):
             raise ValueError("point bone index out of range of the bone list")
+        self._skin: Skin | None = None
+
+    @property
+    def skin(self) -> Skin:
+        """The blend weights of smooth joints, made from the points on first use and kept with them
+        (every frame posed from this connectivity shares them; rig/skinning.py)."""
+        if self._skin is None:
+            self._skin = cached_skin(self)
+        return self._skin
 
     def __len__(self) -> int:
         return len(self.points)
@@ -113,8 +122,10 @@ class Connectivity:
 
     def posed(self, matrices, joints: Joints | None = None) -> Tskel:
         """A frame of these points: one matrix per bone, the joints of the connectivity (or ``joints``)."""
+        joints = self.joints if joints is None else joints
+        skin = self.skin if joints == self.joints and joints.smooth else None
         return Tskel(self.bones, matrices, self.points, self.dt, self.thinness, self.bone, self.metric,
-                     self.geometry, joints=self.joints if joints is None else joints)
+                     self.geometry, joints=joints, skin=skin)
 
     def with_joints(self, joints: Joints) -> Connectivity:
         """The same points with other joints."""
@@ -167,13 +178,6 @@ class Tskel(Connectivity):
         super().__init__(bones, points, dt, thinness, bone, metric, None, geometry, joints)
         self.matrices = _check_matrices(matrices, len(self.bones))
         self._skin = skin
-
-    @property
-    def skin(self) -> Skin:
-        """The blend weights of smooth joints (made from the points once, remembered; rig/skinning.py)."""
-        if self._skin is None:
-            self._skin = cached_skin(self)
-        return self._skin
 
     def with_joints(self, joints: Joints) -> Tskel:
         return self.connectivity.with_joints(joints).posed(self.matrices)

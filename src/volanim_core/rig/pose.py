@@ -47,15 +47,20 @@ def apply_rows(points: np.ndarray, row: np.ndarray, table: np.ndarray, n_bones: 
     """Each point moved by its row of ``table``: the first ``n_bones`` rows are bone matrices shared by
     many points (:func:`apply_matrices`), later ones a point's own (smooth joints' blended motions)."""
     row = np.asarray(row, np.int64)
-    own = row >= n_bones
-    if not own.any():
+    own = np.flatnonzero(row >= n_bones)
+    if not len(own):
         return apply_matrices(points, row, table)
-    p = np.asarray(points, np.float64).reshape(-1, 3)
-    out = np.empty_like(p)
-    shared = ~own
-    out[shared] = apply_matrices(p[shared], row[shared], table)
+    # every point by a bone matrix first (the own rows given their predecessor's, so grouped points stay
+    # sorted for apply_matrices' fast path; no masked copies of 10^5 points), then the few own ones
+    last = np.arange(len(row))
+    last[own] = 0
+    np.maximum.accumulate(last, out=last)  # each point's latest shared row at or before it
+    shared = row[last]
+    shared[shared >= n_bones] = 0  # own rows before any shared one
+    out = apply_matrices(points, shared, table)
     m = table[row[own]]
-    out[own] = np.einsum("ni,nij->nj", p[own], m[:, :3, :3]) + m[:, 3, :3]
+    p = np.asarray(points, np.float64).reshape(-1, 3)[own]
+    out[own] = np.einsum("ni,nij->nj", p, m[:, :3, :3]) + m[:, 3, :3]
     return out
 
 

@@ -211,7 +211,7 @@ def cached_skin(conn, joints: Joints | None = None) -> Skin:
     spacing = float(conn.geometry.spacing[0])
     h = hashlib.blake2b(digest_size=16)
     h.update(joints.text().encode() + np.float64(spacing).tobytes())
-    for part in (conn.points.astype(np.float64), conn.dt, conn.bone.astype(np.int64),
+    for part in (conn.points, conn.dt, conn.bone,
                  np.array([[*b.proximal, *b.distal] for b in conn.bones], np.float64).reshape(-1)):
         h.update(np.ascontiguousarray(part).tobytes())
     key = h.digest()

@@ -11,7 +11,7 @@ from volanim_core.reconstruct.breakage import components
 from volanim_core.reconstruct.engine import posed_centres, reconstruct
 from volanim_core.rig.connectivity import Connectivity, RootBone
 from volanim_core.rig.dual_quaternion import blended_matrices
-from volanim_core.rig.pose import euler
+from volanim_core.rig.pose import apply_rows, euler
 from volanim_core.rig.skinning import Joints, skin_weights, transform_table
 
 SMOOTH = Joints("smooth")
@@ -158,3 +158,13 @@ def test_sampled_mode_reads_each_voxel_through_its_owners_blended_motion():
     np.testing.assert_array_equal(ours.volume[tuple(q.T)], expect)
     assert (rows >= len(mats)).sum() > 50  # many voxels are read through a blended motion
     assert set(row[conn.points[:, 0] < 20]) == {0}  # far from the joint: the bone's own matrix
+
+
+def test_points_in_any_order_move_by_their_own_rows():
+    rng = np.random.default_rng(2)
+    table = np.stack([rotation_about(rng.uniform(0, 9, 3), Rotation.random(random_state=k).as_matrix())
+                      for k in range(6)])
+    points = rng.uniform(0, 30, (40, 3))
+    for row in (np.sort(rng.integers(0, 6, 40)), rng.integers(0, 6, 40), np.r_[5, 4, rng.integers(0, 3, 38)]):
+        expect = np.array([np.append(p, 1) @ table[r] for p, r in zip(points, row)])[:, :3]
+        np.testing.assert_allclose(apply_rows(points, row, table, 3), expect, atol=1e-12)
