@@ -44,8 +44,9 @@ def test_smooth_joints_mend_the_stump_a_rigid_shoulder_leaves(qtbot, window, tmp
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     path = w.files.save_project(path=tmp_path / "p.volanim")
     assert path is not None
+    # the project's .connect records them
     saved = [f.read_text() for f in (tmp_path / "p.volanim.d").glob("*.connect")]
-    assert len(saved) == 1 and all("\n# joints: smooth 1.5\n" in t for t in saved)  # the project's .connect records them
+    assert len(saved) == 1 and all("\n# joints: smooth 1.5\n" in t for t in saved)
 
     from volanim_studio.qt.main_window import MainWindow
 
