@@ -51,6 +51,7 @@ def test_scan_with_smooth_joints(made):
     assert all(v["cracks"] == 0 and v["stump"] == 0 for v in json.loads(smooth.stdout))
 
 
+# spec: docs/formats.md#joints
 def test_connect2tskel_records_smooth_joints_and_reconstruct_follows_them(made):
     out = volanim("connect2tskel", made / "m.connect", made / "hip90.trans", "--joints", "smooth", "--blend", "1.5",
                   "-o", made / "hip.tskel")
@@ -69,6 +70,7 @@ def test_connect2tskel_records_smooth_joints_and_reconstruct_follows_them(made):
     assert (rigid > 0).sum() < (smooth > 0).sum()  # the rigid hip's crack is empty voxels
 
 
+# spec: docs/formats.md#joints
 def test_a_file_without_the_line_is_rigid_and_rigid_files_stay_as_they_were(made):
     out = volanim("connect2tskel", made / "m.connect", made / "hip30.trans", "-o", made / "plain.tskel")
     assert out.returncode == 0 and "rigid joints" in out.stdout
