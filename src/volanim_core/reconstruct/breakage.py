@@ -36,7 +36,7 @@ from volanim_core.reconstruct.engine import OWNER, Reconstruction, posed_centres
 from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.pose import apply_matrices, apply_rows
-from volanim_core.rig.skinning import transform_table
+from volanim_core.rig.skinning import blended_with, transform_table
 from volanim_core.rig.tskel import identity_tskel
 
 
@@ -144,7 +144,7 @@ def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
 def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[Stump]:
     """Misplaced points the pose carries more than a sphere's diameter from where the bone they lie
     along went, grouped by (their bone, that bone); largest first. With smooth joints, a point blended
-    with the bone it lies along is not left behind (:func:`_blended_with`).
+    with the bone it lies along is not left behind (:func:`~volanim_core.rig.skinning.blended_with`).
 
     ``misplaced``: :func:`misplaced_points` of the same connectivity, when scanning many frames.
     """
@@ -156,7 +156,7 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
     table, row = transform_table(tskel)  # smooth joints: a point near its bone's joint moves by the blend
     went = apply_rows(p, row[idx], table, len(tskel.bones))
     should = apply_matrices(p, along, tskel.matrices)
-    behind = (np.linalg.norm(went - should, axis=1) > 2.0 * tskel.dt[idx]) & ~_blended_with(tskel, idx, along)
+    behind = (np.linalg.norm(went - should, axis=1) > 2.0 * tskel.dt[idx]) & ~blended_with(tskel, idx, along)
     names = list(joints)
     pos = np.array([joints[n] for n in names], np.float64) if names else np.zeros((0, 3))
     label = [b.name or f"bone {k}" for k, b in enumerate(tskel.bones)]
@@ -168,21 +168,6 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
         out.append(Stump(len(k), joint, label[o], label[n], went[k], float((tskel.dt[idx[k]] ** 3).sum()),
                          float(tskel.dt[idx[k]].max())))
     return sorted(out, key=lambda s: -s.weight)
-
-
-def _blended_with(tskel: Tskel, idx: np.ndarray, along: np.ndarray) -> np.ndarray:
-    """Whether smooth joints give point ``idx[k]`` some weight on bone ``along[k]``: then it is part of
-    that joint's bend, the body stretching continuously between the two bones, not a piece left behind."""
-    out = np.zeros(len(idx), bool)
-    if not tskel.joints.smooth or not len(tskel.skin):
-        return out
-    skin = tskel.skin
-    row = np.full(len(tskel), -1, np.int64)
-    row[skin.index] = np.arange(len(skin))
-    r = row[idx]
-    has = r >= 0
-    out[has] = (skin.influence[r[has]][:, 1:] == along[has, None]).any(axis=1)
-    return out
 
 
 def components(volume: np.ndarray) -> list[int]:

@@ -227,6 +227,22 @@ def cached_skin(conn, joints: Joints | None = None) -> Skin:
     return skin
 
 
+def blended_with(tskel, idx: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """Whether smooth joints give point ``idx[k]`` some weight on bone ``along[k]``: then it is part of
+    that joint's bend, the body stretching continuously between the two bones, not a piece left behind
+    (the breakage report's stumps)."""
+    out = np.zeros(len(idx), bool)
+    if not tskel.joints.smooth or not len(tskel.skin):
+        return out
+    skin = tskel.skin
+    row = np.full(len(tskel), -1, np.int64)
+    row[skin.index] = np.arange(len(skin))
+    r = row[idx]
+    has = r >= 0
+    out[has] = (skin.influence[r[has]][:, 1:] == along[has, None]).any(axis=1)
+    return out
+
+
 def transform_table(tskel) -> tuple[np.ndarray, np.ndarray]:
     """``(table, row)``: the matrices a frame's points move by and each point's row in ``table``.
 
