@@ -113,7 +113,8 @@ def test_no_module_over_450_lines():
 # transfer functions and surfaces as plain data (volanim_core.camera, .transfer_function,
 # .isosurface), never through the renderer; nothing below the command line imports it.
 LAYERS = [
-    {"errors", "limits", "progress", "geometry", "modes", "camera", "transfer_function", "isosurface", "parallel"},
+    {"errors", "limits", "progress", "geometry", "modes", "camera", "transfer_function", "isosurface", "parallel",
+     "memo"},
     # files hold skeletons and bones (io reads them into their types), volume tools convert with io's:
     # one layer, which never imports the renderer
     {"volume", "io", "skeleton", "colour", "rig"},

@@ -125,17 +125,23 @@ def parse_metric(rec: TextRecords) -> str:
     raise rec.error(None, f"unknown '# metric: {metric}', expected 'euclid' or '345'")
 
 
+def parse_header(rec: TextRecords, key: str, parse, default):
+    """The ``# KEY:`` header through ``parse(text)``, or ``default`` when the file has none; a ValueError
+    from ``parse`` becomes the file's error at that header's line."""
+    text = rec.header.get(key)
+    if text is None:
+        return default
+    try:
+        return parse(text)
+    except ValueError as exc:
+        raise rec.error(rec.header_lines.get(key), f"bad '# {key}:' header: {exc}") from None
+
+
 def parse_geometry(rec: TextRecords):
     """The ``# geometry:`` header (docs/formats.md, "Physical space"); the identity when there is none."""
     from volanim_core.geometry import IDENTITY, Geometry
 
-    text = rec.header.get("geometry")
-    if text is None:
-        return IDENTITY
-    try:
-        return Geometry.parse(text)
-    except ValueError as exc:
-        raise rec.error(rec.header_lines.get("geometry"), f"bad '# geometry:' header: {exc}") from None
+    return parse_header(rec, "geometry", Geometry.parse, IDENTITY)
 
 
 def fmt_float(value: float) -> str:

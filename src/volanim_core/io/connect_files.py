@@ -16,7 +16,7 @@ from volanim_core.rig.skinning import RIGID, Joints
 
 from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
-from ._text import TextRecords, fmt_float, parse_float, parse_geometry, parse_metric, read_records
+from ._text import TextRecords, fmt_float, parse_float, parse_geometry, parse_header, parse_metric, read_records
 
 ROOT_SYNTAX = "'Root: x y z :: x y z [NAME]'"
 
@@ -152,16 +152,10 @@ def read_tskel(path: str | Path) -> Tskel:
                  joints=_parse_joints(rec))
 
 
-# spec: joints
 def _parse_joints(rec: TextRecords) -> Joints:
-    """The ``# joints:`` header: ``rigid`` (also when absent: the seed's files) or ``smooth [WIDTH]``."""
-    text = rec.header.get("joints")
-    if text is None:
-        return RIGID
-    try:
-        return Joints.from_header(text)
-    except ValueError as exc:
-        raise rec.error(rec.header_lines.get("joints"), f"bad '# joints:' header: {exc}") from None
+    """The ``# joints:`` header (docs/formats.md#joints): ``rigid`` (also when absent: the seed's files) or
+    ``smooth [WIDTH]``."""
+    return parse_header(rec, "joints", Joints.from_header, RIGID)
 
 
 def _joints_header(joints: Joints) -> list[str]:

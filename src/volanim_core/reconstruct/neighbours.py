@@ -12,12 +12,9 @@ frame of a clip, every studio preview and the rest frame share one set.
 
 from __future__ import annotations
 
-import hashlib
-import threading
-from collections import OrderedDict
-
 import numpy as np
 
+from volanim_core.memo import Recent, content_key
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.rig.connectivity import Connectivity
 
@@ -67,9 +64,8 @@ def _clipped(tskel: Connectivity, min_radius: float, r2: np.ndarray | None = Non
     return r2, np.flatnonzero(r2 >= radius_squared(np.array([float(min_radius)]))[0])
 
 
-_CACHE: OrderedDict[bytes, np.ndarray] = OrderedDict()
-_CACHE_LOCK = threading.Lock()
 CACHED_CONNECTIVITIES = 4
+_RECENT = Recent(CACHED_CONNECTIVITIES)
 
 
 def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: float = CUT_MIN_RADIUS, *,
@@ -85,22 +81,15 @@ def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     ``r2``: the spheres' :func:`radius_squared`, when the caller has them.
     """
     r2, big = _clipped(tskel, min_radius, r2)
-    h = hashlib.blake2b(digest_size=16)
-    for part in (np.array([len(tskel), k], np.int64), big, np.ascontiguousarray(tskel.points[big], np.float64),
-                 r2[big], np.asarray(tskel.bone)[big].astype(np.int64)):
-        h.update(np.ascontiguousarray(part).tobytes())
-    key = h.digest()
-    with _CACHE_LOCK:
-        if key in _CACHE:
-            _CACHE.move_to_end(key)
-            return _CACHE[key]
-    lists = sphere_neighbours(tskel, k, min_radius)
-    lists.setflags(write=False)
-    with _CACHE_LOCK:
-        _CACHE[key] = lists
-        while len(_CACHE) > CACHED_CONNECTIVITIES:
-            _CACHE.popitem(last=False)
-    return lists
+    key = content_key(np.array([len(tskel), k], np.int64), big, np.asarray(tskel.points[big], np.float64), r2[big],
+                      np.asarray(tskel.bone)[big].astype(np.int64))
+
+    def make() -> np.ndarray:
+        lists = sphere_neighbours(tskel, k, min_radius)
+        lists.setflags(write=False)
+        return lists
+
+    return _RECENT.get(key, make)
 
 
 def check_neighbours(neighbours, n: int) -> None:

@@ -24,12 +24,11 @@ wherever the user put the joint, and a hand resting on the hip never follows it
 
 from __future__ import annotations
 
-import hashlib
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
+
+from volanim_core.memo import Recent, content_key
 
 INFLUENCES = 4  # bones per point at most: its own and three neighbours' (a fork's bone near two children)
 LINK = np.sqrt(3.0)  # points this close (26-neighbours) are always linked, whatever their radii
@@ -37,7 +36,6 @@ KNN = 12  # neighbours examined per point for links (a medial curve or surface i
 DEFAULT_BLEND = 1.0
 
 
-# spec: joints
 @dataclass(frozen=True)
 class Joints:
     """How bones meet: ``rigid`` (each point follows its bone) or ``smooth`` (blended near joints).
@@ -124,14 +122,17 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
     bone = np.asarray(bone, np.int64)
     i, j, _ = links(points, dt)
     cross = bone[i] != bone[j]
-    pairs = np.unique(np.sort(np.column_stack([bone[i][cross], bone[j][cross]]), axis=1), axis=0)
+    i, j = i[cross], j[cross]
+    pair = np.sort(np.column_stack([bone[i], bone[j]]), axis=1)
     others: dict[int, list[tuple[int, float]]] = {}
-    for a, b in pairs:
+    for a, b in np.unique(pair, axis=0):
+        seam = (pair[:, 0] == a) & (pair[:, 1] == b)  # the linked points where the two bones meet
+        meet = float(max(dt[i[seam]].max(), dt[j[seam]].max()))
+        h = joints.blend / spacing if joints.mm else joints.blend * meet
         ia, ib = np.flatnonzero(bone == a), np.flatnonzero(bone == b)
-        da = cKDTree(points[ib]).query(points[ia])[0]  # Euclid: a lower bound of the distance along the body
-        db = cKDTree(points[ia]).query(points[ib])[0]
-        meet = np.concatenate([dt[ia][da <= np.maximum(dt[ia], LINK)], dt[ib][db <= np.maximum(dt[ib], LINK)]])
-        h = joints.blend / spacing if joints.mm else joints.blend * float(meet.max())
+        # Euclid, a lower bound of the distance along the body: only points within h can get weight
+        da = cKDTree(points[ib]).query(points[ia], distance_upper_bound=h, workers=-1)[0]
+        db = cKDTree(points[ia]).query(points[ib], distance_upper_bound=h, workers=-1)[0]
         near = np.concatenate([ia[da < h], ib[db < h]])
         on_b = bone[near] == b
         f = 1.0 - _smoothstep(_geodesic(points[near], dt[near], on_b) / h)
@@ -199,9 +200,7 @@ def _skin(others: dict[int, list[tuple[int, float]]], bone: np.ndarray) -> Skin:
     return Skin(index, influence, weight)
 
 
-_CACHE: OrderedDict[bytes, Skin] = OrderedDict()
-_LOCK = threading.Lock()
-CACHED = 4
+_RECENT = Recent(4)
 
 
 def cached_skin(conn, joints: Joints | None = None) -> Skin:
@@ -209,22 +208,9 @@ def cached_skin(conn, joints: Joints | None = None) -> Skin:
     every frame of a clip and every studio preview shares one set (the key hashes what they depend on)."""
     joints = joints or conn.joints
     spacing = float(conn.geometry.spacing[0])
-    h = hashlib.blake2b(digest_size=16)
-    h.update(joints.text().encode() + np.float64(spacing).tobytes())
-    for part in (conn.points, conn.dt, conn.bone,
-                 np.array([[*b.proximal, *b.distal] for b in conn.bones], np.float64).reshape(-1)):
-        h.update(np.ascontiguousarray(part).tobytes())
-    key = h.digest()
-    with _LOCK:
-        if key in _CACHE:
-            _CACHE.move_to_end(key)
-            return _CACHE[key]
-    skin = skin_weights(conn.points, conn.dt, conn.bone, conn.bones, joints, spacing)
-    with _LOCK:
-        _CACHE[key] = skin
-        while len(_CACHE) > CACHED:
-            _CACHE.popitem(last=False)
-    return skin
+    key = content_key(conn.points, conn.dt, conn.bone, [[*b.proximal, *b.distal] for b in conn.bones],
+                      text=f"{joints.text()} {spacing!r}")
+    return _RECENT.get(key, lambda: skin_weights(conn.points, conn.dt, conn.bone, conn.bones, joints, spacing))
 
 
 def blended_with(tskel, idx: np.ndarray, along: np.ndarray) -> np.ndarray:

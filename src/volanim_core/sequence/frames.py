@@ -36,7 +36,7 @@ class FrameSpec:
         if plain:
             return conn.posed(self.matrices)
         dt = conn.dt * np.asarray(self.dt_scale, np.float64)
-        skin = conn.posed(self.matrices).skin if conn.joints.smooth else None  # blend as the unscaled body does
+        skin = conn.skin if conn.joints.smooth else None  # blend as the unscaled body does
         return Tskel(conn.bones, self.matrices, conn.points, dt, conn.thinness, conn.bone, conn.metric, conn.geometry,
                      joints=conn.joints, skin=skin)
 

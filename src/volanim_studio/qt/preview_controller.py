@@ -41,8 +41,12 @@ class PreviewController(Controller):
         st.dragging.connect(self._on_dragging)
         st.current_frame.connect(lambda **_: self.live_preview_soon() if self.doc.timeline.active else None)
         st.mode.connect(lambda value: self._live_timer.stop() if value != Mode.POSE else None)
-        st.joints.connect(lambda **_: self._settled())  # the pose is shown again the new way at once
-        st.blend.connect(lambda **_: self._settled() if self.doc.settings.joints == "smooth" else None)
+        self._again = QTimer(window)  # a preview asked for while a job runs: made once it has ended
+        self._again.setSingleShot(True)
+        self._again.setInterval(50)
+        self._again.timeout.connect(self._preview_when_idle)
+        st.joints.connect(lambda **_: self._joints_changed())
+        st.blend.connect(lambda **_: self._joints_changed() if self.doc.settings.joints == "smooth" else None)
 
     def fill_menu(self, menu, action) -> None:
         """The Pose menu; ``action(text, slot, shortcut=None, menu=None)`` makes a window action."""
@@ -80,6 +84,22 @@ class PreviewController(Controller):
 
     def _settled(self) -> None:
         if self._posing:
+            self.preview()
+
+    def _joints_changed(self) -> None:
+        """Joints or blend changed: the pose is shown again the new way. A preview running the old way is
+        cancelled and the new one made when it has ended (each step of the Blend box, the last one shown)."""
+        if not self._posing:
+            return
+        worker = self.jobs.worker
+        if worker is not None and getattr(worker, "is_preview", False):
+            worker.cancel()
+        self._preview_when_idle()
+
+    def _preview_when_idle(self) -> None:
+        if self.jobs.busy:
+            self._again.start()
+        elif self._posing:
             self.preview()
 
     def _on_pose_changed(self, **_) -> None:

@@ -39,9 +39,16 @@ def test_smooth_joints_mend_the_stump_a_rigid_shoulder_leaves(qtbot, window, tmp
     assert smooth.healthy and smooth.cracks < rigid.cracks
     assert "healthy: one piece, no stump" in w.verdict_label.text()
 
+    shown = []
+    doc.events.preview.connect(lambda **_: shown.append(doc.preview))
+    w.previews.preview()  # a preview the old way is running when the blend changes (two steps of the box)
+    assert w.busy
+    w.reconstruct_panel.blend.setValue(1.25)
     w.reconstruct_panel.blend.setValue(1.5)
     assert doc.settings.blend == 1.5
-    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: not w.busy and not w.previews._again.isActive() and bool(shown), timeout=JOB_TIMEOUT_MS)
+    assert "A job is running" not in w.statusBar().currentMessage()  # the change was not dropped
+    assert shown[-1].report is not None and shown[-1].report.healthy
     path = w.files.save_project(path=tmp_path / "p.volanim")
     assert path is not None
     # the project's .connect records them
