@@ -168,3 +168,14 @@ def test_points_in_any_order_move_by_their_own_rows():
     for row in (np.sort(rng.integers(0, 6, 40)), rng.integers(0, 6, 40), np.r_[5, 4, rng.integers(0, 3, 38)]):
         expect = np.array([np.append(p, 1) @ table[r] for p, r in zip(points, row)])[:, :3]
         np.testing.assert_allclose(apply_rows(points, row, table, 3), expect, atol=1e-12)
+
+
+def test_the_joint_radius_counts_a_sphere_exactly_its_radius_from_the_other_bone():
+    """The thickest sphere where the bones meet sets the blend width, also when it lies exactly its radius
+    from the other bone's nearest point (a strict distance bound once dropped it: h fell from 5 to 2)."""
+    conn = cylinder(radius=2.0)
+    dt = conn.dt.copy()
+    dt[conn.points[:, 0] == 25] = 5.0  # 5 from x = 30, the LOWER bone's first point
+    skin = skin_weights(conn.points, dt, conn.bone, conn.bones, Joints("smooth", 1.0))
+    x = conn.points[skin.index, 0]
+    assert x.min() == 26 and x.max() == 33  # h = 5 from the seam at 29 | 30 (h = 2 would give 29..30)
