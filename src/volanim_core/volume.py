@@ -176,23 +176,25 @@ def histogram(vol: np.ndarray) -> np.ndarray:
     return np.bincount(vol.ravel(order="K"), minlength=256)
 
 
-SUPER_DIFF_CODES = {"both empty": 0, "both filled": 100, "only first": 150, "only second": 200}
+# The thesis's VolumeSuperDiff codes: a changed value is a difference even where both are non-zero.
+SUPER_DIFF_CODES = {"same value": 0, "only first": 100, "only second": 150, "both, changed": 200}
 
 
 def super_diff(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Voxel-by-voxel comparison of two volumes (VolumeSuperDiff).
+    """Voxel-by-voxel comparison of two volumes (VolumeSuperDiff, the thesis's codes).
 
-    Output: 0 where both are 0, 100 where both are non-zero, 150 where only
-    ``a`` is non-zero, 200 where only ``b`` is.
+    Output: 0 where both hold the same value (empty or not), 100 where only ``a``
+    is non-zero, 150 where only ``b`` is, 200 where both are non-zero with
+    different values.
     """
     a, b = _check3d(a, "first volume"), _check3d(b, "second volume")
     if a.shape != b.shape:
         raise ValueError(f"volumes differ in size: {a.shape} vs {b.shape}")
     fa, fb = a != 0, b != 0
     out = np.zeros(a.shape, np.uint8, order="F")
-    out[fa & fb] = 100
-    out[fa & ~fb] = 150
-    out[~fa & fb] = 200
+    out[fa & ~fb] = 100
+    out[~fa & fb] = 150
+    out[fa & fb & (a != b)] = 200
     return out
 
 

@@ -57,12 +57,21 @@ def test_flip_reverse_remap_histogram(rng):
         volume.remap(v, [1, 2])
 
 
-def test_super_diff_codes():
-    a = np.array([0, 1, 1, 0], np.uint8).reshape(4, 1, 1)
-    b = np.array([0, 1, 0, 5], np.uint8).reshape(4, 1, 1)
-    assert volume.super_diff(a, b).ravel().tolist() == [0, 100, 150, 200]
+# spec: docs/formats.md#diff
+def test_super_diff_codes_are_the_thesis_codes():
+    a = np.array([0, 7, 1, 0, 9, 100], np.uint8).reshape(6, 1, 1)
+    b = np.array([0, 7, 0, 5, 3, 50], np.uint8).reshape(6, 1, 1)
+    # same (empty), same (non-zero), only first, only second, both with other values (twice)
+    assert volume.super_diff(a, b).ravel().tolist() == [0, 0, 100, 150, 200, 200]
     with pytest.raises(ValueError, match="differ in size"):
         volume.super_diff(a, b[:2])
+
+
+def test_super_diff_sees_a_volume_whose_every_value_changed():
+    # The old codes called this "both filled" everywhere: no difference reported.
+    a = np.full((3, 4, 5), 100, np.uint8)
+    assert (volume.super_diff(a, a // 2) == 200).all()
+    assert not volume.super_diff(a, a.copy()).any()
 
 
 def test_fit_pow2_and_float_to_uint8():

@@ -126,11 +126,17 @@ def _count(args):
 
 
 def _diff(args):
-    first = load_scan(args.first, args)
-    out = volume.super_diff(first.data, load(args.second, args))
+    first, second = load_scan(args.first, args), load(args.second, args)
+    if first.data.shape != second.shape:
+        raise ValueError(f"{args.first} is {'x'.join(map(str, first.data.shape))} voxels but {args.second} is "
+                         f"{'x'.join(map(str, second.shape))}: diff compares volumes of one size")
+    out = volume.super_diff(first.data, second)
     counts = np.bincount(out.ravel(), minlength=201)
     for label, code in volume.SUPER_DIFF_CODES.items():
-        print(f"{code:3d} {label:12s} {int(counts[code])}")
+        print(f"{code:3d} {label:14s} {int(counts[code])}")
+    differ = out.size - int(counts[0])
+    print(f"{differ} of {out.size} voxels differ ({100 * differ / max(out.size, 1):.3g} %)"
+          if differ else f"identical: all {out.size} voxels hold the same value")
     if args.output:
         save(args.output, out, first.geometry)
 
@@ -301,9 +307,9 @@ def register(sub) -> None:
     _io(p, output=False)
     p.add_argument("--all", action="store_true", help="list all 256 values, also those with count 0")
 
-    p = add_command(sub, "diff", "Compare two volumes: 0 both empty, 100 both, 150 only first, 200 only second "
-                    "(VolumeSuperDiff).",
-                    "volanim diff frog-body.VOL frog-filled.VOL cavities.VOL   # 200: what fill added", _diff)
+    p = add_command(sub, "diff", "Compare two volumes, the thesis's codes: 0 same value, 100 non-zero only in the "
+                    "first, 150 only in the second, 200 both non-zero with different values (VolumeSuperDiff).",
+                    "volanim diff frog-body.VOL frog-filled.VOL cavities.VOL   # 150: what fill added", _diff)
     add_volume_in(p, "first")
     add_volume_in(p, "second")
     p.add_argument("output", nargs="?", help="optional coded difference volume")
