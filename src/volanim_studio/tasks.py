@@ -13,7 +13,7 @@ import numpy as np
 
 from volanim_core import samples
 from volanim_core.geometry import IDENTITY
-from volanim_core.io import read_mskel, read_scan
+from volanim_core.io import read_scan, read_skeleton
 from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter, stage
 from volanim_core.skeleton.hull import display_hulls
@@ -49,7 +49,7 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     report(10, 100)
 
     if skeleton_path:
-        skel = read_mskel(skeleton_path)
+        skel = read_skeleton(skeleton_path).one_level()
     else:
         skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, geometry=geometry or IDENTITY,
                            progress=stage(report, 10, 80), cancel=cancel)

@@ -10,9 +10,10 @@ import numpy as np
 from volanim_core.io import (
     read_bones,
     read_connect,
-    read_mskel,
+    read_skeleton,
     read_trans,
     read_tskel,
+    skeleton_at,
     write_connect,
     write_output,
     write_trans,
@@ -42,9 +43,7 @@ from ._common import (
 def _connect(args):
     from volanim_core.rig.attach import connect
 
-    skel = read_mskel(args.mskel)
-    if args.thinness is not None:
-        skel = skel.at(args.thinness)
+    skel = skeleton_at(read_skeleton(args.mskel), args.thinness, args.mskel)
     mask = None
     if args.volume:
         from .skeleton_commands import mask_like_skeleton
@@ -154,7 +153,7 @@ def register(sub) -> None:
                      "volanim connect mannequin.mskel mannequin.bones --method path --volume mannequin.VOL "
                      "-o mannequin.path.connect"),
                     _connect)
-    p.add_argument("mskel")
+    p.add_argument("mskel", metavar="SKELETON", help="the skeleton: .mskel, or a .skel (one resolution)")
     p.add_argument("bones")
     p.add_argument("--thinness", type=finite_float, help="only points with thinness >= this")
     p.add_argument("--method", choices=METHODS, default="nearest",

@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from volanim_core.io import read_mskel, write_bones, write_connect
+from volanim_core.io import read_skeleton, skeleton_at, write_bones, write_connect
 
 from ._common import add_command, add_dims, finite_float, parse_range, positive_int
 
@@ -19,9 +19,7 @@ def _autorig(args):
     from volanim_core.rig.attach import connect
     from volanim_core.rig.autorig import autorig
 
-    skel = read_mskel(args.mskel)
-    if args.thinness is not None:
-        skel = skel.at(args.thinness)
+    skel = skeleton_at(read_skeleton(args.mskel), args.thinness, args.mskel)
     t0 = time.perf_counter()
     proposal = autorig(skel, template=args.template, bones=args.bones)
     write_bones(args.output, proposal.bones)
@@ -53,7 +51,7 @@ def register(sub) -> None:
                     ("volanim autorig mannequin.mskel --template humanoid -o proposed.bones --connect proposed.connect",
                      "volanim autorig mannequin.mskel --template none --bones 12 -o chains.bones"),
                     _autorig)
-    p.add_argument("mskel")
+    p.add_argument("mskel", metavar="SKELETON", help="the skeleton: .mskel, or a .skel (one resolution)")
     p.add_argument("--thinness", type=finite_float, help="only points with thinness >= this (default: all)")
     p.add_argument("--template", choices=TEMPLATES, default="auto",
                    help="humanoid (the mannequin's names), quadruped, none (chains named by position) or auto: "

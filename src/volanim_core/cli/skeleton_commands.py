@@ -7,7 +7,7 @@ import time
 import numpy as np
 
 from volanim_core.geometry import mm
-from volanim_core.io import read_scan, write_mskel
+from volanim_core.io import read_scan, write_skeleton
 from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
 from volanim_core.skeleton.hull import isosurface
@@ -39,7 +39,7 @@ def _skeletonize(args):
     t0 = time.perf_counter()
     skel = skeletonize(mask, metric=args.metric, min_thinness=args.min_thinness, geometry=geometry, progress=bar)
     elapsed = time.perf_counter() - t0
-    write_mskel(args.output, skel)
+    write_skeleton(args.output, skel)
     lo, hi = (skel.thinness.min(), skel.thinness.max()) if len(skel) else (float("nan"),) * 2
     print(f"{len(skel)} points from {int(mask.sum())} object voxels, thinness {lo:.3f} .. {hi:.3f}, "
           f"dt up to {skel.dt.max() if len(skel) else 0:.2f} ({args.metric}), {elapsed:.2f} s -> {args.output}")
@@ -72,10 +72,12 @@ def _segment_args(p):
 
 
 def register(sub) -> None:
-    p = add_command(sub, "skeletonize", "Distance transform + thinness -> multi-resolution skeleton (.mskel).",
+    p = add_command(sub, "skeletonize", "Distance transform + thinness -> multi-resolution skeleton (.mskel), or one "
+                    "resolution (.skel).",
                     ("volanim skeletonize mannequin.VOL -o mannequin.mskel",
                      "volanim skeletonize frog.VOL --threshold 1:255 --fill-cavities -o frog.mskel",
-                     "volanim skeletonize mannequin.VOL --min-thinness -inf -o every-voxel.mskel   # all voxels"),
+                     "volanim skeletonize mannequin.VOL --min-thinness -inf -o every-voxel.mskel   # all voxels",
+                     "volanim skeletonize mannequin.VOL --min-thinness 0.5 -o mannequin.0.5.skel   # one resolution"),
                     _skeletonize)
     _segment_args(p)
     p.add_argument("--metric", choices=("euclid", "345"), default="euclid", help="distance metric (default euclid)")
@@ -84,7 +86,8 @@ def register(sub) -> None:
     p.add_argument("--voxel-size", type=positive_float, metavar="MM",
                    help="skeletonize on cubes of this size (default: the scan's smallest spacing); a scan whose "
                         "voxels are not cubes is resampled, so spheres stay spheres in the body")
-    p.add_argument("-o", "--output", required=True, help="output .mskel")
+    p.add_argument("-o", "--output", required=True,
+                   help="output .mskel (every thinness), or .skel (the points at --min-thinness, no thinness column)")
 
     p = add_command(sub, "isosurface", "Isosurface hull of the object as a mesh (.ply, .vtp, .obj, .stl).",
                     "volanim isosurface frog.VOL --threshold 1:255 -o frog-hull.ply", _isosurface)

@@ -26,7 +26,7 @@ from .raw_volumes import (
     write_raw,
 )
 from .render_files import read_camera, read_transfer_function, write_camera, write_transfer_function
-from .skeleton_files import read_mskel, read_skel, write_mskel, write_skel
+from .skeleton_files import read_mskel, read_skel, read_skeleton, skeleton_at, write_mskel, write_skel, write_skeleton
 from .volume_files import (
     Scan,
     float_to_uint8,
@@ -57,6 +57,8 @@ __all__ = [
     "read_mskel",
     "read_raw",
     "read_skel",
+    "read_skeleton",
+    "skeleton_at",
     "read_trans",
     "read_tskel",
     "read_volume",
@@ -69,6 +71,7 @@ __all__ = [
     "write_connect",
     "write_connections",
     "write_mskel",
+    "write_skeleton",
     "write_raw",
     "write_skel",
     "write_trans",

@@ -1,4 +1,8 @@
-"""``.skel`` (x y z dt) and ``.mskel`` (x y z dt thinness, sorted) files."""
+"""``.skel`` (x y z dt: one resolution) and ``.mskel`` (x y z dt thinness, sorted) files.
+
+:func:`read_skeleton` and :func:`write_skeleton` pick the format by the name, so every
+tool that takes a skeleton takes both, as the thesis's tools took ``.skel``.
+"""
 
 from __future__ import annotations
 
@@ -52,3 +56,23 @@ def write_mskel(path: str | Path, skel: Skeleton) -> None:
     skel = skel if skel.is_sorted() else skel.sorted()
     lines = _header("mskel", skel) + format_point_rows(skel.points, skel.dt, skel.thinness)
     atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def read_skeleton(path: str | Path) -> Skeleton:
+    """A ``.skel`` (thinness NaN: one resolution) or a ``.mskel``, by the file's suffix."""
+    return read_skel(path) if Path(path).suffix.lower() == ".skel" else read_mskel(path)
+
+
+def write_skeleton(path: str | Path, skel: Skeleton) -> None:
+    """``.skel`` (the points as they are, no thinness) or ``.mskel``, by the file's suffix."""
+    (write_skel if Path(path).suffix.lower() == ".skel" else write_mskel)(path, skel)
+
+
+def skeleton_at(skel: Skeleton, thinness: float | None, path) -> Skeleton:
+    """``skel`` at ``thinness`` (None: as it is); a ``.skel`` has one resolution, so a thinness is refused."""
+    if thinness is None:
+        return skel
+    if skel.single_resolution:
+        raise ValueError(f"{path}: a .skel holds one resolution (no thinness column), so there is no "
+                         f"thinness {thinness:g} to choose; give a .mskel, or leave out --thinness")
+    return skel.at(thinness)

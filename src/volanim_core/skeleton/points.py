@@ -79,6 +79,18 @@ class Skeleton:
         key = np.where(np.isnan(self.thinness), -np.inf, self.thinness)
         return bool(np.all(key[:-1] >= key[1:]))
 
+    @property
+    def single_resolution(self) -> bool:
+        """No thinness known (a ``.skel``): the points are one skeleton, not a family of them."""
+        return len(self) > 0 and bool(np.isnan(self.thinness).all())
+
+    def one_level(self, thinness: float = 0.0) -> Skeleton:
+        """A ``.skel``'s points given one thinness, so a tool that chooses by thinness (the studio's slider)
+        shows them all; a skeleton with thinness is returned as it is."""
+        if not self.single_resolution:
+            return self
+        return Skeleton(self.points, self.dt, np.full(len(self), float(thinness)), self.metric, self.geometry)
+
     def count_at(self, thinness: float) -> int:
         """Number of points with thinness >= ``thinness`` (the sorted prefix length)."""
         # Sorted decreasing, so search the negated (increasing) array.

@@ -167,7 +167,7 @@ class FilesController(Controller):
 
     def open_mskel(self, path) -> bool:
         def load():
-            skel = io.read_mskel(path)
+            skel = io.read_skeleton(path).one_level()  # a .skel: one level of the slider
             self.doc.loading(lambda: self.doc.set_skeleton(skel, path))
             return skel
 
@@ -254,7 +254,7 @@ class FilesController(Controller):
             self._ask_open(kind)
 
     def _ask_open(self, kind: str) -> None:
-        filters = {"mskel": "Skeletons (*.mskel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
+        filters = {"mskel": "Skeletons (*.mskel *.skel)", "bones": "Bones (*.bones)", "project": "Projects (*.volanim)",
                    "connect": "Connectivity (*.connect)", "connections": "Connections (*.connections)"}
         path, _ = QFileDialog.getOpenFileName(self.window, f"Open {kind}", self.folder(),
                                               f"{filters[kind]};;All files (*)")

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from runnable import volanim
 from volanim_core import io
+from volanim_core.cli import main
+from volanim_core.samples import write_sample
 
 
 def _vol(path, v):
@@ -30,3 +33,46 @@ def test_diff_reports_changed_values_and_a_summary(tmp_path):
     assert same.returncode == 0 and "identical: all 120 voxels" in same.stdout
     bad = volanim("diff", tmp_path / "a.VOL", _vol(tmp_path / "small.VOL", a[:3]))
     assert bad.returncode == 2 and "6x5x4 voxels but" in bad.stderr and "small.VOL is 3x5x4" in bad.stderr
+
+
+@pytest.fixture(scope="module")
+def mannequin(tmp_path_factory):
+    d = tmp_path_factory.mktemp("thesis")
+    write_sample("mannequin", d)
+    assert main(["skeletonize", str(d / "mannequin.VOL"), "-o", str(d / "m.mskel")]) == 0
+    return d
+
+
+# spec: docs/formats.md#skel
+def test_a_thesis_skel_is_written_and_read_by_every_skeleton_tool(mannequin):
+    d = mannequin
+    r = volanim("skeletonize", d / "mannequin.VOL", "--min-thinness", "0.5", "-o", d / "m.skel")
+    assert r.returncode == 0, r.stderr
+    rows = [line.split() for line in (d / "m.skel").read_text().splitlines() if not line.startswith("#")]
+    assert {len(row) for row in rows} == {4}  # x y z dt: no thinness column
+    at = io.read_mskel(d / "m.mskel").at(0.5)
+    assert np.array_equal(np.array([[int(v) for v in row[:3]] for row in rows]), at.points)
+    assert np.allclose([float(row[3]) for row in rows], at.dt, atol=1e-4)
+
+    # the thesis's own kind of file: bare rows, no header, in another order
+    order = np.random.default_rng(3).permutation(len(at))
+    (d / "thesis.skel").write_text("".join(f"{x} {y} {z} {r:.4f}\n" for (x, y, z), r in
+                                           zip(at.points[order], at.dt[order])))
+    a = volanim("connect", d / "thesis.skel", d / "mannequin.bones", "-o", d / "s.connect")
+    b = volanim("connect", d / "m.mskel", d / "mannequin.bones", "--thinness", "0.5", "-o", d / "m.connect")
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    cs, cm = io.read_connect(d / "s.connect"), io.read_connect(d / "m.connect")
+    bone_s = {tuple(p): cs.bone[i] for i, p in enumerate(cs.points)}
+    assert len(cs) == len(cm) == len(at)
+    assert all(bone_s[tuple(p)] == cm.bone[i] for i, p in enumerate(cm.points))
+    t = volanim("connect2identitytskel", d / "s.connect", "-o", d / "s.tskel")
+    rec = volanim("reconstruct", d / "s.tskel", "-o", d / "s.vti")
+    assert t.returncode == 0 and rec.returncode == 0, t.stderr + rec.stderr
+    assert volanim("autorig", d / "thesis.skel", "-o", d / "a.bones").returncode == 0
+
+    refused = volanim("connect", d / "thesis.skel", d / "mannequin.bones", "--thinness", "1", "-o", d / "x.connect")
+    assert refused.returncode == 2 and "thesis.skel: a .skel holds one resolution" in refused.stderr
+    assert not (d / "x.connect").exists()
+    (d / "bad.skel").write_text("1 2 3 1.5\n4 5 6\n")
+    bad = volanim("connect", d / "bad.skel", d / "mannequin.bones", "-o", d / "x.connect")
+    assert bad.returncode == 2 and "bad.skel:2" in bad.stderr

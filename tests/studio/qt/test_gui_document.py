@@ -196,3 +196,16 @@ def test_a_project_in_the_autosave_area_is_saved_where_the_user_says(qtbot, wind
     assert window.files.save_project() == chosen  # Ctrl+S
     assert asked and "autosave area" in asked[0][1] and cached.read_bytes() == before
     assert window.doc.project_path == str(chosen) and not window.isWindowModified()
+
+
+# spec: docs/formats.md#skel
+def test_the_studio_opens_a_thesis_skel_and_shows_all_of_it(window, tmp_path):
+    # bare 'x y z dt' rows, as the thesis's tools wrote them (no header, no thinness)
+    at = window.doc.skeleton.at(0.8)
+    (tmp_path / "thesis.skel").write_text("".join(f"{x} {y} {z} {r:.3f}\n" for (x, y, z), r in zip(at.points, at.dt)))
+    assert window.files.open_mskel(tmp_path / "thesis.skel")
+    assert len(window.doc.skeleton) == len(at) and window.doc.visible_count == len(at)
+    assert window.doc.thinness_range == (0.0, 0.0)
+    path = window.files.save_project(path=tmp_path / "thesis.volanim")
+    window.files.open_project(path)
+    assert window.doc.visible_count == len(at)
