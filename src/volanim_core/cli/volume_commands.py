@@ -147,12 +147,14 @@ def _reverse(args):
 
 
 def read_remap_table(path: str) -> np.ndarray:
-    """A remap table file: ``FROM TO`` pairs (others unchanged) or 256 single values."""
+    """A remap table file: ``FROM TO`` pairs (others unchanged) or single values, line k for value k:
+    256 lines, or the thesis's 255 (values 0..254; 255 stays 255)."""
     rec = read_records(path)
     table = np.arange(256)
     if all(len(t) == 1 for _, t in rec.records):
-        if len(rec.records) != 256:
-            raise rec.error(None, f"a table of single values needs 256 lines, got {len(rec.records)}")
+        if len(rec.records) not in (255, 256):
+            raise rec.error(None, f"a table of single values needs 256 lines (or the thesis's 255), "
+                                  f"got {len(rec.records)}")
         for i, (line, toks) in enumerate(rec.records):
             table[i] = parse_int(rec, line, toks[0], "value")
     else:
@@ -193,8 +195,9 @@ def _addheader(args):
 
 
 def _rmheader(args):
-    dims = remove_header(args.input, args.output)
-    print(f"wrote {args.output} ({dims[0]}x{dims[1]}x{dims[2]}, no header)")
+    dims = remove_header(args.input, args.output, args.header_size, args.dims)
+    size = f"{dims[0]}x{dims[1]}x{dims[2]}" if dims else f"{Path(args.output).stat().st_size} bytes"
+    print(f"wrote {args.output} ({size}, no header)")
 
 
 def _fitpow2(args):
@@ -320,17 +323,22 @@ def register(sub) -> None:
     _io(p)
 
     p = add_command(sub, "remap", "Remap values through a table (remapVolume): a file of 'FROM TO' lines or of "
-                    "256 lines of one value, or FROM:TO pairs on the command line; other values are unchanged.",
+                    "256 (or the thesis's 255) lines of one value, or FROM:TO pairs on the command line; other values are unchanged.",
                     "volanim remap frog.VOL frog-merged.VOL --pairs 2:1 3:1   # tissues 2 and 3 become 1", _remap)
     _io(p)
     how = p.add_mutually_exclusive_group(required=True)
-    how.add_argument("--table", help="table file: 'FROM TO' lines, or 256 lines of one value (docs/formats.md)")
+    how.add_argument("--table", help="table file: 'FROM TO' lines, or 256 (255) lines of one value (docs/formats.md)")
     how.add_argument("--pairs", nargs="+", type=remap_pair, metavar="FROM:TO", help="value pairs, e.g. 2:1 3:1")
 
-    p = add_command(sub, "rmheader", "Remove the 100-byte .VOL header, streaming (rmhdr).",
-                    "volanim rmheader frog.VOL frog.500x470x136.vol", _rmheader)
-    p.add_argument("input", help=".VOL with header")
+    p = add_command(sub, "rmheader", "Remove the 100-byte .VOL header, or a header of any size, streaming (rmhdr).",
+                    ("volanim rmheader frog.VOL frog.500x470x136.vol",
+                     "volanim rmheader frog.VOL body.500x470x136.vol --header-size 100 --dims 500 470 136"), _rmheader)
+    p.add_argument("input", help=".VOL with header, or any raw file with --header-size")
     p.add_argument("output", help="output .vol")
+    p.add_argument("--header-size", type=ascii_int, metavar="BYTES",
+                   help="drop this many bytes, whatever they hold (default: the .VOL header, sized from it)")
+    p.add_argument("--dims", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"),
+                   help="with --header-size: the voxels the rest must hold (checked)")
 
     p = add_command(sub, "addheader", "Add the 100-byte .VOL header, streaming (AddHeader).",
                     "volanim addheader frog.500x470x136.vol frog-again.VOL", _addheader)

@@ -217,18 +217,31 @@ def add_header(src: str | Path, dst: str | Path, dims=None) -> tuple[int, int, i
     return dims
 
 
-def remove_header(src: str | Path, dst: str | Path) -> tuple[int, int, int]:
-    """Stream a ``.VOL`` into a bare ``.vol`` (rmhdr)."""
-    dims = read_header_dims(src, allocate=False)
-    n, size = math.prod(dims), Path(src).stat().st_size
-    channels = channels_for(size - HEADER_BYTES, n)
-    if not channels:
-        raise FormatError(src, f"file has {size} bytes, expected {n + HEADER_BYTES} for header + {dims} voxels "
-                               f"(or {3 * n + HEADER_BYTES} in RGB)")
+def remove_header(src: str | Path, dst: str | Path, header_size: int | None = None,
+                  dims=None) -> tuple[int, int, int] | None:
+    """Stream a file minus its header into a bare ``.vol`` (rmhdr).
+
+    Without ``header_size`` the file is a ``.VOL``: its 100-byte header names the size, which is
+    checked and returned. With it (the thesis's rmhdr took one), that many bytes are dropped from
+    whatever file it is; the rest must be ``dims`` voxels (grey or RGB) when ``dims`` is given, and
+    the dims (or None) are returned.
+    """
+    size = Path(src).stat().st_size
+    if header_size is None:
+        dims = read_header_dims(src, allocate=False)
+        header_size = HEADER_BYTES
+    if header_size < 0 or header_size >= size:
+        raise FormatError(src, f"has {size} bytes: a header of {header_size} bytes leaves no voxels")
+    body = size - header_size
+    if dims is not None:
+        n = math.prod(dims)
+        if not channels_for(body, n):
+            raise FormatError(src, f"file has {size} bytes, expected {n + header_size} for a {header_size}-byte "
+                                   f"header + {'x'.join(map(str, dims))} voxels (or {3 * n + header_size} in RGB)")
     with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
-        fin.seek(HEADER_BYTES)
-        _copy_stream(fin, fout, n * channels)
-    return dims
+        fin.seek(header_size)
+        _copy_stream(fin, fout, body)
+    return None if dims is None else tuple(int(v) for v in dims)
 
 
 def histogram_file(path: str | Path, dims=None) -> np.ndarray:

@@ -76,3 +76,35 @@ def test_a_thesis_skel_is_written_and_read_by_every_skeleton_tool(mannequin):
     (d / "bad.skel").write_text("1 2 3 1.5\n4 5 6\n")
     bad = volanim("connect", d / "bad.skel", d / "mannequin.bones", "-o", d / "x.connect")
     assert bad.returncode == 2 and "bad.skel:2" in bad.stderr
+
+
+def test_rmheader_takes_a_header_size_as_the_thesis_rmhdr_did(tmp_path):
+    v = np.random.default_rng(5).integers(0, 256, (7, 6, 5), dtype=np.uint8)
+    raw = np.ascontiguousarray(v.transpose(2, 1, 0)).tobytes()
+    (tmp_path / "scanner.img").write_bytes(b"SCANNER HEADER".ljust(512, b"\0") + raw)  # another header, 512 bytes
+    r = volanim("rmheader", tmp_path / "scanner.img", tmp_path / "s.7x6x5.vol", "--header-size", "512",
+                "--dims", "7", "6", "5")
+    assert r.returncode == 0, r.stderr
+    assert "7x6x5, no header" in r.stdout
+    assert np.array_equal(io.read_volume(tmp_path / "s.7x6x5.vol"), v)
+    bare = volanim("rmheader", tmp_path / "scanner.img", tmp_path / "bare.raw", "--header-size", "512")
+    assert bare.returncode == 0 and (tmp_path / "bare.raw").read_bytes() == raw
+    wrong = volanim("rmheader", tmp_path / "scanner.img", tmp_path / "w.vol", "--header-size", "500",
+                    "--dims", "7", "6", "5")
+    assert wrong.returncode == 2 and "scanner.img" in wrong.stderr and "500-byte header" in wrong.stderr
+    assert not (tmp_path / "w.vol").exists()
+    big = volanim("rmheader", tmp_path / "scanner.img", tmp_path / "w.vol", "--header-size", "99999")
+    assert big.returncode == 2 and "leaves no voxels" in big.stderr
+
+
+# spec: docs/formats.md#remap
+def test_remap_reads_the_thesis_255_line_tables(tmp_path):
+    v = np.arange(256, dtype=np.uint8).repeat(2).reshape(8, 8, 8)
+    (tmp_path / "t255.txt").write_text("".join(f"{(k * 7) % 256}\n" for k in range(255)))
+    r = volanim("remap", _vol(tmp_path / "v.VOL", v), tmp_path / "o.VOL", "--table", tmp_path / "t255.txt")
+    assert r.returncode == 0, r.stderr
+    expected = np.where(v == 255, 255, (v.astype(int) * 7) % 256)
+    assert np.array_equal(io.read_volume(tmp_path / "o.VOL"), expected)
+    (tmp_path / "t200.txt").write_text("1\n" * 200)
+    bad = volanim("remap", tmp_path / "v.VOL", tmp_path / "x.VOL", "--table", tmp_path / "t200.txt")
+    assert bad.returncode == 2 and "t200.txt" in bad.stderr and "got 200" in bad.stderr
