@@ -142,6 +142,14 @@ def positive_int(text: str) -> int:
     return value
 
 
+def non_negative_int(text: str) -> int:
+    """A whole number of 0 or more (first numbers of a series, frame indices)."""
+    value = ascii_int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected 0 or more, got {text!r}")
+    return value
+
+
 AXIS_OPTIONS = ("--down", "--up", "--forward")  # options whose value is a signed axis such as -z
 _SIGNED_AXIS = re.compile(r"-[xyz]", re.IGNORECASE)
 RANGE_OPTIONS = ("--threshold", "--range")  # LO[:HI]: a CT's body starts at -300 Hounsfield units

@@ -14,7 +14,7 @@ import numpy as np
 
 from volanim_core.progress import TextProgress
 
-from ._common import EXAMPLES_HEADER, add_command, add_dims, ascii_int, finite_float
+from ._common import EXAMPLES_HEADER, add_command, add_dims, ascii_int, finite_float, non_negative_int
 
 PALETTE_EXAMPLES = (
     "volanim palette build mannequin-colour.VOL -o mannequin.palette.txt --colours 255",
@@ -26,7 +26,7 @@ ALPHA_EXAMPLES = (
     "volanim alpha ramp 0:0 1:0.02 254:0.6 -o mannequin-ramp.alpha   # see-through skin, solid bone",
     "volanim alpha merge mannequin-sorted.palette.txt mannequin-ramp.alpha --clear-black -o mannequin.tf",
     "volanim alpha factor mannequin-ramp.alpha 0.5 -o mannequin-faint.alpha",
-    "volanim alpha interpolate mannequin-ramp.alpha mannequin-faint.alpha -n 3 -o mannequin-fade",
+    "volanim alpha interpolate mannequin-ramp.alpha mannequin-faint.alpha -n 3 -o mannequin-fade --start 41",
 )
 
 
@@ -170,8 +170,8 @@ def _interpolate(args):
     from volanim_core.io.palette_files import read_alpha_map, write_alpha_map
 
     maps = interpolate_alpha(read_alpha_map(args.first), read_alpha_map(args.second), args.n)
-    width = len(str(len(maps)))
-    for k, (values, alphas) in enumerate(maps, start=1):
+    width = len(str(args.start + len(maps) - 1))
+    for k, (values, alphas) in enumerate(maps, start=args.start):
         path = f"{args.output}-{k:0{width}d}.alpha"
         write_alpha_map(path, values, alphas)
         print(f"wrote {path}")
@@ -251,4 +251,8 @@ def register(sub) -> None:
     p.add_argument("first", help="alpha map file")
     p.add_argument("second", help="alpha map file")
     p.add_argument("-n", type=ascii_int, required=True, help="maps between the two")
-    p.add_argument("-o", "--output", required=True, metavar="PREFIX", help="write PREFIX-1.alpha ... PREFIX-N.alpha")
+    p.add_argument("--start", type=non_negative_int, default=1, metavar="K",
+                   help="number of the first map (default 1), e.g. the frame the fade starts on, as the thesis's "
+                        "InterpolateAlpha took")
+    p.add_argument("-o", "--output", required=True, metavar="PREFIX",
+                   help="write PREFIX-K.alpha ... PREFIX-(K+N-1).alpha")

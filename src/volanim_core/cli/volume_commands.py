@@ -323,7 +323,8 @@ def register(sub) -> None:
     _io(p)
 
     p = add_command(sub, "remap", "Remap values through a table (remapVolume): a file of 'FROM TO' lines or of "
-                    "256 (or the thesis's 255) lines of one value, or FROM:TO pairs on the command line; other values are unchanged.",
+                    "256 (or the thesis's 255) lines of one value, or FROM:TO pairs on the command line; other "
+                    "values are unchanged.",
                     "volanim remap frog.VOL frog-merged.VOL --pairs 2:1 3:1   # tissues 2 and 3 become 1", _remap)
     _io(p)
     how = p.add_mutually_exclusive_group(required=True)

@@ -108,3 +108,21 @@ def test_remap_reads_the_thesis_255_line_tables(tmp_path):
     (tmp_path / "t200.txt").write_text("1\n" * 200)
     bad = volanim("remap", tmp_path / "v.VOL", tmp_path / "x.VOL", "--table", tmp_path / "t200.txt")
     assert bad.returncode == 2 and "t200.txt" in bad.stderr and "got 200" in bad.stderr
+
+
+# spec: docs/formats.md#alpha
+def test_alpha_interpolate_numbers_its_maps_from_a_start_index(tmp_path):
+    (tmp_path / "a.alpha").write_text("0 0\n255 1\n")
+    (tmp_path / "b.alpha").write_text("0 1\n255 0\n")
+    r = volanim("alpha", "interpolate", tmp_path / "a.alpha", tmp_path / "b.alpha", "-n", "3", "--start", "98",
+                "-o", tmp_path / "fade")
+    assert r.returncode == 0, r.stderr
+    assert sorted(p.name for p in tmp_path.glob("fade-*")) == ["fade-098.alpha", "fade-099.alpha", "fade-100.alpha"]
+    # map k of 3 is a quarter, a half, three quarters of the way: at index 0 the alpha goes 0 -> 1
+    from volanim_core.io.palette_files import read_alpha_map
+
+    firsts = [read_alpha_map(tmp_path / f"fade-{k:03d}.alpha")[1][0] for k in (98, 99, 100)]
+    assert np.allclose(firsts, [0.25, 0.5, 0.75])
+    bad = volanim("alpha", "interpolate", tmp_path / "a.alpha", tmp_path / "b.alpha", "-n", "3", "--start", "-1",
+                  "-o", tmp_path / "x")
+    assert bad.returncode == 2 and "expected 0 or more" in bad.stderr
