@@ -142,6 +142,14 @@ def positive_int(text: str) -> int:
     return value
 
 
+def non_negative_float(text: str) -> float:
+    """A finite number of 0 or more (accelerations)."""
+    value = finite_float(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected 0 or more, got {text!r}")
+    return value
+
+
 def non_negative_int(text: str) -> int:
     """A whole number of 0 or more (first numbers of a series, frame indices)."""
     value = ascii_int(text)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+from volanim_core.progress import TextProgress
+
 from ._common import (
     FrameProgress,
     add_command,
@@ -12,10 +14,14 @@ from ._common import (
     ascii_int,
     checked_by,
     joints_of,
+    load_scan,
     load_source,
     local_workers,
+    non_negative_float,
+    non_negative_int,
     positive_float,
     positive_int,
+    save,
 )
 
 EXAMPLE = (
@@ -40,12 +46,17 @@ def _sequence(args):
     bones = read_bones(args.bones) if args.bones else None
     frames = frames_from_files(conn, args.frames, bones=bones, mapping=read_mapping(args.map) if args.map else None,
                                frames=args.range, up=args.up, forward=args.forward)
-    if args.melt:
+    if not args.crumble and (args.acceleration or args.heap != "keep"):
+        raise ValueError("--acceleration and --heap shape a crumble: give --crumble N")
+    if args.melt and args.teleport:
+        raise ValueError("--melt and --teleport are two ends: give one (--melt combines with --crumble)")
+    if args.crumble:  # with --melt the spheres shrink while they fall (the thesis's melt and crumble at once)
+        frames += crumble(frames, args.crumble, down=args.down, acceleration=args.acceleration, heap=args.heap,
+                          melt=args.melt or 0, conn=conn)
+    elif args.melt:
         frames += melt(frames, args.melt)
     elif args.teleport:
         frames += teleport(conn, frames, args.teleport, down=args.down)
-    elif args.crumble:
-        frames += crumble(frames, args.crumble, down=args.down)
     source, source_geometry = load_source(args, conn)
     workers = local_workers(args)
     rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_geometry=source_geometry,
@@ -57,6 +68,25 @@ def _sequence(args):
     print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "
           f"origin {rep.bounds.lo}; {rep.computed} made, {rep.skipped} already complete; {rep.workers}; "
           f"{rep.seconds:.1f} s")
+
+
+def _crumble(args):
+    from volanim_core.io.volume_files import _natural_key
+    from volanim_core.sequence.effects import fall_series
+
+    names = {args.output % 1, args.output % 2} if "%" in args.output else set()
+    if len(names) != 2:
+        raise ValueError(f"-o {args.output!r} needs one number field for the frame, e.g. heap/frame.%%04d.VOL")
+    paths = sorted(args.volumes, key=lambda p: _natural_key(str(p)))  # frame.2 before frame.10
+    scans = [load_scan(p, args) for p in paths]
+    bar = TextProgress("crumble")
+    frames = fall_series([s.data for s in scans], args.n, args.down, acceleration=args.acceleration, heap=args.heap)
+    for k, vol in enumerate(frames, start=args.start):
+        save(args.output % k, vol, scans[0].geometry)
+        bar(k - args.start + 1, args.n)
+    bar.close()
+    print(f"{args.n} frames from {len(paths)} volume{'s' * (len(paths) > 1)} -> {args.output % args.start} .. "
+          f"{args.output % (args.start + args.n - 1)}")
 
 
 def format_report(rep) -> str:
@@ -72,6 +102,25 @@ def format_report(rep) -> str:
 
 def register(sub) -> None:
     from volanim_core.reconstruct.engine import MODES
+
+    p = add_command(sub, "crumble", "Any volume, or a numbered series of them, falls into a heap frame by frame "
+                    "(the thesis's multiVolumeMelt): one output volume a frame.",
+                    ("volanim crumble mannequin.VOL -n 4 --heap sum -o mannequin-heap.%04d.VOL",
+                     "volanim crumble mannequin-heap.0001.VOL mannequin-heap.0002.VOL -n 2 --acceleration 20 "
+                     "-o again.%04d.nrrd   # a series: one volume a frame"),
+                    _crumble)
+    p.add_argument("volumes", nargs="+", help="one volume (held), or one for each frame (numbered: taken in order)")
+    p.add_argument("-n", type=positive_int, required=True, help="frames; the top lands on the last one")
+    p.add_argument("-o", "--output", required=True, metavar="DIR/NAME.%%04d.VOL",
+                   help="the frames' files (any volume format; %%04d = frame number)")
+    p.add_argument("--start", type=non_negative_int, default=1, help="number of the first frame (default 1)")
+    p.add_argument("--acceleration", type=non_negative_float, default=0.0, metavar="A",
+                   help="fall a*k^2/2 voxels by frame k (default: the top lands on the last frame)")
+    p.add_argument("--heap", choices=("keep", "sum"), default="keep",
+                   help="a heap voxel keeps its value (default), or holds the capped sum of what rests on it")
+    p.add_argument("--down", default="-z", type=checked_by("volanim_core.sequence.effects:parse_axis"),
+                   help="the way down (default -z)")
+    add_dims(p)
 
     from .motion_commands import parse_frames
 
@@ -96,12 +145,17 @@ def register(sub) -> None:
     p.add_argument("--force", action="store_true", help="recompute every frame (and replace another sequence)")
     p.add_argument("--fps", type=positive_float, default=24.0, help="frame rate recorded in the store (default 24)")
     effect = p.add_mutually_exclusive_group()
-    effect.add_argument("--melt", type=positive_int, metavar="N",
-                        help="after the frames, N more: every DT shrinks to 0")
+    p.add_argument("--melt", type=positive_int, metavar="N",
+                   help="after the frames, N more: every DT shrinks to 0 (with --crumble: while it falls)")
     effect.add_argument("--teleport", type=positive_int, metavar="N",
                         help="after the frames, N more: the body vanishes from the head down")
     effect.add_argument("--crumble", type=positive_int, metavar="N",
                         help="after the frames, N more: the voxels fall and pile into a heap")
+    p.add_argument("--acceleration", type=non_negative_float, default=0.0, metavar="A",
+                   help="crumble: fall a*k^2/2 voxels by frame k (default: the top lands on the last frame)")
+    p.add_argument("--heap", choices=("keep", "sum"), default="keep",
+                   help="crumble: a heap voxel keeps its value (default), or holds the sum of what rests on it, "
+                        "capped (the thesis's multiVolumeMelt)")
     p.add_argument("--down", default="-z",
                    type=checked_by("volanim_core.sequence.effects:parse_axis"),
                    help="teleport/crumble: the way down (default -z)")

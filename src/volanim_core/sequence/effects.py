@@ -2,7 +2,8 @@
 
     melt(frames, N)              every sphere's DT shrinks linearly to 0 (the old ``meltMan``)
     teleport(conn, frames, N)    a beam sweeps head to feet; each sphere shrinks to 0 as it passes
-    crumble(frames, N)           voxels fall with constant acceleration and pile into a heap (``multiVolumeMelt``)
+    crumble(frames, N)           voxels fall with constant acceleration and pile into a heap (``multiVolumeMelt``);
+                                 with ``melt`` the spheres shrink as they fall; ``heap="sum"``: the thesis's heap colour
 
 Melt and teleport only scale the radii, so their frames are ordinary
 reconstructions. A crumble frame is the last pose reconstructed and then
@@ -67,44 +68,85 @@ def teleport(conn: Connectivity, after: list[FrameSpec], n: int, down: str = "-z
     return out
 
 
-def crumble(after: list[FrameSpec], n: int, down: str = "-z") -> list[FrameSpec]:
-    """``n`` frames in which the last pose's voxels fall (distance grows with the square of time)
-    onto the floor under its lowest voxel; the top lands exactly at the last frame."""
+HEAPS = ("keep", "sum")  # a heap voxel: its own grain's value, or the capped sum resting on it (multiVolumeMelt)
+
+
+def crumble(after: list[FrameSpec], n: int, down: str = "-z", *, acceleration: float = 0.0, heap: str = "keep",
+            melt: int = 0, conn: Connectivity | None = None) -> list[FrameSpec]:
+    """``n`` frames in which the last pose's voxels fall onto the floor under its lowest voxel.
+
+    By default the distance grows with the square of time so that the top lands exactly at the last
+    frame; ``acceleration`` (voxels per frame², the thesis's multiVolumeMelt parameter) gives the
+    distance ``a k² / 2`` at frame k instead, landed or not. ``melt`` (frames; needs ``conn``) shrinks
+    every sphere to nothing over that many frames while it falls: the floor and the height stay the
+    standing pose's. ``heap`` is :data:`HEAPS`.
+    """
     last = _check(after, n, "crumble")
-    parse_axis(down)  # refuse a bad axis before any frame runs
-    return [FrameSpec(last.number + k, last.matrices, 1.0, k / n, down) for k in range(1, n + 1)]
+    axis, sign = parse_axis(down)  # refuse a bad axis before any frame runs
+    if heap not in HEAPS:
+        raise ValueError(f"a heap is one of {', '.join(HEAPS)}, got {heap!r}")
+    if not np.isfinite(acceleration) or acceleration < 0:
+        raise ValueError(f"the acceleration is a number of voxels per frame squared >= 0, got {acceleration}")
+    total = max(n, melt)
+    floor = height = None
+    if melt or acceleration:  # distances fixed now, from the standing body: a shrinking one keeps its floor
+        if conn is None:
+            raise ValueError("a crumble that melts or has an acceleration needs the connectivity")
+        from volanim_core.reconstruct.engine import grid_bounds
+
+        box = grid_bounds(last.tskel(conn), 0)
+        floor = box.lo[axis] if sign < 0 else box.hi[axis]
+        height = box.hi[axis] - box.lo[axis]
+    out = []
+    for k in range(1, total + 1):
+        fraction = min(k / n, 1.0)
+        drop = None
+        if floor is not None:
+            drop = 0.5 * acceleration * k * k if acceleration else height * fraction * fraction
+        scale = max(0.0, 1.0 - k / melt) if melt else 1.0
+        out.append(FrameSpec(last.number + k, last.matrices, scale, fraction, down, heap=heap, floor=floor,
+                             drop=drop))
+    return out
 
 
-def fall(volume: np.ndarray, fraction: float, down: str = "-z") -> np.ndarray:
+def fall(volume: np.ndarray, fraction: float, down: str = "-z", *, heap: str = "keep", floor: int | None = None,
+         drop: float | None = None) -> np.ndarray:
     """``volume`` (x, y, z) after its voxels have fallen ``fraction`` (0..1) of the way.
 
     Every filled voxel falls straight down its column by ``d = H * fraction**2``
     voxels (constant acceleration; ``H`` = the body's height above the floor, its
-    lowest voxel), so the top lands exactly at ``fraction = 1``. Nothing passes
+    lowest voxel), so the top lands exactly at ``fraction = 1``; ``drop`` gives
+    ``d`` itself and ``floor`` the floor's index along the axis (a body that moves
+    or melts while it falls keeps the floor it stood on). Nothing passes
     through anything: voxel ``r`` of a column (counted from the bottom) would be
     at ``max(z - d, floor + r)``; those resting (the second term wins -- always the
     bottom of a column) form the heap, which slumps until no slope is steeper than
     45 degrees (:func:`settle`; the grid's sides are walls). Voxels that the
     settled heap now reaches land on it and settle too, until the rest are all
-    above it, still falling. Every voxel keeps its value, so the heap
-    is coloured by everything that fell on it. Each frame is computed from the
-    standing volume alone: any worker, any order, the same voxels.
+    above it, still falling. With ``heap="keep"`` every voxel keeps its value, so
+    the heap is coloured by everything that fell on it; with ``"sum"`` a heap voxel
+    holds the sum of its value and those resting above it in its column, capped
+    at the type's maximum (the thesis's multiVolumeMelt). Each frame is computed
+    from the standing volume alone: any worker, any order, the same voxels.
     """
     from ._heap_kernels import settle
 
     if not 0.0 <= fraction <= 1.0:
         raise ValueError(f"a fall fraction is between 0 and 1, got {fraction}")
+    if heap not in HEAPS:
+        raise ValueError(f"a heap is one of {', '.join(HEAPS)}, got {heap!r}")
     axis, sign = parse_axis(down)
-    if fraction == 0.0:
+    if fraction == 0.0 and not drop:
         return volume.copy()  # still standing: it turns to sand the moment it starts to fall
     a = np.moveaxis(volume, axis, -1)
     if sign > 0:
         a = a[..., ::-1]  # falling toward higher indices: flip so that down is always toward 0
+        floor = None if floor is None else a.shape[2] - 1 - floor
     i, j, k = np.nonzero(a)  # C order: by column, then from the bottom up within a column
     out = np.zeros_like(a)
     if len(k):
-        floor = int(k.min())
-        d = int(np.floor((int(k.max()) - floor) * fraction * fraction + 1e-9))
+        floor = int(k.min()) if floor is None else max(0, min(int(floor), int(k.min())))
+        d = int(np.floor((int(k.max()) - floor) * fraction * fraction + 1e-9)) if drop is None else int(drop)
         ny = a.shape[1]
         heights = np.zeros(a.shape[:2], np.int64)
         stacks = np.full((*a.shape[:2], a.shape[2] - floor), -1, np.int32)  # grain ids, bottom up
@@ -123,13 +165,44 @@ def fall(volume: np.ndarray, fraction: float, down: str = "-z") -> np.ndarray:
             np.add.at(heights, (i[g], j[g]), 1)
             settle(stacks, heights)
             falling = falling[~lands]
+        values = a[i, j, k]
         x, y, h = np.nonzero(stacks >= 0)
-        out[x, y, floor + h] = a[i, j, k][stacks[x, y, h]]
+        if heap == "sum":
+            out[..., floor:] = _resting_sums(stacks, values, a.dtype)
+        else:
+            out[x, y, floor + h] = values[stacks[x, y, h]]
         fi, fj = i[falling], j[falling]  # still in the air, above the heap
-        out[fi, fj, k[falling] - d] = a[fi, fj, k[falling]]
+        out[fi, fj, k[falling] - d] = values[falling]
     if sign > 0:
         out = out[..., ::-1]
     return np.ascontiguousarray(np.moveaxis(out, -1, axis))
+
+
+def fall_series(volumes, n: int, down: str = "-z", *, acceleration: float = 0.0, heap: str = "keep"):
+    """The thesis's multiVolumeMelt on any volumes: ``n`` frames, frame k (1..n) the k-th volume (or the one
+    volume, held) fallen as :func:`fall` makes it, all onto the floor under the first one's lowest voxel;
+    ``acceleration`` as in :func:`crumble`. Yields the frames one at a time (volumes on one grid)."""
+    if n < 1:
+        raise ValueError(f"a crumble needs at least one frame, got {n}")
+    if len(volumes) not in (1, n):
+        raise ValueError(f"give one volume, or one for each of the {n} frames, not {len(volumes)}")
+    axis, sign = parse_axis(down)
+    first = volumes[0]
+    if any(v.shape != first.shape for v in volumes):
+        raise ValueError("the volumes of a series must share one grid")
+    filled = np.flatnonzero(np.moveaxis(first, axis, 0).reshape(first.shape[axis], -1).any(axis=1))
+    floor, height = (int(filled[0] if sign < 0 else filled[-1]), int(np.ptp(filled))) if len(filled) else (0, 0)
+    for k in range(1, n + 1):
+        drop = 0.5 * acceleration * k * k if acceleration else height * (k / n) ** 2
+        yield fall(volumes[k - 1 if len(volumes) == n else 0], k / n, down, heap=heap, floor=floor, drop=drop)
+
+
+def _resting_sums(stacks: np.ndarray, values: np.ndarray, dtype) -> np.ndarray:
+    """Each heap voxel's value plus those resting above it in its column, capped at ``dtype``'s maximum."""
+    grain = np.where(stacks >= 0, values[np.maximum(stacks, 0)].astype(np.float64), 0.0)
+    sums = np.cumsum(grain[..., ::-1], axis=2)[..., ::-1]
+    cap = np.iinfo(dtype).max if np.issubdtype(dtype, np.integer) else np.inf
+    return np.where(stacks >= 0, np.minimum(sums, cap), 0).astype(dtype)
 
 
 def _rank_among(i: np.ndarray, j: np.ndarray, ny: int) -> np.ndarray:

@@ -30,6 +30,9 @@ class FrameSpec:
     dt_scale: float | np.ndarray = 1.0  # every DT times this (a number, or one per point)
     crumble: float = 0.0  # 0: standing; 1: every voxel has fallen onto the heap
     down: str = "-z"  # the way voxels fall in a crumble
+    heap: str = "keep"  # a crumble heap's values: each grain's own, or the capped sum resting on it
+    floor: int | None = None  # a crumble's floor (voxel index along its axis); None: the body's lowest voxel
+    drop: float | None = None  # how far a crumble's voxels have fallen; None: from ``crumble`` and the height
 
     def tskel(self, conn: Connectivity) -> Tskel:
         plain = np.isscalar(self.dt_scale) and self.dt_scale == 1.0
@@ -42,8 +45,11 @@ class FrameSpec:
 
     def key(self) -> bytes:
         """Everything that decides this frame's voxels besides the connectivity (for plan keys)."""
+        fall = (self.crumble, self.down)
+        if (self.heap, self.floor, self.drop) != ("keep", None, None):  # older stores' keys stay as they were
+            fall += (self.heap, self.floor, self.drop)
         return b"|".join([np.ascontiguousarray(self.matrices).tobytes(), str(self.number).encode(),
-                          np.asarray(self.dt_scale, np.float64).tobytes(), repr((self.crumble, self.down)).encode()])
+                          np.asarray(self.dt_scale, np.float64).tobytes(), repr(fall).encode()])
 
 
 def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, frames=slice(None),

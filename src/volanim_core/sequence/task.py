@@ -95,9 +95,11 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
                     bounds=grid, threads=p.threads)  # neighbour lists: remembered per connectivity
     zyx = r.volume.T  # the engine's own [z, y, x] array: C-contiguous, no copy
     if spec.crumble:
-        from .effects import fall
+        from .effects import fall, parse_axis
 
-        zyx = np.ascontiguousarray(fall(r.volume, spec.crumble, spec.down).T)
+        floor = None if spec.floor is None else spec.floor - grid.lo[parse_axis(spec.down)[0]]  # world -> grid index
+        zyx = np.ascontiguousarray(fall(r.volume, spec.crumble, spec.down, heap=spec.heap, floor=floor,
+                                        drop=spec.drop).T)
         region = occupied(zyx)
         part = zyx[region]
         box = tight_bounds(zyx.T)

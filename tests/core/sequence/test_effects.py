@@ -135,3 +135,82 @@ def test_dash_values_are_joined_only_where_an_option_takes_them():
     assert join_dash_values(["x", "--down", "-z", "--min-thinness", "-inf", "--up", "-Y", "-o", "f"]) == \
         ["x", "--down=-z", "--min-thinness=-inf", "--up=-Y", "-o", "f"]
     assert join_dash_values(["--force", "-x", "--down=-y"]) == ["--force", "-x", "--down=-y"]  # -x: not an axis here
+
+
+def test_a_summed_heap_holds_what_rests_on_each_voxel_capped():
+    for seed in range(6):
+        vol = random_body(seed, density=0.4)
+        keep, summed = fall(vol, 1.0), fall(vol, 1.0, heap="sum")
+        assert np.array_equal(keep != 0, summed != 0)  # the same grains in the same places
+        for x, y in np.ndindex(*keep.shape[:2]):  # the oracle: a column summed from its top down, by hand
+            total = 0
+            for z in range(keep.shape[2] - 1, -1, -1):
+                total += int(keep[x, y, z])
+                assert summed[x, y, z] == (min(total, 255) if keep[x, y, z] else 0), (seed, x, y, z)
+    assert (fall(random_body(1, density=0.9), 1.0, heap="sum") == 255).any()  # deep heaps reach the cap
+    with pytest.raises(ValueError, match="keep, sum"):
+        fall(random_body(), 1.0, heap="add")
+
+
+def test_an_acceleration_sets_how_far_each_frame_falls(conn):
+    walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 1))
+    frames = crumble(walk, 4, acceleration=3.0, conn=conn)
+    assert [f.drop for f in frames] == [1.5, 6.0, 13.5, 24.0]  # a k^2 / 2
+    vol = np.zeros((4, 5, 60), np.uint8)
+    vol[1:3, 1:4, 30:40] = 9
+    vol[0, 0, 5] = 1  # the floor
+    assert np.array_equal(fall(vol, 0.25, drop=6.0)[1:3, 1:4, 24:34], vol[1:3, 1:4, 30:40])  # 6 down, in the air
+    with pytest.raises(ValueError, match="per frame squared"):
+        crumble(walk, 4, acceleration=-1.0, conn=conn)
+
+
+def test_melt_and_crumble_at_once_shrink_the_falling_body_onto_the_standing_floor(tmp_path, conn):
+    walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 1))
+    frames = walk + crumble(walk, 3, melt=4, conn=conn)
+    assert len(frames) == 5 and [f.dt_scale for f in frames[1:]] == [0.75, 0.5, 0.25, 0.0]
+    rep = run_sequence(conn, frames, tmp_path / "m.zarr", mode="mottled", workers=1)
+    filled = [r["filled"] for r in rep.records]
+    assert filled[0] > filled[1] > filled[2] > filled[3] > 0 and filled[4] == 0  # melting while it falls
+    floor = np.nonzero(store.read_frame(tmp_path / "m.zarr", 0))[2].min()
+    for i in (1, 2, 3):  # the shrunken body falls to the floor the whole body stood on, not to its own lowest voxel
+        z = np.nonzero(store.read_frame(tmp_path / "m.zarr", i))[2]
+        assert z.min() >= floor - 1
+    assert np.nonzero(store.read_frame(tmp_path / "m.zarr", 3))[2].min() <= floor
+
+
+def test_cli_melt_with_crumble_an_acceleration_and_a_summed_heap(tmp_path):
+    from runnable import volanim
+
+    base = ["sequence", CONNECT, WALK, "--bones", ASSETS / "mannequin.bones", "--frames", "0:1", "--mode", "bone",
+            "--workers", "1"]
+    r = volanim(*base, "--crumble", "2", "--melt", "3", "--acceleration", "40", "--heap", "sum",
+                "-o", tmp_path / "c.zarr")
+    assert r.returncode == 0, r.stderr
+    assert "4 made" in r.stdout and not store.read_frame(tmp_path / "c.zarr", 3).any()
+    both = volanim(*base, "--teleport", "2", "--melt", "3", "-o", tmp_path / "x.zarr")
+    assert both.returncode == 2 and "--melt and --teleport" in both.stderr and not (tmp_path / "x.zarr").exists()
+    neg = volanim(*base, "--crumble", "2", "--acceleration", "-1", "-o", tmp_path / "x.zarr")
+    assert neg.returncode == 2 and "expected 0 or more" in neg.stderr
+
+
+def test_crumble_command_drops_any_volume_series_onto_the_first_ones_floor(tmp_path):
+    from runnable import volanim
+
+    body = random_body(4, shape=(9, 8, 60))
+    moved = np.roll(body, 6, axis=2)  # the next frame's body stands 6 voxels higher
+    io.write_volume(tmp_path / "b.1.nrrd", body)
+    io.write_volume(tmp_path / "b.2.nrrd", moved)
+    r = volanim("crumble", tmp_path / "b.2.nrrd", tmp_path / "b.1.nrrd", "-n", "2", "--acceleration", "2",
+                "-o", tmp_path / "f.%03d.VOL")  # given out of order: taken by number
+    assert r.returncode == 0, r.stderr
+    one, two = io.read_volume(tmp_path / "f.001.VOL"), io.read_volume(tmp_path / "f.002.VOL")
+    floor = np.nonzero(body)[2].min()
+    assert np.array_equal(one, fall(body, 0.5, drop=1.0))  # a k^2 / 2 = 1 voxel at frame 1
+    assert np.array_equal(two, fall(moved, 1.0, drop=4.0, floor=floor))  # 4 voxels, onto the first one's floor
+    assert np.array_equal(np.sort(two[two > 0]), np.sort(moved[moved > 0]))  # every grain kept
+    s = volanim("crumble", tmp_path / "b.1.nrrd", "-n", "3", "--heap", "sum", "-o", tmp_path / "s.%d.nrrd")
+    assert s.returncode == 0 and np.array_equal(io.read_volume(tmp_path / "s.3.nrrd"), fall(body, 1.0, heap="sum"))
+    bad = volanim("crumble", tmp_path / "b.1.nrrd", tmp_path / "b.2.nrrd", "-n", "3", "-o", tmp_path / "x.%d.VOL")
+    assert bad.returncode == 2 and "not 2" in bad.stderr
+    nopattern = volanim("crumble", tmp_path / "b.1.nrrd", "-n", "3", "-o", tmp_path / "x.VOL")
+    assert nopattern.returncode == 2 and "one number field" in nopattern.stderr and not (tmp_path / "x.VOL").exists()
