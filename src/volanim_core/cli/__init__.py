@@ -17,6 +17,7 @@ from volanim_core.errors import Cancelled, FormatError
 from . import (
     check_commands,
     colour_commands,
+    combine_commands,
     demo_command,
     motion_commands,
     reconstruct_commands,
@@ -50,9 +51,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (volume_commands, skeleton_commands, rig_commands, reconstruct_commands, check_commands,
-                   motion_commands, sequence_commands, render_commands, colour_commands, slicer_commands, view_command,
-                   demo_command):
+    for module in (volume_commands, skeleton_commands, combine_commands, rig_commands, reconstruct_commands,
+                   check_commands, motion_commands, sequence_commands, render_commands, colour_commands,
+                   slicer_commands, view_command, demo_command):
         module.register(sub)
     return parser
 
