@@ -1,4 +1,5 @@
-"""Motion subcommands: bvh2trans (motion capture -> one .trans per frame), trans2tskel."""
+"""Motion subcommands: bvh2trans (motion capture -> one .trans per frame), trans2tskel, trans2bvh (back to an
+animation package)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from volanim_core.motion.retarget import Retarget, check_mapping_file, format_ma
 from volanim_core.progress import TextProgress
 from volanim_core.rig.tskel import connect_to_tskel
 
-from ._common import add_command
+from ._common import add_command, positive_float
 
 
 def parse_frames(text: str) -> slice:
@@ -76,6 +77,20 @@ def _trans2tskel(args):
     print(f"wrote {len(args.trans)} .tskel files -> {out}")
 
 
+def _trans2bvh(args):
+    from volanim_core.motion.bvh_export import write_bvh
+    from volanim_core.motion.frames import read_frames
+
+    bones = read_bones(args.bones)
+    mats, paths = read_frames(args.trans, bones)
+    worst = write_bvh(args.output, bones, mats, args.fps, args.scale)
+    print(f"wrote {args.output}: {len(bones)} bones, {len(paths)} frames at {args.fps:g} fps, z up, "
+          f"{args.scale:g} BVH units per voxel")
+    if worst > 0.01:
+        print(f"note: a child bone moved apart from its parent by up to {worst:.2f} voxels in these frames; BVH moves "
+              "children only by rotation, so the clip keeps them joined")
+
+
 def register(sub) -> None:
     p = add_command(sub, "bvh2trans", "Motion capture onto the bone skeleton: one .trans (and .tskel) per frame.",
                     "volanim bvh2trans walk.bvh --bones mannequin.bones --frames 0:200:10 -o walk/", _bvh2trans)
@@ -91,6 +106,15 @@ def register(sub) -> None:
     p.add_argument("--no-check", action="store_true",
                    help="write the frames even when the retargeted figure fails the plausibility checks")
     p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
+
+    p = add_command(sub, "trans2bvh", "Our bones and their frames as a BVH clip, to refine in an animation package "
+                    "(Blender, Maya) and bring back with bvh2trans.",
+                    "volanim trans2bvh mannequin.bones walk/*.trans --fps 12 -o walk-mannequin.bvh", _trans2bvh)
+    p.add_argument("bones", help="our .bones file")
+    p.add_argument("trans", nargs="+", help=".trans files (numbered: taken in order), or a folder of them")
+    p.add_argument("--fps", type=positive_float, default=24.0, help="frames per second (default 24)")
+    p.add_argument("--scale", type=positive_float, default=1.0, help="BVH units per voxel (default 1)")
+    p.add_argument("-o", "--output", required=True, help="the .bvh to write")
 
     p = add_command(sub, "trans2tskel", "A .connect plus many .trans frames -> one .tskel each.",
                     "volanim trans2tskel mannequin.0.50.connect walk/*.trans -o walk/", _trans2tskel)

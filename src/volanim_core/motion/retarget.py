@@ -73,10 +73,14 @@ class Match:
 def match(bones: BoneSkeleton, motion: Motion, sampled: Sampled | None = None) -> Match:
     """Which BVH joint drives each of our bones, from names and shape together (module docstring).
 
-    Pelvis bones (``L_PELVIS``, from the root joint sideways) follow the BVH root. Where the name
+    A clip with a joint named as each of our bones (``volanim trans2bvh`` wrote it) maps each bone to its
+    own joint. Pelvis bones (``L_PELVIS``, from the root joint sideways) follow the BVH root. Where the name
     and the shape disagree, the name wins when its joint lies in the limb the shape found (a
     scheme's finer choice inside a limb), the shape wins otherwise (a name that means another limb).
     """
+    if all(b.label in motion.names for b in bones.bones):  # a clip volanim wrote for these bones (trans2bvh)
+        own = {b.label: b.label for b in bones.bones}
+        return Match(own, dict.fromkeys(own, "its own joint (a clip volanim wrote)"), "volanim trans2bvh", [])
     preset, named = best_preset(motion.names)
     s = sampled if sampled is not None else sample(motion)
     body = read_body(motion, s)
