@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frames import write_frames
@@ -91,6 +93,35 @@ def _trans2bvh(args):
               "children only by rotation, so the clip keeps them joined")
 
 
+def _trans2positions(args):
+    from volanim_core.motion.frames import frame_number, read_frames
+    from volanim_core.motion.positions import posed_joints, write_positions
+
+    bones = read_bones(args.bones)
+    mats, paths = read_frames(args.trans, bones)
+    names, positions = posed_joints(bones, mats)
+    numbers = [frame_number(p) if frame_number(p) is not None else i for i, p in enumerate(paths)]
+    write_positions(args.output, numbers, names, positions)
+    print(f"wrote {args.output}: {len(names)} joints in {len(paths)} frames")
+
+
+def _positions2trans(args):
+    from volanim_core.motion.positions import read_positions, solve
+
+    bones = read_bones(args.bones)
+    names = list(bones.joints)
+    numbers, positions = read_positions(args.positions, names, args.scale)
+    have = [n for j, n in enumerate(names) if not np.isnan(positions[:, j]).all()]
+    missing = [n for n in names if n not in have]
+    print(f"{len(numbers)} frames, {len(have)} of {len(names)} joints in {args.positions}"
+          + (f"; no data for {', '.join(missing)} (their bones follow their parents)" if missing else ""))
+    mats = solve(bones, positions, names)
+    conn = read_connect(args.connect) if args.connect else None
+    write_frames(args.output, Path(args.positions).stem, bones, mats, numbers, connect=conn,
+                 progress=TextProgress(f"writing {len(numbers)} frames"))
+    print(f"wrote {len(numbers)} frames -> {args.output}")
+
+
 def register(sub) -> None:
     p = add_command(sub, "bvh2trans", "Motion capture onto the bone skeleton: one .trans (and .tskel) per frame.",
                     "volanim bvh2trans walk.bvh --bones mannequin.bones --frames 0:200:10 -o walk/", _bvh2trans)
@@ -115,6 +146,24 @@ def register(sub) -> None:
     p.add_argument("--fps", type=positive_float, default=24.0, help="frames per second (default 24)")
     p.add_argument("--scale", type=positive_float, default=1.0, help="BVH units per voxel (default 1)")
     p.add_argument("-o", "--output", required=True, help="the .bvh to write")
+
+    p = add_command(sub, "trans2positions", "Every joint's position in each frame, as the CSV positions2trans "
+                    "reads (to plot, or to compare with marker data).",
+                    "volanim trans2positions mannequin.bones walk/*.trans -o walk-joints.csv", _trans2positions)
+    p.add_argument("bones", help="our .bones file")
+    p.add_argument("trans", nargs="+", help=".trans files (numbered: taken in order), or a folder of them")
+    p.add_argument("-o", "--output", required=True, help="the CSV to write (frame,joint,x,y,z)")
+
+    p = add_command(sub, "positions2trans", "Joint positions per frame (markers, a video pose estimator: a CSV of "
+                    "frame,joint,x,y,z) -> one .trans per frame; the twist from a third marker (ivskelgetrot).",
+                    "volanim positions2trans walk-joints.csv --bones mannequin.bones -o from-positions/",
+                    _positions2trans)
+    p.add_argument("positions", help="CSV: a 'frame,joint,x,y,z' header, then a row per joint and frame; joints "
+                                     "named as in the .bones, in its coordinates (voxels) times --scale")
+    p.add_argument("--bones", required=True, help="our .bones file")
+    p.add_argument("--scale", type=positive_float, default=1.0, help="multiply the positions by this (default 1)")
+    p.add_argument("--connect", help="also write each frame's .tskel for this .connect")
+    p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
 
     p = add_command(sub, "trans2tskel", "A .connect plus many .trans frames -> one .tskel each.",
                     "volanim trans2tskel mannequin.0.50.connect walk/*.trans -o walk/", _trans2tskel)
