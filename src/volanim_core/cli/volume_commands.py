@@ -256,7 +256,8 @@ def _samples(args):
 def _io(p, output=True):
     add_volume_in(p, "input")
     if output:
-        p.add_argument("output", help="output volume (.vol, .VOL, .vti, .nrrd, .nii, .nii.gz or .mha)")
+        p.add_argument("output", help="output volume (.vol, .VOL, .vti, .nrrd, .nii, .nii.gz, .mha, a 3-D .tif), or "
+                                      "slices/NAME%%04d.png for one image a slice")
     add_dims(p)
 
 
@@ -268,7 +269,9 @@ def register(sub) -> None:
     add_dims(p)
 
     p = add_command(sub, "convert", "Convert between volume formats (Vol2Vtk / Vtk2Vol).",
-                    "volanim convert frog.VOL frog.vti", _convert)
+                    ("volanim convert frog.VOL frog.vti",
+                     "volanim convert frog.VOL frog.tif   # one 3-D TIFF, spacing for Fiji",
+                     "volanim convert frog.VOL frog-slices/frog%04d.png   # a slice stack"), _convert)
     _io(p)
     p.add_argument("--rescale", action="store_true", help="map non-uint8 data min..max onto 0..255")
     p.add_argument("--grey", action="store_true", help="write a colour volume as grey (luminance)")

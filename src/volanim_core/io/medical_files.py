@@ -14,6 +14,7 @@ voxel and millimetre for millimetre (tests/core/io/test_real_scans.py).
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
@@ -160,3 +161,37 @@ def read_tiff_stack(path: str | Path):
     if rgb:
         vol = vol[..., :3]
     return np.asfortranarray(vol), Geometry(tuple(spacing))
+
+
+def write_tiff_stack(path: str | Path, vol: np.ndarray, geometry) -> None:
+    """One 3-D TIFF (pages z, rows y, columns x) with ImageJ's spacing metadata, atomically; what
+    :func:`read_tiff_stack` and Fiji read back (the thesis's Toolbar wrote slice stacks)."""
+    import tifffile
+
+    from ._atomic import atomic_open
+
+    zyx = np.ascontiguousarray(np.moveaxis(vol, (0, 1, 2), (2, 1, 0)))  # colour keeps its channels last
+    sx, sy, sz = (float(v) for v in geometry.spacing)
+    buffer = io.BytesIO()  # tifffile wants a named file; the atomic temporary has none
+    tifffile.imwrite(buffer, zyx, imagej=True, resolution=(1 / sx, 1 / sy),
+                     metadata={"spacing": sz, "unit": "mm", "axes": "ZYXS" if zyx.ndim == 4 else "ZYX"})
+    with atomic_open(path, "wb") as fh:
+        fh.write(buffer.getvalue())
+
+
+def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
+    """One 2-D image a z slice (rows y, columns x), named by ``pattern % z`` (``slices/frog%04d.png``); the
+    folder reads back as a volume. Returns the paths."""
+    import imageio.v3 as iio
+
+    from ._atomic import atomic_open
+
+    out = []
+    for z in range(vol.shape[2]):
+        path = Path(pattern % z)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_open(path, "wb") as fh:
+            fh.write(iio.imwrite("<bytes>", np.ascontiguousarray(np.swapaxes(vol[:, :, z], 0, 1)),
+                                 extension=path.suffix))
+        out.append(path)
+    return out

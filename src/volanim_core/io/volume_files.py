@@ -49,7 +49,8 @@ TIFF_SUFFIXES = (".tif", ".tiff")
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".jpg", ".jpeg", ".bmp", ".pgm", ".ppm")
 READ_SUFFIXES = (".vol", ".VOL", *VTK_SUFFIXES, *NRRD_SUFFIXES, *META_SUFFIXES, *NIBABEL_SUFFIXES,
                  *DICOM_SUFFIXES, *TIFF_SUFFIXES)
-WRITE_SUFFIXES = (".vol", ".VOL", ".vti", ".nrrd", ".nii", ".nii.gz", ".mha")
+WRITE_SUFFIXES = (".vol", ".VOL", ".vti", ".nrrd", ".nii", ".nii.gz", ".mha", ".tif", ".tiff")
+SLICE_SUFFIXES = (".png", ".tif", ".tiff")  # NAME%04d.png: one image a slice
 
 
 @dataclass(frozen=True)
@@ -366,14 +367,15 @@ def write_output(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTIT
     vol, note = saturate_for_raw(path, np.asarray(vol))
     path = raw_volumes.raw_name_for(path, vol.shape[:3])
     write_volume(path, vol, geometry, mode)
-    if path.suffix.lower() == ".vol" and not geometry.is_identity:
+    if (path.suffix.lower() == ".vol" or "%" in path.name) and not geometry.is_identity:
         lost = f"{path.name} holds no geometry ({geometry.describe()}): write .nrrd, .nii, .mha or .vti to keep it"
         note = f"{note}; {lost}" if note else lost
     return path, note
 
 
 def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTITY, mode: str | None = None) -> None:
-    """Write a volume as ``.vol``, ``.VOL``, ``.vti``, ``.nrrd``, ``.nii``/``.nii.gz`` or ``.mha``, atomically.
+    """Write a volume as ``.vol``, ``.VOL``, ``.vti``, ``.nrrd``, ``.nii``/``.nii.gz``, ``.mha`` or a 3-D
+    ``.tif``, atomically; a name with a number field (``slices/NAME%04d.png``) writes one image a slice.
 
     ``mode``: the reconstruction mode of a result, recorded in ``.vti`` and ``.nrrd`` so a viewer draws
     it in that mode's colours (a bone volume in bone colours, not a grey ramp).
@@ -386,8 +388,12 @@ def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTIT
         raise ValueError(f"a volume must be 3-D (or 3-D with 3 colour channels), got shape {vol.shape}")
     if not isinstance(geometry, Geometry):
         raise TypeError(f"geometry must be a Geometry, got {type(geometry).__name__}")
+    from . import medical_files
+
     suffix = _suffix(path)
-    if suffix == ".vol":
+    if "%" in path.name and path.suffix.lower() in SLICE_SUFFIXES:
+        medical_files.write_slices(str(path), vol)
+    elif suffix == ".vol":
         raw_volumes.write_raw(path, vol)
     elif suffix == ".vti":
         _write_vti(path, vol, geometry, mode)
@@ -397,6 +403,8 @@ def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTIT
         write_metaimage(path, vol, geometry)
     elif suffix in (".nii", ".nii.gz"):
         _write_nifti(path, vol, geometry)
+    elif suffix in TIFF_SUFFIXES:
+        medical_files.write_tiff_stack(path, vol, geometry)
     else:
         raise ValueError(f"cannot write {path.name}: choose one of {', '.join(WRITE_SUFFIXES)}")
 
