@@ -210,7 +210,7 @@ def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
 
 @pytest.mark.parametrize("option", [["--workers", "0"], ["--fps", "0"], ["--melt", "-2"],
                                     ["--every-frame-as", "frames/walk.vti"], ["--down=up"],
-                                    ["--melt", "2", "--crumble", "3"]])
+                                    ["--teleport", "2", "--crumble", "3"]])  # --melt and --crumble combine (#43)
 def test_bad_options_are_argument_errors_naming_the_option(tmp_path, capsys, option):
     with pytest.raises(SystemExit) as exc:
         main(["sequence", str(CONNECT), str(WALK), "--bones", str(ASSETS / "mannequin.bones"), "-o",
