@@ -126,36 +126,22 @@ def ascii_int(text: str) -> int:
     raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}")
 
 
-def positive_float(text: str) -> float:
-    """A finite number above 0 (frame rates)."""
-    value = finite_float(text)
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a number above 0, got {text!r}")
-    return value
+def _at_least(parse, low: float, strict: bool, what: str):
+    """An argparse type: ``parse(text)`` (a whole or finite number), refused below ``low`` (or at it if ``strict``)."""
+    def check(text: str):
+        value = parse(text)
+        if value < low or (strict and value == low):
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+        return value
+
+    check.__doc__ = f"{what} ({parse.__name__})"
+    return check
 
 
-def positive_int(text: str) -> int:
-    """A whole number of 1 or more (workers, threads, frames)."""
-    value = ascii_int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected 1 or more, got {text!r}")
-    return value
-
-
-def non_negative_float(text: str) -> float:
-    """A finite number of 0 or more (accelerations)."""
-    value = finite_float(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected 0 or more, got {text!r}")
-    return value
-
-
-def non_negative_int(text: str) -> int:
-    """A whole number of 0 or more (first numbers of a series, frame indices)."""
-    value = ascii_int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected 0 or more, got {text!r}")
-    return value
+positive_float = _at_least(finite_float, 0, True, "a number above 0")  # frame rates
+positive_int = _at_least(ascii_int, 1, False, "1 or more")  # workers, threads, frames
+non_negative_float = _at_least(finite_float, 0, False, "0 or more")  # accelerations
+non_negative_int = _at_least(ascii_int, 0, False, "0 or more")  # first numbers of a series
 
 
 AXIS_OPTIONS = ("--down", "--up", "--forward")  # options whose value is a signed axis such as -z

@@ -30,9 +30,9 @@ def _peek(args):
 
 
 def _onevolume(args):
-    from volanim_core.io.volume_files import _natural_key
+    from volanim_core.io.volume_files import natural_order
 
-    paths = sorted(args.volumes, key=lambda p: _natural_key(str(p)))  # part.2 before part.10
+    paths = natural_order(args.volumes)
     first = load_scan(paths[0], args)
     out = np.zeros(first.data.shape, np.uint8 if args.label else first.data.dtype, order="F")
     for k, path in enumerate(paths, start=1):

@@ -79,12 +79,21 @@ def _trans2tskel(args):
     print(f"wrote {len(args.trans)} .tskel files -> {out}")
 
 
-def _trans2bvh(args):
-    from volanim_core.motion.bvh_export import write_bvh
+def _bones_and_frames(args):
+    """``args.bones`` and the matrices of ``args.trans`` (files or a folder), in frame-number order."""
     from volanim_core.motion.frames import read_frames
 
     bones = read_bones(args.bones)
-    mats, paths = read_frames(args.trans, bones)
+    bar = TextProgress("reading frames")
+    out = read_frames(args.trans, bones, progress=bar)
+    bar.close()
+    return (bones, *out)
+
+
+def _trans2bvh(args):
+    from volanim_core.motion.bvh_export import write_bvh
+
+    bones, mats, paths = _bones_and_frames(args)
     worst = write_bvh(args.output, bones, mats, args.fps, args.scale)
     print(f"wrote {args.output}: {len(bones)} bones, {len(paths)} frames at {args.fps:g} fps, z up, "
           f"{args.scale:g} BVH units per voxel")
@@ -94,11 +103,10 @@ def _trans2bvh(args):
 
 
 def _trans2positions(args):
-    from volanim_core.motion.frames import frame_number, read_frames
+    from volanim_core.motion.frames import frame_number
     from volanim_core.motion.positions import posed_joints, write_positions
 
-    bones = read_bones(args.bones)
-    mats, paths = read_frames(args.trans, bones)
+    bones, mats, paths = _bones_and_frames(args)
     names, positions = posed_joints(bones, mats)
     numbers = [frame_number(p) if frame_number(p) is not None else i for i, p in enumerate(paths)]
     write_positions(args.output, numbers, names, positions)
@@ -115,11 +123,18 @@ def _positions2trans(args):
     missing = [n for n in names if n not in have]
     print(f"{len(numbers)} frames, {len(have)} of {len(names)} joints in {args.positions}"
           + (f"; no data for {', '.join(missing)} (their bones follow their parents)" if missing else ""))
-    mats = solve(bones, positions, names)
+    bar = TextProgress("solving bones")
+    mats = solve(bones, positions, names, progress=bar)
+    bar.close()
     conn = read_connect(args.connect) if args.connect else None
     write_frames(args.output, Path(args.positions).stem, bones, mats, numbers, connect=conn,
                  progress=TextProgress(f"writing {len(numbers)} frames"))
     print(f"wrote {len(numbers)} frames -> {args.output}")
+
+
+def _bones_and_frames_args(p) -> None:
+    p.add_argument("bones", help="our .bones file")
+    p.add_argument("trans", nargs="+", help=".trans files (numbered: taken in order), or a folder of them")
 
 
 def register(sub) -> None:
@@ -141,8 +156,7 @@ def register(sub) -> None:
     p = add_command(sub, "trans2bvh", "Our bones and their frames as a BVH clip, to refine in an animation package "
                     "(Blender, Maya) and bring back with bvh2trans.",
                     "volanim trans2bvh mannequin.bones walk/*.trans --fps 12 -o walk-mannequin.bvh", _trans2bvh)
-    p.add_argument("bones", help="our .bones file")
-    p.add_argument("trans", nargs="+", help=".trans files (numbered: taken in order), or a folder of them")
+    _bones_and_frames_args(p)
     p.add_argument("--fps", type=positive_float, default=24.0, help="frames per second (default 24)")
     p.add_argument("--scale", type=positive_float, default=1.0, help="BVH units per voxel (default 1)")
     p.add_argument("-o", "--output", required=True, help="the .bvh to write")
@@ -150,8 +164,7 @@ def register(sub) -> None:
     p = add_command(sub, "trans2positions", "Every joint's position in each frame, as the CSV positions2trans "
                     "reads (to plot, or to compare with marker data).",
                     "volanim trans2positions mannequin.bones walk/*.trans -o walk-joints.csv", _trans2positions)
-    p.add_argument("bones", help="our .bones file")
-    p.add_argument("trans", nargs="+", help=".trans files (numbered: taken in order), or a folder of them")
+    _bones_and_frames_args(p)
     p.add_argument("-o", "--output", required=True, help="the CSV to write (frame,joint,x,y,z)")
 
     p = add_command(sub, "positions2trans", "Joint positions per frame (markers, a video pose estimator: a CSV of "

@@ -71,13 +71,12 @@ def _sequence(args):
 
 
 def _crumble(args):
-    from volanim_core.io.volume_files import _natural_key
+    from volanim_core.io.volume_files import WRITE_SUFFIXES, natural_order
     from volanim_core.sequence.effects import fall_series
+    from volanim_core.sequence.task import check_frame_pattern
 
-    names = {args.output % 1, args.output % 2} if "%" in args.output else set()
-    if len(names) != 2:
-        raise ValueError(f"-o {args.output!r} needs one number field for the frame, e.g. heap/frame.%%04d.VOL")
-    paths = sorted(args.volumes, key=lambda p: _natural_key(str(p)))  # frame.2 before frame.10
+    check_frame_pattern(args.output, "-o", tuple(s.lower() for s in dict.fromkeys(WRITE_SUFFIXES)))
+    paths = natural_order(args.volumes)
     scans = [load_scan(p, args) for p in paths]
     bar = TextProgress("crumble")
     frames = fall_series([s.data for s in scans], args.n, args.down, acceleration=args.acceleration, heap=args.heap)
@@ -100,6 +99,18 @@ def format_report(rep) -> str:
     return "\n".join(lines)
 
 
+def _fall_options(p, what: str, down: str | None = None) -> None:
+    """--acceleration, --heap and --down, as ``volanim crumble`` and ``sequence --crumble`` share them
+    (choices: ``sequence.effects.HEAPS``, not imported here to keep ``volanim --help`` light)."""
+    p.add_argument("--acceleration", type=non_negative_float, default=0.0, metavar="A",
+                   help=f"{what}fall a*k^2/2 voxels by frame k (default: the top lands on the last frame)")
+    p.add_argument("--heap", choices=("keep", "sum"), default="keep",
+                   help=f"{what}a heap voxel keeps its value (default), or holds the sum of what rests on it, "
+                        "capped (the thesis's multiVolumeMelt)")
+    p.add_argument("--down", default="-z", type=checked_by("volanim_core.sequence.effects:parse_axis"),
+                   help=f"{what if down is None else down}the way down (default -z)")
+
+
 def register(sub) -> None:
     from volanim_core.reconstruct.engine import MODES
 
@@ -114,12 +125,7 @@ def register(sub) -> None:
     p.add_argument("-o", "--output", required=True, metavar="DIR/NAME.%%04d.VOL",
                    help="the frames' files (any volume format; %%04d = frame number)")
     p.add_argument("--start", type=non_negative_int, default=1, help="number of the first frame (default 1)")
-    p.add_argument("--acceleration", type=non_negative_float, default=0.0, metavar="A",
-                   help="fall a*k^2/2 voxels by frame k (default: the top lands on the last frame)")
-    p.add_argument("--heap", choices=("keep", "sum"), default="keep",
-                   help="a heap voxel keeps its value (default), or holds the capped sum of what rests on it")
-    p.add_argument("--down", default="-z", type=checked_by("volanim_core.sequence.effects:parse_axis"),
-                   help="the way down (default -z)")
+    _fall_options(p, "")
     add_dims(p)
 
     from .motion_commands import parse_frames
@@ -151,14 +157,7 @@ def register(sub) -> None:
                         help="after the frames, N more: the body vanishes from the head down")
     effect.add_argument("--crumble", type=positive_int, metavar="N",
                         help="after the frames, N more: the voxels fall and pile into a heap")
-    p.add_argument("--acceleration", type=non_negative_float, default=0.0, metavar="A",
-                   help="crumble: fall a*k^2/2 voxels by frame k (default: the top lands on the last frame)")
-    p.add_argument("--heap", choices=("keep", "sum"), default="keep",
-                   help="crumble: a heap voxel keeps its value (default), or holds the sum of what rests on it, "
-                        "capped (the thesis's multiVolumeMelt)")
-    p.add_argument("--down", default="-z",
-                   type=checked_by("volanim_core.sequence.effects:parse_axis"),
-                   help="teleport/crumble: the way down (default -z)")
+    _fall_options(p, "crumble: ", down="teleport/crumble: ")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",

@@ -183,6 +183,11 @@ def _natural_key(name: str):
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", name)]
 
 
+def natural_order(paths) -> list:
+    """``paths`` in natural order (``frame.2`` before ``frame.10``): how a numbered series is taken."""
+    return sorted(paths, key=lambda p: _natural_key(str(p)))
+
+
 def slice_files(folder: str | Path) -> list[Path]:
     """The slice images of a folder in natural order (``s2`` before ``s10``)."""
     folder = Path(folder)

@@ -111,18 +111,20 @@ def bvh_text(bones: BoneSkeleton, matrices: np.ndarray, fps: float, scale: float
         else:  # the root moves and turns as the first top-level bone
             root_rot = rot[tops[0]]
             row = [*(placed[tops[0]] * scale), *_euler(root_rot)]
-        where = {}
+        where, locals_ = {}, []
         for i in order:
             if i in parent:
                 p = parent[i]
-                local = rot[p].T @ rot[i]
+                locals_.append(rot[p].T @ rot[i])
                 where[i] = where[p] + rot[p] @ (rest[i] - rest[p])
             else:
-                local = root_rot.T @ rot[i]
+                locals_.append(root_rot.T @ rot[i])
                 where[i] = placed[i] if moving_tops else placed[tops[0]]
-                if moving_tops:
-                    row.extend(placed[i] * scale)
-            row.extend(_euler(local))
+        angles = _euler(np.array(locals_))  # one call a frame: the clip's angles, joint by joint
+        for k, i in enumerate(order):
+            if moving_tops and i not in parent:
+                row.extend(placed[i] * scale)
+            row.extend(angles[k])
         worst = max(worst, max(float(np.linalg.norm(where[i] - placed[i])) for i in order))
         lines.append(" ".join(f"{v:.6f}" for v in row))
     return "\n".join(lines) + "\n", worst

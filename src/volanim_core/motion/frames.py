@@ -58,10 +58,11 @@ def frame_number(path: str | Path) -> int | None:
     return int(m.group(1)) if m else None
 
 
-def read_frames(paths, bones: BoneSkeleton) -> tuple[np.ndarray, list[Path]]:
+def read_frames(paths, bones: BoneSkeleton, progress=None) -> tuple[np.ndarray, list[Path]]:
     """``.trans`` files (or one folder of them) as ``(F, B, 4, 4)`` matrices, in frame-number order.
 
-    Every file must name our bones in our root order (FormatError naming the file otherwise).
+    Every file must name our bones in our root order (FormatError naming the file otherwise);
+    ``progress(done, total)`` after each file (a clip's thousand frames take seconds).
     """
     from volanim_core import io
 
@@ -74,11 +75,14 @@ def read_frames(paths, bones: BoneSkeleton) -> tuple[np.ndarray, list[Path]]:
     paths.sort(key=lambda p: (frame_number(p) is None, frame_number(p) or 0, p.name))
     roots = root_bones(bones)
     mats = np.empty((len(paths), len(bones), 4, 4))
+    report = Reporter(progress)
     for i, p in enumerate(paths):
+        report(i, len(paths))
         trans = io.read_trans(p)
         try:
             check_root_order(roots, trans.bones, p.name)
         except ValueError as exc:
             raise FormatError(p, str(exc)) from None
         mats[i] = trans.matrices
+    report(len(paths), len(paths))
     return mats, paths

@@ -38,7 +38,11 @@ def read_positions(path: str | Path, names: list[str], scale: float = 1.0) -> tu
     from volanim_core.errors import FormatError
 
     rows = {}
-    text = Path(path).read_text(encoding="utf-8-sig")
+    from volanim_core.io._files import regular_file_bytes
+    from volanim_core.io._text import MAX_TEXT_BYTES
+
+    # as every text reader: a missing file, a folder or /dev/zero is a one-line error, not a hang
+    text = regular_file_bytes(path, MAX_TEXT_BYTES, "CSV file").decode("utf-8-sig", errors="replace")
     index = {n: j for j, n in enumerate(names)}
     for line_no, line in enumerate(text.splitlines(), start=1):
         fields = [f.strip() for f in line.split(",")]
@@ -139,8 +143,12 @@ def third_markers(bones: BoneSkeleton) -> list[str | None]:
     return out
 
 
-def solve(bones: BoneSkeleton, positions: np.ndarray, names: list[str]) -> np.ndarray:
-    """``(F, B, 4, 4)`` row-vector matrices from ``(F, J, 3)`` joint positions (``names`` order, NaN: missing)."""
+def solve(bones: BoneSkeleton, positions: np.ndarray, names: list[str], progress=None) -> np.ndarray:
+    """``(F, B, 4, 4)`` row-vector matrices from ``(F, J, 3)`` joint positions (``names`` order, NaN: missing);
+    ``progress(done, total)`` after each frame."""
+    from volanim_core.progress import Reporter
+
+    report = Reporter(progress)
     index = {n: j for j, n in enumerate(names)}
     parents = bones.parents()
     thirds = third_markers(bones)
@@ -150,6 +158,8 @@ def solve(bones: BoneSkeleton, positions: np.ndarray, names: list[str]) -> np.nd
     previous = [None] * len(bones)
     order = sorted(range(len(bones)), key=lambda i: _depth(parents, i))  # parents first
     for f in range(n_frames):
+        report(f, n_frames)
+
         def at(name, frame=f):
             j = index.get(name)
             return None if j is None or np.isnan(positions[frame, j]).any() else positions[frame, j]
@@ -177,6 +187,7 @@ def solve(bones: BoneSkeleton, positions: np.ndarray, names: list[str]) -> np.nd
                 origin = r_parent @ rest[b.proximal] + out[f, p, 3, :3]
             out[f, i, :3, :3] = r.T
             out[f, i, 3, :3] = origin - r @ rest[b.proximal]
+    report(n_frames, n_frames)
     return out
 
 

@@ -166,10 +166,10 @@ def fall(volume: np.ndarray, fraction: float, down: str = "-z", *, heap: str = "
             settle(stacks, heights)
             falling = falling[~lands]
         values = a[i, j, k]
-        x, y, h = np.nonzero(stacks >= 0)
         if heap == "sum":
             out[..., floor:] = _resting_sums(stacks, values, a.dtype)
         else:
+            x, y, h = np.nonzero(stacks >= 0)
             out[x, y, floor + h] = values[stacks[x, y, h]]
         fi, fj = i[falling], j[falling]  # still in the air, above the heap
         out[fi, fj, k[falling] - d] = values[falling]

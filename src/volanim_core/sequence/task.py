@@ -68,17 +68,18 @@ def frame_file(pattern: str, number: int) -> str:
     return pattern % number
 
 
-def check_frame_pattern(pattern: str) -> None:
+def check_frame_pattern(pattern: str, option: str = "--every-frame-as",
+                        suffixes: tuple[str, ...] = (".vti", ".nrrd", ".vol")) -> None:
     """Refuse (before any frame runs) a per-frame name that is not one %d field or names no volume format."""
     try:
         names = {pattern % 0, pattern % 1}
     except (TypeError, ValueError):
         names = set()
     if len(names) != 2:
-        raise ValueError(f"--every-frame-as {pattern!r} needs one number field for the frame, e.g. "
-                         "frames/walk.%04d.vti")
-    if not pattern.lower().endswith((".vti", ".nrrd", ".vol")):
-        raise ValueError(f"--every-frame-as {pattern!r} must end in .vti, .nrrd or .vol/.VOL")
+        raise ValueError(f"{option} {pattern!r} needs one number field for the frame, e.g. "
+                         f"frames/walk.%04d{suffixes[0]}")
+    if not pattern.lower().endswith(suffixes):
+        raise ValueError(f"{option} {pattern!r} must end in {', '.join(suffixes)}")
 
 
 def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid: Bounds) -> dict:

@@ -9,15 +9,12 @@ import pytest
 from runnable import volanim
 from volanim_core import io
 from volanim_core.cli import main
-from volanim_core.samples import mannequin_bones, write_sample
+from volanim_core.samples import mannequin_bones
 
 
-@pytest.fixture(scope="module")
-def made(tmp_path_factory):
-    d = tmp_path_factory.mktemp("autorig")
-    write_sample("mannequin", d)
-    assert main(["skeletonize", str(d / "mannequin.VOL"), "-o", str(d / "m.mskel")]) == 0
-    return d
+@pytest.fixture
+def made(skeletonized_mannequin):
+    return skeletonized_mannequin
 
 
 def test_autorig_writes_the_humanoids_bones_and_a_posable_connect(made):

@@ -3,12 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from runnable import volanim
 from volanim_core import io
-from volanim_core.cli import main
-from volanim_core.samples import write_sample
 
 
 def _vol(path, v):
@@ -35,17 +32,9 @@ def test_diff_reports_changed_values_and_a_summary(tmp_path):
     assert bad.returncode == 2 and "6x5x4 voxels but" in bad.stderr and "small.VOL is 3x5x4" in bad.stderr
 
 
-@pytest.fixture(scope="module")
-def mannequin(tmp_path_factory):
-    d = tmp_path_factory.mktemp("thesis")
-    write_sample("mannequin", d)
-    assert main(["skeletonize", str(d / "mannequin.VOL"), "-o", str(d / "m.mskel")]) == 0
-    return d
-
-
 # spec: docs/formats.md#skel
-def test_a_thesis_skel_is_written_and_read_by_every_skeleton_tool(mannequin):
-    d = mannequin
+def test_a_thesis_skel_is_written_and_read_by_every_skeleton_tool(skeletonized_mannequin):
+    d = skeletonized_mannequin
     r = volanim("skeletonize", d / "mannequin.VOL", "--min-thinness", "0.5", "-o", d / "m.skel")
     assert r.returncode == 0, r.stderr
     rows = [line.split() for line in (d / "m.skel").read_text().splitlines() if not line.startswith("#")]

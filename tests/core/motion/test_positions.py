@@ -45,6 +45,7 @@ def test_the_walks_joints_come_back_exactly_and_the_body_nearly_so(tmp_path):
     assert out.returncode == 0 and "19 joints in 5 frames" in out.stdout
     back = volanim("positions2trans", tmp_path / "j.csv", "--bones", ASSETS / "mannequin.bones", "-o", tmp_path / "p")
     assert back.returncode == 0, back.stderr
+    assert "reading frames" in out.stderr and "solving bones" in back.stderr  # a clip's thousand frames take seconds
     a, _ = read_frames(tmp_path / "w", bones)
     b, _ = read_frames(tmp_path / "p", bones)
     assert np.abs(posed_joints(bones, a)[1] - posed_joints(bones, b)[1]).max() < 1e-4  # what positions hold
@@ -71,3 +72,8 @@ def test_missing_joints_follow_their_parent_and_bad_rows_name_their_line(tmp_pat
     (tmp_path / "bad.csv").write_text("frame,joint,x,y,z\n0,PELVIS,1,2,3\n1,PELVIS,1,2\n")
     bad = volanim("positions2trans", tmp_path / "bad.csv", "--bones", ASSETS / "mannequin.bones", "-o", tmp_path / "x")
     assert bad.returncode == 2 and "bad.csv:3" in bad.stderr and not (tmp_path / "x").exists()
+
+
+def test_a_positions_file_that_is_no_file_is_refused_not_read_forever(tmp_path):
+    r = volanim("positions2trans", "/dev/zero", "--bones", ASSETS / "mannequin.bones", "-o", tmp_path / "p")
+    assert r.returncode == 2 and "/dev/zero: is not a regular file" in r.stderr and not (tmp_path / "p").exists()
