@@ -144,7 +144,7 @@ non_negative_float = _at_least(finite_float, 0, False, "0 or more")  # accelerat
 non_negative_int = _at_least(ascii_int, 0, False, "0 or more")  # first numbers of a series
 
 
-AXIS_OPTIONS = ("--down", "--up", "--forward")  # options whose value is a signed axis such as -z
+AXIS_OPTIONS = ("--down", "--up", "--forward", "--floor")  # options whose value is a signed axis such as -z
 _SIGNED_AXIS = re.compile(r"-[xyz]", re.IGNORECASE)
 RANGE_OPTIONS = ("--threshold", "--range")  # LO[:HI]: a CT's body starts at -300 Hounsfield units
 _NEGATIVE_RANGE = re.compile(r"-[0-9.][0-9.eE+-]*(?::[0-9.eE+-]*)?")

@@ -23,6 +23,7 @@ EXAMPLE = (
     "volanim render arm.vti -o arm-edited.png --style volume --tf arm.tf",
     "volanim render walk.zarr -o frames/ --camera front.camera --cut 80 50 150 0 -1 0   # cut away the front half",
     "volanim render walk.zarr -o walk-follow.mp4 --camera follow --view side   # the camera walks along",
+    "volanim render crumble.zarr -o heap.png --frames=-1: --view side --floor   # the heap on its ground",
 )
 
 
@@ -73,7 +74,8 @@ def _render(args):
     settings = RenderSettings(camera, style=args.style, preset=preset, vmax=inputs.vmax,
                               transfer=io.read_transfer_function(args.tf) if args.tf else None, size=(w, h),
                               background=args.background, cut=cut, title=args.title,
-                              frame_numbers=args.frame_numbers, mapper=args.mapper, spacing=inputs.spacing)
+                              frame_numbers=args.frame_numbers, mapper=args.mapper, spacing=inputs.spacing,
+                              floor=(args.floor, inputs.lo, inputs.hi) if args.floor else None)
     if args.save_tf:
         io.write_transfer_function(args.save_tf, transfer_of(settings))
         print(f"wrote {args.save_tf} (the {'--tf' if args.tf else preset + ' preset'}'s transfer function)")
@@ -117,6 +119,10 @@ def register(sub) -> None:
                    type=checked_by("volanim_core.render.scene:check_colour"), help="a colour name or #rrggbb")
     p.add_argument("--cut", nargs=6, type=finite_float, action=CutAction, metavar=("X", "Y", "Z", "NX", "NY", "NZ"),
                    help="cut away everything on the side the normal (NX NY NZ) points to from voxel (X Y Z)")
+    p.add_argument("--floor", nargs="?", const="-z", metavar="DOWN",
+                   type=checked_by("volanim_core.sequence.effects:parse_axis"),
+                   help="a grey ground under the lowest voxel any frame fills along DOWN (default -z): where a "
+                   "crumble's heap lands")
     p.add_argument("--title", help="text in the top left corner")
     p.add_argument("--frame-numbers", action="store_true", help="the frame number in the top right corner")
     p.add_argument("--fps", type=positive_float, help="movie frame rate (default: the sequence's, else 24)")

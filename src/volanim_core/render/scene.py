@@ -58,6 +58,7 @@ class RenderSettings:
     frame_numbers: bool = False
     mapper: str = "auto"  # volume style: "cpu" (fixed-point ray caster), "gpu" (VTK's smart mapper), "auto"
     spacing: tuple[float, float, float] = (1.0, 1.0, 1.0)  # world units per voxel (origins, cuts: in voxels)
+    floor: tuple | None = None  # (down axis like "-z", body lo, body hi in voxels): a ground plane under the body
 
     def check(self) -> None:
         if self.style not in STYLES:
@@ -141,6 +142,34 @@ def cut_away(volume: np.ndarray, origin, point, normal) -> np.ndarray:
     return out
 
 
+FLOOR = "#777777"  # mid grey: seen on black and on white backgrounds
+
+
+def floor_corners(down: str, lo, hi, spacing=(1.0, 1.0, 1.0)) -> np.ndarray:
+    """``(4, 3)`` world corners of the ground under the body box ``lo..hi`` (voxel centres): the face of
+    the box's lowest voxels along ``down``, a square centred under the box, twice its wider side across
+    (the heap of a crumble lands on this floor: the lowest voxel the standing body had)."""
+    from volanim_core.sequence.effects import parse_axis
+
+    axis, sign = parse_axis(down)
+    lo, hi = np.asarray(lo, np.float64) - 0.5, np.asarray(hi, np.float64) + 0.5  # voxel faces
+    centre = (lo + hi) / 2
+    u, v = [a for a in range(3) if a != axis]
+    half = float(max(hi[u] - lo[u], hi[v] - lo[v]))  # half of twice the wider side
+    corners = np.repeat(centre[None], 4, axis=0)
+    corners[:, axis] = lo[axis] if sign < 0 else hi[axis]
+    corners[:, u] += [-half, half, half, -half]
+    corners[:, v] += [-half, -half, half, half]
+    return corners * np.asarray(spacing, np.float64)
+
+
+def floor_plane(down: str, lo, hi, spacing=(1.0, 1.0, 1.0)):
+    """The ground of :func:`floor_corners` as a pyvista quad."""
+    import pyvista as pv
+
+    return pv.PolyData(floor_corners(down, lo, hi, spacing), faces=[4, 0, 1, 2, 3])
+
+
 def has_display() -> bool:
     """Whether an on-screen window can open (an X11 or Wayland display on Linux; always elsewhere)."""
     import os
@@ -193,6 +222,9 @@ class Renderer:
         if settings.title:
             self.plotter.add_text(settings.title, position="upper_left", font_size=12, name="title",
                                   color=_contrast(settings.background))
+        if settings.floor is not None:
+            self.plotter.add_mesh(floor_plane(*settings.floor, settings.spacing), color=FLOOR, name="floor",
+                                  reset_camera=False, render=False)
         settings.camera.apply(self.plotter.renderer.GetActiveCamera())
         self.plotter.camera_set = True  # never reset to fit a frame: the camera is the sequence's
 
