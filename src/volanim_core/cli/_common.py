@@ -146,7 +146,7 @@ non_negative_int = _at_least(ascii_int, 0, False, "0 or more")  # first numbers 
 
 AXIS_OPTIONS = ("--down", "--up", "--forward", "--floor")  # options whose value is a signed axis such as -z
 _SIGNED_AXIS = re.compile(r"-[xyz]", re.IGNORECASE)
-RANGE_OPTIONS = ("--threshold", "--range")  # LO[:HI]: a CT's body starts at -300 Hounsfield units
+RANGE_OPTIONS = ("--threshold", "--range", "--window")  # LO[:HI]: a CT body starts at -300 HU
 _NEGATIVE_RANGE = re.compile(r"-[0-9.][0-9.eE+-]*(?::[0-9.eE+-]*)?")
 
 

@@ -41,6 +41,7 @@ class FilesController(Controller):
         action("Open connections…", lambda: self.open_dialog("connections"), menu=menu)
         action("Open &project…", lambda: self.open_dialog("project"), menu=menu)
         action("View volume or &mesh…", lambda: self.view_file_dialog(), menu=menu)
+        action("View s&lices…", lambda: self.view_slices_dialog(), menu=menu)
         menu.addSeparator()
         action("&Save project", lambda: self.save_project(), "Ctrl+S", menu=menu)
         action("Save project &as…", lambda: self.save_project(ask=True), "Ctrl+Shift+S", menu=menu)
@@ -68,6 +69,24 @@ class FilesController(Controller):
             "Sequences: the zarr.json inside NAME.zarr (zarr.json volanim-plan.json);;All files (*)")
         if path:
             self.view_file(path)
+
+    def view_slices(self, path):
+        """Show any volume one slice at a time in a window of its own (the document is untouched)."""
+        from .slice_window import SliceWindow
+
+        window = self.attempt("View slices", lambda: SliceWindow(path, self.window),
+                              lambda w: f"Viewing slices of {Path(path).name}: {w.what}.")
+        if window is FAILED:
+            return None
+        self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
+        window.show()
+        return window
+
+    def view_slices_dialog(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self.window, "View slices", self.folder(),
+                                              f"Volumes ({VOLUME_PATTERNS});;All files (*)")
+        if path:
+            self.view_slices(path)
 
     # -------------------------------------------------------------- loading
     def _apply_prepared(self, result: dict, path=None, spacing=None, dims=None) -> None:
