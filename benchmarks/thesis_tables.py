@@ -8,15 +8,27 @@ bone turned 45 degrees at its proximal joint): time, voxels, % loss against
 the same skeleton's identity frame, hotspot maximum redundancy.
 
 mannequin-large (the thesis's half-size Visible Human scale, 290 x 169 x 940)
-prints Table 2.2 with the thesis's own row at that scale beside ours.
+prints Table 2.2 with the thesis's own row at that scale beside ours. Table 2.2's
+"% loss vs densest posed" is the thesis's own baseline: the posed frame of the
+densest skeleton (every object voxel a sphere), against which a sparser skeleton's
+posed frame loses voxels.
 
-Run: .venv/bin/python benchmarks/thesis_tables.py [mannequin] [mannequin-large] [frog]
+Fig 5.1: the mannequin's left leg (L_THIGH turned forward 45 degrees at the hip), the
+same columns, and its picture at thinness >= 0.5 (docs/thesis-left-leg.png).
+Fig 5.2: the thesis's old algorithm (the cube scan, benchmarks/_old_reconstruct.py) against
+ours on the aliasing cube, sampled, 2 threads, at each thinness.
+Thinness: the thesis's thresholds (1.03 .. 2.48) are in 3-4-5 chamfer units (3 a voxel step);
+the table counts the points at each with --metric 345 beside ours (Euclidean) at a third of it,
+and how many points the two share.
+
+Run: .venv/bin/python benchmarks/thesis_tables.py [mannequin] [mannequin-large] [frog] [leg] [aliascube] [thinness]
 """
 
 from __future__ import annotations
 
 import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -35,23 +47,23 @@ from volanim_core.skeleton.skeletonize import skeletonize  # noqa: E402
 
 THINNESS = (1.0, 0.75, 0.5, 0.25, 0.0, -np.inf)
 POSE = {"mannequin": ("L_UPPERARM", (0, -45, 0)), "mannequin-large": ("L_UPPERARM", (0, -45, 0)),
-        "frog": ("LEGS", (0, 0, 45))}
+        "frog": ("LEGS", (0, 0, 45)), "leg": ("L_THIGH", (45, 0, 0))}
 #: The thesis's own Table 2.2 row at this scale: the half-size Visible Human (290 x 169 x 940) on 2001 hardware.
 THESIS_ROW = ["thesis, Visible Human 1/2", 29777, f"{48 * 60 + 51} (48 min 51 s)", "-", "-", "-", "-"]
 
 
-def tables(name: str) -> tuple[str, str]:
+def tables(name: str, pose: tuple | None = None) -> tuple[str, str]:
     s = samples.load(name)
     full = skeletonize(s.mask, min_thinness=-np.inf)
     densest = int(s.mask.sum())
-    bone, angles = POSE[name]
+    bone, angles = pose or POSE[name]
     mats = pose_matrices(s.bones, {bone: angles})
     rows1, rows2 = [], []
     for th in THINNESS:
         skel = full.at(th)
         if not len(skel):  # no point is that thin: nothing to reconstruct
             rows1.append([f"{th:g}", 0, 0, "100.00"])
-            rows2.append([f"{th:g}", 0, "-", 0, "-", "-", "-"])
+            rows2.append([f"{th:g}", 0, "-", 0, "-", None, "-", "-"])
             continue
         conn = connect_nearest(skel, s.bones)
         rest = reconstruct(identity_tskel(conn), mode="binary")
@@ -65,20 +77,97 @@ def tables(name: str) -> tuple[str, str]:
         elapsed = time.perf_counter() - t0
         hot = reconstruct(posed, mode="hotspot")
         ploss = 100.0 * (rest.stats["filled"] - r.stats["filled"]) / rest.stats["filled"]
-        rows2.append([f"{th:g}", len(skel), f"{elapsed:.3f}", r.stats["filled"], f"{ploss:.2f}",
+        rows2.append([f"{th:g}", len(skel), f"{elapsed:.3f}", r.stats["filled"], f"{ploss:.2f}", None,
                       hot.stats["hotspot_max"], f"{hot.stats['hotspot_mean']:.1f}"])
+    densest_posed = rows2[-1][3]  # the last row: every object voxel a sphere (the thesis's baseline)
+    for row in rows2:
+        row[5] = "-" if not row[3] else f"{100.0 * (densest_posed - row[3]) / densest_posed:.2f}"
     if name == "mannequin-large":
-        rows2.append(THESIS_ROW)
+        rows2.append(THESIS_ROW[:5] + ["-"] + THESIS_ROW[5:])
     t1 = table(rows1, ["thinness >=", "points", "identity voxels", "% loss from densest"])
     t2 = table(rows2, ["thinness >=", "points", "time s (sampled, 2 threads)", "voxels", "% loss vs identity",
-                       "hotspot max", "hotspot mean"])
+                       "% loss vs densest posed (thesis)", "hotspot max", "hotspot mean"])
     return t1, t2
 
 
+def left_leg_picture(path: Path) -> None:
+    """Fig 5.1's picture: the mannequin at thinness >= 0.5 with its left leg turned, in bone colours."""
+    from volanim_core.render.camera import named_view
+    from volanim_core.render.run import write_png
+    from volanim_core.render.scene import Renderer, RenderSettings
+
+    s = samples.load("mannequin")
+    conn = connect_nearest(skeletonize(s.mask, min_thinness=0.5), s.bones)
+    bone, angles = POSE["leg"]
+    r = reconstruct(connect_to_tskel(conn, Trans(root_bones(s.bones), pose_matrices(s.bones, {bone: angles}))),
+                    mode="bone")
+    lo = np.asarray(r.origin)
+    camera = named_view("three-quarter", tuple(lo), tuple(lo + np.asarray(r.volume.shape) - 1), aspect=4 / 3)
+    renderer = Renderer(RenderSettings(camera, preset="bone", vmax=float(r.volume.max()), size=(480, 360)))
+    write_png(path, renderer.render(r.volume, r.origin))
+    renderer.close()
+
+
+def aliascube_timing() -> str:
+    """Fig 5.2: the old cube scan against ours on the aliasing cube (one bone, identity frame, sampled)."""
+    from _old_reconstruct import run_cube_scan
+
+    from volanim_core.reconstruct.engine import grid_bounds
+    from volanim_core.rig.bones import Bone, BoneSkeleton
+
+    s = samples.load("aliascube")
+    bones = BoneSkeleton({"A": (64, 64, 0), "B": (64, 64, 127)}, [Bone("A", "B", "CUBE")])
+    full = skeletonize(s.mask, min_thinness=-np.inf)
+    rows = []
+    for th in (0.5, 0.25):  # every voxel a sphere (thinness >= 0): the cube scan takes over 2 minutes
+        tsk = identity_tskel(connect_nearest(full.at(th), bones))
+        bounds, nbrs = grid_bounds(tsk), sphere_neighbours(tsk)
+        times = {}
+        for key, run in (("old", partial(run_cube_scan, tsk, bounds, s.volume, True, 2)),
+                         ("ours", partial(reconstruct, tsk, mode="sampled", source=s.volume, neighbours=nbrs))):
+            run()  # warm: numba's cache, the pages
+            t0 = time.perf_counter()
+            run()
+            times[key] = time.perf_counter() - t0
+        rows.append([f"{th:g}", len(tsk), f"{times['old']:.3f}", f"{times['ours']:.3f}",
+                     f"{times['old'] / times['ours']:.1f}x"])
+    return table(rows, ["thinness >=", "spheres", "old cube scan s", "ours s", "old / ours"])
+
+
+def thinness_mapping() -> str:
+    """The thesis's thresholds (3-4-5 chamfer units) against ours (Euclidean voxels) on the mannequins."""
+    rows = []
+    for name in ("mannequin", "mannequin-large"):
+        mask = samples.load(name).mask
+        chamfer = skeletonize(mask, metric="345", min_thinness=1.0)
+        euclid = skeletonize(mask, min_thinness=0.3)
+        for th in (1.03, 1.5, 2.0, 2.48):
+            a, b = chamfer.at(th), euclid.at(th / 3)
+            ka = np.ravel_multi_index(np.asarray(a.points, np.int64).T, mask.shape)
+            kb = np.ravel_multi_index(np.asarray(b.points, np.int64).T, mask.shape)
+            shared = len(np.intersect1d(ka, kb))
+            rows.append([name, f"{th:g}", len(a), f"{th / 3:.3f}", len(b), f"{100.0 * shared / max(len(a), 1):.0f} %"])
+    return table(rows, ["object", "thesis thinness (--metric 345)", "points", "ours (euclid) = thesis / 3",
+                        "points", "of the thesis's points also ours"])
+
+
 def main() -> None:
-    for name in sys.argv[1:] or ("mannequin", "mannequin-large", "frog"):
-        t1, t2 = tables(name)
+    for name in sys.argv[1:] or ("mannequin", "mannequin-large", "frog", "leg", "aliascube", "thinness"):
+        if name == "aliascube":
+            print(f"\nFig 5.2: the thesis's cube scan against ours, aliasing cube, sampled, 2 threads\n"
+                  f"{aliascube_timing()}")
+            continue
+        if name == "thinness":
+            print(f"\nThinness: the thesis's thresholds (3-4-5 chamfer) and ours (Euclidean)\n{thinness_mapping()}")
+            continue
         bone, angles = POSE[name]
+        if name == "leg":
+            _, t2 = tables("mannequin", POSE["leg"])
+            left_leg_picture(Path(__file__).resolve().parents[1] / "docs" / "thesis-left-leg.png")
+            print(f"\nFig 5.1: mannequin, the left leg ({bone} turned {angles} degrees at the hip; picture: "
+                  f"docs/thesis-left-leg.png)\n{t2}")
+            continue
+        t1, t2 = tables(name)
         print(f"\n{name}: Table 2.1 (object: {int(samples.load(name).mask.sum())} voxels)\n{t1}")
         print(f"\n{name}: Table 2.2 ({bone} turned {angles} degrees at its proximal joint)\n{t2}")
 
