@@ -54,13 +54,7 @@ class FilesController(Controller):
         """Show a volume, a sequence's first frame or a mesh in a window of its own (the document is untouched)."""
         from .quicklook_window import QuickLookWindow
 
-        window = self.attempt("View", lambda: QuickLookWindow(path, self.window),
-                              lambda w: f"Viewing {Path(path).name}: {w.what}.")
-        if window is FAILED:
-            return None
-        self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
-        window.show()
-        return window
+        return self._viewer("View", lambda: QuickLookWindow(path, self.window), f"Viewing {Path(path).name}")
 
     def view_file_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
@@ -74,8 +68,12 @@ class FilesController(Controller):
         """Show any volume one slice at a time in a window of its own (the document is untouched)."""
         from .slice_window import SliceWindow
 
-        window = self.attempt("View slices", lambda: SliceWindow(path, self.window),
-                              lambda w: f"Viewing slices of {Path(path).name}: {w.what}.")
+        return self._viewer("View slices", lambda: SliceWindow(path, self.window),
+                            f"Viewing slices of {Path(path).name}")
+
+    def _viewer(self, title: str, make, doing: str):
+        """A looking window made by ``make()`` and shown, kept while visible; None (the error shown) on failure."""
+        window = self.attempt(title, make, lambda w: f"{doing}: {w.what}.")
         if window is FAILED:
             return None
         self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
