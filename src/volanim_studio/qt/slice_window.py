@@ -66,7 +66,7 @@ class SliceWindow(QMainWindow):
         super().__init__(parent)
         scan = read_scan(path, colour=True)  # FormatError names the file; the caller shows it
         self.path, self.volume, self.spacing = Path(path), scan.data, scan.geometry.spacing
-        self.window = default_window(self.volume) if self.volume.ndim == 3 else None
+        self.grey = default_window(self.volume) if self.volume.ndim == 3 else None
         self.setWindowTitle(f"Slices — {self.path.name}")
         self.resize(700, 760)
         self.canvas = SliceCanvas()
@@ -84,7 +84,7 @@ class SliceWindow(QMainWindow):
         layout.addLayout(row)
         self.setCentralWidget(body)
         shape = "x".join(str(v) for v in self.volume.shape[:3])
-        self.what = f"{shape} voxels" + (f", grey {self.window[0]:g}..{self.window[1]:g}" if self.window else ", RGB")
+        self.what = f"{shape} voxels" + (f", grey {self.grey[0]:g}..{self.grey[1]:g}" if self.grey else ", RGB")
         self.axis_box.currentIndexChanged.connect(self.set_axis)
         self.slider.valueChanged.connect(self.show_slice)
         self.canvas.hovered.connect(self.report)
@@ -104,7 +104,7 @@ class SliceWindow(QMainWindow):
         self.show_slice(n // 2)
 
     def show_slice(self, index: int) -> None:
-        self.canvas.set_picture(slice_picture(self.volume, self.axis, index, self.window),
+        self.canvas.set_picture(slice_picture(self.volume, self.axis, index, self.grey),
                                 pixel_aspect(self.spacing, self.axis))
         self.label.setText(f"{AXES[self.axis]} = {index} of 0..{self.volume.shape[self.axis] - 1}")
         self.statusBar().showMessage(f"{self.path.name}: {self.what}. Slider or Page Up / Page Down to move.")
