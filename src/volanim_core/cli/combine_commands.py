@@ -33,6 +33,8 @@ def _onevolume(args):
     from volanim_core.io.volume_files import natural_order
 
     paths = natural_order(args.volumes)
+    if args.label and len(paths) > 255:  # before reading any: a long series takes a while
+        raise ValueError(f"--label numbers volumes 1..255 in a byte; {len(paths)} given")
     first = load_scan(paths[0], args)
     out = np.zeros(first.data.shape, np.uint8 if args.label else first.data.dtype, order="F")
     for k, path in enumerate(paths, start=1):
@@ -43,8 +45,6 @@ def _onevolume(args):
         keep = vol > args.threshold
         out[keep] = k if args.label else vol[keep]  # a later volume wins where two overlap
         print(f"{path}: {int(keep.sum())} voxels above {args.threshold:g}" + (f" -> label {k}" if args.label else ""))
-    if args.label and len(paths) > 255:
-        raise ValueError(f"--label numbers volumes 1..255 in a byte; {len(paths)} given")
     save(args.output, out, first.geometry)
 
 

@@ -46,7 +46,7 @@ def _view_slices(args):
     from volanim_core.render.run import write_png
     from volanim_core.render.scene import can_open_window
     from volanim_core.render.slice_view import SliceView
-    from volanim_core.render.slices import AXES, parse_slice_axis
+    from volanim_core.render.slices import AXES, describe, parse_slice_axis
 
     window = args.screenshot is None
     if window and not can_open_window():
@@ -64,9 +64,7 @@ def _view_slices(args):
         grey = (lo, hi)
     view = SliceView(scan.data, scan.geometry.spacing, axis, args.slice, grey, off_screen=True if not window else None,
                      slider=window, title=f" of {n}")
-    shape = "x".join(str(v) for v in scan.data.shape[:3])
-    what = f"{AXES[axis]} slices 0..{n - 1} of {shape} voxels" + (
-        f", grey {view.window[0]:g}..{view.window[1]:g}" if view.window else ", RGB")
+    what = f"{AXES[axis]} slices 0..{n - 1} of {describe(scan.data, view.grey)}"
     if window:
         print(f"{args.file}: {what}; drag the slider, q to close")
         view.plotter.show(title=f"volanim view {args.file}")

@@ -195,6 +195,8 @@ def _addheader(args):
 
 
 def _rmheader(args):
+    if args.dims and args.header_size is None:  # a .VOL's own header sizes it: the dims would go unchecked
+        raise ValueError("--dims goes with --header-size (a .VOL's header gives its dims)")
     dims = remove_header(args.input, args.output, args.header_size, args.dims)
     size = f"{dims[0]}x{dims[1]}x{dims[2]}" if dims else f"{Path(args.output).stat().st_size} bytes"
     print(f"wrote {args.output} ({size}, no header)")

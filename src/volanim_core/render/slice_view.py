@@ -30,14 +30,14 @@ class SliceView:
     """A slice of ``volume`` in a pyvista plotter (made here; ``off_screen`` as for ``pyvista.Plotter``)."""
 
     def __init__(self, volume: np.ndarray, spacing=(1.0, 1.0, 1.0), axis: int = 2, index: int | None = None,
-                 window=None, off_screen: bool | None = True, slider: bool = False, title: str = ""):
+                 grey=None, off_screen: bool | None = True, slider: bool = False, title: str = ""):
         import pyvista as pv
 
         from .scene import prefer_egl_without_display
 
         prefer_egl_without_display()
         self.volume, self.axis = volume, axis
-        self.window = window if window is not None else default_window(volume) if volume.ndim == 3 else None
+        self.grey = grey if grey is not None else default_window(volume) if volume.ndim == 3 else None
         self.index = volume.shape[axis] // 2 if index is None else int(index)
         w, h = window_size(volume.shape, axis, spacing)
         margin = SLIDER_MARGIN if slider else 0
@@ -68,7 +68,7 @@ class SliceView:
                                            pointa=(0.1, y), pointb=(0.9, y), style="modern")
 
     def picture(self) -> np.ndarray:
-        return slice_picture(self.volume, self.axis, self.index, self.window)
+        return slice_picture(self.volume, self.axis, self.index, self.grey)
 
     def show(self, index: int) -> None:
         """Slice ``index`` in place of the one shown."""

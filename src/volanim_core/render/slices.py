@@ -20,7 +20,7 @@ AXES = "xyz"
 def parse_slice_axis(text: str) -> int:
     """``x``, ``y`` or ``z`` -> 0, 1, 2 (the axis a slice is across)."""
     t = str(text).strip().lower()
-    if t not in AXES or not t:
+    if t not in ("x", "y", "z"):  # not `in AXES`: "xy" is a substring of "xyz"
         raise ValueError(f"a slice is across x, y or z, got {text!r}")
     return AXES.index(t)
 
@@ -33,6 +33,12 @@ def default_window(volume: np.ndarray) -> tuple[float, float]:
         return 0.0, 1.0
     lo, hi = float(finite.min()), float(finite.max())
     return (lo, hi) if hi > lo else (lo, lo + 1.0)
+
+
+def describe(volume: np.ndarray, grey: tuple[float, float] | None) -> str:
+    """``228x142x120 voxels, grey -1000..900`` (or ``, RGB``): what a slice viewer shows, in a line."""
+    shape = "x".join(str(v) for v in volume.shape[:3])
+    return f"{shape} voxels" + (f", grey {grey[0]:g}..{grey[1]:g}" if grey is not None else ", RGB")
 
 
 def slice_picture(volume: np.ndarray, axis: int, index: int, window: tuple[float, float] | None = None

@@ -15,7 +15,7 @@ from PySide6.QtCore import QRectF, Qt, Signal
 from PySide6.QtGui import QImage, QPainter
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QMainWindow, QSlider, QVBoxLayout, QWidget
 
-from volanim_core.render.slices import AXES, default_window, pixel_aspect, slice_picture, voxel_at
+from volanim_core.render.slices import AXES, default_window, describe, pixel_aspect, slice_picture, voxel_at
 
 
 class SliceCanvas(QWidget):
@@ -83,8 +83,7 @@ class SliceWindow(QMainWindow):
         layout.addWidget(self.canvas, 1)
         layout.addLayout(row)
         self.setCentralWidget(body)
-        shape = "x".join(str(v) for v in self.volume.shape[:3])
-        self.what = f"{shape} voxels" + (f", grey {self.grey[0]:g}..{self.grey[1]:g}" if self.grey else ", RGB")
+        self.what = describe(self.volume, self.grey)
         self.axis_box.currentIndexChanged.connect(self.set_axis)
         self.slider.valueChanged.connect(self.show_slice)
         self.canvas.hovered.connect(self.report)

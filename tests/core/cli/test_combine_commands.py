@@ -43,6 +43,10 @@ def test_onevolume_merges_a_numbered_series_above_a_threshold(tmp_path):
     io.write_volume(tmp_path / "small.VOL", parts[0][:3])
     bad = volanim("onevolume", tmp_path / "part.1.VOL", tmp_path / "small.VOL", "-o", tmp_path / "x.VOL")
     assert bad.returncode == 2 and "small.VOL is 3x5x4 voxels" in bad.stderr and not (tmp_path / "x.VOL").exists()
+    # 256 volumes cannot be labelled in a byte: refused before any is read (it read them all first)
+    many = volanim("onevolume", *[tmp_path / f"missing.{k}.VOL" for k in range(256)], "-o", tmp_path / "x.VOL",
+                   "--label")
+    assert many.returncode == 2 and "--label numbers volumes 1..255" in many.stderr, many.stderr
 
 
 def test_addskel_burns_points_in_through_physical_space_and_at_half_size(tmp_path):

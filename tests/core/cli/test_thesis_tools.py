@@ -84,6 +84,11 @@ def test_rmheader_takes_a_header_size_as_the_thesis_rmhdr_did(tmp_path):
     assert not (tmp_path / "w.vol").exists()
     big = volanim("rmheader", tmp_path / "scanner.img", tmp_path / "w.vol", "--header-size", "99999")
     assert big.returncode == 2 and "leaves no voxels" in big.stderr
+    # --dims checks what --header-size leaves; on a .VOL the header sizes it, and --dims was ignored silently
+    io.write_volume(tmp_path / "v.VOL", v)
+    unchecked = volanim("rmheader", tmp_path / "v.VOL", tmp_path / "w.vol", "--dims", "1", "2", "3")
+    assert unchecked.returncode == 2 and "--dims goes with --header-size" in unchecked.stderr
+    assert not (tmp_path / "w.vol").exists()
 
 
 # spec: docs/formats.md#remap

@@ -101,6 +101,7 @@ def test_the_windows_slider_moves_through_the_slices(tmp_path):
 def test_slice_refusals_name_what_is_wrong(tmp_path):
     io.write_volume(tmp_path / "v.nrrd", np.ones((4, 5, 6), np.uint8))
     for args, message in ((["--slices", "q"], "a slice is across x, y or z"),
+                          (["--slices", "xy"], "a slice is across x, y or z"),  # was taken as x
                           (["--slices", "y", "--slice", "5"], "v.nrrd: --slice 5 is outside the volume: y runs 0..4"),
                           (["--slices", "--window", "9:2"], "--window needs LO:HI with LO < HI"),
                           (["--slice", "2"], "add --slices")):
