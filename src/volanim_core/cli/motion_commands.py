@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.errors import FormatError
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frames import write_frames
@@ -114,14 +115,14 @@ def _trans2positions(args):
 
 
 def _positions2trans(args):
-    from volanim_core.motion.positions import read_positions, solve
+    from volanim_core.motion.positions import solve
 
     bones = read_bones(args.bones)
     names = list(bones.joints)
-    numbers, positions = read_positions(args.positions, names, args.scale)
+    numbers, positions, what = _joint_positions(args, bones, names)
     have = [n for j, n in enumerate(names) if not np.isnan(positions[:, j]).all()]
     missing = [n for n in names if n not in have]
-    print(f"{len(numbers)} frames, {len(have)} of {len(names)} joints in {args.positions}"
+    print(f"{len(numbers)} frames, {len(have)} of {len(names)} joints in {args.positions}{what}"
           + (f"; no data for {', '.join(missing)} (their bones follow their parents)" if missing else ""))
     bar = TextProgress("solving bones")
     mats = solve(bones, positions, names, progress=bar)
@@ -130,6 +131,40 @@ def _positions2trans(args):
     write_frames(args.output, Path(args.positions).stem, bones, mats, numbers, connect=conn,
                  progress=TextProgress(f"writing {len(numbers)} frames"))
     print(f"wrote {len(numbers)} frames -> {args.output}")
+
+
+def _joint_positions(args, bones, names):
+    """(frame numbers, (F, J, 3) in the bones' space, what was read and fitted) from a CSV or a C3D file."""
+    from volanim_core.motion import markers
+    from volanim_core.motion.positions import read_positions
+
+    mapping = markers.read_marker_map(args.map) if args.map else None
+    c3d = Path(args.positions).suffix.lower() == ".c3d"
+    if c3d:
+        labels, data, rate, unit = markers.read_c3d(args.positions)
+        numbers = np.arange(len(data))
+        what = f" ({len(labels)} markers at {rate:g} Hz, in {unit or 'unnamed units'})"
+    else:
+        labels = sorted({m for ms in mapping.values() for m in ms}) if mapping else names
+        numbers, data = read_positions(args.positions, labels)
+        what = ""
+    if mapping is None:
+        mapping = markers.default_map(labels, names)
+        if not mapping:
+            raise FormatError(args.positions, f"no marker is named after a joint of {args.bones}: give --map "
+                              f"(JOINT MARKER [MARKER ...] per line); its {markers.listed(labels)}")
+    positions = markers.joints_from_markers(labels, data, mapping, names, args.map or args.positions)
+    numbers, positions = numbers[args.frames], positions[args.frames]
+    if not len(numbers):
+        raise FormatError(args.positions, f"--frames selects none of its {len(data)} frames")
+    auto = "auto" if c3d else None  # a CSV is in the bones' space already (as trans2positions writes it)
+    up, forward = args.up or auto, args.forward or auto
+    scale = args.scale if args.scale is not None else (None if c3d else 1.0)
+    if up is None and forward is None:
+        return numbers, positions * scale, what
+    fitted = markers.fit(bones, positions, names, up or "z", forward or "-y", scale)
+    print(f"data up {fitted.up}, forward {fitted.forward}, {fitted.scale:.4g} voxels per unit ({fitted.how})")
+    return numbers, fitted.apply(positions), what
 
 
 def _bones_and_frames_args(p) -> None:
@@ -171,10 +206,18 @@ def register(sub) -> None:
                     "frame,joint,x,y,z) -> one .trans per frame; the twist from a third marker (ivskelgetrot).",
                     "volanim positions2trans walk-joints.csv --bones mannequin.bones -o from-positions/",
                     _positions2trans)
-    p.add_argument("positions", help="CSV: a 'frame,joint,x,y,z' header, then a row per joint and frame; joints "
-                                     "named as in the .bones, in its coordinates (voxels) times --scale")
+    p.add_argument("positions", help="CSV: a 'frame,joint,x,y,z' header, then a row per joint and frame, in the "
+                                     ".bones' coordinates (voxels) times --scale; or a C3D file (motion capture), "
+                                     "fitted onto the bones")
     p.add_argument("--bones", required=True, help="our .bones file")
-    p.add_argument("--scale", type=positive_float, default=1.0, help="multiply the positions by this (default 1)")
+    p.add_argument("--map", help="JOINT MARKER [MARKER ...] per line: each joint the mean of its markers "
+                                 "(default: markers named after the joints)")
+    p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
+    p.add_argument("--up", help="the data's up axis (x, y, z, -x, ...; default for C3D: auto, from the legs' "
+                                "and spine's directions; for a CSV: the bones' own, z)")
+    p.add_argument("--forward", help="the way the data's figure faces at rest (default: as --up; -y for a CSV)")
+    p.add_argument("--scale", type=positive_float, help="voxels per data unit (default for C3D: our bone lengths "
+                                                        "over the data's; for a CSV: 1)")
     p.add_argument("--connect", help="also write each frame's .tskel for this .connect")
     p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
 
