@@ -42,6 +42,7 @@ from volanim_core.reconstruct.neighbours import (
 )
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.sampling import sample_source
+from volanim_core.reconstruct.speedups import ALL, Speedups
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.pose import apply_rows
 from volanim_core.rig.skinning import transform_table
@@ -227,6 +228,7 @@ def reconstruct(
     out: np.ndarray | None = None,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
+    speedups: Speedups = ALL,
 ) -> Reconstruction:
     """Re-grow a volume from the spheres of a ``.tskel`` frame.
 
@@ -255,13 +257,15 @@ def reconstruct(
     neighbours : (N, k) int ndarray, optional
         :func:`sphere_neighbours` of this connectivity (made once per connectivity and remembered when not
         given); lets each sphere skip voxels a larger neighbour provably wins.
-        The result does not depend on it; ``neighbours=False`` turns the cut off.
+        The result does not depend on it; ``speedups=Speedups(cut=False)`` turns the cut off.
     out : ndarray, optional
         A previous result's ``volume`` of the same grid and dtype to overwrite
         (saves the first-touch cost of a fresh array; the studio's live preview).
     progress, cancel : callables, optional
         ``progress(done, total)`` in output slices; ``cancel() -> True``
         raises :class:`~volanim_core.errors.Cancelled`.
+    speedups : Speedups
+        Optimisations to switch off, to measure them (:mod:`.speedups`); the result does not depend on it.
 
     Returns
     -------
@@ -281,7 +285,7 @@ def reconstruct(
     report = Reporter(progress, cancel)
     minv_rest = check_matrices(tskel)
     check_frame(tskel)
-    if neighbours is not None and neighbours is not False:
+    if neighbours is not None:
         check_neighbours(neighbours, len(tskel))
     tskel, order = file_ordered(tskel)
     table, rows = transform_table(tskel)
@@ -312,7 +316,7 @@ def reconstruct(
     scratch = np.empty((nthreads, ny, nx) if relax else (nthreads, 1, 1), np.float32)
     row_lo = np.full((nz, ny) if relax else (1, 1), nx, np.int32)  # each row's span of written output
     row_hi = np.full(row_lo.shape, -1, np.int32)
-    if metric == K.EUCLID and mode != "hotspot" and neighbours is not False and len(tskel):
+    if metric == K.EUCLID and mode != "hotspot" and speedups.cut and len(tskel):
         nbrs = cached_neighbours(tskel, min_radius=CUT_MIN_RADIUS, r2=r2s) if neighbours is None \
             else reorder_neighbours(neighbours, order)
         plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
@@ -340,7 +344,8 @@ def reconstruct(
             z1 = min(nz, z0 + chunk)
             started = time.perf_counter()
             K.fill_slices(out, scratch, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric,
-                          _MODE_CODE[mode], plane_start, planes, max_planes, row_lo, row_hi, filled, visits)
+                          _MODE_CODE[mode], plane_start, planes, max_planes, row_lo, row_hi, filled, visits,
+                          speedups.box_sweep, K.AHEAD if speedups.prefetch else 0)
             report(z1, total)
             # ... and the next ones last about LAUNCH_SECONDS each: progress and cancel stay that responsive,
             # and a fast call is not cut into many launches (each ends on its slowest thread)

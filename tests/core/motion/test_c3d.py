@@ -113,3 +113,18 @@ def test_c3d_input_that_cannot_work_is_refused_naming_the_file(tmp_path):
     r = volanim("positions2trans", tmp_path / "none.c3d", "--bones", bones, "-o", tmp_path / "e")
     assert r.returncode == 2 and "none.c3d" in r.stderr
     assert not any((tmp_path / d).exists() for d in "bcde")
+
+
+@pytest.mark.parametrize("up, forward", [("y", "z"), ("z", "x"), ("-x", "y")])
+def test_the_fit_finds_a_lab_turn_scale_and_place_it_was_given(up, forward):
+    """Our rest joints put in a lab by hand (axes, millimetres, somewhere on the floor) come back exactly."""
+    bones = io.read_bones(ASSETS / "mannequin.bones")
+    names = list(bones.joints)
+    rest = np.array([bones.joints[n] for n in names], float)
+    u, f = (np.eye(3)[["xyz".index(a[-1])]][0] * (-1 if a.startswith("-") else 1) for a in (up, forward))
+    lab_of_ours = np.column_stack([np.cross(-f, u), -f, u])  # our x = y cross z, y (we face -y), z in the lab
+    lab = (rest @ lab_of_ours.T) / 0.17 + np.array([2500.0, -300.0, 40.0])  # 0.17 voxels per mm
+    fitted = markers.fit(bones, lab[None], names)
+    assert (fitted.up, fitted.forward) == (up, forward)
+    assert fitted.scale == pytest.approx(0.17, rel=1e-9)
+    np.testing.assert_allclose(fitted.apply(lab[None])[0], rest, atol=1e-9)

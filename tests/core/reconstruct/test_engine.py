@@ -11,9 +11,12 @@ from volanim_core import samples
 from volanim_core.errors import Cancelled
 from volanim_core.geometry import Geometry
 from volanim_core.reconstruct.engine import grid_bounds, reconstruct
+from volanim_core.reconstruct.speedups import Speedups
 from volanim_core.rig.connectivity import RootBone, Tskel
 from volanim_core.skeleton.skeletonize import skeletonize
 from volanim_core.volume import Bounds
+
+NO_CUT = Speedups(cut=False)  # the overdraw cut off: every sphere visits its whole ball
 
 
 def random_rigid(rng, centre, quarter_turns=False):
@@ -137,7 +140,7 @@ def test_overdraw_cut_changes_nothing_but_visits(rng, mode, monkeypatch):
     source = rng.integers(1, 256, (30, 30, 30)).astype(np.uint8)
     t = random_tskel(rng, n=800, size=30, nbones=2)
     cut = reconstruct(t, mode=mode, source=source)
-    full = reconstruct(t, mode=mode, source=source, neighbours=False)
+    full = reconstruct(t, mode=mode, source=source, speedups=NO_CUT)
     assert np.array_equal(cut.volume, full.volume)
     assert cut.stats["filled"] == full.stats["filled"]
     assert cut.stats["visits"] < full.stats["visits"]
@@ -154,7 +157,7 @@ def test_overdraw_cut_on_large_rotated_spheres_changes_nothing_but_visits(rng):
         t = Tskel(t.bones, t.matrices, t.points, np.sqrt(rng.integers(int(CUT_MIN_RADIUS**2) - 20, 200, len(t))),
                   None, t.bone)
         cut = reconstruct(t, mode="bone", source=source)
-        full = reconstruct(t, mode="bone", source=source, neighbours=False)
+        full = reconstruct(t, mode="bone", source=source, speedups=NO_CUT)
         assert np.array_equal(cut.volume, full.volume) and cut.stats["filled"] == full.stats["filled"]
         assert cut.stats["visits"] < full.stats["visits"]
     want, _, ties = naive.reconstruct(t, cut.bounds, mode="bone", source=source)
@@ -193,7 +196,7 @@ def test_a_plane_along_y_or_z_cuts_rows_or_whole_slices_exactly():
     t = Tskel(bone, np.eye(4)[None], pts, [11.0, 13.0, 13.0, 13.0, 12.0], None, [0] * 5)
     b = Bounds((0, 0, 0), (40, 40, 40))
     cut = reconstruct(t, mode="mottled", bounds=b)
-    full = reconstruct(t, mode="mottled", bounds=b, neighbours=False)
+    full = reconstruct(t, mode="mottled", bounds=b, speedups=NO_CUT)
     assert np.array_equal(cut.volume, full.volume)
     assert cut.stats["visits"] < full.stats["visits"]
     want, _, ties = naive.reconstruct(t, b, mode="mottled")
@@ -354,7 +357,7 @@ def test_neighbours_refer_to_the_callers_order(rng, monkeypatch):
     mixed_order = rng.permutation(len(t))
     mixed = Tskel(t.bones, t.matrices, t.points[mixed_order], t.dt[mixed_order], None, t.bone[mixed_order])
     cut = reconstruct(mixed, mode="mottled", neighbours=sphere_neighbours(mixed))
-    plain = reconstruct(mixed, mode="mottled", neighbours=False)
+    plain = reconstruct(mixed, mode="mottled", speedups=NO_CUT)
     assert np.array_equal(cut.volume, plain.volume)
 
 
