@@ -31,6 +31,19 @@ def parse_frames(text: str) -> slice:
     return slice(*values)
 
 
+def axis_or_auto(text: str) -> str:
+    """``auto`` or a signed axis (``z``, ``-y``), checked where it is typed."""
+    from volanim_core.motion.retarget import axis_vector
+
+    if text.strip().lower() == "auto":
+        return "auto"
+    try:
+        axis_vector(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    return text.strip().lower()
+
+
 def _bvh2trans(args):
     bones = read_bones(args.bones)
     motion = read_bvh(args.clip)
@@ -162,7 +175,7 @@ def _joint_positions(args, bones, names):
     scale = args.scale if args.scale is not None else (None if c3d else 1.0)
     if up is None and forward is None:
         return numbers, positions * scale, what
-    fitted = markers.fit(bones, positions, names, up or "z", forward or "-y", scale)
+    fitted = markers.fit(bones, positions, names, up or "auto", forward or "auto", scale)
     print(f"data up {fitted.up}, forward {fitted.forward}, {fitted.scale:.4g} voxels per unit ({fitted.how})")
     return numbers, fitted.apply(positions), what
 
@@ -179,10 +192,10 @@ def register(sub) -> None:
     p.add_argument("--bones", required=True, help="our .bones file")
     p.add_argument("--map", help="BONE BVH_JOINT per line (default: suggested from the names; printed)")
     p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
-    p.add_argument("--up", default="auto", help="the clip's up axis: x, y, z, -x, ... (default: detected "
-                                                "from the motion: the feet are lowest)")
-    p.add_argument("--forward", default="auto", help="the way the clip's figure faces at rest (default: detected "
-                                                     "from where the feet point)")
+    p.add_argument("--up", type=axis_or_auto, default="auto",
+                   help="the clip's up axis: x, y, z, -x, ... (default: detected from the motion: the feet are lowest)")
+    p.add_argument("--forward", type=axis_or_auto, default="auto",
+                   help="the way the clip's figure faces at rest (default: detected from where the feet point)")
     p.add_argument("--connect", help="also write each frame's .tskel for this .connect")
     p.add_argument("--no-check", action="store_true",
                    help="write the frames even when the retargeted figure fails the plausibility checks")
@@ -213,9 +226,11 @@ def register(sub) -> None:
     p.add_argument("--map", help="JOINT MARKER [MARKER ...] per line: each joint the mean of its markers "
                                  "(default: markers named after the joints)")
     p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
-    p.add_argument("--up", help="the data's up axis (x, y, z, -x, ...; default for C3D: auto, from the legs' "
-                                "and spine's directions; for a CSV: the bones' own, z)")
-    p.add_argument("--forward", help="the way the data's figure faces at rest (default: as --up; -y for a CSV)")
+    p.add_argument("--up", type=axis_or_auto, help="the data's up axis (x, y, z, -x, ...) or auto: from the legs' "
+                   "and spine's directions (the default for C3D; a CSV is taken as in the bones' own axes unless "
+                   "--up or --forward is given)")
+    p.add_argument("--forward", type=axis_or_auto, help="the way the data's figure faces (x, -y, ...) or auto "
+                   "(the default, as for --up)")
     p.add_argument("--scale", type=positive_float, help="voxels per data unit (default for C3D: our bone lengths "
                                                         "over the data's; for a CSV: 1)")
     p.add_argument("--connect", help="also write each frame's .tskel for this .connect")

@@ -128,3 +128,12 @@ def test_the_fit_finds_a_lab_turn_scale_and_place_it_was_given(up, forward):
     assert (fitted.up, fitted.forward) == (up, forward)
     assert fitted.scale == pytest.approx(0.17, rel=1e-9)
     np.testing.assert_allclose(fitted.apply(lab[None])[0], rest, atol=1e-9)
+
+
+def test_axes_and_scale_given_are_kept_and_a_bad_axis_is_refused_where_typed(tmp_path):
+    bones = ASSETS / "mannequin.bones"
+    r = volanim("positions2trans", QUALISYS, "--bones", bones, "--map", MAP, "--frames", "0:1", "--up", "z",
+                "--forward", "-y", "--scale", "0.25", "-o", tmp_path / "a")
+    assert r.returncode == 0 and "data up z, forward -y, 0.25 voxels per unit (given)" in r.stdout
+    r = volanim("positions2trans", QUALISYS, "--bones", bones, "--map", MAP, "--up", "w", "-o", tmp_path / "b")
+    assert r.returncode == 2 and "--up" in r.stderr and "x, y or z" in r.stderr and not (tmp_path / "b").exists()
