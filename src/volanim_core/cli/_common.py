@@ -43,7 +43,7 @@ def add_joints(p: argparse.ArgumentParser, what: str = "the file's") -> None:
                    help=f"how bones meet: rigid (each point follows its bone) or smooth (points near a joint blend "
                         f"their bones' motions, dual quaternions); default {what}")
     p.add_argument("--blend", metavar="W",
-                   help="smooth joints' blend half-width: times the joint's radius (default 1), or millimetres "
+                   help="smooth joints' blend width: times each bone's thickness (default 1), or millimetres "
                         "like 12mm")
 
 

@@ -161,7 +161,7 @@ class Attachments:
             self.doc.settings.joints = "smooth"
             if conn.joints.mm:
                 warnings.append(f"{Path(path).name}: smooth joints {conn.joints.text()}: the studio sets the "
-                                f"blend as a multiple of the joint's radius, kept at {self.doc.settings.blend:g}")
+                                f"blend as a multiple of the bones' thickness, kept at {self.doc.settings.blend:g}")
             else:
                 self.doc.settings.blend = min(max(conn.joints.blend, 0.1), 10.0)
         return warnings

@@ -102,7 +102,7 @@ SETTINGS: dict[str, Setting] = {
     "preview_kernel": Setting(1, one_of(1, 3, 5), "sampled mode's kernel"),
     "preview_padding": Setting(2, number(0, 64, int), "voxels around the posed spheres"),
     "joints": Setting("rigid", one_of("rigid", "smooth"), "how bones meet: rigid, or smooth (blended near joints)"),
-    "blend": Setting(1.0, number(0.1, 10), "smooth joints' blend half-width, times the joint's radius"),
+    "blend": Setting(1.0, number(0.1, 10), "smooth joints' blend width, times the bones' thickness"),
     "live_preview": Setting(True, flag, "half-resolution preview while a pose slider moves"),
     "show_rest": Setting(False, flag, "show the rest pose's reconstruction instead (compare)"),
     # connect tools

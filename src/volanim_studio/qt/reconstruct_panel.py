@@ -44,7 +44,7 @@ class ReconstructPanel(QWidget):
                                    "smooth: points near a joint blend the two bones' motions (dual quaternions),\n"
                                    "so shoulders, hips, elbows and knees bend without breaking")
         self.blend = QDoubleSpinBox(minimum=0.1, maximum=10.0, singleStep=0.25, decimals=2)
-        self.blend.setToolTip("smooth joints: how far from a joint the blend reaches, times the joint's radius")
+        self.blend.setToolTip("smooth joints: how far from a joint the blend reaches, times the bones' thickness")
         self.live = QCheckBox("Live preview while posing (half resolution)")
         self.slices = QCheckBox("Orthogonal slices")
         self.show_rest = QCheckBox("Show the rest pose instead (compare)")
@@ -68,7 +68,7 @@ class ReconstructPanel(QWidget):
         form.addRow("Kernel (sampled)", self.kernel)
         form.addRow("Padding", self.padding)
         form.addRow("Joints", self.joint_kind)
-        form.addRow("Blend (× joint radius)", self.blend)
+        form.addRow("Blend (× bone thickness)", self.blend)
         form.addRow("Metric (from the skeleton)", self.metric_label)
         form.addRow(self.live)
         form.addRow(self.preview_button)

@@ -83,15 +83,44 @@ def test_weights_are_a_partition_of_unity_falling_off_from_the_joint():
     assert np.all(skin.weight >= 0)
     np.testing.assert_allclose(skin.weight.sum(1), 1.0, atol=1e-12)
     x = conn.points[skin.index, 0]
-    # blend half-width h: 1 x the radius (4), from the other bone's nearest point; bones meet at x 29 | 30,
-    # so x 26 and 33 are h away: weight 0, rigid
-    assert x.min() == 27 and x.max() == 32
+    # blend width h: 1 x the bones' thickness (4); each bone reaches fully h along the rod from its
+    # nearest point, then fades to nothing at 2h: UPPER's last point is x 29, LOWER's first 30
+    assert x.min() == 30 - 2 * 4 + 1 and x.max() == 29 + 2 * 4 - 1
     own = skin.weight[:, 0]
     lower = conn.bone[skin.index] == 1
-    assert np.all(np.diff(own[~lower]) < 0) and np.all(np.diff(own[lower]) > 0)  # 1 far away, 1/2 at the seam
-    f = 1 - (1 / 4) ** 2 * (3 - 2 / 4)  # the other bone's closeness one voxel from the seam: 1 - smoothstep(1/4)
-    assert own[x == 29][0] == pytest.approx(1 / (1 + f))
+    assert np.all(np.diff(own[~lower]) < 0) and np.all(np.diff(own[lower]) > 0)  # 1 far away, 1/2 at the joint
+    assert own[x == 30][0] == pytest.approx(0.5, abs=0.05)  # x 30 lies on both segments: the joint
     np.testing.assert_array_equal(skin.influence[:, 1], 1 - conn.bone[skin.index])
+
+
+def test_a_seam_along_the_limb_blends_only_at_the_joint():
+    """mannequin-large's hip: the torso's lowest points run beside the thigh for a long way below the
+    joint. The thigh there stays rigid and those torso points go with the thigh; blending by the
+    distance from the seam instead dragged the thigh's upper half (far-thigh Dice 0.90 at 120 degrees)."""
+    z_torso, z_leg = np.arange(20, 81), np.arange(0, 40)
+    points = np.vstack([np.column_stack([np.full_like(z_torso, 20), np.full_like(z_torso, 20), z_torso]),
+                        np.column_stack([np.full_like(z_leg, 23), np.full_like(z_leg, 20), z_leg])])
+    bone = np.r_[np.zeros(len(z_torso), int), np.ones(len(z_leg), int)]
+    joint = np.array([21.5, 20.0, 40.0])
+    bones = [RootBone(joint, (20, 20, 80), "TORSO"), RootBone(joint, (23, 20, 0), "LEG")]
+    conn = Connectivity(bones, points, np.full(len(points), 5.0), None, bone, joints=SMOOTH)
+    skin = conn.skin
+    weight_on = np.zeros((len(points), 2))
+    weight_on[np.arange(len(points)), bone] = 1.0
+    for r, i in enumerate(skin.index):
+        weight_on[i] = 0.0
+        for k, w in zip(skin.influence[r], skin.weight[r]):
+            if k >= 0:
+                weight_on[i, k] += w
+    far = points[:, 2] <= 40 - 3 * 5  # 3 blend widths (the thickness, 5) or more below the joint
+    assert np.all(weight_on[far & (bone == 1), 1] == 1.0)  # the leg: rigid
+    assert np.all(weight_on[far & (bone == 0), 1] > 0.95)  # the torso's points beside it: with the leg
+    mats = np.stack([np.eye(4), rotation_about(joint, euler((90, 0, 0)))])
+    bent = conn.posed(mats)
+    leg = far & (bone == 1)
+    np.testing.assert_allclose(posed_centres(bent)[leg], (np.c_[points[leg], np.ones(leg.sum())] @ mats[1])[:, :3],
+                               atol=1e-9)
+    assert len(components(reconstruct(bent, mode="binary", padding=1).volume)) == 1
 
 
 def test_weights_are_zero_across_a_gap():
@@ -170,12 +199,15 @@ def test_points_in_any_order_move_by_their_own_rows():
         np.testing.assert_allclose(apply_rows(points, row, table, 3), expect, atol=1e-12)
 
 
-def test_the_joint_radius_counts_a_sphere_exactly_its_radius_from_the_other_bone():
-    """The thickest sphere where the bones meet sets the blend width, also when it lies exactly its radius
-    from the other bone's nearest point (a strict distance bound once dropped it: h fell from 5 to 2)."""
+def test_a_thick_bone_reaches_further_than_a_thin_one():
+    """The blend width is a multiple of each bone's own thickness (its thickest sphere): one sphere of
+    radius 5 on UPPER widens UPPER's reach into LOWER, while LOWER (radius 2) reaches UPPER as before."""
     conn = cylinder(radius=2.0)
     dt = conn.dt.copy()
-    dt[conn.points[:, 0] == 25] = 5.0  # 5 from x = 30, the LOWER bone's first point
+    dt[conn.points[:, 0] == 25] = 5.0
     skin = skin_weights(conn.points, dt, conn.bone, conn.bones, Joints("smooth", 1.0))
     x = conn.points[skin.index, 0]
-    assert x.min() == 26 and x.max() == 33  # h = 5 from the seam at 29 | 30 (h = 2 would give 29..30)
+    lower = conn.bone[skin.index] == 1
+    assert x[~lower].min() == 30 - 2 * 2 + 1  # LOWER reaches 2h = 4 from x 30
+    assert x[lower].max() > 29 + 2 * 2  # UPPER reaches beyond LOWER's 2h (up to 2 x 5 from x 29)
+    assert x[lower].max() < 29 + 2 * 5
