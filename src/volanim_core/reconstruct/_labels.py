@@ -1,6 +1,7 @@
 """The 26-connected pieces of a grid, found and measured on its x-runs, without holding Python's GIL.
 
-    runs(zyx)                          -> every row's runs of non-zero voxels
+    runs(zyx[, by_value])              -> every row's runs of non-zero voxels (or of one value each)
+    run_values(zyx, ...)               -> each run's value, a label grid's runs as "pieces" for the rest
     label_runs(zyx)                    -> the runs, each run's piece (1..n), n
     piece_stats(...)                   -> each piece's voxel count and coordinate sums
     group_starts(counts, skip)         -> where each piece's rows start in piece_voxels' output
@@ -37,20 +38,21 @@ _BEFORE = ((0, -1), (-1, -1), (-1, 0), (-1, 1))
 
 
 @njit(cache=True, nogil=True)
-def runs(zyx):
+def runs(zyx, by_value=False):
     """``(first, x0, x1)``: row ``z * ny + y``'s runs of non-zero voxels are ``first[row]:first[row + 1]``,
-    each ``x0..x1`` inclusive, in ``(z, y, x)`` order. Counted first, then written: arrays grown inside
-    the voxel loop made this 40x slower than reading the grid."""
+    each ``x0..x1`` inclusive, in ``(z, y, x)`` order; ``by_value``: a run also ends where the value
+    changes (runs of one label each, :func:`run_values`). Counted first, then written: arrays grown
+    inside the voxel loop made this 40x slower than reading the grid."""
     nz, ny, nx = zyx.shape
     first = np.zeros(nz * ny + 1, np.int64)
     for z in range(nz):
         for y in range(ny):
             row = zyx[z, y]
             starts = 0
-            before = False
+            before = row[0] * 0
             for x in range(nx):
-                here = row[x] != 0
-                starts += here and not before
+                here = row[x]
+                starts += here != 0 and (before == 0 or (by_value and here != before))
                 before = here
             first[z * ny + y + 1] = starts
     first = np.cumsum(first)
@@ -62,18 +64,31 @@ def runs(zyx):
             if k == first[z * ny + y + 1]:
                 continue
             row = zyx[z, y]
-            before = False
+            before = row[0] * 0
             for x in range(nx):
-                here = row[x] != 0
-                if here and not before:
-                    x0[k] = x
-                elif before and not here:
+                here = row[x]
+                changed = here != before and (by_value or here == 0 or before == 0)
+                if before != 0 and changed:
                     x1[k] = x - 1
                     k += 1
+                if here != 0 and changed:
+                    x0[k] = x
                 before = here
-            if before:
+            if before != 0:
                 x1[k] = nx - 1
     return first, x0, x1
+
+
+@njit(cache=True, nogil=True)
+def run_values(zyx, first, x0):
+    """The value of each run of :func:`runs` ``(zyx, by_value=True)`` (its first voxel's)."""
+    ny = zyx.shape[1]
+    out = np.empty(len(x0), np.int64)
+    for row in range(len(first) - 1):
+        z, y = row // ny, row % ny
+        for r in range(first[row], first[row + 1]):
+            out[r] = zyx[z, y, x0[r]]
+    return out
 
 
 @njit(cache=True, nogil=True)

@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct import _labels as L
@@ -253,48 +252,6 @@ def torn_off(rest_piece: np.ndarray, posed_piece: np.ndarray, n_posed: int) -> n
     return np.flatnonzero(torn)
 
 
-@njit(cache=True, nogil=True)
-def _label_stats(labels, n):
-    """Per label 0..n of a ``[z, y, x]`` grid (here: a rest volume's bones): its voxel count and the
-    sum of its voxels' ``(z, y, x)`` (float64); label 0 (empty) is not measured."""
-    counts = np.zeros(n + 1, np.int64)
-    sums = np.zeros((n + 1, 3))
-    nz, ny, nx = labels.shape
-    for z in range(nz):
-        for y in range(ny):
-            row = labels[z, y]
-            for x in range(nx):
-                k = row[x]
-                if k == 0:
-                    continue
-                counts[k] += 1
-                sums[k, 0] += z
-                sums[k, 1] += y
-                sums[k, 2] += x
-    return counts, sums
-
-
-@njit(cache=True, nogil=True)
-def _piece_voxels(labels, counts, skip):
-    """The ``(z, y, x)`` of every voxel of each label but 0 and ``skip`` (0: none more), grouped by
-    label (label k's rows ``start[k]:start[k + 1]``), in scan order within each; ``counts`` from
-    :func:`_label_stats`."""
-    start = L.group_starts(counts, skip)
-    fill = start.copy()
-    out = np.empty((start[-1], 3), np.int64)
-    _, ny, nx = labels.shape
-    flat = labels.ravel()  # a view for a C-contiguous grid (numba copies any other)
-    for i in range(flat.size):
-        k = flat[i]
-        if k == 0 or k == skip:
-            continue
-        f = fill[k]
-        out[f, 0], rest = divmod(i, ny * nx)  # coordinates only for the voxels kept
-        out[f, 1], out[f, 2] = divmod(rest, nx)
-        fill[k] = f + 1
-    return start, out
-
-
 def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
     """Every filled voxel of a rest reconstruction in bone (or owner) mode: its rest coordinates ``(K, 3)``
     and its label - 1 ``(K,)`` (the bone; the owner's row of the transform table), grouped by it (so
@@ -302,8 +259,10 @@ def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
     on the frog than a mask per bone), in x-fastest order within a label. Pose-independent, so a
     caller reporting on many poses makes them once."""
     zyx = np.asarray(rest_bone.volume).T  # C-contiguous for a reconstruction
-    counts, _ = _label_stats(zyx, int(zyx.max()) if zyx.size else 0)
-    _, voxels = _piece_voxels(zyx, counts, 0)  # two passes, no grid-sized temporaries
+    first, x0, x1 = L.runs(zyx, True)  # runs of one label each, measured and listed as the pieces are
+    label = L.run_values(zyx, first, x0)
+    counts, _ = L.piece_stats(first, x0, x1, label, int(label.max(initial=0)), zyx.shape[1])
+    _, voxels = L.piece_voxels(first, x0, x1, label, counts, 0, zyx.shape[1])
     bone = np.repeat(np.arange(len(counts) - 1), counts[1:])
     return voxels[:, ::-1] + np.asarray(rest_bone.origin), bone
 

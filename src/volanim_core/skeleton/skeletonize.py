@@ -64,14 +64,18 @@ def distance_transform(mask, *, metric: str = "euclid", squared: bool = False) -
     """
     check_metric(metric)
     m = _as_mask(mask)
-    zyx = np.ascontiguousarray(m.T).view(np.uint8)  # [z, y, x], C order
+    dist, is_squared = _distances(np.ascontiguousarray(m.T).view(np.uint8), metric)
+    return dist.T if squared or not is_squared else np.sqrt(dist, dtype=np.float32).T
+
+
+def _distances(zyx: np.ndarray, metric: str) -> tuple[np.ndarray, bool]:
+    """The distance transform of a C-ordered ``[z, y, x]`` uint8 mask, and whether it is squared:
+    3-4-5 chamfer units (int32) or squared Euclidean distances (float32, edt on up to 8 threads)."""
     if metric == "345":
-        return chamfer345(zyx).T
+        return chamfer345(zyx), False
     import edt
 
-    threads = max(1, min(os.cpu_count() or 1, 8))
-    d2 = edt.edtsq(zyx, black_border=True, parallel=threads)
-    return d2.T if squared else np.sqrt(d2, dtype=np.float32).T
+    return edt.edtsq(zyx, black_border=True, parallel=max(1, min(os.cpu_count() or 1, 8))), True
 
 
 def skeletonize(
@@ -134,15 +138,7 @@ def skeletonize(
         raise ValueError("the mask is empty: no object voxel to skeletonize")
     box = m[bounds.slices()]
     report(5, 100)
-    zyx = np.ascontiguousarray(box.T).view(np.uint8)
-    if metric == "345":
-        dist, squared = chamfer345(zyx), False
-    else:
-        import edt
-
-        dist = edt.edtsq(zyx, black_border=True, parallel=max(1, min(os.cpu_count() or 1, 8)))
-        squared = True
-    del zyx
+    dist, squared = _distances(np.ascontiguousarray(box.T).view(np.uint8), metric)
     report(40, 100)
     nz = dist.shape[0]
     counts = np.count_nonzero(dist.reshape(nz, -1), axis=1)

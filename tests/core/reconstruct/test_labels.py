@@ -49,6 +49,26 @@ def test_runs_that_touch_only_by_a_corner_or_an_edge_join():
     assert n == m == 2 and np.array_equal(paint(zyx.shape, first, x0, x1, piece), want)
 
 
+@pytest.mark.parametrize("shape", SHAPES)
+@pytest.mark.parametrize("density", [0.0, 0.35, 1.0])
+def test_runs_by_value_are_the_longest_runs_of_one_label(shape, density):
+    """A label grid (a rest volume's bones) cut into runs of one value each: painted back they are the
+    grid, and no two runs of a row could be one (they are apart or hold other values)."""
+    zyx = noise(shape, density, seed=7 + sum(shape))
+    zyx //= 50  # few labels, so neighbours often share one
+    first, x0, x1 = L.runs(zyx, True)
+    value = L.run_values(zyx, first, x0)
+    assert np.array_equal(paint(shape, first, x0, x1, value), zyx)
+    for row in range(len(first) - 1):
+        z, y = divmod(row, shape[1])
+        for r in range(first[row], first[row + 1]):
+            assert np.all(zyx[z, y, x0[r]:x1[r] + 1] == value[r]) and value[r] != 0
+            if r + 1 < first[row + 1]:
+                assert x0[r + 1] > x1[r] + 1 or value[r + 1] != value[r]
+    plain = L.runs(zyx)  # without by_value: runs of non-zero voxels, whatever their values
+    assert np.array_equal(paint(shape, *plain, np.ones(len(plain[1]), np.int64)), (zyx != 0).astype(np.int64))
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_counts_centroid_sums_voxels_and_boundary_of_every_piece(seed):
     zyx = noise((14, 16, 18), 0.3, seed)
@@ -81,8 +101,8 @@ def test_counts_centroid_sums_voxels_and_boundary_of_every_piece(seed):
 def test_every_kernel_lets_other_threads_run():
     """The studio makes the report on a worker thread while its window draws: none of these may hold
     the GIL (cc3d, used before, froze the window for 0.3 s per frog preview)."""
-    kernels = [L.runs, L.label_runs, L.piece_stats, L.group_starts, L.piece_voxels, L.boundary_voxels,
-               breakage._label_stats, breakage._piece_voxels]
+    kernels = [L.runs, L.run_values, L.label_runs, L.piece_stats, L.group_starts, L.piece_voxels,
+               L.boundary_voxels]
     assert all(k.targetoptions.get("nogil") for k in kernels)
 
 
