@@ -1,0 +1,57 @@
+"""The thinness slider: the points shown, a held slider's coarser drawing, one frame per change."""
+
+from __future__ import annotations
+
+import pytest
+
+pytestmark = pytest.mark.gui
+
+
+def test_thinness_slider_shows_the_prefix(window):
+    panel, skel = window.display_panel, window.doc.skeleton
+    for step in (0, 250, 500, 900, 1000):
+        panel.thinness_slider.setValue(step)
+        t = window.doc.thinness
+        assert window.scene.shown_points == skel.count_at(t) == int((skel.thinness >= t).sum())
+    assert f"{window.scene.shown_points} of {len(skel)} points shown" == panel.count_label.text()
+
+
+def test_a_held_slider_draws_fewer_points_and_a_coarser_hull(window, monkeypatch):
+    """While the thinness slider is held: a spread subset of the points, the coarse hull and no FXAA
+    pass (software GL spends most of such a frame on them); on release, everything again."""
+    from volanim_core.skeleton.hull import LOD_FACES
+    from volanim_studio.scene import view
+
+    monkeypatch.setattr(view, "LOD_POINTS", 1000)  # the mannequin shows ~3 k points: make the LOD bite
+    panel, scene, doc = window.display_panel, window.scene, window.doc
+    full_faces = len(doc.hull[1])
+    assert full_faces > LOD_FACES and doc.hull_lod is not None and len(doc.hull_lod[1]) <= LOD_FACES
+    panel.thinness_slider.setValue(0)
+    assert scene.shown_points == doc.visible_count > 1000 and scene.hull.drawn_faces == full_faces
+    renderer = window.plotter.renderer
+    assert renderer.GetUseFXAA()
+    panel.thinness_slider.setSliderDown(True)
+    panel.thinness_slider.setValue(100)
+    assert scene.shown_points == min(1000, doc.visible_count) and scene.hull.drawn_faces == len(doc.hull_lod[1])
+    assert not renderer.GetUseFXAA()
+    panel.thinness_slider.setSliderDown(False)
+    assert scene.shown_points == doc.visible_count and scene.hull.drawn_faces == full_faces
+    assert renderer.GetUseFXAA()
+
+
+def test_a_change_draws_one_frame_and_an_idle_window_draws_none(qtbot, window):
+    """Software GL spends 0.1-0.6 s on a frame: the studio drew each slider step three times
+    (pyvistaqt's 5 Hz timer, plotter.render(), then the widget's paint) and redrew while idle."""
+    renders = []
+    window.plotter.ren_win.AddObserver("StartEvent", lambda *_: renders.append(1))
+    qtbot.wait(300)  # anything pending from loading is drawn
+    renders.clear()
+    qtbot.wait(700)  # idle: the old timer drew ~3 frames here
+    assert renders == []
+    panel = window.display_panel
+    for step in (300, 500, 700):
+        panel.thinness_slider.setValue(step)
+        qtbot.waitUntil(lambda: len(renders) >= 1, timeout=5000)
+        qtbot.wait(250)
+        assert len(renders) == 1, f"{len(renders)} renders for one slider step"
+        renders.clear()
