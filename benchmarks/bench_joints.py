@@ -98,7 +98,7 @@ def live_rate(rounds: int) -> float:
     from volanim_core.reconstruct.engine import reconstruct
     from volanim_core.rig.pose import pose_matrices
     from volanim_core.rig.skinning import Joints
-    from volanim_core.rig.tskel import coarse_tskel
+    from volanim_core.rig.tskel_tools import coarse_tskel
 
     s = samples.mannequin()
     conn = samples.part_connectivity(s).with_joints(Joints("smooth"))

@@ -53,7 +53,7 @@ def main(argv=None) -> int:
     from volanim_core.io.dicom_files import write_dicom_series
     from volanim_core.reconstruct.engine import reconstruct
     from volanim_core.rig.attach import connect_nearest
-    from volanim_core.rig.tskel import identity_tskel
+    from volanim_core.rig.tskel_tools import identity_tskel
     from volanim_core.skeleton.skeletonize import skeletonize
 
     rows = ["| case | round | ours s | baseline s | ours / baseline |", "|---|---|---|---|---|"]

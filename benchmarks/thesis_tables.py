@@ -47,7 +47,7 @@ from volanim_core.reconstruct.neighbours import sphere_neighbours  # noqa: E402
 from volanim_core.rig.attach import connect_nearest  # noqa: E402
 from volanim_core.rig.connectivity import Trans  # noqa: E402
 from volanim_core.rig.pose import pose_matrices, root_bones  # noqa: E402
-from volanim_core.rig.tskel import connect_to_tskel, identity_tskel  # noqa: E402
+from volanim_core.rig.tskel_tools import connect_to_tskel, identity_tskel  # noqa: E402
 from volanim_core.skeleton.skeletonize import skeletonize  # noqa: E402
 
 THINNESS = (1.0, 0.75, 0.5, 0.25, 0.0, -np.inf)
@@ -98,7 +98,7 @@ def tables(name: str, pose: tuple | None = None) -> tuple[str, str]:
 def left_leg_picture(path: Path) -> None:
     """Fig 5.1's picture: the mannequin at thinness >= 0.5 with its left leg turned, in bone colours."""
     from volanim_core.render.camera import named_view
-    from volanim_core.render.run import write_png
+    from volanim_core.render.movie import write_png
     from volanim_core.render.scene import Renderer, RenderSettings
 
     s = samples.load("mannequin")

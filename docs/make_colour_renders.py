@@ -65,7 +65,7 @@ def posed() -> None:
     from volanim_core.render.camera import named_view
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.pose import pose_matrices, root_bones
-    from volanim_core.rig.tskel import connect_to_tskel
+    from volanim_core.rig.tskel_tools import connect_to_tskel
 
     rgb = samples.mannequin_colour().volume
     conn = io.read_connect(ROOT / "assets" / "mannequin.0.50.connect")

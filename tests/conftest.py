@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from volanim_core.rig.bones import Bone, BoneSkeleton
-from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.skeleton.points import Skeleton
 
 
@@ -32,7 +32,7 @@ def small_skeleton(rng) -> Skeleton:
 
 @pytest.fixture
 def small_connect(small_skeleton, small_bones) -> Connectivity:
-    roots = [RootBone(*small_bones.segment(i), small_bones.bones[i].name) for i in range(len(small_bones))]
+    roots = [BoneSegment(*small_bones.segment(i), small_bones.bones[i].name) for i in range(len(small_bones))]
     bone = np.arange(len(small_skeleton)) % 2
     s = small_skeleton
     return Connectivity(roots, s.points, s.dt, s.thinness, bone).grouped()

@@ -36,7 +36,7 @@ from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
-from volanim_core.rig.tskel import check_root_order, connect_to_tskel, identity_tskel
+from volanim_core.rig.tskel_tools import check_root_order, connect_to_tskel, identity_tskel
 from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
@@ -136,7 +136,7 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
 def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
     """Motion capture onto the mannequin: a few frames across the clip written and reconstructed."""
     from volanim_core.motion.bvh import read_bvh
-    from volanim_core.motion.frames import frame_path, write_frames
+    from volanim_core.motion.frame_files import frame_path, write_frames
     from volanim_core.motion.retarget import Retarget
 
     t = time.perf_counter()
@@ -182,7 +182,7 @@ def _movie(sequence: Path, out: Path) -> Path:
     """The sequence as a small looping GIF, seen from the side (where a walk reads best), off-screen."""
     from volanim_core.parallel import default_workers
     from volanim_core.render.camera import place_camera
-    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings
 
     camera, inputs = place_camera(open_inputs([sequence]), "side", aspect=320 / 240)  # every frame's body in view

@@ -39,7 +39,7 @@ def compile_kernels(progress=None) -> float:
     from volanim_core.reconstruct.engine import MODES, reconstruct
     from volanim_core.rig.attach import auto_connect
     from volanim_core.rig.bones import Bone, BoneSkeleton
-    from volanim_core.rig.connectivity import Connectivity, RootBone, Tskel
+    from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
     from volanim_core.rig.pose import pose_matrices
     from volanim_core.sequence.effects import fall
     from volanim_core.skeleton.skeletonize import skeletonize
@@ -49,7 +49,7 @@ def compile_kernels(progress=None) -> float:
     source = np.where(mask, 200, 0).astype(np.uint8)
     bones = BoneSkeleton({"A": (3.0, 6.0, 6.0), "B": (12.0, 6.0, 6.0), "C": (21.0, 6.0, 6.0)},
                          [Bone("A", "B"), Bone("B", "C")])
-    roots = [RootBone(*bones.segment(i), bones.bones[i].label) for i in range(len(bones))]
+    roots = [BoneSegment(*bones.segment(i), bones.bones[i].label) for i in range(len(bones))]
     matrices = pose_matrices(bones, {1: np.array([0.0, 0.0, 30.0])})
     metrics = ("euclid", "345")
     total, done = len(metrics) * (len(MODES) + 1) + 1, 0

@@ -111,7 +111,7 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
     from pathlib import Path
 
     from volanim_core.parallel import default_workers
-    from volanim_core.render.run import open_inputs, output_kind, render
+    from volanim_core.render.movie import open_inputs, output_kind, render
     from volanim_core.render.scene import RenderSettings
     from volanim_core.sequence.frames import FrameSpec
     from volanim_core.sequence.run import run_sequence

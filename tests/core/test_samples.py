@@ -89,7 +89,7 @@ def test_colour_mannequin_is_the_mannequin_in_colour():
 def test_large_mannequin_is_the_mannequin_on_a_finer_grid(tmp_path):
     """The thesis's half-size Visible Human scale; its .connect reconstructs the body."""
     from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.rig.tskel import identity_tskel
+    from volanim_core.rig.tskel_tools import identity_tskel
 
     small, large = samples.mannequin(), samples.mannequin_large()
     assert large.volume.shape == (290, 169, 940)

@@ -35,7 +35,7 @@ def _mirror(args):
 
 
 def _keys(args):
-    from volanim_core.motion.frames import write_frames
+    from volanim_core.motion.frame_files import write_frames
     from volanim_core.motion.keyframes import keys
     from volanim_core.motion.keys_files import read_keys
 
@@ -70,7 +70,7 @@ def _report(args):
 
 
 def _scan(args):
-    from volanim_core.motion.frames import frame_number
+    from volanim_core.motion.frame_files import frame_number
     from volanim_core.reconstruct.checks import scan, scan_json
 
     conn = joints_of(args, read_connect(args.connect))

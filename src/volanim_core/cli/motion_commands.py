@@ -11,11 +11,11 @@ import numpy as np
 from volanim_core.errors import FormatError
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
 from volanim_core.motion.bvh import read_bvh
-from volanim_core.motion.frames import write_frames
+from volanim_core.motion.frame_files import write_frames
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget, check_mapping_file, format_mapping, read_mapping
 from volanim_core.progress import TextProgress
-from volanim_core.rig.tskel import connect_to_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel
 
 from ._common import add_command, positive_float
 
@@ -95,7 +95,7 @@ def _trans2tskel(args):
 
 def _bones_and_frames(args):
     """``args.bones`` and the matrices of ``args.trans`` (files or a folder), in frame-number order."""
-    from volanim_core.motion.frames import read_frames
+    from volanim_core.motion.frame_files import read_frames
 
     bones = read_bones(args.bones)
     bar = TextProgress("reading frames")
@@ -117,7 +117,7 @@ def _trans2bvh(args):
 
 
 def _trans2positions(args):
-    from volanim_core.motion.frames import frame_number
+    from volanim_core.motion.frame_files import frame_number
     from volanim_core.motion.positions import posed_joints, write_positions
 
     bones, mats, paths = _bones_and_frames(args)

@@ -25,7 +25,7 @@ from volanim_core.rig.attach import METHODS
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
 from volanim_core.rig.skinning import transform_table
-from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel, identity_tskel, sort_tskel
 
 from ._common import (
     add_command,

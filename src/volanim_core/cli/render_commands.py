@@ -51,7 +51,7 @@ def _render(args):
 
     from volanim_core import io
     from volanim_core.render.camera import place_camera
-    from volanim_core.render.run import open_inputs, render
+    from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings, transfer_of
 
     inputs = open_inputs(args.inputs, args.range, dims=args.dims)
@@ -99,7 +99,7 @@ def register(sub) -> None:
     p = add_command(sub, "render", "Render a volume, several volumes or a zarr sequence to a PNG, a folder of "
                     "PNGs, an .mp4 or a .gif, with one fixed camera, off-screen.", EXAMPLE, _render)
     p.add_argument("inputs", nargs="+", help="a .zarr sequence, or volume files (.vti .nrrd .vol .VOL ...)")
-    p.add_argument("-o", "--output", required=True, type=checked_by("volanim_core.render.run:check_output"),
+    p.add_argument("-o", "--output", required=True, type=checked_by("volanim_core.render.movie:check_output"),
                    help="NAME.png (one frame), a folder, NAME.mp4 or NAME.gif")
     p.add_argument("--style", choices=STYLES, default="surface",
                    help="surface: the filled voxels' boundary (fast); volume: ray-cast (default surface)")

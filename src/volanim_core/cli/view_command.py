@@ -21,8 +21,8 @@ def _view(args):
     if args.slice is not None or args.window is not None:
         raise ValueError("--slice and --window choose a slice: add --slices")
 
+    from volanim_core.render.movie import write_png
     from volanim_core.render.quicklook import quick_look
-    from volanim_core.render.run import write_png
     from volanim_core.render.scene import can_open_window
 
     window = args.screenshot is None
@@ -43,7 +43,7 @@ def _view(args):
 
 def _view_slices(args):
     from volanim_core.io import read_scan
-    from volanim_core.render.run import write_png
+    from volanim_core.render.movie import write_png
     from volanim_core.render.scene import can_open_window
     from volanim_core.render.slice_view import SliceView
     from volanim_core.render.slices import AXES, describe, parse_slice_axis

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.rig.connectivity import Connectivity, RootBone, Trans, Tskel
+from volanim_core.rig.connectivity import BoneSegment, Connectivity, Trans, Tskel
 from volanim_core.rig.skinning import RIGID, Joints
 
 from ._atomic import atomic_write_text
@@ -25,7 +25,7 @@ def _is_root(toks: list[str]) -> bool:
     return toks[0].lower().startswith("root:")
 
 
-def _parse_root(rec: TextRecords, line: int, toks: list[str]) -> RootBone:
+def _parse_root(rec: TextRecords, line: int, toks: list[str]) -> BoneSegment:
     first = toks[0]
     rest = ([first[5:]] if len(first) > 5 else []) + toks[1:]  # allow 'Root:212'
     if "::" not in rest:
@@ -36,10 +36,10 @@ def _parse_root(rec: TextRecords, line: int, toks: list[str]) -> RootBone:
         raise rec.error(line, f"expected {ROOT_SYNTAX}, got {' '.join(toks)!r}")
     p = [parse_float(rec, line, t, "proximal joint coordinate") for t in prox]
     d = [parse_float(rec, line, t, "distal joint coordinate") for t in tail[:3]]
-    return RootBone(p, d, tail[3] if len(tail) == 4 else "")
+    return BoneSegment(p, d, tail[3] if len(tail) == 4 else "")
 
 
-def _format_root(b: RootBone) -> str:
+def _format_root(b: BoneSegment) -> str:
     p = " ".join(fmt_float(v) for v in b.proximal)
     d = " ".join(fmt_float(v) for v in b.distal)
     return f"Root: {p} :: {d}" + (f" {b.name}" if b.name else "")
@@ -88,7 +88,7 @@ def _check_point_count(rec: TextRecords, found: int) -> None:
 def _read_rooted(path, *, matrices: bool, points: bool):
     rec = read_records(path)
     records = rec.records
-    bones: list[RootBone] = []
+    bones: list[BoneSegment] = []
     mats: list[np.ndarray] = []
     rows: list[tuple[int, list[str]]] = []
     owner: list[int] = []

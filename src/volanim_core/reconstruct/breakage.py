@@ -36,7 +36,7 @@ from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.pose import apply_matrices, apply_rows
 from volanim_core.rig.skinning import blended_with, transform_table
-from volanim_core.rig.tskel import identity_tskel
+from volanim_core.rig.tskel_tools import identity_tskel
 
 
 @dataclass

@@ -22,7 +22,7 @@ from volanim_core.reconstruct.scan import FrameVerdict, scan_frames, worst_first
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity, Trans
 from volanim_core.rig.pose import posed_joints
-from volanim_core.rig.tskel import check_root_order, connect_to_tskel
+from volanim_core.rig.tskel_tools import check_root_order, connect_to_tskel
 
 SLAB_VOXELS = 8_000_000  # source voxels looked at per step of the coverage count (bounded memory)
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from volanim_core.geometry import Geometry
 from volanim_core.rig.connectivity import Connectivity, Trans
-from volanim_core.rig.tskel import connect_to_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel
 
 OUTSIDE = ("empty", "identity")
 SLAB_VOXELS = 4_000_000  # target voxels per step: the field's temporaries stay ~300 MB

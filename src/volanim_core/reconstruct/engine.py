@@ -274,8 +274,8 @@ def reconstruct(
     Examples
     --------
     >>> import numpy as np
-    >>> from volanim_core.rig.connectivity import RootBone, Tskel
-    >>> t = Tskel([RootBone((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[5, 5, 5]], [2.0], None, [0])
+    >>> from volanim_core.rig.connectivity import BoneSegment, Tskel
+    >>> t = Tskel([BoneSegment((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[5, 5, 5]], [2.0], None, [0])
     >>> r = reconstruct(t, padding=0)
     >>> int((r.volume > 0).sum()), r.origin   # voxels strictly within 2 of the centre: 3x3x3
     (27, (3, 3, 3))
@@ -303,7 +303,7 @@ def reconstruct(
     r2s = radius_squared(tskel.dt)
     radii = np.ascontiguousarray(tskel.dt, np.float64)
     metric = K.CHAMFER if tskel.metric == "345" else K.EUCLID
-    out_dtype, values = _labels(mode, tskel, value, rows, len(table))
+    out_dtype, values = _sphere_values(mode, tskel, value, rows, len(table))
     final_dtype = source.dtype if mode == "sampled" else out_dtype
     relax = mode not in ("hotspot", "binary")  # binary is a union and hotspot a count: no stencil
     per_voxel = np.dtype(out_dtype).itemsize + \
@@ -401,7 +401,7 @@ def output_dtype(mode: str, n_bones: int, source_dtype=None) -> np.dtype:
     return np.dtype(np.uint8)
 
 
-def _labels(mode: str, tskel: Tskel, value: int, rows: np.ndarray, n_rows: int) -> tuple[type, np.ndarray]:
+def _sphere_values(mode: str, tskel: Tskel, value: int, rows: np.ndarray, n_rows: int) -> tuple[type, np.ndarray]:
     """The kernel's output dtype and the value each sphere writes.
 
     Sampled relaxes like the owner pass (each sphere writes its row of the transform table + 1: its

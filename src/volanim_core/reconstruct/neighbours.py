@@ -41,7 +41,7 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
 
     n = len(tskel)
     out = np.full((n, k), -1, np.int32)
-    r2, big = _clipped(tskel, min_radius)
+    r2, big = _big_spheres(tskel, min_radius)
     for b in np.unique(tskel.bone[big]):
         idx = big[tskel.bone[big] == b]
         if len(idx) < 2:
@@ -57,7 +57,7 @@ def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     return out
 
 
-def _clipped(tskel: Connectivity, min_radius: float, r2: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _big_spheres(tskel: Connectivity, min_radius: float, r2: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Every sphere's squared radius (``r2`` when the caller has it), and the indices of those the
     kernel clips (radius >= ``min_radius``)."""
     r2 = radius_squared(tskel.dt) if r2 is None else r2
@@ -80,7 +80,7 @@ def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     clip, the studio's live and full previews and the rest frame share one set.
     ``r2``: the spheres' :func:`radius_squared`, when the caller has them.
     """
-    r2, big = _clipped(tskel, min_radius, r2)
+    r2, big = _big_spheres(tskel, min_radius, r2)
     key = content_key(np.array([len(tskel), k], np.int64), big, np.asarray(tskel.points[big], np.float64), r2[big],
                       np.asarray(tskel.bone)[big].astype(np.int64))
 

@@ -22,7 +22,7 @@ from volanim_core.progress import Reporter
 from volanim_core.reconstruct.breakage import components, cracks, misplaced_points, stumps, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.connectivity import Connectivity
-from volanim_core.rig.tskel import coarse_tskel, identity_tskel
+from volanim_core.rig.tskel_tools import coarse_tskel, identity_tskel
 
 
 @dataclass(frozen=True)

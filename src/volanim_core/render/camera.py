@@ -20,7 +20,7 @@ import numpy as np
 from volanim_core.camera import Camera
 
 if TYPE_CHECKING:
-    from .run import RenderInputs
+    from .movie import RenderInputs
 
 __all__ = ["VIEWS", "Camera", "follow_cameras", "named_view", "natural_axes", "place_camera", "union_box"]
 

@@ -20,9 +20,9 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
     """Draw ``path`` (not rendered yet) and return the renderer and a one-line description of what it shows."""
     from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh
 
+    from .bone_colours import SKIN
     from .camera import named_view, place_camera
-    from .colours import SKIN
-    from .run import open_inputs, read_frame
+    from .movie import open_inputs, read_frame
 
     path = Path(path)
     w, h = size

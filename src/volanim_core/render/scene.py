@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.io.volume_files import to_grey
+from volanim_core.render.bone_colours import SKIN, rgb
 from volanim_core.render.camera import Camera
-from volanim_core.render.colours import SKIN, rgb
-from volanim_core.render.transfer import (
+from volanim_core.render.volume_style import (
     LABEL_MODES,
     add_volume_uncopied,
     apply_labels,
@@ -319,7 +319,7 @@ class Renderer:
 
     def _cpu_caster(self) -> bool:
         """``cpu``: the fixed-point ray caster; ``gpu`` and an unresolved ``auto``: VTK's smart mapper.
-        (A sequence's driver resolves ``auto`` by timing both, :func:`volanim_core.render.run.choose_mapper`.)"""
+        (A sequence's driver resolves ``auto`` by timing both, :func:`volanim_core.render.movie.choose_mapper`.)"""
         return self.settings.mapper == "cpu"
 
     def _add_colour_bar(self) -> None:

@@ -19,7 +19,7 @@ def label_surface(volume: np.ndarray, origin, spacing, table: np.ndarray | None 
         whose surface is coloured by its voxels (``table`` is not used)
     origin, spacing : world position of voxel [0, 0, 0] and the voxel size
     table : (L, 3) uint8, optional
-        Colour of label value v at row v (e.g. :func:`~volanim_core.render.colours.label_table`);
+        Colour of label value v at row v (e.g. :func:`~volanim_core.render.bone_colours.label_table`);
         without it the surface has no colours.
 
     Returns

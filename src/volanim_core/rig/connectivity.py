@@ -2,7 +2,7 @@
 
 One flat layout serves ``.connect``, ``.trans`` and ``.tskel``::
 
-    bones[b]          RootBone(proximal xyz, distal xyz, name)   b in root order
+    bones[b]          BoneSegment(proximal xyz, distal xyz, name)   b in root order
     points[i], dt[i], thinness[i], bone[i]                          i = point
     matrices[b]       4x4, row-vector convention: [x y z 1] @ M     (frames only)
 
@@ -23,7 +23,7 @@ from volanim_core.skeleton.points import check_metric
 
 
 @dataclass(eq=False)
-class RootBone:
+class BoneSegment:
     """A bone as ``Root:`` lines name it: joint coordinates and an optional name."""
 
     proximal: np.ndarray
@@ -36,13 +36,13 @@ class RootBone:
 
     def __eq__(self, other) -> bool:
         return (
-            isinstance(other, RootBone)
+            isinstance(other, BoneSegment)
             and self.name == other.name
             and np.array_equal(self.proximal, other.proximal)
             and np.array_equal(self.distal, other.distal)
         )
 
-    def same_segment(self, other: RootBone, tol: float = 1e-6) -> bool:
+    def same_segment(self, other: BoneSegment, tol: float = 1e-6) -> bool:
         return bool(
             np.allclose(self.proximal, other.proximal, atol=tol)
             and np.allclose(self.distal, other.distal, atol=tol)
@@ -73,7 +73,7 @@ class Connectivity:
     attached to no bone are not part of a ``.connect``).
     """
 
-    bones: list[RootBone]
+    bones: list[BoneSegment]
     points: np.ndarray
     dt: np.ndarray
     thinness: np.ndarray | None
@@ -152,7 +152,7 @@ def _check_matrices(matrices, nbones):
 class Trans:
     """Contents of a ``.trans`` file: one 4x4 matrix per bone, root order."""
 
-    bones: list[RootBone]
+    bones: list[BoneSegment]
     matrices: np.ndarray
 
     def __post_init__(self):

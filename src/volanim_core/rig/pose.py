@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from volanim_core.rig.bones import BoneSkeleton
-from volanim_core.rig.connectivity import RootBone
+from volanim_core.rig.connectivity import BoneSegment
 
 
 def apply_matrices(points: np.ndarray, bone: np.ndarray, matrices: np.ndarray) -> np.ndarray:
@@ -167,9 +167,9 @@ def scaled(matrices: np.ndarray, factor: float) -> np.ndarray:
     return np.asarray(matrices) @ s
 
 
-def root_bones(bones: BoneSkeleton) -> list[RootBone]:
+def root_bones(bones: BoneSkeleton) -> list[BoneSegment]:
     """The ``Root:`` records of a bone skeleton, in root order."""
-    return [RootBone(*bones.segment(i), b.label) for i, b in enumerate(bones.bones)]
+    return [BoneSegment(*bones.segment(i), b.label) for i, b in enumerate(bones.bones)]
 
 
 def posed_joints(bones: BoneSkeleton, matrices: np.ndarray) -> dict[str, np.ndarray]:

@@ -138,6 +138,6 @@ def mirror(conn: Connectivity, bones: BoneSkeleton, *, side: str = "L", only=Non
 def check_same_bones(conn: Connectivity, bones: BoneSkeleton) -> None:
     """ValueError unless ``conn``'s bones are ``bones``' segments in the same order (on its grid)."""
     from volanim_core.rig.pose import root_bones
-    from volanim_core.rig.tskel import check_root_order
+    from volanim_core.rig.tskel_tools import check_root_order
 
     check_root_order(conn.bones, root_bones(bones.on_grid(conn.geometry)), ".bones")

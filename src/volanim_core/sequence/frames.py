@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.motion.frames import frame_number
+from volanim_core.motion.frame_files import frame_number
 from volanim_core.rig.connectivity import Connectivity, Tskel
-from volanim_core.rig.tskel import check_root_order
+from volanim_core.rig.tskel_tools import check_root_order
 
 
 @dataclass(frozen=True)

@@ -241,7 +241,7 @@ def frames_per_task(seconds: list[float], task_seconds: float, most: int = 16) -
 def _rest_filled(conn) -> int:
     """Filled voxels of the rest pose (every mode covers the same voxels): each frame's loss is against it."""
     from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.rig.tskel import identity_tskel
+    from volanim_core.rig.tskel_tools import identity_tskel
 
     r = reconstruct(identity_tskel(conn), mode="bone")
     return int(r.stats["filled"])

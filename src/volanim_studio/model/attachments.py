@@ -17,7 +17,7 @@ from volanim_core import io
 from volanim_core.rig import symmetry
 from volanim_core.rig.attach import UNATTACHED, auto_connect
 from volanim_core.rig.bones import Bone, BoneSkeleton
-from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.rig.skinning import Joints
 from volanim_core.skeleton.points import Skeleton
 
@@ -132,7 +132,7 @@ class Attachments:
         if s is None:  # an empty studio: F5, exports and saves end here, with words instead of a traceback
             raise ValueError("nothing loaded yet: open a volume, a demo or a project first (File menu)")
         keep = self.bone >= 0
-        roots = [RootBone(*doc.bones.segment(i), b.label) for i, b in enumerate(doc.bones.bones)]
+        roots = [BoneSegment(*doc.bones.segment(i), b.label) for i, b in enumerate(doc.bones.bones)]
         conn = Connectivity(roots, s.points[keep], s.dt[keep], s.thinness[keep], self.bone[keep], s.metric,
                             thinness, s.geometry, Joints(doc.settings.joints, doc.settings.blend))
         return conn.grouped()

@@ -14,7 +14,7 @@ import numpy as np
 from volanim_core import io
 from volanim_core.rig.connectivity import Trans, Tskel
 from volanim_core.rig.pose import local_motion, pose_matrices, posed_joints, root_bones
-from volanim_core.rig.tskel import check_root_order
+from volanim_core.rig.tskel_tools import check_root_order
 
 from .undo import Command
 
@@ -38,7 +38,7 @@ class PoseState:
     def rest_preview(self, mode: str):
         """The rest pose's reconstruction in ``mode`` (Compare shows it instead of the posed one), made
         once per attachments, bones, thinness and mode; None when nothing is attached."""
-        from volanim_core.rig.tskel import identity_tskel
+        from volanim_core.rig.tskel_tools import identity_tskel
 
         from .preview import make_preview
 

@@ -14,7 +14,7 @@ import numpy as np
 from volanim_core.reconstruct.breakage import BreakageReport, RestParts, breakage_report
 from volanim_core.reconstruct.engine import Reconstruction, reconstruct
 from volanim_core.rig.connectivity import Tskel
-from volanim_core.rig.tskel import coarse_tskel
+from volanim_core.rig.tskel_tools import coarse_tskel
 
 
 @dataclass

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.motion.bvh import Motion, read_bvh
-from volanim_core.motion.frames import frame_number, read_frames
+from volanim_core.motion.frame_files import frame_number, read_frames
 from volanim_core.motion.keyframes import KeyPose, interpolate
 from volanim_core.motion.retarget import Retarget, check_mapping_file
 

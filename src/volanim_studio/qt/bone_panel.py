@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from volanim_core.render.colours import bone_colour
+from volanim_core.render.bone_colours import bone_colour
 
 from ..model.document import Document
 

@@ -21,7 +21,7 @@ from PySide6.QtWidgets import QDialog, QFileDialog
 from volanim_core import io
 from volanim_core.io.volume_files import to_grey
 from volanim_core.motion.bvh import read_bvh
-from volanim_core.motion.frames import write_frames
+from volanim_core.motion.frame_files import write_frames
 from volanim_core.reconstruct.scan import scan_frames, worst_first
 from volanim_core.render.camera import Camera
 

@@ -15,7 +15,7 @@ from collections.abc import Callable
 import numpy as np
 import pyvista as pv
 
-from volanim_core.render.colours import bone_colour
+from volanim_core.render.bone_colours import bone_colour
 
 from .pose_layer import bone_lines
 

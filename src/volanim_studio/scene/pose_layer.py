@@ -15,9 +15,9 @@ import numpy as np
 import pyvista as pv
 from matplotlib.colors import ListedColormap
 
-from volanim_core.render.colours import SKIN, label_table
+from volanim_core.render.bone_colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
-from volanim_core.render.transfer import (
+from volanim_core.render.volume_style import (
     add_volume_uncopied,
     apply_labels,
     apply_rgba,
@@ -189,7 +189,7 @@ class PoseLayer:
     def volume_mapper(self, components: int = 1) -> str:
         """pyvista's name of the mapper full previews use: the CPU ray caster on software OpenGL
         (2.3x faster there on label volumes, as fast on grey ones), VTK's smart mapper on a GPU; colour
-        (``components`` 4) always the smart mapper (:func:`~volanim_core.render.transfer.volume_mapper`)."""
+        (``components`` 4) always the smart mapper (:func:`~volanim_core.render.volume_style.volume_mapper`)."""
         if self._mapper is None:
             ren_win = self.view.plotter.ren_win
             renderer = gl_renderer(ren_win) if ren_win is not None else ""

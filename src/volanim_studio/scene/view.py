@@ -16,7 +16,7 @@ from collections.abc import Callable
 import numpy as np
 import pyvista as pv
 
-from volanim_core.render.colours import label_table, scalar_colours
+from volanim_core.render.bone_colours import label_table, scalar_colours
 from volanim_core.render.scene import reset_clipping
 
 from ..model.document import Document

@@ -17,7 +17,7 @@ from volanim_core.cli import main
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
-from volanim_core.rig.tskel import connect_to_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel
 from volanim_core.samples import write_sample
 from volanim_core.volume import Bounds
 

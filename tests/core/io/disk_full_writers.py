@@ -24,9 +24,9 @@ def writers(spare: Path):
     from volanim_core import io
     from volanim_core.geometry import Geometry
     from volanim_core.io.mesh_files import write_mesh
-    from volanim_core.render.run import encode, write_png
+    from volanim_core.render.movie import encode, write_png
     from volanim_core.rig.bones import Bone, BoneSkeleton
-    from volanim_core.rig.connectivity import Connectivity, RootBone, Tskel
+    from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
     from volanim_core.skeleton.points import Skeleton
 
     rng = np.random.default_rng(0)
@@ -37,7 +37,7 @@ def writers(spare: Path):
     pts = np.unique(rng.integers(0, 5000, (40_000, 3)), axis=0)
     skel = Skeleton(pts, rng.random(len(pts)) + 1, rng.random(len(pts))).sorted()
     bones = BoneSkeleton({f"J{i}": (i, i, i) for i in range(3)}, [Bone("J0", "J1"), Bone("J1", "J2")])
-    roots = [RootBone(*bones.segment(i), "") for i in range(2)]
+    roots = [BoneSegment(*bones.segment(i), "") for i in range(2)]
     conn = Connectivity(roots, skel.points, skel.dt, skel.thinness, np.arange(len(skel)) % 2).grouped()
     picture = rng.integers(0, 255, (600, 800, 3), dtype=np.uint8)
     pngs = []

@@ -20,7 +20,7 @@ from volanim_core.geometry import Geometry
 from volanim_core.io.slicer_files import read_markups, write_markups
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.pose import posed_joints
-from volanim_core.rig.tskel import connect_to_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel
 from volanim_core.samples import write_sample
 
 GEOMETRY = Geometry((0.8, 0.8, 0.8), (-40.0, 20.0, 100.0), (-1, 0, 0, 0, 1, 0, 0, 0, 1))

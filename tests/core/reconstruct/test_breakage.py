@@ -8,9 +8,9 @@ import pytest
 from paths import ASSETS
 from volanim_core import io, samples
 from volanim_core.reconstruct.breakage import breakage_report, components, misplaced_points, stumps
-from volanim_core.rig.connectivity import Connectivity, RootBone, Trans
+from volanim_core.rig.connectivity import BoneSegment, Connectivity, Trans
 from volanim_core.rig.pose import local_motion, pose_matrices, posed_joints, root_bones, scaled
-from volanim_core.rig.tskel import connect_to_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel
 
 
 @pytest.fixture(scope="module")
@@ -76,7 +76,7 @@ def test_correct_connectivity_has_no_stump_in_any_pose(man, rotations):
 
 def test_misplaced_points_ignore_points_near_a_joint():
     """A point as close to both bones (within its radius) is never counted as lying along the other."""
-    bones = [RootBone([0, 0, 0], [10, 0, 0], "A"), RootBone([10, 0, 0], [20, 0, 0], "B")]
+    bones = [BoneSegment([0, 0, 0], [10, 0, 0], "A"), BoneSegment([10, 0, 0], [20, 0, 0], "B")]
     pts = np.array([[9.0, 1, 0], [15.0, 1, 0], [18.0, 0, 0]])
     conn = Connectivity(bones, pts, np.array([2.0, 2.0, 2.0]), None, np.array([0, 0, 1]))
     idx, along = misplaced_points(conn)
@@ -151,7 +151,7 @@ def test_a_piece_far_from_the_main_body_is_located_where_it_is_nearest():
 def test_rest_voxels_kept_by_the_caller_give_the_same_report(man):
     from volanim_core.reconstruct.breakage import lost_voxels, rest_voxels
     from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.rig.tskel import identity_tskel
+    from volanim_core.rig.tskel_tools import identity_tskel
 
     s, conn = man
     m = pose_matrices(s.bones, {"L_UPPERARM": (0, -60, 0)})

@@ -32,12 +32,12 @@ def test_linear_averaging_keeps_an_edge_between_two_colours_bright():
     """Red next to green, kernel 3: the last red column gets about a quarter of its neighbour's
     green by weight. Averaged in linear light that shows as green 131, as bright as the two colours
     look side by side; averaged on sRGB bytes it would be 58, a dark seam."""
-    from volanim_core.rig.connectivity import RootBone, Tskel
+    from volanim_core.rig.connectivity import BoneSegment, Tskel
 
     src = np.zeros((12, 12, 12, 3), np.uint8)
     src[:6, ..., 0] = 255
     src[6:, ..., 1] = 255
-    t = Tskel([RootBone((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[6, 6, 6]], [5.0], None, [0])
+    t = Tskel([BoneSegment((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[6, 6, 6]], [5.0], None, [0])
     r = reconstruct(t, mode="sampled", source=src, kernel=3, padding=0)
     at = (5 - r.origin[0], 6 - r.origin[1], 6 - r.origin[2])  # the last red column
     bytes_average = reconstruct(t, mode="sampled", source=src[..., 1], kernel=3, padding=0).volume[at]
@@ -46,9 +46,9 @@ def test_linear_averaging_keeps_an_edge_between_two_colours_bright():
 
 
 def test_a_colour_source_must_be_bytes():
-    from volanim_core.rig.connectivity import RootBone, Tskel
+    from volanim_core.rig.connectivity import BoneSegment, Tskel
 
-    t = Tskel([RootBone((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[5, 5, 5]], [2.0], None, [0])
+    t = Tskel([BoneSegment((0, 0, 0), (1, 0, 0))], np.eye(4)[None], [[5, 5, 5]], [2.0], None, [0])
     with pytest.raises(ValueError, match="8-bit RGB"):
         reconstruct(t, mode="sampled", source=np.zeros((9, 9, 9, 3), np.float32))
     with pytest.raises(ValueError, match="3-D RGB"):

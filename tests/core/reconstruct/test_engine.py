@@ -12,7 +12,7 @@ from volanim_core.errors import Cancelled
 from volanim_core.geometry import Geometry
 from volanim_core.reconstruct.engine import grid_bounds, reconstruct
 from volanim_core.reconstruct.speedups import Speedups
-from volanim_core.rig.connectivity import RootBone, Tskel
+from volanim_core.rig.connectivity import BoneSegment, Tskel
 from volanim_core.skeleton.skeletonize import skeletonize
 from volanim_core.volume import Bounds
 
@@ -40,7 +40,7 @@ def random_tskel(rng, n=25, nbones=3, metric="euclid", size=14, quarter_turns=Fa
     bone = np.sort(rng.integers(0, nbones, len(pts)))  # grouped by bone, as files list them
     mats = np.array([np.eye(4) if identity else random_rigid(rng, (size / 2,) * 3, quarter_turns)
                      for _ in range(nbones)])
-    bones = [RootBone((b, 0, 0), (b, 1, 0), f"B{b}") for b in range(nbones)]
+    bones = [BoneSegment((b, 0, 0), (b, 1, 0), f"B{b}") for b in range(nbones)]
     return Tskel(bones, mats, pts, dt, None, bone, metric=metric)
 
 
@@ -168,7 +168,7 @@ def test_visits_are_the_voxels_examined_and_filled_the_voxels_won():
     """A small sphere sweeps the x-box of each slice's disc (every voxel strictly within the disc's
     half-width of the centre) on the rows that cross the disc: ``visits`` counts those voxels, corners
     outside the sphere included (the kernel's work), while ``filled`` counts only the voxels won."""
-    bone = [RootBone((0, 0, 0), (1, 0, 0))]
+    bone = [BoneSegment((0, 0, 0), (1, 0, 0))]
     c, r2 = np.array([10.3, 10.6, 10.2]), 7.0
     m = np.eye(4)
     m[3, :3] = c - 10  # a centre off the voxels, so the boxes hold corners outside the sphere
@@ -191,7 +191,7 @@ def test_visits_are_the_voxels_examined_and_filled_the_voxels_won():
 def test_a_plane_along_y_or_z_cuts_rows_or_whole_slices_exactly():
     """Neighbours straight above (z), beside (y) and ahead (x): a bisector parallel to the rows
     cuts whole rows, one parallel to the slices cuts whole slices, one across the rows cuts runs."""
-    bone = [RootBone((0, 0, 0), (1, 0, 0))]
+    bone = [BoneSegment((0, 0, 0), (1, 0, 0))]
     pts = [[20, 20, 20], [20, 20, 27], [20, 27, 20], [27, 20, 20], [13, 20, 20]]
     t = Tskel(bone, np.eye(4)[None], pts, [11.0, 13.0, 13.0, 13.0, 12.0], None, [0] * 5)
     b = Bounds((0, 0, 0), (40, 40, 40))
@@ -206,7 +206,7 @@ def test_a_plane_along_y_or_z_cuts_rows_or_whole_slices_exactly():
 # spec: docs/formats.md#reconstruction
 def test_ties_go_to_the_first_sphere_in_file_order():
     # two equal spheres, centres 2 apart: the mid-plane voxels are equidistant
-    bones = [RootBone((0, 0, 0), (1, 0, 0))]
+    bones = [BoneSegment((0, 0, 0), (1, 0, 0))]
     t = Tskel(bones, np.eye(4)[None], [[5, 5, 5], [7, 5, 5]], [2.5, 2.5], None, [0, 0])
     r = reconstruct(t, mode="mottled", bounds=Bounds((0, 0, 0), (12, 10, 10)))
     first, second = r.volume[5, 5, 5], r.volume[7, 5, 5]
@@ -215,7 +215,7 @@ def test_ties_go_to_the_first_sphere_in_file_order():
 
 def _all_voxel_tskel(mask, metric="euclid"):
     s = skeletonize(mask, metric=metric, min_thinness=-np.inf)
-    bones = [RootBone((0, 0, 0), (1, 0, 0), "ALL")]
+    bones = [BoneSegment((0, 0, 0), (1, 0, 0), "ALL")]
     return Tskel(bones, np.eye(4)[None], s.points, s.dt, s.thinness, np.zeros(len(s), int), metric=metric)
 
 
@@ -236,7 +236,7 @@ def test_identity_with_all_voxels_reproduces_source(metric):
 def test_aliascube_rotated_45_stays_sharp():
     cube = samples.aliascube().volume
     s = skeletonize(cube > 0)  # its default skeleton (thinness >= 0.5)
-    t = Tskel([RootBone((0, 0, 0), (1, 0, 0))], np.eye(4)[None], s.points, s.dt, s.thinness, np.zeros(len(s), int))
+    t = Tskel([BoneSegment((0, 0, 0), (1, 0, 0))], np.eye(4)[None], s.points, s.dt, s.thinness, np.zeros(len(s), int))
     rot = np.eye(4)
     rot[:3, :3] = Rotation.from_euler("z", 45, degrees=True).as_matrix().T  # row-vector convention
     c = np.array([63.5, 63.5, 63.5])
@@ -257,7 +257,7 @@ def test_aliascube_rotated_45_stays_sharp():
 
 
 def test_clipping_is_counted_not_fatal():
-    bones = [RootBone((0, 0, 0), (1, 0, 0))]
+    bones = [BoneSegment((0, 0, 0), (1, 0, 0))]
     t = Tskel(bones, np.eye(4)[None], [[5, 5, 5]], [3.0], None, [0])
     whole = reconstruct(t)
     half = reconstruct(t, bounds=Bounds((5, 0, 0), (20, 20, 20)))
@@ -267,7 +267,7 @@ def test_clipping_is_counted_not_fatal():
 
 
 def test_empty_bone_zero_points_and_singular_matrix():
-    bones = [RootBone((0, 0, 0), (1, 0, 0), "A"), RootBone((1, 0, 0), (2, 0, 0), "EMPTY")]
+    bones = [BoneSegment((0, 0, 0), (1, 0, 0), "A"), BoneSegment((1, 0, 0), (2, 0, 0), "EMPTY")]
     t = Tskel(bones, np.tile(np.eye(4), (2, 1, 1)), [[5, 5, 5]], [2.0], None, [0])
     assert reconstruct(t, mode="bone").volume.max() == 1
     none = Tskel(bones, np.tile(np.eye(4), (2, 1, 1)), np.zeros((0, 3)), [], None, [])
@@ -293,7 +293,7 @@ def test_a_fast_call_is_one_launch_after_the_first_and_a_slow_one_reports_often(
     launch waits for its slowest thread), many -- progress and cancel -- for a slow one."""
     from volanim_core.reconstruct import engine as rec
 
-    t = Tskel([RootBone((0, 0, 0), (0, 0, 300))], np.eye(4)[None], [[5, 5, z] for z in range(0, 300, 2)],
+    t = Tskel([BoneSegment((0, 0, 0), (0, 0, 300))], np.eye(4)[None], [[5, 5, z] for z in range(0, 300, 2)],
               [3.0] * 150, None, [0] * 150)
     calls = []
     reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d))
@@ -369,7 +369,7 @@ def test_cancel_is_checked_while_sampling_not_only_while_filling(monkeypatch):
     mask = np.zeros((20, 20, 40), bool)
     mask[5:15, 5:15, 2:38] = True
     pts = np.argwhere(mask)
-    t = Tskel([RootBone((10, 10, 2), (10, 10, 38))], np.eye(4)[None], pts, np.full(len(pts), 1.5), None,
+    t = Tskel([BoneSegment((10, 10, 2), (10, 10, 38))], np.eye(4)[None], pts, np.full(len(pts), 1.5), None,
               np.zeros(len(pts), int))
     source = mask.astype(np.uint8) * 100
     calls = []
@@ -393,7 +393,7 @@ def test_runs_in_one_row_in_any_order_over_a_stencil_slice_an_earlier_slice_used
     counts only once a sphere of this slice has won it. Runs landing right, then left, then in
     the gaps must win every voxel, never lose to the small distances an earlier slice left."""
     bounds = Bounds((0, 0, 0), (39, 4, 11))
-    bone = [RootBone((0, 2, 2), (39, 2, 2))]
+    bone = [BoneSegment((0, 2, 2), (39, 2, 2))]
     xs = [20, 34, 5, 12, 27]  # middle, far right, far left, then both gaps
     # first a big sphere over the whole row in slices 0..5, then small ones in slices 7..9
     pts = [[20, 2, 2]] + [[x, 2, 8] for x in xs]

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from volanim_core.reconstruct.engine import grid_bounds, reconstruct
-from volanim_core.rig.connectivity import RootBone, Tskel
+from volanim_core.rig.connectivity import BoneSegment, Tskel
 from volanim_core.skeleton.skeletonize import skeletonize
 from volanim_core.volume import Bounds
 
-BONES = [RootBone((0, 0, 0), (1, 0, 0), "A")]
+BONES = [BoneSegment((0, 0, 0), (1, 0, 0), "A")]
 
 
 def frame(points, dt, matrix=None, metric="euclid") -> Tskel:

@@ -59,7 +59,7 @@ def test_pieces_apart_at_rest_are_not_breakage_a_torn_forearm_still_is():
     from volanim_core.reconstruct.breakage import breakage_report
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.pose import posed_joints
-    from volanim_core.rig.tskel import connect_to_tskel
+    from volanim_core.rig.tskel_tools import connect_to_tskel
 
     bones, conn = speckled_arm()
     rest, torn = pose_matrices(bones), pose_matrices(bones, translations={2: [12.0, 0.0, 0.0]})

@@ -13,7 +13,7 @@ from volanim_core.reconstruct.speedups import Speedups
 from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
-from volanim_core.rig.tskel import connect_to_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel
 from volanim_core.skeleton.skeletonize import skeletonize
 
 

@@ -15,7 +15,7 @@ from volanim_core.cli import main
 from volanim_core.errors import FormatError
 from volanim_core.geometry import Geometry
 from volanim_core.render.camera import Camera, named_view
-from volanim_core.render.run import frame_path, open_inputs, render
+from volanim_core.render.movie import frame_path, open_inputs, render
 from volanim_core.render.scene import Renderer, RenderSettings
 from volanim_core.sequence import store
 from volanim_core.transfer_function import TransferFunction
@@ -76,7 +76,7 @@ def test_a_parallel_camera_draws_true_size_and_the_cut_shows_the_inside():
         cut.close()
     radius = np.sqrt(lit(a).sum() / np.pi)
     assert radius == pytest.approx(20.5 / 40.0 * H / 2, rel=0.03)  # R / parallel_scale of the half-height
-    from volanim_core.render.transfer import label_colours
+    from volanim_core.render.volume_style import label_colours
 
     bone0, bone1 = (np.round(c * 255) for c in label_colours("bone", 2))
     centre = b[H // 2 - 3: H // 2 + 3, W // 2 - 3: W // 2 + 3].reshape(-1, 3).mean(0)
@@ -282,7 +282,7 @@ def test_a_reused_plotter_draws_each_frame_as_a_fresh_one_would(style):
 
 
 def test_auto_mapper_is_resolved_once_for_the_whole_sequence(tmp_path):
-    from volanim_core.render.run import choose_mapper
+    from volanim_core.render.movie import choose_mapper
 
     seq = make_sequence(tmp_path / "s.zarr", frames=4)
     inputs = open_inputs([seq])
@@ -322,7 +322,7 @@ def test_hotspot_gets_a_heat_colour_bar_and_labels_do_not():
     ("AMD Radeon Pro 5500M OpenGL Engine", False),
 ])
 def test_software_gl_reads_the_renderer_string(renderer, software):
-    from volanim_core.render.transfer import software_gl
+    from volanim_core.render.volume_style import software_gl
 
     assert software_gl(renderer) is software
 
@@ -330,7 +330,7 @@ def test_software_gl_reads_the_renderer_string(renderer, software):
 def test_the_renderer_string_comes_from_a_drawn_window():
     import pyvista as pv
 
-    from volanim_core.render.transfer import gl_renderer
+    from volanim_core.render.volume_style import gl_renderer
 
     p = pv.Plotter(off_screen=True, window_size=(64, 64))
     try:

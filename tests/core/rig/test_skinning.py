@@ -9,7 +9,7 @@ from tests import naive
 
 from volanim_core.reconstruct.breakage import components
 from volanim_core.reconstruct.engine import posed_centres, reconstruct
-from volanim_core.rig.connectivity import Connectivity, RootBone
+from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.rig.dual_quaternion import blended_matrices
 from volanim_core.rig.pose import apply_rows, euler
 from volanim_core.rig.skinning import Joints, skin_weights, transform_table
@@ -29,7 +29,8 @@ def cylinder(length=60, radius=4.0, joint=30) -> Connectivity:
     """A straight rod along x: two bones meeting at x = ``joint``, one medial point per voxel."""
     x = np.arange(5, 5 + length)
     points = np.column_stack([x, np.full_like(x, 20), np.full_like(x, 20)])
-    bones = [RootBone((5, 20, 20), (joint, 20, 20), "UPPER"), RootBone((joint, 20, 20), (5 + length, 20, 20), "LOWER")]
+    bones = [BoneSegment((5, 20, 20), (joint, 20, 20), "UPPER"),
+             BoneSegment((joint, 20, 20), (5 + length, 20, 20), "LOWER")]
     return Connectivity(bones, points, np.full(len(x), radius), None, (x >= joint).astype(int), joints=SMOOTH)
 
 
@@ -102,7 +103,7 @@ def test_a_seam_along_the_limb_blends_only_at_the_joint():
                         np.column_stack([np.full_like(z_leg, 23), np.full_like(z_leg, 20), z_leg])])
     bone = np.r_[np.zeros(len(z_torso), int), np.ones(len(z_leg), int)]
     joint = np.array([21.5, 20.0, 40.0])
-    bones = [RootBone(joint, (20, 20, 80), "TORSO"), RootBone(joint, (23, 20, 0), "LEG")]
+    bones = [BoneSegment(joint, (20, 20, 80), "TORSO"), BoneSegment(joint, (23, 20, 0), "LEG")]
     conn = Connectivity(bones, points, np.full(len(points), 5.0), None, bone, joints=SMOOTH)
     skin = conn.skin
     weight_on = np.zeros((len(points), 2))
@@ -129,7 +130,7 @@ def test_weights_are_zero_across_a_gap():
     rod = cylinder()
     x = np.arange(50, 65)
     hand = np.column_stack([x, np.full_like(x, 28), np.full_like(x, 20)])  # 8 voxels over the rod: spheres touch
-    bones = [*rod.bones, RootBone((70, 28, 20), (50, 28, 20), "HAND")]
+    bones = [*rod.bones, BoneSegment((70, 28, 20), (50, 28, 20), "HAND")]
     points = np.vstack([rod.points, hand])
     bone = np.concatenate([rod.bone, np.full(len(x), 2)])
     dt = np.full(len(points), 4.0)

@@ -11,7 +11,7 @@ from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.attach import attach_nearest_bone, connect_nearest
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, posed_joints, root_bones
-from volanim_core.rig.tskel import connect_to_tskel, identity_tskel, sort_tskel
+from volanim_core.rig.tskel_tools import connect_to_tskel, identity_tskel, sort_tskel
 from volanim_core.skeleton.skeletonize import skeletonize
 
 

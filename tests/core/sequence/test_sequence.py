@@ -16,7 +16,7 @@ from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT lice
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
-from volanim_core.motion.frames import write_frames
+from volanim_core.motion.frame_files import write_frames
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
@@ -199,7 +199,7 @@ def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
     assert not (tmp_path / "bad.zarr").exists()  # refused before anything was written
     with pytest.raises(ValueError, match="needs the source"):
         run_sequence(conn, walk, tmp_path / "s.zarr", mode="sampled")
-    from volanim_core.rig.tskel import identity_tskel
+    from volanim_core.rig.tskel_tools import identity_tskel
 
     io.write_tskel(tmp_path / "x.0001.tskel", identity_tskel(conn.take(np.arange(100))))
     with pytest.raises(FormatError, match=r"x\.0001\.tskel.*not the \.connect"):

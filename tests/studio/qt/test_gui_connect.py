@@ -14,7 +14,7 @@ from PySide6.QtWidgets import QMessageBox
 
 from paths import ASSETS
 from volanim_core import io, samples
-from volanim_core.render.colours import label_table
+from volanim_core.render.bone_colours import label_table
 from volanim_core.skeleton.points import Skeleton
 from volanim_studio.model.modes import Mode
 from volanim_studio.model.project import read_project

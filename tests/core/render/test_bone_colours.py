@@ -8,7 +8,7 @@ import numpy as np
 from skimage.color import deltaE_ciede2000, rgb2lab
 
 from volanim_core import samples
-from volanim_core.render.colours import label_table
+from volanim_core.render.bone_colours import label_table
 
 
 def test_the_first_24_bone_colours_are_pairwise_distinct_in_ciede2000():

@@ -128,7 +128,7 @@ def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
 
 
 def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
-    from volanim_core.motion.frames import frame_number
+    from volanim_core.motion.frame_files import frame_number
 
     numbers = [frame_number(p) for p in paths]
     if None in numbers or len(set(numbers)) != len(numbers):

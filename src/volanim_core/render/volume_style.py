@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.render.colours import SKIN, bone_colours, rgb
+from volanim_core.render.bone_colours import SKIN, bone_colours, rgb
 
 LABEL_MODES = ("bone", "mottled", "binary")
 

@@ -17,7 +17,7 @@ from volanim_core.progress import Reporter
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity, Trans
 from volanim_core.rig.pose import root_bones
-from volanim_core.rig.tskel import check_root_order, connect_to_tskel
+from volanim_core.rig.tskel_tools import check_root_order, connect_to_tskel
 
 
 def frame_path(folder: str | Path, stem: str, frame: int, suffix: str = ".trans") -> Path:
