@@ -134,9 +134,9 @@ def test_in_memory_order_reconstructs_like_the_written_file(tmp_path, rng):
 
 @pytest.mark.parametrize("mode", ["binary", "mottled", "bone", "sampled"])
 def test_overdraw_cut_changes_nothing_but_visits(rng, mode, monkeypatch):
-    from volanim_core.reconstruct import engine as rec
+    from volanim_core.reconstruct import plan
 
-    monkeypatch.setattr(rec, "CUT_MIN_RADIUS", 0.0)  # cut every sphere, however small
+    monkeypatch.setattr(plan, "CUT_MIN_RADIUS", 0.0)  # cut every sphere, however small
     source = rng.integers(1, 256, (30, 30, 30)).astype(np.uint8)
     t = random_tskel(rng, n=800, size=30, nbones=2)
     cut = reconstruct(t, mode=mode, source=source)
@@ -349,10 +349,10 @@ def test_concurrent_reconstructions_do_not_share_scratch_memory(rng):
 
 def test_neighbours_refer_to_the_callers_order(rng, monkeypatch):
     """reconstruct() groups points by bone; neighbours the caller computed on its own order must follow."""
-    from volanim_core.reconstruct import engine as rec
+    from volanim_core.reconstruct import plan
     from volanim_core.reconstruct.neighbours import sphere_neighbours
 
-    monkeypatch.setattr(rec, "CUT_MIN_RADIUS", 0.0)
+    monkeypatch.setattr(plan, "CUT_MIN_RADIUS", 0.0)
     t = random_tskel(rng, n=500, size=30)
     mixed_order = rng.permutation(len(t))
     mixed = Tskel(t.bones, t.matrices, t.points[mixed_order], t.dt[mixed_order], None, t.bone[mixed_order])
