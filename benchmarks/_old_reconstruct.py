@@ -50,7 +50,7 @@ def cube_scan(out, stencil, nthreads, offsets, ids, centres, r2s, minv, bone, so
 
 
 def prepare(tskel, bounds):
-    from volanim_core.reconstruct import _kernels as K
+    from volanim_core.reconstruct import _plan_kernels as P
     from volanim_core.reconstruct.engine import check_matrices, posed_centres
     from volanim_core.reconstruct.radii import radius_squared
 
@@ -63,7 +63,7 @@ def prepare(tskel, bounds):
     nz = bounds.shape[2]
     zlo = np.floor(centres[:, 2] - tskel.dt).astype(np.int64) - 1
     zhi = np.ceil(centres[:, 2] + tskel.dt).astype(np.int64) + 1
-    offsets, ids = K.slice_lists(zlo, zhi, nz)
+    offsets, ids = P.slice_lists(zlo, zhi, nz)
     return centres, r2s, minv, offsets, ids
 
 

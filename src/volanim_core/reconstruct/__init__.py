@@ -1,8 +1,12 @@
 """Re-growing a volume from a posed frame, and finding where a pose breaks it.
 
-    engine.py ....... reconstruct(): spheres -> output grid, five modes, two metrics
-    _kernels.py ..... the numba kernels behind it (tested against tests/naive.py)
-    breakage.py ..... connected components, cracks and detached pieces of a posed frame
+    plan.py ............ a frame checked and made ready: FramePlan (grid, centres, values, cut, slice lists)
+    engine.py .......... reconstruct(): runs the plan, five modes, two metrics
+    _plan_kernels.py ... the plan's numba kernels; _kernels.py the fill and sample kernels (tested
+                         against tests/naive.py); _clip_kernels.py what falls outside the grid
+    sampling.py ........ sampled mode, grey or colour; neighbours.py the overdraw cut's neighbour lists
+    breakage.py ........ cracks, stumps and torn-off pieces of a posed frame (_label_kernels.py: pieces
+                         found on x-runs, nogil); scan.py many frames; bend.py how a bent joint keeps shape
 """
 
 from volanim_core.reconstruct.engine import MODES, Reconstruction, grid_bounds, reconstruct

@@ -11,8 +11,7 @@ values >= 1) its value is ignored, as if it were inf. Growing an initialised
 span row by row cost 17 % of the frog's kernel (a short, badly predicted loop
 per row); the extra test is one lane-wise compare on data already loaded.
 
-    slice_lists  bucket spheres by the output z-slices they overlap, keeping
-                 file order inside each slice (that order is the tie-break)
+    (slice_lists, build_halfspaces: _plan_kernels.py, made by plan.py before the fill)
     fill_slices  for each slice (threads take slices round-robin), for each of
                  its spheres, for each row y: the exact x-run of the circle;
                  per voxel: distance vs stencil, and on a win write the mode's
@@ -64,42 +63,6 @@ AHEAD = 8  # spheres prefetched ahead in a slice's list (6 to 12 measure alike o
 EUCLID, CHAMFER = 0, 1
 
 
-@njit(cache=True)
-def slice_lists(zlo, zhi, nz):
-    """Spheres per z-slice: ``(offsets[nz + 1], ids)``, file order within a slice."""
-    starts = np.zeros(nz + 1, np.int64)  # spheres starting minus spheres ending at each slice ...
-    for i in range(len(zlo)):
-        a, b = max(zlo[i], 0), min(zhi[i], nz - 1)
-        if a <= b:
-            starts[a] += 1
-            starts[b + 1] -= 1
-    offsets = np.zeros(nz + 1, np.int64)
-    running = 0
-    for z in range(nz):  # ... summed: the spheres on each slice
-        running += starts[z]
-        offsets[z + 1] = offsets[z] + running
-    ids = np.empty(offsets[-1], np.int32)
-    fill = offsets[:-1].copy()
-    for i in range(len(zlo)):
-        for z in range(max(zlo[i], 0), min(zhi[i], nz - 1) + 1):
-            ids[fill[z]] = i
-            fill[z] += 1
-    return offsets, ids
-
-
-@njit(cache=True)
-def sphere_box(centres, extents):
-    """``(lo[3], hi[3])``: the smallest and largest ``centre -+ extent`` on each axis (finite input)."""
-    lo = np.full(3, np.inf)
-    hi = np.full(3, -np.inf)
-    for i in range(centres.shape[0]):
-        e = extents[i]
-        for k in range(3):
-            lo[k] = min(lo[k], centres[i, k] - e)
-            hi[k] = max(hi[k], centres[i, k] + e)
-    return lo, hi
-
-
 @njit(cache=True, inline="always")
 def _distance(metric, dx, dy, dz, dy2, dz2):
     if metric == EUCLID:
@@ -112,19 +75,6 @@ def _distance(metric, dx, dy, dz, dy2, dz2):
     if a < b:
         a, b = b, a
     return 3.0 * a + b + c
-
-
-@njit(cache=True)
-def spheres_fit(centres, extents, limit):
-    """True when every sphere (centre +- extent, the extent not negative) is finite and lies within
-    ``limit`` voxels of the origin: the frame checks' fast path, one pass (on the frog the NumPy checks
-    took 4 ms of a 65 ms call); only when it fails do the callers find the point and say what is wrong."""
-    for i in range(centres.shape[0]):
-        e = extents[i]
-        reach = max(abs(centres[i, 0]), abs(centres[i, 1]), abs(centres[i, 2])) + e
-        if not (e >= 0.0 and reach <= limit):  # NaN fails both
-            return False
-    return True
 
 
 @njit(cache=True, inline="always")
@@ -404,43 +354,3 @@ def sample_rows(owner, out, z0, z1, nthreads, row_lo, row_hi, minv, source, weig
                         last = b
                     v = _sample(source, rx + x * sx, ry + x * sy, rz + x * sz, weights, half)
                     out[z, y, x] = np.floor(v + 0.5) if half else v
-
-
-@njit(cache=True)
-def build_halfspaces(centres, r2s, neighbours, min_r2):
-    """Bisector half-spaces of each sphere against its larger neighbours, with the float margin,
-    in the sphere's own frame ``u = q - c_i``: ``a.u + w <= 0`` keeps ``q``, where
-    ``a = 2 (c_j - c_i)`` and ``w = -|c_j - c_i|^2 - margin``, so ``a.u + w`` is
-    ``|q - c_i|^2 - |q - c_j|^2 - margin`` computed from small numbers (its rounding stays far
-    below the margin wherever the grid lies). Column 4 is ``|(a_x, a_y)|``, how fast the value
-    changes within a slice. Sphere i's planes are rows ``start[i]:start[i + 1]``; spheres with
-    ``r2 < min_r2`` get none: for small spheres clipping each row costs more than it saves."""
-    n, k = neighbours.shape
-    start = np.zeros(n + 1, np.int64)
-    for i in range(n):
-        c = 0
-        if r2s[i] >= min_r2:
-            for h in range(k):
-                if neighbours[i, h] >= 0:
-                    c += 1
-        start[i + 1] = start[i] + c
-    planes = np.empty((start[n], 5))
-    for i in range(n):
-        if start[i + 1] == start[i]:
-            continue
-        margin = r2s[i] * 2.0**-20 + 1e-6
-        row = start[i]
-        for h in range(k):
-            j = neighbours[i, h]
-            if j < 0:
-                continue
-            d0 = centres[j, 0] - centres[i, 0]
-            d1 = centres[j, 1] - centres[i, 1]
-            d2 = centres[j, 2] - centres[i, 2]
-            planes[row, 0] = 2.0 * d0
-            planes[row, 1] = 2.0 * d1
-            planes[row, 2] = 2.0 * d2
-            planes[row, 3] = -(d0 * d0 + d1 * d1 + d2 * d2) - margin
-            planes[row, 4] = 2.0 * np.sqrt(d0 * d0 + d1 * d1)
-            row += 1
-    return start, planes

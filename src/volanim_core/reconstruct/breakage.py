@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volanim_core.progress import Reporter
-from volanim_core.reconstruct import _labels as L
+from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct.engine import OWNER, Reconstruction, posed_centres, reconstruct
 from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel

@@ -30,7 +30,7 @@ import numpy as np
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
-from volanim_core.reconstruct._clipped import count_outside
+from volanim_core.reconstruct._clip_kernels import count_outside
 
 # the plan's checks and geometry are this module's API too (callers import them from here)
 from volanim_core.reconstruct.plan import (  # noqa: F401

@@ -5,8 +5,8 @@
       --transform_table, posed_centres--> posed centres (snapped; smooth joints: blended)
       --grid_bounds (or the given bounds, check_reach)--> the output grid
       --_sphere_values--> what each sphere writes, the output dtypes
-      --cached_neighbours, K.build_halfspaces--> the overdraw cut's half-spaces (Euclid, big spheres)
-      --K.slice_lists--> the spheres each z slice visits
+      --cached_neighbours, P.build_halfspaces--> the overdraw cut's half-spaces (Euclid, big spheres)
+      --P.slice_lists--> the spheres each z slice visits
       --> FramePlan (engine.reconstruct runs it)
 
 Why a plan: the kernel takes some twenty arrays; made here under names, once, they are
@@ -23,6 +23,7 @@ import numpy as np
 from volanim_core.limits import MAX_COORD, check_allocation
 from volanim_core.modes import MODES
 from volanim_core.reconstruct import _kernels as K
+from volanim_core.reconstruct import _plan_kernels as P
 from volanim_core.reconstruct.neighbours import CUT_MIN_RADIUS, cached_neighbours, check_neighbours, reorder_neighbours
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.speedups import ALL, Speedups
@@ -103,7 +104,7 @@ def plan_frame(tskel: Tskel, mode: str, *, source=None, kernel: int = 1, value: 
     if metric == K.EUCLID and mode != "hotspot" and speedups.cut and len(tskel):
         nbrs = cached_neighbours(tskel, min_radius=CUT_MIN_RADIUS, r2=r2s) if neighbours is None \
             else reorder_neighbours(neighbours, order)
-        plane_start, planes = K.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
+        plane_start, planes = P.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 5))
     # Euclid: the slices with |z - cz| < r + 1e-7 (one slice in from floor/ceil at each end): the kernel
@@ -113,7 +114,7 @@ def plan_frame(tskel: Tskel, mode: str, *, source=None, kernel: int = 1, value: 
     reach, inward = (np.sqrt(r2s) + 1e-7, 1) if metric == K.EUCLID else (_extent(tskel), -1)
     zlo = np.floor(centres[:, 2] - reach).astype(np.int64) + inward
     zhi = np.ceil(centres[:, 2] + reach).astype(np.int64) - inward
-    offsets, ids = K.slice_lists(zlo, zhi, bounds.shape[2])
+    offsets, ids = P.slice_lists(zlo, zhi, bounds.shape[2])
     return FramePlan(tskel, minv_rest, table, bounds, own_bounds, centres, r2s,
                      np.ascontiguousarray(tskel.dt, np.float64), metric, values, out_dtype, final_dtype,
                      relax=mode not in ("hotspot", "binary"),  # binary is a union and hotspot a count: no stencil
@@ -147,7 +148,7 @@ def check_frame(tskel: Tskel) -> None:
     """Refuse points a reconstruction cannot place: NaN/infinite values, negative radii,
     and spheres that reach beyond ``MAX_COORD`` voxels."""
     pts, dt = np.ascontiguousarray(tskel.points, np.float64), np.ascontiguousarray(tskel.dt, np.float64)
-    if K.spheres_fit(pts, dt, MAX_COORD):
+    if P.spheres_fit(pts, dt, MAX_COORD):
         return
     finite = np.isfinite(pts)
     bad = ~(finite[:, 0] & finite[:, 1] & finite[:, 2]) | ~np.isfinite(dt) | (dt < 0)
@@ -159,7 +160,7 @@ def check_frame(tskel: Tskel) -> None:
 
 def check_reach(centres: np.ndarray, extents: np.ndarray, where: str) -> None:
     """Every sphere (centre +- extent) must lie within ``MAX_COORD`` voxels of the origin."""
-    if not len(centres) or K.spheres_fit(np.ascontiguousarray(centres, np.float64),
+    if not len(centres) or P.spheres_fit(np.ascontiguousarray(centres, np.float64),
                                          np.ascontiguousarray(extents, np.float64), MAX_COORD):
         return
     a = np.abs(centres)
@@ -228,7 +229,7 @@ def grid_bounds(tskels: Tskel | list[Tskel], padding: int = 2, *, centres: list 
         if len(t):
             c, e = (posed_centres(t) if centres is None else centres[k]), _extent(t)
             check_reach(c, e, " once posed")  # else the int conversion below wraps silently
-            lo, hi = K.sphere_box(np.ascontiguousarray(c, np.float64), np.ascontiguousarray(e, np.float64))
+            lo, hi = P.sphere_box(np.ascontiguousarray(c, np.float64), np.ascontiguousarray(e, np.float64))
             los.append(lo)
             his.append(hi)
     if not los:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from volanim_core.reconstruct import _labels as L
+from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct import breakage
 
 SHAPES = [(1, 1, 1), (1, 1, 6), (3, 1, 7), (1, 9, 1), (5, 6, 7), (20, 20, 20), (7, 30, 2), (33, 17, 29)]
