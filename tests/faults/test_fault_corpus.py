@@ -16,7 +16,7 @@ import random
 import pytest
 
 from .cases import HOSTILE_NUMBERS, hand_written, mutated
-from .movie import run_corpus, table
+from .run import run_corpus, table
 from .round2_cases import round2_cases
 from .scan_cases import scan_cases
 from .store_cases import store_cases
