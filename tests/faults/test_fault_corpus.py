@@ -16,8 +16,8 @@ import random
 import pytest
 
 from .cases import HOSTILE_NUMBERS, hand_written, mutated
-from .run import run_corpus, table
 from .round2_cases import round2_cases
+from .run import run_corpus, table
 from .scan_cases import scan_cases
 from .store_cases import store_cases
 
