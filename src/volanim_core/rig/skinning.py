@@ -126,9 +126,9 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
     Each bone ``k`` that meets another (their points are linked, :func:`links`) reaches along the body
     (Dijkstra over the links from its points) fully for one blend width ``h_k`` and fades out over the
     next (``g_k``: 1 .. 0). A reached point weighs every bone that reaches it, its own with ``g = 1``,
-    by ``g_k * exp(-d_k / tau_k)``: ``d_k`` its distance to the bone's segment, ``tau_k = h_k / SHARPNESS``
-    (so a thick bone's points are not taken by a thin neighbour's segment); normalised, weights under
-    ``MIN_WEIGHT`` dropped."""
+    by ``g_k * exp(-(d_k / tau_k)^2 / 2)``: ``d_k`` its distance to the bone's segment, ``tau_k = h_k /
+    SHARPNESS`` (so a thick bone's points are not taken by a thin neighbour's segment); normalised, smoothed
+    by heat diffusion (:func:`_diffused`), weights under ``MIN_WEIGHT`` dropped."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
@@ -138,8 +138,9 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
     n = len(points)
     i, j, d = links(points, dt)
     cross = bone[i] != bone[j]
-    thickness = [max(float(dt[bone == k].max(initial=0.0)), LINK) for k in range(len(bones))]
-    h = np.array([joints.blend / spacing if joints.mm else joints.blend * t for t in thickness])
+    thickness = np.full(len(bones), LINK)  # each bone's thickest sphere
+    np.maximum.at(thickness, bone, dt)
+    h = np.full(len(bones), joints.blend / spacing) if joints.mm else joints.blend * thickness
     graph = coo_matrix((d, (i, j)), shape=(n, n)).tocsr()
     reached = []  # per bone: the points of other bones it reaches, and how far (g)
     for k in np.unique(np.concatenate([bone[i][cross], bone[j][cross]])):
@@ -213,7 +214,6 @@ def _weights(reached: list, points: np.ndarray, bone: np.ndarray, bones, tau: np
     # per point: own first, then the others by weight, at most INFLUENCES and none under MIN_WEIGHT
     order = np.lexsort((-w, k != bone[index[at]], at))
     at, k, w = at[order], k[order], w[order]
-    m = len(index)
     col = np.arange(len(at)) - np.searchsorted(at, np.arange(m))[at]
     keep = (col < INFLUENCES) & ((col == 0) | (w >= MIN_WEIGHT))
     influence = np.full((m, INFLUENCES), -1, np.int64)
