@@ -35,7 +35,7 @@ from volanim_core.reconstruct.engine import OWNER, Reconstruction, posed_centres
 from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.pose import apply_matrices, apply_rows
-from volanim_core.rig.skinning import blended_with, transform_table
+from volanim_core.rig.skinning import blended_with, links, transform_table
 from volanim_core.rig.tskel_tools import identity_tskel
 
 
@@ -121,14 +121,21 @@ class Stump:
                 f"{self.lies_along} and stay behind (connect them to {self.lies_along})")
 
 
+TOUCH_NEIGHBOURS = 16  # spheres of the other bone examined per misplaced point
+
+
 def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
     """Points that lie clearly closer to another bone's rest segment than to their own (pose-independent).
 
     Returns ``(indices, the bone they lie along)``. "Clearly": closer by more than the
-    point's radius, so points near a joint, equally close to both bones, never count.
+    point's radius, so points near a joint, equally close to both bones, never count. And part of
+    that bone's flesh: its sphere reaches one of the bone's spheres. A point the body keeps apart from
+    that bone by a gap (the torso's flank beside a hanging arm, nearer the arm's segment than the
+    spine's) is not a piece of the limb, and stays where it is in any pose.
     """
     if not len(conn) or len(conn.bones) < 2:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
+
     segs = np.array([[b.proximal, b.distal] for b in conn.bones])
     d = np.vstack([segment_distances(conn.points[s:s + 65536], segs)  # bounded temporaries on 10^5 points
                    for s in range(0, len(conn), 65536)])
@@ -137,7 +144,36 @@ def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
     d[rows, conn.bone] = np.inf
     near = d.argmin(1)
     idx = np.flatnonzero(own > d[rows, near] + conn.dt)
-    return idx, near[idx]
+    return _part_of_flesh(conn, idx, near[idx])
+
+
+def _part_of_flesh(conn: Connectivity, idx: np.ndarray, along: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The misplaced points ``idx`` that are part of the flesh of the bone they lie ``along``: linked
+    (:func:`~volanim_core.rig.skinning.links`, through each other) to a point whose sphere reaches one
+    of that bone's spheres. A bone with no points of its own yet takes every point along it."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    points, dt = np.asarray(conn.points, np.float64), np.asarray(conn.dt, np.float64)
+    touching = np.zeros(len(idx), bool)
+    for b in np.unique(along):
+        mine = np.flatnonzero(conn.bone == b)
+        sel = np.flatnonzero(along == b)
+        if not len(mine):
+            touching[sel] = True
+            continue
+        # the bone's nearest spheres (a limb's medial points are dense: the one reached is among them)
+        dist, nb = cKDTree(points[mine]).query(points[idx[sel]], k=min(TOUCH_NEIGHBOURS, len(mine)))
+        dist, nb = dist.reshape(len(sel), -1), nb.reshape(len(sel), -1)
+        touching[sel] = (dist <= dt[mine][nb] + dt[idx[sel], None]).any(1)
+    # and those linked to them through misplaced points of the same two bones (a stump's far end)
+    i, j, _ = links(points[idx], dt[idx])
+    same = (along[i] == along[j]) & (conn.bone[idx[i]] == conn.bone[idx[j]])
+    _, part = connected_components(coo_matrix((np.ones(int(same.sum())), (i[same], j[same])),
+                                              shape=(len(idx), len(idx))), directed=False)
+    keep = np.isin(part, np.unique(part[touching]))
+    return idx[keep], along[keep]
 
 
 def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[Stump]:

@@ -8,6 +8,7 @@
       --per reached point: w_k = g_k * exp(-(d_k / tau_k)^2 / 2), d_k its distance to bone k's segment,
         tau_k = h_k / SHARPNESS, the own bone with g = 1; normalised
       --heat diffusion over the links, DIFFUSION steps, of the blended points only
+      --specks (linked groups of one-voxel spheres): the weights of the sphere each lies deepest in
       --> Skin: the blended points, their bones (own first) and weights (summing to 1)
     Skin + a frame's matrices --dual_quaternion.blended_matrices--> one matrix per blended point
       --transform_table--> bone matrices + blended ones, and each point's row in it
@@ -44,6 +45,7 @@ PLATEAU = 2.0  # a bone reaches fully (PLATEAU - 1) blend widths along the body 
 SHARPNESS = 1.25  # tau = h / SHARPNESS: how fast a bone's weight falls with distance from its segment
 MIN_WEIGHT = 0.005  # smaller weights are dropped (and the rest renormalised): far points move exactly rigidly
 DIFFUSION = 8  # smoothing steps over the links (heat diffusion, as Bender does over voxels)
+SPECK = 2.0  # spheres thinner than this are one voxel: linked groups of only those are specks of the surface
 
 
 @dataclass(frozen=True)
@@ -148,7 +150,66 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
         p = np.flatnonzero(np.isfinite(geo) & (bone != k))
         g = 1.0 - _smoothstep((geo[p] - (PLATEAU - 1) * h[k]) / h[k])
         reached.append((p[g > 0], np.full(int((g > 0).sum()), k), g[g > 0]))
-    return _weights(reached, points, bone, bones, h / SHARPNESS, graph)
+    return _with_specks(_weights(reached, points, bone, bones, h / SHARPNESS, graph), points, dt, bone, graph)
+
+
+def _with_specks(skin: Skin, points, dt, bone, graph) -> Skin:
+    """Each speck moves with the body beside it: a speck is a group of linked points whose spheres are
+    all one voxel (``dt < SPECK``), the skeleton's noise at the surface. No link reaches it, so no bone's
+    reach does, and left rigid on its own bone it would stay put while the blended flesh around it
+    moves: a lone voxel torn off at every bent joint. It takes the weights of the sphere outside any
+    speck that it lies deepest in (its own bone first, with weight 0 when that point has none on it)."""
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    if not len(skin):
+        return skin
+    _, part = connected_components(graph, directed=False)
+    big = np.zeros(part.max() + 1, bool)
+    np.logical_or.at(big, part, dt >= SPECK)
+    speck = np.flatnonzero(~big[part])
+    body = np.flatnonzero(big[part])
+    if not len(speck) or not len(body):
+        return skin
+    row = np.full(len(points), -1, np.int64)
+    row[skin.index] = np.arange(len(skin))
+    # only a speck that may lie deepest in a blended sphere can change: one within the largest radius
+    # of a blended centre beyond its nearest body centre (the frog has 26 k speck points, few near joints)
+    nearest, _ = cKDTree(points[body]).query(points[speck])
+    blended, _ = cKDTree(points[skin.index]).query(points[speck], distance_upper_bound=nearest.max() + dt.max())
+    speck = speck[blended <= nearest + dt.max()]
+    if not len(speck):
+        return skin
+    near = body[_deepest(points[body], dt[body], points[speck])]
+    speck, near = speck[row[near] >= 0], near[row[near] >= 0]  # beside a blended point
+    influence, weight = skin.influence[row[near]].copy(), skin.weight[row[near]].copy()
+    # own bone first: where it is among the influences, or in the last place with weight 0
+    own = bone[speck]
+    has = influence == own[:, None]
+    at = np.where(has.any(1), has.argmax(1), INFLUENCES - 1)
+    r = np.arange(len(speck))
+    weight[r, at] *= has.any(1)
+    influence[r, at] = own
+    col = np.arange(INFLUENCES)[None, :]
+    order = np.where(col == 0, at[:, None], col - (col <= at[:, None]))  # at, then the others in order
+    influence, weight = np.take_along_axis(influence, order, 1), np.take_along_axis(weight, order, 1)
+    weight /= weight.sum(1, keepdims=True)
+    keep = np.setdiff1d(np.arange(len(skin)), row[speck[row[speck] >= 0]])  # a speck's own weights give way
+    index = np.concatenate([skin.index[keep], speck])
+    order = np.argsort(index, kind="stable")
+    return Skin(index[order], np.concatenate([skin.influence[keep], influence])[order],
+                np.concatenate([skin.weight[keep], weight])[order])
+
+
+def _deepest(centres: np.ndarray, radii: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """For each of ``points``, the sphere it lies deepest in, or nearest outside, by power distance
+    ``|p - c|^2 - r^2``: the nearest neighbour of ``(p, 0)`` among the lifted centres
+    ``(c, sqrt(R^2 - r^2))`` (``R`` the largest radius), one KD-tree query for all."""
+    from scipy.spatial import cKDTree
+
+    lift = np.sqrt(np.maximum(radii.max() ** 2 - radii ** 2, 0.0))
+    tree = cKDTree(np.column_stack([centres, lift]))
+    return tree.query(np.column_stack([points, np.zeros(len(points))]))[1]
 
 
 def links(points: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

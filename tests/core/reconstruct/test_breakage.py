@@ -179,3 +179,21 @@ def test_rest_voxels_of_a_volume_in_any_memory_order():
     for v in (vol, np.asfortranarray(vol)):
         points, bone = rest_voxels(Reconstruction(v, (10, 20, 30)))
         assert points.tolist() == [[14, 20, 32], [11, 22, 30], [10, 23, 31]] and bone.tolist() == [0, 1, 1]
+
+
+def test_misplaced_points_are_part_of_the_limbs_flesh():
+    """A torso point on the flank beside a hanging arm, a gap between them, lies nearer the arm's segment
+    than the spine's but is no piece of the arm: it is not misplaced (mannequin-large's torso flank read as
+    a 4-point stump at every shoulder angle). Torso points in the arm's flesh are, and so are those linked
+    to them through each other, though their own spheres do not reach the arm's (a stump's far end)."""
+    bones = [BoneSegment([0, 0, 0], [0, 0, 100], "SPINE"), BoneSegment([30, 0, 90], [30, 0, 40], "ARM")]
+    torso = np.column_stack([np.zeros(101), np.zeros(101), np.arange(101)])
+    arm = np.column_stack([np.full(51, 30), np.zeros(51), np.arange(40, 91)])
+    flank = np.array([[17, 0, 45]])  # 13 from the arm's segment, 17 from the spine's; the arm's spheres 5 thick
+    line = np.column_stack([np.full(11, 22), np.zeros(11), np.arange(55, 66)])  # 8 from the arm: a gap of 1
+    touching = np.array([[24, 0, 60]])  # 6 from the arm: its sphere (2) reaches the arm's (5)
+    points = np.vstack([torso, arm, flank, line, touching]).astype(float)
+    dt = np.r_[np.full(101, 16.0), np.full(51, 5.0), 1.0, np.full(11, 2.0), 2.0]
+    bone = np.r_[np.zeros(101, int), np.ones(51, int), np.zeros(13, int)]
+    idx, along = misplaced_points(Connectivity(bones, points, dt, None, bone))
+    assert sorted(idx.tolist()) == list(range(153, 165)) and set(along.tolist()) == {1}

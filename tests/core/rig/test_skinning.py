@@ -212,3 +212,41 @@ def test_a_thick_bone_reaches_further_than_a_thin_one():
     assert x[~lower].min() == 30 - 2 * 2 + 1  # LOWER reaches 2h = 4 from x 30
     assert x[lower].max() > 29 + 2 * 2  # UPPER reaches beyond LOWER's 2h (up to 2 x 5 from x 29)
     assert x[lower].max() < 29 + 2 * 5
+
+
+@pytest.mark.parametrize("angle", [60, 90, 120])
+def test_a_speck_at_the_surface_moves_with_the_flesh_it_lies_on(angle):
+    """A one-voxel sphere at the rod's surface beside the joint, linked to nothing (the skeleton's noise at
+    a scan's surface): no bone's reach gets to it, so it used to move rigidly with its own bone while the
+    blended flesh under it turned half as far, and the bend tore it off as a piece of its own."""
+    rod = cylinder(radius=4.0)
+    speck = np.array([[31, 24, 21]])  # 4.1 voxels from the nearest centre: in no sphere, unlinked, touching the rod
+    conn = Connectivity(rod.bones, np.vstack([rod.points, speck]), np.r_[rod.dt, 1.0], None,
+                        np.r_[rod.bone, 1], joints=SMOOTH)
+    joint = np.array([30.0, 20.0, 20.0])
+    mats = np.stack([np.eye(4), rotation_about(joint, euler((0, 0, angle)))])
+    assert len(components(reconstruct(conn.posed(np.stack([np.eye(4)] * 2)), mode="binary", padding=1).volume)) == 1
+    assert len(components(reconstruct(conn.posed(mats), mode="binary", padding=1).volume)) == 1
+    skin = skin_weights(conn.points, conn.dt, conn.bone, conn.bones, SMOOTH)
+    host = 26  # the rod point at x = 31, the sphere the speck lies on
+    at = {int(k): r for r, k in enumerate(skin.index)}
+    assert len(conn) - 1 in at and host in at
+    np.testing.assert_array_equal(skin.influence[at[len(conn) - 1]], skin.influence[at[host]])
+    np.testing.assert_allclose(skin.weight[at[len(conn) - 1]], skin.weight[at[host]])
+
+
+def test_mannequin_large_raises_its_arm_with_nothing_torn_off_and_no_stump():
+    """The largest sample, arm raised 90 degrees with smooth joints: its one-voxel surface specks (two
+    stay apart at rest already) moved rigidly while the flesh they lie on blended, and tore off two pieces
+    at the shoulder; four torso points on the flank beside the hanging arm, a gap from it, were reported as
+    a stump (#42)."""
+    from volanim_core import samples
+    from volanim_core.reconstruct.breakage import breakage_report
+    from volanim_core.rig.pose import pose_matrices, posed_joints
+
+    s = samples.mannequin_large()
+    conn = samples.part_connectivity(s).with_joints(SMOOTH)
+    m = pose_matrices(s.bones, {"L_UPPERARM": (0, -90, 0)})
+    report = breakage_report(conn.posed(m), s.bones.joints, posed_joints(s.bones, m))
+    assert report.rest_pieces == 3 and len(report.components) == 3
+    assert report.pieces == [] and report.stumps == [] and report.cracks == 0 and report.healthy
