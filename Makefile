@@ -10,7 +10,7 @@ APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxc
 	libfontconfig1 libdbus-1-3
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test install install-test system-deps lint bench docs screenshots clean
+.PHONY: demo test install install-test system-deps lint bench docs screenshots coverage clean
 
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -51,6 +51,24 @@ test: install-test system-deps
 	$(VENV)/bin/ruff check src tests benchmarks assets docs
 	$(PY) -m pytest
 
+# The coverage of volanim_core (about 30 minutes on 2 cores): the core tests with the kernels compiled (numba
+# code runs as machine code, so coverage sees none of its lines), then the kernels' own tests on small
+# inputs with NUMBA_DISABLE_JIT=1, which runs them as Python, as stumpy measures its kernels. A report per
+# module; htmlcov/ has every line. The CLI tests' child processes are not measured.
+KERNEL_TESTS := tests/core/reconstruct/test_labels.py tests/core/reconstruct/test_neighbours.py \
+	tests/core/skeleton/test_skeletonize.py tests/core/rig/test_attach.py tests/core/colour/test_sort.py
+coverage: install-test system-deps
+	rm -rf .coverage-data htmlcov && mkdir -p .coverage-data
+	$(VENV)/bin/coverage run -m pytest -q -p no:cacheprovider tests/core
+	# (as Python a kernel holds the GIL: the test that the compiled ones release it does not apply)
+	NUMBA_DISABLE_JIT=1 $(VENV)/bin/coverage run -m pytest -q -p no:cacheprovider -k "not other_threads_run" \
+		$(KERNEL_TESTS)
+	NUMBA_DISABLE_JIT=1 $(VENV)/bin/coverage run -m pytest -q -p no:cacheprovider -k oracle \
+		tests/core/reconstruct/test_engine.py
+	$(VENV)/bin/coverage combine -q
+	$(VENV)/bin/coverage report
+	$(VENV)/bin/coverage html -q
+
 lint: install-test
 	$(VENV)/bin/ruff check src tests benchmarks
 
@@ -72,4 +90,4 @@ screenshots: install-test system-deps
 	$(PY) docs/make_colour_renders.py
 
 clean:
-	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache
+	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .coverage-data htmlcov

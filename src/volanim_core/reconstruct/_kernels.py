@@ -190,8 +190,10 @@ def fill_slices(out, scratch, z0, z1, nthreads, offsets, ids, centres, r2s, radi
         for z in range(z0 + t, z1, nthreads):
             n_filled = 0
             n_visits = 0
-            lo_z = row_lo[z]
-            hi_z = row_hi[z]
+            # binary and hotspot keep no spans (row_lo is one row): reading row z there read past the array,
+            # which compiled code does not check (NUMBA_DISABLE_JIT's IndexError found it)
+            lo_z = row_lo[z if relax else 0]
+            hi_z = row_hi[z if relax else 0]
             end = offsets[z + 1]
             for k in range(offsets[z], end):
                 if ahead and k + ahead < end:  # the sphere `ahead` places on: its data is anywhere in memory

@@ -22,11 +22,12 @@ from volanim_core.render.scene import reset_clipping
 from ..model.document import Document
 from ..model.modes import PickEvent
 from . import camera
+from .bones_layer import BonesLayer
 from .hull_layer import HullLayer
 from .names_layer import ACTORS as NAME_ACTORS
 from .names_layer import NamesLayer
 from .overlays import CubeOverlay, LassoOverlay
-from .pose_layer import PoseLayer, bone_lines
+from .pose_layer import PoseLayer
 from .projection import CLICK_SLOP, nearest_in_radius, project, segment_distance_2d
 from .xray_layer import XRayLayer
 
@@ -37,8 +38,9 @@ PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
 class SceneView:
     """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor``.
 
-    Composed of parts that each own their actors: ``cube`` and ``lasso``
-    (selection overlays) and ``pose_layer`` (posed bones, previews).
+    Composed of parts that each own their actors: ``hull``, ``bone_layer`` (rest bones, joints, the
+    selected bones' halo), ``names``, ``cube`` and ``lasso`` (selection overlays), ``xray`` and
+    ``pose_layer`` (posed bones, previews). The view keeps the point cloud, which picking reads.
     """
 
     EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube", *NAME_ACTORS)
@@ -49,8 +51,7 @@ class SceneView:
         self.doc = doc
         self.on_pick = on_pick
         self.settings = doc.settings
-        self._cloud_actor = self._bones_actor = self._joints_actor = None
-        self._selected_actor = self._picked_actor = None
+        self._cloud_actor = self._picked_actor = None
         self._world = np.zeros((0, 3), np.float32)
         self._colours = np.zeros((0, 3), np.uint8)
         self._press = None
@@ -88,6 +89,7 @@ class SceneView:
         self.xray = XRayLayer(plotter)  # posed bones and their axes, drawn over the preview
         self.names = NamesLayer(self)  # first: the other layers switch stages, which the labels follow
         self.hull = HullLayer(self)
+        self.bone_layer = BonesLayer(self)  # the rest bones, joints and selection halo
         self.cube = CubeOverlay(self)
         self.lasso = LassoOverlay(self)
         self.pose_layer = PoseLayer(self)
@@ -358,40 +360,17 @@ class SceneView:
             return 0
         return int(self._cloud_actor.mapper.GetInput().GetNumberOfPoints())
 
-    # ---------------------------------------------------------------- bones
-    def _on_bones_changed(self, **_) -> None:
-        if self.settings.colour_by == "bone" and self.doc.skeleton is not None:
+    # ----------------------------------------------- what bones and selection change in the cloud
+    def _on_bones_changed(self, **_) -> None:  # the actors of the bones are BonesLayer's
+        if self.doc.skeleton is not None and self.settings.colour_by == "bone":
             self._recolour()
             self._update_cloud()
-        for name in ("bones", "joints", "selected"):
-            self.plotter.remove_actor(name, render=False)
-        self._bones_actor = self._joints_actor = self._selected_actor = None
-        bones = self.doc.bones
-        if len(bones.joints):
-            jpos = self.world(np.array(list(bones.joints.values())))
-            self._joints_actor = self.plotter.add_mesh(
-                pv.PolyData(jpos.astype(np.float32)), color="white", point_size=14,
-                render_points_as_spheres=True, name="joints", render=False, reset_camera=False)
-        if len(bones):
-            poly = bone_lines(self.world(bones.segments()))
-            poly.cell_data["rgb"] = label_table(len(bones))[1:]
-            self._bones_actor = self.plotter.add_mesh(
-                poly, scalars="rgb", rgb=True, line_width=6, render_lines_as_tubes=True, name="bones",
-                render=False, reset_camera=False)
-        self._on_selection_changed()
+        elif self.doc.only_working:
+            self._update_cloud()
 
-    def _on_selection_changed(self, **_) -> None:
+    def _on_selection_changed(self, **_) -> None:  # "only the working bone's points" follows the selection
         if self.doc.only_working:
             self._update_cloud()
-        self.plotter.remove_actor("selected", render=False)
-        self._selected_actor = None
-        sel = [i for i in self.doc.selected_bones if i < len(self.doc.bones)]
-        if sel:
-            self._selected_actor = self.plotter.add_mesh(
-                bone_lines(self.world(self.doc.bones.segments()[sel])), color="white", line_width=12,
-                render_lines_as_tubes=True, opacity=0.5, name="selected", render=False, reset_camera=False)
-        self.apply_stage()
-        self.render()
 
     def _on_picked_changed(self, index=None, **_) -> None:
         self.plotter.remove_actor("picked", render=False)
