@@ -66,7 +66,7 @@ coverage: install-test system-deps
 	NUMBA_DISABLE_JIT=1 $(VENV)/bin/coverage run -m pytest -q -p no:cacheprovider -k oracle \
 		tests/core/reconstruct/test_engine.py
 	NUMBA_DISABLE_JIT=1 $(VENV)/bin/coverage run -m pytest -q -p no:cacheprovider \
-		-k "settled_heap or cannot_fit or any_axis or summed_heap or acceleration_sets" tests/core/sequence/test_effects.py
+		-k "settled_heap or cannot_fit or any_axis or what_rests or acceleration_sets" tests/core/sequence/test_effects.py
 	NUMBA_DISABLE_JIT=1 $(VENV)/bin/coverage run -m pytest -q -p no:cacheprovider \
 		-k "star or bent_chain or a_t_has or splits or refused" tests/core/rig/test_autorig.py
 	$(VENV)/bin/coverage combine -q
