@@ -244,7 +244,7 @@ def _smoothstep(t: np.ndarray) -> np.ndarray:
 
 
 def _weights(reached: list, points: np.ndarray, bone: np.ndarray, bones, tau: np.ndarray, graph) -> Skin:
-    """Normalised ``g_k * exp(-d_k / tau_k)`` of every reached point (own bone first, ``g = 1``).
+    """Normalised ``g_k * exp(-(d_k / tau_k)^2 / 2)`` of every reached point (own bone first, ``g = 1``).
 
     A function of the position alone (and of which bones reach it), so two neighbouring points of
     different bones get nearly the same weights: a seam that runs along a limb (a torso's lowest points
