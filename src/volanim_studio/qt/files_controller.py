@@ -64,21 +64,33 @@ class FilesController(Controller):
         if path:
             self.view_file(path)
 
-    def view_slices(self, path):
-        """Show any volume one slice at a time in a window of its own (the document is untouched)."""
-        from .slice_window import SliceWindow
+    def view_slices(self, path) -> Worker | None:
+        """Read any volume in the background (progress, Cancel) and show it one slice at a time in a
+        window of its own (``viewers[-1]``); the document is untouched, and its own job, if one runs,
+        goes on. The reading worker, or None while another file is still being read for viewing."""
+        from .slice_window import SliceWindow, read_for_slices
 
-        return self._viewer("View slices", lambda: SliceWindow(path, self.window),
-                            f"Viewing slices of {Path(path).name}")
+        name = Path(path).name
+        readers = self.window.readers
+        if readers.busy:
+            self.doc.message(f"Still reading a file to view: open {name} when that window has opened.")
+            return None
+        return readers.run(f"Reading {name}", lambda progress, cancel: read_for_slices(path, cancel),
+                           lambda source: self._viewer("View slices", lambda: SliceWindow(path, source, self.window),
+                                                       f"Viewing slices of {name}"))
 
     def _viewer(self, title: str, make, doing: str):
         """A looking window made by ``make()`` and shown, kept while visible; None (the error shown) on failure."""
         window = self.attempt(title, make, lambda w: f"{doing}: {w.what}.")
         if window is FAILED:
             return None
-        self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
+        self.viewers = self.open_viewers() + [window]
         window.show()
         return window
+
+    def open_viewers(self) -> list:
+        """The looking windows still shown (View and View slices), oldest first."""
+        return [v for v in getattr(self, "viewers", []) if v.isVisible()]
 
     def view_slices_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "View slices", self.folder(),

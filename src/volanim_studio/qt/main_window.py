@@ -97,6 +97,9 @@ class MainWindow(QMainWindow):
         self._entered = Mode.VIEW  # the handler entered last (settings.mode is the mode)
         self.jobs = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text),
                               on_idle=self.activateWindow)  # focus back after a job (Xvfb has no WM to do it)
+        # Files read only to look at them (View slices) have a runner of their own: a large scan's read
+        # neither freezes the window nor waits for (or blocks) the document's job.
+        self.readers = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text))
         self.last_error: str | None = None
         self._error_box: QMessageBox | None = None
 
@@ -347,8 +350,8 @@ class MainWindow(QMainWindow):
 
     @property
     def busy(self) -> bool:
-        """A background job is running (its thread has not ended yet)."""
-        return self.jobs.busy
+        """A background job or a read for a viewer is running (its thread has not ended yet)."""
+        return self.jobs.busy or self.readers.busy
 
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
@@ -359,6 +362,7 @@ class MainWindow(QMainWindow):
             return
         self.timeline.stop()
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
+        self.readers.shutdown()
         self.session.close()
         close_interactor(self.plotter)
         super().closeEvent(event)

@@ -1,13 +1,18 @@
 """*File → View slices…*: any volume one slice at a time, the thesis's View.tcl (as ``volanim view --slices``).
 
-    file --io.read_scan--> volume --slice_picture(axis, k)--> QImage, scaled to fit (tall voxels tall)
+    file --read_for_slices (in the window's reader thread: io.read_scan, grey window, description)-->
+      SlicesSource --slice_picture(axis, k)--> QImage, scaled to fit (tall voxels tall)
     axis box, slider, Page Up / Page Down --> k;   mouse over the picture --> status bar: x y z = value
 
-It only looks: the document is untouched.
+It only looks: the document is untouched. The file is read off the GUI thread
+(``FilesController.view_slices``): a Visible-Human-sized scan takes seconds to
+read and to window, and meanwhile the studio keeps drawing, offers Cancel and
+lets the document's own job go on.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +21,31 @@ from PySide6.QtGui import QImage, QPainter
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QMainWindow, QSlider, QVBoxLayout, QWidget
 
 from volanim_core.render.slices import AXES, default_window, describe, pixel_aspect, slice_picture, voxel_at
+
+
+@dataclass(frozen=True)
+class SlicesSource:
+    """What a slice window shows: the voxels, their spacing, the grey window (None: colour) and a description."""
+
+    volume: np.ndarray
+    spacing: tuple
+    grey: tuple | None
+    what: str
+
+
+def read_for_slices(path, cancel=lambda: False) -> SlicesSource:
+    """Read and prepare a volume for :class:`SliceWindow` (the slow part: a worker runs it). A bad file is
+    a FormatError naming it; ``cancel()`` true once the read returns raises Cancelled (a read cannot be
+    stopped half-way)."""
+    from volanim_core.errors import Cancelled
+    from volanim_core.io import read_scan
+
+    scan = read_scan(path, colour=True)
+    if cancel():
+        raise Cancelled()
+    volume = scan.data
+    grey = default_window(volume) if volume.ndim == 3 else None
+    return SlicesSource(volume, tuple(scan.geometry.spacing), grey, describe(volume, grey))
 
 
 class SliceCanvas(QWidget):
@@ -60,13 +90,9 @@ class SliceCanvas(QWidget):
 
 
 class SliceWindow(QMainWindow):
-    def __init__(self, path, parent=None):
-        from volanim_core.io import read_scan
-
+    def __init__(self, path, source: SlicesSource, parent=None):
         super().__init__(parent)
-        scan = read_scan(path, colour=True)  # FormatError names the file; the caller shows it
-        self.path, self.volume, self.spacing = Path(path), scan.data, scan.geometry.spacing
-        self.grey = default_window(self.volume) if self.volume.ndim == 3 else None
+        self.path, self.volume, self.spacing, self.grey = Path(path), source.volume, source.spacing, source.grey
         self.setWindowTitle(f"Slices — {self.path.name}")
         self.resize(700, 760)
         self.canvas = SliceCanvas()
@@ -83,7 +109,7 @@ class SliceWindow(QMainWindow):
         layout.addWidget(self.canvas, 1)
         layout.addLayout(row)
         self.setCentralWidget(body)
-        self.what = describe(self.volume, self.grey)
+        self.what = source.what
         self.axis_box.currentIndexChanged.connect(self.set_axis)
         self.slider.valueChanged.connect(self.show_slice)
         self.canvas.hovered.connect(self.report)
