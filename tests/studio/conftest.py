@@ -148,6 +148,18 @@ def new_window(qtbot):
     return w
 
 
+def viewer_opened(window, qtbot, view, path):
+    """``view(path)`` (``window.files.view_file`` or ``view_slices``: the file is read in the window's
+    reader thread), the read waited for: the looking window it opened, or None (a refusal)."""
+    from volanim_studio.qt.worker import Worker
+
+    before = window.files.open_viewers()
+    assert isinstance(view(path), Worker), "the file is read in the background"
+    qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
+    new = [v for v in window.files.open_viewers() if v not in before]
+    return new[-1] if new else None
+
+
 @pytest.fixture
 def window(qtbot):
     w = new_window(qtbot)

@@ -3,10 +3,14 @@
 Used by ``volanim view`` (a pyvista window or a picture) and by the studio's
 *File → View volume or mesh…* (a window of its own); both draw through the
 same ``Renderer`` as ``volanim render``, so a quick look shows what a movie will.
+
+    file --read_look (reads; any thread)--> Look (settings, mesh or volume, description)
+         --draw_look (the GUI thread: VTK actors)--> Renderer
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -14,13 +18,25 @@ import numpy as np
 from .scene import Renderer, RenderSettings, reset_clipping
 
 
-def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str = "surface",
-               preset: str | None = None, view: str = "three-quarter", frame: int = 0, dims=None,
-               size=(800, 600)) -> tuple[Renderer, str]:
-    """Draw ``path`` (not rendered yet) and return the renderer and a one-line description of what it shows."""
+@dataclass
+class Look:
+    """What a quick look draws, read from its file: a mesh, or a volume and its origin and frame number,
+    with the settings to draw it by and a one-line description. Making one reads the file and opens no
+    window, so a worker thread may make it (the studio does) and the GUI thread draw it."""
+
+    settings: RenderSettings
+    what: str
+    mesh: object = None
+    volume: np.ndarray | None = None
+    origin: np.ndarray | None = None
+    number: int = 0
+
+
+def read_look(path, *, style: str = "surface", preset: str | None = None, view: str = "three-quarter",
+              frame: int = 0, dims=None, size=(800, 600)) -> Look:
+    """Read ``path`` (a mesh, a volume, or frame ``frame`` of a sequence) for :func:`draw_look`."""
     from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh
 
-    from .bone_colours import SKIN
     from .camera import named_view, place_camera
     from .movie import open_inputs, read_frame
 
@@ -30,21 +46,36 @@ def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str
         mesh = read_mesh(path)
         lo, hi = tuple(np.asarray(mesh.bounds[0::2])), tuple(np.asarray(mesh.bounds[1::2]))
         settings = RenderSettings(named_view(view, lo, hi, aspect=w / h, faces=0.0), size=(w, h))
-        renderer = Renderer(settings, off_screen=off_screen, plotter=plotter)
-        renderer.plotter.add_mesh(mesh, color=SKIN, smooth_shading=True, name="body", reset_camera=False)
-        settings.camera.apply(renderer.plotter.renderer.GetActiveCamera())  # (a volume's draw() applies it)
+        return Look(settings, f"{mesh.n_points:,} points, {mesh.n_cells:,} faces", mesh=mesh)
+    camera, inputs = place_camera(open_inputs([path], slice(frame, frame + 1), dims=dims), view, aspect=w / h)
+    settings = RenderSettings(camera, style=style, preset=preset or inputs.mode or "sampled", vmax=inputs.vmax,
+                              size=(w, h), spacing=inputs.spacing)
+    ref = inputs.frames[0]
+    volume, origin = read_frame(ref, dims)
+    shown = "RGB" if volume.ndim == 4 else settings.preset
+    what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {shown} colours"
+    if ref.index >= 0:
+        what = f"frame {ref.number}: {what}"
+    return Look(settings, what, volume=volume, origin=origin, number=ref.number)
+
+
+def draw_look(look: Look, *, plotter=None, off_screen: bool | None = True) -> Renderer:
+    """Draw a :class:`Look` (not rendered yet) into ``plotter`` (or a renderer's own window)."""
+    from .bone_colours import SKIN
+
+    renderer = Renderer(look.settings, off_screen=off_screen, plotter=plotter)
+    if look.mesh is not None:
+        renderer.plotter.add_mesh(look.mesh, color=SKIN, smooth_shading=True, name="body", reset_camera=False)
+        look.settings.camera.apply(renderer.plotter.renderer.GetActiveCamera())  # (a volume's draw() applies it)
         reset_clipping(renderer.plotter.renderer)
-        what = f"{mesh.n_points:,} points, {mesh.n_cells:,} faces"
     else:
-        camera, inputs = place_camera(open_inputs([path], slice(frame, frame + 1), dims=dims), view, aspect=w / h)
-        settings = RenderSettings(camera, style=style, preset=preset or inputs.mode or "sampled", vmax=inputs.vmax,
-                                  size=(w, h), spacing=inputs.spacing)
-        renderer = Renderer(settings, off_screen=off_screen, plotter=plotter)
-        ref = inputs.frames[0]
-        volume, origin = read_frame(ref, dims)
-        renderer.draw(volume, origin, ref.number)
-        shown = "RGB" if volume.ndim == 4 else settings.preset
-        what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {shown} colours"
-        if ref.index >= 0:
-            what = f"frame {ref.number}: {what}"
-    return renderer, what
+        renderer.draw(look.volume, look.origin, look.number)
+    return renderer
+
+
+def quick_look(path, *, plotter=None, off_screen: bool | None = True, style: str = "surface",
+               preset: str | None = None, view: str = "three-quarter", frame: int = 0, dims=None,
+               size=(800, 600)) -> tuple[Renderer, str]:
+    """Draw ``path`` (not rendered yet) and return the renderer and a one-line description of what it shows."""
+    look = read_look(path, style=style, preset=preset, view=view, frame=frame, dims=dims, size=size)
+    return draw_look(look, plotter=plotter, off_screen=off_screen), look.what

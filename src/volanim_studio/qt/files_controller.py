@@ -18,6 +18,7 @@ from pathlib import Path
 from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
+from volanim_core.errors import Cancelled
 
 from .. import tasks
 from ..model import autosave
@@ -50,11 +51,15 @@ class FilesController(Controller):
         action("Screenshot…", lambda: self.save_dialog("png"), menu=menu)
 
     # ------------------------------------------------------------ looking
-    def view_file(self, path):
-        """Show a volume, a sequence's first frame or a mesh in a window of its own (the document is untouched)."""
-        from .quicklook_window import QuickLookWindow
+    def view_file(self, path) -> Worker | None:
+        """Read a volume, a sequence's first frame or a mesh in the background and show it in a window of
+        its own (``viewers[-1]``); the document is untouched. See :meth:`_read_then_view`."""
+        from volanim_core.render.quicklook import read_look
 
-        return self._viewer("View", lambda: QuickLookWindow(path, self.window), f"Viewing {Path(path).name}")
+        from .quicklook_window import SIZE, QuickLookWindow
+
+        return self._read_then_view(path, "View", lambda: read_look(path, size=SIZE),
+                                    lambda look: QuickLookWindow(path, look, self.window), f"Viewing {Path(path).name}")
 
     def view_file_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(
@@ -65,19 +70,33 @@ class FilesController(Controller):
             self.view_file(path)
 
     def view_slices(self, path) -> Worker | None:
-        """Read any volume in the background (progress, Cancel) and show it one slice at a time in a
-        window of its own (``viewers[-1]``); the document is untouched, and its own job, if one runs,
-        goes on. The reading worker, or None while another file is still being read for viewing."""
+        """Read any volume in the background and show it one slice at a time in a window of its own
+        (``viewers[-1]``); the document is untouched. See :meth:`_read_then_view`."""
         from .slice_window import SliceWindow, read_for_slices
 
+        return self._read_then_view(path, "View slices", lambda: read_for_slices(path),
+                                    lambda source: SliceWindow(path, source, self.window),
+                                    f"Viewing slices of {Path(path).name}")
+
+    def _read_then_view(self, path, title: str, read, make, doing: str) -> Worker | None:
+        """``read()`` in the window's reader thread (a progress dialog with Cancel; the document's own job,
+        if one runs, goes on), then the looking window ``make(what was read)`` shown on the GUI thread.
+        The worker, or None while another file is still being read for viewing (said in the status bar).
+        A bad file is shown under ``title`` naming it; a read cannot stop half-way, so Cancel (or closing
+        the studio) opens nothing once it returns."""
         name = Path(path).name
         readers = self.window.readers
         if readers.busy:
             self.doc.message(f"Still reading a file to view: open {name} when that window has opened.")
             return None
-        return readers.run(f"Reading {name}", lambda progress, cancel: read_for_slices(path, cancel),
-                           lambda source: self._viewer("View slices", lambda: SliceWindow(path, source, self.window),
-                                                       f"Viewing slices of {name}"))
+
+        def task(progress, cancel):
+            result = read()
+            if cancel():
+                raise Cancelled()
+            return result
+
+        return readers.run(f"Reading {name}", task, lambda result: self._viewer(title, lambda: make(result), doing))
 
     def _viewer(self, title: str, make, doing: str):
         """A looking window made by ``make()`` and shown, kept while visible; None (the error shown) on failure."""

@@ -33,16 +33,12 @@ class SlicesSource:
     what: str
 
 
-def read_for_slices(path, cancel=lambda: False) -> SlicesSource:
+def read_for_slices(path) -> SlicesSource:
     """Read and prepare a volume for :class:`SliceWindow` (the slow part: a worker runs it). A bad file is
-    a FormatError naming it; ``cancel()`` true once the read returns raises Cancelled (a read cannot be
-    stopped half-way)."""
-    from volanim_core.errors import Cancelled
+    a FormatError naming it."""
     from volanim_core.io import read_scan
 
     scan = read_scan(path, colour=True)
-    if cancel():
-        raise Cancelled()
     volume = scan.data
     grey = default_window(volume) if volume.ndim == 3 else None
     return SlicesSource(volume, tuple(scan.geometry.spacing), grey, describe(volume, grey))

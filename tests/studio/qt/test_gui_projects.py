@@ -9,7 +9,7 @@ import pytest
 from volanim_core import io, samples
 from volanim_core.geometry import Geometry
 
-from ..conftest import JOB_TIMEOUT_MS, open_project
+from ..conftest import JOB_TIMEOUT_MS, open_project, viewer_opened
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
@@ -161,18 +161,18 @@ def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(q
     write_mesh(tmp_path / "hull.ply", verts, faces)
     points_before = len(window.doc.skeleton)
     for name in ("posed.vti", "hull.ply"):
-        viewer = window.files.view_file(tmp_path / name)
+        viewer = viewer_opened(window, qtbot, window.files.view_file, tmp_path / name)
         assert viewer is not None and viewer.isVisible() and "body" in viewer.plotter.renderer.actors
         assert name in viewer.windowTitle() and name in window.statusBar().currentMessage()
         viewer.close()
     assert len(window.doc.skeleton) == points_before and window.doc.volume_path != str(tmp_path / "posed.vti")
     (tmp_path / "bad.ply").write_text("not a mesh")
-    assert window.files.view_file(tmp_path / "bad.ply") is None
+    assert viewer_opened(window, qtbot, window.files.view_file, tmp_path / "bad.ply") is None
     assert "bad.ply" in window.last_error
     # a sequence: the file dialog picks the zarr.json inside NAME.zarr ("unknown volume format" before)
     from core.render.test_render import make_sequence
 
     make_sequence(tmp_path / "walk.zarr", frames=2)
-    viewer = window.files.view_file(tmp_path / "walk.zarr" / "zarr.json")
+    viewer = viewer_opened(window, qtbot, window.files.view_file, tmp_path / "walk.zarr" / "zarr.json")
     assert viewer is not None and "frame 100" in viewer.what and "body" in viewer.plotter.renderer.actors
     viewer.close()

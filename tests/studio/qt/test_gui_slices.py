@@ -18,18 +18,13 @@ from PySide6.QtTest import QTest
 from volanim_core import io
 from volanim_studio.qt.worker import Worker
 
-from ..conftest import JOB_TIMEOUT_MS, new_window
+from ..conftest import JOB_TIMEOUT_MS, new_window, viewer_opened
 
 ANATOMICAL = Path(nib.__file__).parent / "tests" / "data" / "anatomical.nii"
 
 
 def opened(window, qtbot, path):
-    """View slices of ``path`` as the menu does, wait for the read, and return the window it opened."""
-    before = window.files.open_viewers()
-    assert isinstance(window.files.view_slices(path), Worker)
-    qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
-    new = [v for v in window.files.open_viewers() if v not in before]
-    return new[-1] if new else None
+    return viewer_opened(window, qtbot, window.files.view_slices, path)
 
 
 def big_scan(folder: Path) -> tuple[Path, np.ndarray]:
