@@ -3,6 +3,7 @@ skeletons, bones, connectivity and projects.
 
     File menu / buttons --> FilesController --> volanim_core readers / Document
                                    |--> JobRunner (segmenting, skeletonizing) --> Document on the GUI thread
+                                   |--> readers, a JobRunner of its own (View, View slices) --> a looking window
     errors --> the window's error dialog naming the file and line; the document stays as it was
 
 Owned by :class:`~volanim_studio.qt.main_window.MainWindow` (composed, not

@@ -97,8 +97,8 @@ class MainWindow(QMainWindow):
         self._entered = Mode.VIEW  # the handler entered last (settings.mode is the mode)
         self.jobs = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text),
                               on_idle=self.activateWindow)  # focus back after a job (Xvfb has no WM to do it)
-        # Files read only to look at them (View slices) have a runner of their own: a large scan's read
-        # neither freezes the window nor waits for (or blocks) the document's job.
+        # Files read only to look at them (View slices, View volume or mesh) have a runner of their own:
+        # a large scan's read neither freezes the window nor waits for (or blocks) the document's job.
         self.readers = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text))
         self.last_error: str | None = None
         self._error_box: QMessageBox | None = None
