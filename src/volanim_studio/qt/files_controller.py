@@ -19,7 +19,6 @@ from pathlib import Path
 from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
-from volanim_core.errors import Cancelled
 
 from .. import tasks
 from ..model import autosave
@@ -84,20 +83,14 @@ class FilesController(Controller):
         if one runs, goes on), then the looking window ``make(what was read)`` shown on the GUI thread.
         The worker, or None while another file is still being read for viewing (said in the status bar).
         A bad file is shown under ``title`` naming it; a read cannot stop half-way, so Cancel (or closing
-        the studio) opens nothing once it returns."""
+        the studio) lets it finish and opens nothing (the runner drops a cancelled job's result)."""
         name = Path(path).name
         readers = self.window.readers
         if readers.busy:
             self.doc.message(f"Still reading a file to view: open {name} when that window has opened.")
             return None
-
-        def task(progress, cancel):
-            result = read()
-            if cancel():
-                raise Cancelled()
-            return result
-
-        return readers.run(f"Reading {name}", task, lambda result: self._viewer(title, lambda: make(result), doing))
+        return readers.run(f"Reading {name}", lambda progress, cancel: read(),
+                           lambda result: self._viewer(title, lambda: make(result), doing))
 
     def _viewer(self, title: str, make, doing: str):
         """A looking window made by ``make()`` and shown, kept while visible; None (the error shown) on failure."""

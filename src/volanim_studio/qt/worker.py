@@ -4,7 +4,7 @@
         task(progress, cancel) runs in a Worker (a QThread)
             progress(done, total) --Signal--> QProgressDialog
             Cancel button --> cancel() returns True --> Cancelled --> was_cancelled
-            return value --succeeded(object)--> on_done on the GUI thread
+            return value --succeeded(object)--> on_done on the GUI thread (dropped if cancelled by then)
     JobRunner.shutdown()   (window close) cancel, show "Finishing…", wait as long as it takes
 
 Why ``shutdown`` never gives up: a QThread object destroyed while its thread
@@ -13,7 +13,10 @@ running"). A numba kernel cannot be interrupted, and its first compile or a
 large frame can take longer than any fixed timeout, so the window waits
 (keeping the UI painted) until the task has seen its cancel flag and returned.
 For the same reason a job counts as running until its thread has really ended,
-not merely until it emitted its result.
+not merely until it emitted its result. A job cancelled after its task returned
+(Cancel pressed, or the window closed, as the last step finished) is still
+cancelled: its result is dropped, so nothing is applied or opened after the
+user said no or the window went away.
 """
 
 from __future__ import annotations
@@ -46,6 +49,11 @@ class Worker(QThread):
 
     def cancel(self) -> None:
         self._cancel = True
+
+    @property
+    def cancelled(self) -> bool:
+        """Cancel was asked for (the task may have finished anyway)."""
+        return self._cancel
 
     def run(self) -> None:
         try:
@@ -100,9 +108,13 @@ class JobRunner(QObject):
             self.dialog = None
             self._on_idle()
 
-        worker.succeeded.connect(lambda result: (finish(), on_done(result)))
+        def cancelled():
+            finish()
+            self._message(f"{label}: cancelled.")
+
+        worker.succeeded.connect(lambda result: cancelled() if worker.cancelled else (finish(), on_done(result)))
         worker.failed.connect(lambda msg: (finish(), self._show_error(label, msg)))
-        worker.was_cancelled.connect(lambda: (finish(), self._message(f"{label}: cancelled.")))
+        worker.was_cancelled.connect(cancelled)
         self.worker, self.dialog = worker, dialog
         worker.start()
         return worker

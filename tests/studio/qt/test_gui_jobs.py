@@ -49,4 +49,5 @@ def test_close_while_a_job_runs_waits_for_it_instead_of_aborting(qtbot):
     w.close()
     assert worker.isFinished() and not w.busy
     assert seen["cancel"] is True  # close asked the job to stop
+    assert "result" not in seen  # and a result that came anyway is dropped: nothing applied after closing
     assert any("Finishing" in m for m in messages)  # and said what it was waiting for
