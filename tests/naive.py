@@ -181,3 +181,19 @@ def dual_quaternion_blend(point, matrices, influence, weight):
     t = 2 * _qmul(dual, real * np.array([1, -1, -1, -1]))[1:]
     v = _qmul(_qmul(real, np.array([0.0, *point])), real * np.array([1, -1, -1, -1]))[1:]
     return v + t
+
+
+def thinned_radii(rest, posed, dt, sheet, pairs, floor):
+    """Smooth joints' radii of a posed frame, one point at a time: a sheet point's radius over the mean
+    of ``|posed_a - posed_b| / |rest_a - rest_b|`` over its links ``pairs``, kept within ``floor``..1 of it."""
+    ratios = {}
+    for a, b in pairs:
+        ratio = np.linalg.norm(posed[a] - posed[b]) / np.linalg.norm(np.subtract(rest[a], rest[b], dtype=float))
+        ratios.setdefault(a, []).append(ratio)
+        ratios.setdefault(b, []).append(ratio)
+    out = np.array(dt, np.float64)
+    for p in sheet:
+        mean = sum(ratios[p]) / len(ratios[p])
+        if mean > 1 + 1e-6:
+            out[p] = dt[p] * min(1.0, max(floor, 1.0 / mean))
+    return out

@@ -3,6 +3,7 @@
     Tskel, mode, bounds | padding --check_matrices, check_frame--> inverse bone matrices
       --file_ordered--> points grouped by bone (ties go to the first in file order)
       --transform_table, posed_centres--> posed centres (snapped; smooth joints: blended)
+      --posed_radii--> the radii (smooth joints: a stretched medial sheet's spheres thin)
       --grid_bounds (or the given bounds, check_reach)--> the output grid
       --_sphere_values--> what each sphere writes, the output dtypes
       --cached_neighbours, P.build_halfspaces--> the overdraw cut's half-spaces (Euclid, big spheres)
@@ -29,7 +30,7 @@ from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.reconstruct.speedups import ALL, Speedups
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.pose import apply_rows
-from volanim_core.rig.skinning import transform_table
+from volanim_core.rig.skinning import posed_radii, transform_table
 from volanim_core.volume import Bounds
 
 #: Not a user's mode: bone mode's pass labelling each voxel with its owner's row of the transform table
@@ -86,6 +87,10 @@ def plan_frame(tskel: Tskel, mode: str, *, source=None, kernel: int = 1, value: 
     tskel, order = file_ordered(tskel)
     table, rows = transform_table(tskel)
     posed = posed_centres(tskel, (table, rows))
+    rest = tskel
+    radii = posed_radii(tskel, posed)
+    if radii is not tskel.dt:
+        tskel = tskel.with_radii(radii)
     own_bounds = bounds is None
     if own_bounds:  # grid_bounds checks the posed reach itself
         bounds = grid_bounds(tskel, padding, centres=[posed]) if len(tskel) else Bounds((0, 0, 0), (0, 0, 0))
@@ -102,8 +107,11 @@ def plan_frame(tskel: Tskel, mode: str, *, source=None, kernel: int = 1, value: 
         (np.dtype(final_dtype).itemsize if final_dtype != out_dtype else 0) + (3 if np.ndim(source) == 4 else 0)
     check_output_grid(bounds.shape, per_voxel)
     if metric == K.EUCLID and mode != "hotspot" and speedups.cut and len(tskel):
-        nbrs = cached_neighbours(tskel, min_radius=CUT_MIN_RADIUS, r2=r2s) if neighbours is None \
-            else reorder_neighbours(neighbours, order)
+        # the rest radii's lists even when a sheet thinned: a cut plane is exact for any pair of spheres
+        # (the part of sphere i on j's side of their power plane lies in j), so the lists only say which
+        # pairs are tried; made once per connectivity, not per frame
+        nbrs = cached_neighbours(rest, min_radius=CUT_MIN_RADIUS, r2=r2s if rest is tskel else None) \
+            if neighbours is None else reorder_neighbours(neighbours, order)
         plane_start, planes = P.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 5))

@@ -182,6 +182,11 @@ class Tskel(Connectivity):
     def with_joints(self, joints: Joints) -> Tskel:
         return self.connectivity.with_joints(joints).posed(self.matrices)
 
+    def with_radii(self, dt: np.ndarray) -> Tskel:
+        """The same frame (and skin) with other radii: the ones a pose grows it with (rig/skinning.posed_radii)."""
+        return Tskel(self.bones, self.matrices, self.points, dt, self.thinness, self.bone, self.metric,
+                     self.geometry, joints=self.joints, skin=self._skin)
+
     def __eq__(self, other) -> bool:
         return super().__eq__(other) and np.array_equal(self.matrices, other.matrices)
 

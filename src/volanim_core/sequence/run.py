@@ -104,7 +104,9 @@ def plan_key(conn: Connectivity, frames: list[FrameSpec], mode: str, kernel: int
     if not conn.geometry.is_identity:  # keys of stores made before geometry was recorded stay the same
         h.update(conn.geometry.header_value().encode())
     if conn.joints.smooth:  # likewise for stores made before smooth joints
-        h.update(f"joints {conn.joints.text()}".encode())
+        # "thin": a stretched sheet's spheres thin (rig/skinning.posed_radii); a store made before they did
+        # holds other voxels and is not resumed
+        h.update(f"joints {conn.joints.text()} thin".encode())
     if source_geometry is not None and not source_geometry.is_identity:
         h.update(source_geometry.header_value().encode())
     if source is not None:

@@ -197,3 +197,33 @@ def test_misplaced_points_are_part_of_the_limbs_flesh():
     bone = np.r_[np.zeros(101, int), np.ones(51, int), np.zeros(13, int)]
     idx, along = misplaced_points(Connectivity(bones, points, dt, None, bone))
     assert sorted(idx.tolist()) == list(range(153, 165)) and set(along.tolist()) == {1}
+
+
+def thinned_pair(*middle):
+    """Two spheres of different bones, overlapping at rest, on a medial sheet (smooth joints; the skin made
+    by hand): LOWER moves 3 voxels away, the link between them stretches 2x, both thin to THIN_FLOOR and
+    part; ``middle``: spheres of UPPER in between, on no sheet."""
+    from volanim_core.rig.connectivity import Tskel
+    from volanim_core.rig.skinning import Joints, Skin
+
+    points = np.array([[10, 20, 20], [13, 20, 20], *middle])
+    bone = np.array([0, 1] + [0] * len(middle))
+    bones = [BoneSegment((0, 20, 20), (12, 20, 20), "UPPER"), BoneSegment((12, 20, 20), (30, 20, 20), "LOWER")]
+    skin = Skin(np.zeros(0, np.int64), np.zeros((0, 4), np.int64), np.zeros((0, 4)),
+                np.array([0, 1]), np.array([[0, 1]]), np.array([3.0]))
+    mats = np.stack([np.eye(4)] * 2)
+    mats[1, 3, 0] = 3.0
+    return Tskel(bones, mats, points, np.full(len(points), 3.0), None, bone, joints=Joints("smooth"), skin=skin)
+
+
+def test_spheres_parted_by_thinning_are_a_crack_unless_something_fills_the_gap():
+    """A stretched sheet's spheres thin (rig/skinning.posed_radii): two that part only because they thinned
+    open a crack when nothing lies between them, and none when a sphere fills the gap. With the rest radii
+    (6 voxels apart, radii 3 + 3) neither was a crack."""
+    from volanim_core.reconstruct.breakage import cracks
+
+    where, gaps = cracks(thinned_pair())
+    np.testing.assert_allclose(gaps, [6.0 - 2 * 0.75 * 3.0])
+    np.testing.assert_allclose(where, [[11.5, 20, 20]])
+    assert len(cracks(thinned_pair([12, 21, 20]))[1]) == 0
+    assert len(cracks(thinned_pair([12, 29, 20]))[1]) == 1  # a sphere beside the gap, not in it
