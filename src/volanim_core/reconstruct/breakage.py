@@ -31,11 +31,12 @@ import numpy as np
 
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct import _label_kernels as L
-from volanim_core.reconstruct.engine import OWNER, Reconstruction, posed_centres, reconstruct
+from volanim_core.reconstruct.cracks import cracks, touching_pairs
+from volanim_core.reconstruct.engine import OWNER, Reconstruction, reconstruct
 from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.pose import apply_matrices, apply_rows
-from volanim_core.rig.skinning import blended_with, links, posed_radii, transform_table
+from volanim_core.rig.skinning import blended_with, links, transform_table
 from volanim_core.rig.tskel_tools import identity_tskel
 
 
@@ -325,73 +326,6 @@ def lost_voxels(rest_bone: Reconstruction, posed: Reconstruction, matrices: np.n
     filled = np.zeros(len(q), bool)
     filled[inside] = posed.volume[tuple(q[inside].T)] > 0
     return points[~filled]
-
-
-def touching_pairs(tskel: Tskel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Sphere pairs ``(i, j, touch)`` of different bones that overlap at rest (pose-independent).
-
-    ``touch`` is the sum of the radii: a posed pair further apart than that has cracked.
-    """
-    from scipy.spatial import cKDTree
-
-    if len(tskel) < 2:
-        return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
-    p = tskel.points.astype(np.float64)
-    # cracks are local: each sphere against its nearest neighbours (all pairs would be
-    # ~10^8 on the frog's 137 k spheres)
-    k = min(17, len(p))
-    _, nn = cKDTree(p).query(p, k=k, workers=-1)
-    i = np.repeat(np.arange(len(p)), k - 1)
-    j = nn[:, 1:].ravel()
-    keep = (j < len(p)) & (i < j)
-    i, j = i[keep], j[keep]
-    keep = tskel.bone[i] != tskel.bone[j]
-    i, j = i[keep], j[keep]
-    touch = tskel.dt[i] + tskel.dt[j]
-    overlap = np.linalg.norm(p[i] - p[j], axis=1) < touch
-    return i[overlap], j[overlap], touch[overlap]
-
-
-def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, np.ndarray]:
-    """Sphere pairs of different bones that overlap at rest and are ``min_gap`` apart in the pose.
-
-    Returns the pairs' rest midpoints ``(K, 3)`` and their gaps ``(K,)`` in voxels.
-    ``pairs``: :func:`touching_pairs` of the same points, when the caller scans many frames.
-
-    With smooth joints the gap is between the spheres as the frame grows them: a stretched medial
-    sheet's thin (:func:`~volanim_core.rig.skinning.posed_radii`). A pair that parts only because
-    its spheres thinned is a crack only where no other sphere fills the middle of the gap: in a sheet
-    the spheres between the two do (mannequin-large's crotch at a 120-degree hip: one such pair, its
-    gap filled from end to end).
-    """
-    i, j, touch = touching_pairs(tskel) if pairs is None else pairs
-    if not len(i):
-        return np.zeros((0, 3)), np.zeros(0)
-    p = tskel.points.astype(np.float64)
-    c = posed_centres(tskel)
-    dist = np.linalg.norm(c[i] - c[j], axis=1)
-    r = posed_radii(tskel, c)
-    if r is tskel.dt:
-        gap = dist - touch
-        open_ = gap > min_gap
-    else:
-        gap = dist - (r[i] + r[j])
-        open_ = gap > min_gap
-        thinned = np.flatnonzero(open_ & (dist - touch <= min_gap))
-        if len(thinned):
-            a, b = i[thinned], j[thinned]
-            middle = c[a] + (c[b] - c[a]) * ((r[a] + gap[thinned] / 2) / dist[thinned])[:, None]
-            open_[thinned] = ~_in_any_sphere(middle, c, r)
-    return (p[i[open_]] + p[j[open_]]) / 2.0, gap[open_]
-
-
-def _in_any_sphere(points: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
-    """Whether each of ``points`` lies in one of the spheres (``centres``, ``radii``)."""
-    from scipy.spatial import cKDTree
-
-    near = cKDTree(centres).query_ball_point(points, float(radii.max()))
-    return np.array([bool(len(k)) and bool((np.linalg.norm(centres[k] - q, axis=1) <= radii[k]).any())
-                     for q, k in zip(points, near)], bool)
 
 
 @dataclass

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.progress import Reporter
-from volanim_core.reconstruct.breakage import components, cracks, misplaced_points, stumps, touching_pairs
+from volanim_core.reconstruct.breakage import components, misplaced_points, stumps
+from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.tskel_tools import coarse_tskel, identity_tskel

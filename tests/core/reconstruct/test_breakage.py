@@ -220,7 +220,7 @@ def test_spheres_parted_by_thinning_are_a_crack_unless_something_fills_the_gap()
     """A stretched sheet's spheres thin (rig/skinning.posed_radii): two that part only because they thinned
     open a crack when nothing lies between them, and none when a sphere fills the gap. With the rest radii
     (6 voxels apart, radii 3 + 3) neither was a crack."""
-    from volanim_core.reconstruct.breakage import cracks
+    from volanim_core.reconstruct.cracks import cracks
 
     where, gaps = cracks(thinned_pair())
     np.testing.assert_allclose(gaps, [6.0 - 2 * 0.75 * 3.0])
