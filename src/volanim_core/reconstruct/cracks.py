@@ -2,7 +2,7 @@
 
     rest frame --touching_pairs (each sphere against its 16 nearest)--> pairs (i, j) and their radii's sum
     posed frame --posed_centres, posed_radii--> the gap of each pair as grown
-      --> open pairs (a pair parted only by thinned spheres: where nothing fills its gap)
+      --> open pairs (one parted only by spheres smaller than at rest: where nothing fills its gap)
       --> cracks: rest midpoints and gaps
 
 A crack is where the posed spheres of two bones that touched at rest part. Its
@@ -16,7 +16,7 @@ import numpy as np
 
 from volanim_core.reconstruct.engine import posed_centres
 from volanim_core.rig.connectivity import Tskel
-from volanim_core.rig.skinning import posed_radii
+from volanim_core.rig.skinning import deepest_sphere, posed_radii
 
 
 def touching_pairs(tskel: Tskel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -50,37 +50,25 @@ def cracks(tskel: Tskel, min_gap: float = 0.5, pairs=None) -> tuple[np.ndarray, 
     Returns the pairs' rest midpoints ``(K, 3)`` and their gaps ``(K,)`` in voxels.
     ``pairs``: :func:`touching_pairs` of the same points, when the caller scans many frames.
 
-    With smooth joints the gap is between the spheres as the frame grows them: a stretched medial
-    sheet's thin (:func:`~volanim_core.rig.skinning.posed_radii`). A pair that parts only because
-    its spheres thinned is a crack only where no other sphere fills the middle of the gap: in a sheet
-    the spheres between the two do (mannequin-large's crotch at a 120-degree hip: one such pair, its
-    gap filled from end to end).
+    The gap is between the spheres as the frame grows them: with smooth joints a stretched medial
+    sheet's thin (:func:`~volanim_core.rig.skinning.posed_radii`). A pair that parts only because its
+    spheres are smaller than at rest (``touch``) is a crack only where no other sphere fills the middle
+    of the gap: in a sheet the spheres between the two do (mannequin-large's crotch at a 120-degree
+    hip: one such pair, its gap filled from end to end).
     """
     i, j, touch = touching_pairs(tskel) if pairs is None else pairs
     if not len(i):
         return np.zeros((0, 3)), np.zeros(0)
     p = tskel.points.astype(np.float64)
     c = posed_centres(tskel)
+    r = posed_radii(tskel, c)  # tskel.dt unless a sheet thinned; with dt, r[i] + r[j] is touch and none thinned
     dist = np.linalg.norm(c[i] - c[j], axis=1)
-    r = posed_radii(tskel, c)
-    if r is tskel.dt:
-        gap = dist - touch
-        open_ = gap > min_gap
-    else:
-        gap = dist - (r[i] + r[j])
-        open_ = gap > min_gap
-        thinned = np.flatnonzero(open_ & (dist - touch <= min_gap))
-        if len(thinned):
-            a, b = i[thinned], j[thinned]
-            middle = c[a] + (c[b] - c[a]) * ((r[a] + gap[thinned] / 2) / dist[thinned])[:, None]
-            open_[thinned] = ~_in_any_sphere(middle, c, r)
+    gap = dist - (r[i] + r[j])
+    open_ = gap > min_gap
+    thinned = np.flatnonzero(open_ & (dist - touch <= min_gap))
+    if len(thinned):
+        a, b = i[thinned], j[thinned]
+        middle = c[a] + (c[b] - c[a]) * ((r[a] + gap[thinned] / 2) / dist[thinned])[:, None]
+        deepest = deepest_sphere(c, r, middle)
+        open_[thinned] = ((middle - c[deepest]) ** 2).sum(axis=1) > r[deepest] ** 2
     return (p[i[open_]] + p[j[open_]]) / 2.0, gap[open_]
-
-
-def _in_any_sphere(points: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
-    """Whether each of ``points`` lies in one of the spheres (``centres``, ``radii``)."""
-    from scipy.spatial import cKDTree
-
-    near = cKDTree(centres).query_ball_point(points, float(radii.max()))
-    return np.array([bool(len(k)) and bool((np.linalg.norm(centres[k] - q, axis=1) <= radii[k]).any())
-                     for q, k in zip(points, near)], bool)

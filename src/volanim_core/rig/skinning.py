@@ -232,7 +232,7 @@ def posed_radii(tskel, centres: np.ndarray) -> np.ndarray:
     if not (mean > 1.0 + STRETCH_TOL).any():
         return dt
     out = dt.astype(np.float64, copy=True)
-    out[skin.sheet] *= np.where(mean > 1.0 + STRETCH_TOL, np.clip(1.0 / mean, THIN_FLOOR, 1.0), 1.0)
+    out[skin.sheet] *= np.where(mean > 1.0 + STRETCH_TOL, np.maximum(1.0 / mean, THIN_FLOOR), 1.0)
     return out
 
 
@@ -263,7 +263,7 @@ def _with_specks(skin: Skin, points, dt, bone, graph) -> Skin:
     speck = speck[blended <= nearest + dt.max()]
     if not len(speck):
         return skin
-    near = body[_deepest(points[body], dt[body], points[speck])]
+    near = body[deepest_sphere(points[body], dt[body], points[speck])]
     speck, near = speck[row[near] >= 0], near[row[near] >= 0]  # beside a blended point
     influence, weight = skin.influence[row[near]].copy(), skin.weight[row[near]].copy()
     # own bone first: where it is among the influences, or in the last place with weight 0
@@ -284,7 +284,7 @@ def _with_specks(skin: Skin, points, dt, bone, graph) -> Skin:
                 np.concatenate([skin.weight[keep], weight])[order])
 
 
-def _deepest(centres: np.ndarray, radii: np.ndarray, points: np.ndarray) -> np.ndarray:
+def deepest_sphere(centres: np.ndarray, radii: np.ndarray, points: np.ndarray) -> np.ndarray:
     """For each of ``points``, the sphere it lies deepest in, or nearest outside, by power distance
     ``|p - c|^2 - r^2``: the nearest neighbour of ``(p, 0)`` among the lifted centres
     ``(c, sqrt(R^2 - r^2))`` (``R`` the largest radius), one KD-tree query for all."""
