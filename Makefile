@@ -10,7 +10,7 @@ APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxc
 	libfontconfig1 libdbus-1-3
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test install install-test system-deps lint bench docs screenshots coverage clean
+.PHONY: demo test test-all flake explore install install-test system-deps lint bench docs screenshots coverage clean
 
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -47,9 +47,29 @@ demo: install
 		echo "no display: ran the pipeline headless; on a desktop run .venv/bin/volanim-studio --demo mannequin"; \
 	fi
 
+# Two tiers, as napari and scikit-image have them (README, "Testing"). Two pytest-xdist workers, each
+# with its own virtual display (pytest-xvfb); hypothesis draws the same examples every run (tests/conftest.py).
+#   make test      every unit, model, GUI and CLI test that proves a behaviour: under 10 minutes on 2 cores
+#   make test-all  everything: also the `slow` tier (the README and --help chains, the fault corpus,
+#                  disk-full, real clips, Visible-Human scale, long property runs); what .ci/run runs
+#   make flake     the default tier FLAKE_RUNS times under a CPU load: any test whose result changes
+#   make explore   the property tests drawing new examples (HYPOTHESIS_PROFILE=explore)
+PYTEST_WORKERS ?= 2
+FLAKE_RUNS ?= 3
 test: install-test system-deps
 	$(VENV)/bin/ruff check src tests benchmarks assets docs
-	$(PY) -m pytest
+	$(PY) -m pytest -n $(PYTEST_WORKERS) -m "not slow"
+
+test-all: install-test system-deps
+	$(VENV)/bin/ruff check src tests benchmarks assets docs
+	$(PY) -m pytest -n $(PYTEST_WORKERS)
+
+flake: install-test system-deps
+	$(PY) tests/flake.py --runs $(FLAKE_RUNS) -- -n $(PYTEST_WORKERS) -m "not slow"
+
+explore: install-test system-deps
+	HYPOTHESIS_PROFILE=explore $(PY) -m pytest -n $(PYTEST_WORKERS) tests/studio/model/test_document_state.py \
+		tests/core/io/test_io_fuzz.py
 
 # The coverage of volanim_core (about 30 minutes on 2 cores): the core tests with the kernels compiled (numba
 # code runs as machine code, so coverage sees none of its lines), then the kernels' own tests on small

@@ -15,20 +15,23 @@ the order ``volanim --help`` lists the commands; an example may use the files of
 The top-level examples run in a folder of their own. ``volanim demo`` is the one example not run
 there: it is what ``make demo`` runs, and the README chain runs that.
 
-The two chains are independent, so they run side by side (each one in order): the suite stays
-well under ten minutes.
+**Where they run** (``runnable.run_documented``). Plain ``volanim`` lines run through the CLI's
+``main()`` in this interpreter; the first example of every subcommand runs as its own process with
+the installed ``volanim`` script, so each subcommand's entry point is proven too, as are ``make demo``
+and the studio. The two chains are ``slow`` (``make test-all``); the default tier checks that every
+documented line is accepted by its subcommand's parser, in a second.
 """
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
-
 import numpy as np
+import pytest
 
 from paths import REPO
-from runnable import check, help_examples, run, shell_blocks
+from runnable import check, documented_argv, help_examples, join_continuations, run, run_documented, shell_blocks
 from volanim_core import io
 from volanim_core.cli import build_parser
+from volanim_core.cli._common import join_dash_values
 
 FIRST_BLOCK = ["make demo", "make test"]
 DEMO = "volanim demo -o demo-out/"
@@ -40,6 +43,11 @@ def _commands(block: str) -> list[str]:
 
 def _readme_blocks() -> list[str]:
     return shell_blocks((REPO / "README.md").read_text(encoding="utf-8"))
+
+
+def _readme_lines() -> list[str]:
+    """Every command of the README after its opening block, continuation lines joined."""
+    return [c for b in _readme_blocks()[1:] for c in join_continuations(b.splitlines())]
 
 
 def test_the_readme_opens_with_the_two_commands():
@@ -61,21 +69,33 @@ def test_the_help_examples_are_commands_of_their_own_program():
     assert demos and set(demos) == {DEMO}, "volanim demo is skipped in the examples only because make demo runs it"
 
 
-def test_the_readme_and_every_help_example_run_as_printed_in_fresh_folders(tmp_path):
-    with ThreadPoolExecutor(2) as pool:
-        readme = pool.submit(_run_the_readme, tmp_path / "newcomer")
-        examples = pool.submit(_run_the_help_examples, tmp_path / "examples")
-        readme.result()
-        examples.result()
+def test_every_documented_volanim_line_is_accepted_by_its_subcommand_s_parser(capsys):
+    """The default tier's check of the chains: every README and --help line that runs ``volanim`` parses
+    (an option renamed or removed, a typo, a missing argument); running them is ``make test-all``'s."""
+    lines = _readme_lines() + [c for _, c in help_examples(build_parser())]
+    plain = [(line, documented_argv(line)) for line in lines]
+    assert sum(p is not None for _, p in plain) >= 150, "the documented lines are found"
+    refused = []
+    for line, found in plain:
+        if found is None:
+            assert line.split()[0] in ("volanim-studio", "volanim"), f"a documented line runs another program: {line}"
+            continue
+        try:
+            build_parser().parse_args(join_dash_values(found[0]))
+        except SystemExit:
+            refused.append(f"{line}\n    {capsys.readouterr().err.strip().splitlines()[-1]}")
+    assert not refused, "documented lines the parser refuses:\n" + "\n".join(refused)
 
 
-def _run_the_readme(folder) -> None:
+@pytest.mark.slow
+def test_the_readme_runs_as_printed_in_a_fresh_folder(tmp_path):
+    folder = tmp_path / "newcomer"
     folder.mkdir()
     demo = run(f"make -s -C {REPO} demo DEMO_OUT={folder / 'demo-out'}", folder)
     check(demo, "make demo")
     _check_demo(demo.stdout, folder / "demo-out")
-    for block in _readme_blocks()[1:]:
-        check(run(block, folder), block)
+    for command in _readme_lines():
+        check(run_documented(command, folder), command)
     # what the blocks promise, spot-checked
     assert (folder / "data" / "walk.bvh").is_file() and (folder / "data" / "frog.VOL").is_file()
     assert (folder / "mannequin.0.50.connect").is_file() and len(list((folder / "walk").glob("*.tskel"))) > 10
@@ -83,21 +103,25 @@ def _run_the_readme(folder) -> None:
     assert len(list((folder / "frames").glob("walk.*.vti"))) == len(list((folder / "walk").glob("*.trans")))
 
 
-def _run_the_help_examples(root) -> None:
+@pytest.mark.slow
+def test_every_help_example_runs_as_printed_in_fresh_folders(tmp_path):
     found = help_examples(build_parser())
     top = [c for name, c in found if name == "volanim" and not c.startswith("volanim demo")]
-    first = [c for n, c in found if n == "samples"]
-    rest = [c for n, c in found if n not in ("volanim", "samples") and not c.startswith("volanim demo")]
-    folder = root / "commands"
+    first = [(n, c) for n, c in found if n == "samples"]
+    rest = [(n, c) for n, c in found if n not in ("volanim", "samples") and not c.startswith("volanim demo")]
+    folder = tmp_path / "commands"
     folder.mkdir(parents=True)
-    for command in first + rest:
-        check(run(command, folder), command)
+    proven: set[str] = set()  # subcommands whose entry point ran as a process
+    for name, command in first + rest:
+        check(run_documented(command, folder, as_process=name not in proven), command)
+        proven.add(name)
+    assert len(proven) >= 30
     assert len(list(folder.glob("arm-bone.*x*x*.vol"))) == 1  # a headerless .vol is named by its size
     assert (folder / "walk.mp4").stat().st_size > 0 and (folder / "hull.png").stat().st_size > 0
-    own = root / "top"
+    own = tmp_path / "top"
     own.mkdir()
     for command in top:
-        check(run(command, own), command)
+        check(run_documented(command, own), command)
 
 
 def _check_demo(text: str, out) -> None:

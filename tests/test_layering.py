@@ -117,9 +117,9 @@ LAYERS = [
      "memo"},
     # files hold skeletons and bones (io reads them into their types), volume tools convert with io's:
     # one layer, which never imports the renderer
-    {"volume", "io", "skeleton", "colour", "rig"},
+    {"volume", "io", "skeleton", "colour", "rig", "mannequin_body"},
     {"reconstruct", "motion"},
-    {"sequence", "render", "samples", "ant_sample", "warmup"},
+    {"sequence", "render", "samples", "ant_sample", "warmup", "posed_truth"},
     {"pipeline_demo"},
     {"cli", "__main__"},
 ]

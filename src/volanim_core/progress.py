@@ -19,6 +19,7 @@ from volanim_core.errors import Cancelled
 
 ProgressFn = Callable[[int, int], None]
 CancelFn = Callable[[], bool]
+Clock = Callable[[], float]  # seconds, only differences count (time.perf_counter); tests pass a fake one
 
 
 class Reporter:
@@ -33,6 +34,39 @@ class Reporter:
             raise Cancelled("cancelled by the user")
         if self._progress is not None:
             self._progress(done, total)
+
+
+class Pacer:
+    """Cuts ``0..total`` into launches that each last about ``seconds``: the first is ``first`` long and
+    measures the pace, each next one is sized from the last one's pace (never under ``least``). Between
+    launches the caller reports progress and checks cancel, so both stay responsive; a fast job is not
+    cut into many launches (a parallel launch ends on its slowest thread).
+
+    The pace is read off ``clock``, so a loaded machine changes the launches but never the result; a test
+    passes a fake clock and knows every launch.
+
+    >>> ticks = iter(range(100))
+    >>> pacer = Pacer(first=4, least=2, seconds=3.0, clock=lambda: next(ticks))  # each launch takes 1 s
+    >>> list(pacer.spans(20))  # 4 rows in 1 s: 12 rows make 3 s
+    [(0, 4), (4, 16), (16, 20)]
+    """
+
+    def __init__(self, first: int, least: int, seconds: float, clock: Clock = time.perf_counter):
+        self.size = max(1, int(first))
+        self.least = max(1, int(least))
+        self.seconds = float(seconds)
+        self.clock = clock
+
+    def spans(self, total: int):
+        """Yield ``(start, stop)`` launches covering ``0..total``; ``self.size`` is then the next launch's
+        length (what a second pass over the same work uses)."""
+        start = 0
+        while start < total:
+            stop = min(total, start + self.size)
+            began = self.clock()
+            yield start, stop
+            pace = (stop - start) / max(self.clock() - began, 1e-6)
+            start, self.size = stop, max(self.least, int(pace * self.seconds))
 
 
 def stage(progress: ProgressFn | None, start: int, stop: int, total: int = 100) -> ProgressFn:

@@ -22,6 +22,21 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.mannequin_body import (  # noqa: F401 -- the body's names are the samples' too
+    BONE,
+    BRAIN,
+    FAT,
+    LARGE_SHAPE,
+    MANNEQUIN_SHAPE,
+    MID_X,
+    MUSCLE_A,
+    MUSCLE_B,
+    SKIN,
+    SKULL,
+    mannequin_bones,
+    mannequin_bones_at,
+    paint_mannequin,
+)
 from volanim_core.progress import stage
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
@@ -32,10 +47,6 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 #: placed on it as Slicer markups (``ant.mrk.json``) and a gait (``ant.keys``): :mod:`volanim_core.ant_sample`.
 FILE_SAMPLES = ("walk", "mannequin-ct", "ant")
 
-# Tissue values: distinct so sampled reconstruction shows the interior moving.
-SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
-MANNEQUIN_SHAPE = (160, 100, 300)
-LARGE_SHAPE = (290, 169, 940)  # the thesis's half-size Visible Human
 CT_SPACING, CT_ORIGIN = (0.7, 0.7, 2.5), (-56.0, -35.0, -1150.0)  # a CT's voxels (mm), somewhere in a scanner
 #: Hounsfield units a CT of the mannequin's tissues would read (air: -1000).
 CT_HU = {SKIN: 30, FAT: -100, MUSCLE_A: 45, MUSCLE_B: 60, BONE: 700, SKULL: 900, BRAIN: 35}
@@ -51,43 +62,12 @@ class Sample:
     part: np.ndarray | None = None  # bone index + 1 per voxel, 0 background
     spacing: tuple[float, float, float] = (1.0, 1.0, 1.0)
     mask_level: int = 1  # the object is volume >= mask_level
+    origin: tuple[int, int, int] = (0, 0, 0)  # voxel [0, 0, 0] is this voxel of the rest grid (a posed body)
 
     @property
     def mask(self) -> np.ndarray:
         grey = self.volume.max(axis=3) if self.volume.ndim == 4 else self.volume
         return grey >= self.mask_level
-
-
-MID_X = (MANNEQUIN_SHAPE[0] - 1) / 2  # 79.5: the volume's mid-plane, the studio's default symmetry plane
-
-
-def _mirror(x: float) -> float:
-    return 2 * MID_X - x
-
-
-def mannequin_bones() -> BoneSkeleton:
-    """The mannequin's bone skeleton: 18 bones, root order spine, head, arms, legs."""
-    j = {
-        "PELVIS": (MID_X, 50, 140), "NECK": (MID_X, 50, 234), "HEAD": (MID_X, 50, 288),
-        "L_SHOULDER": (108, 50, 226), "L_ELBOW": (124, 50, 178), "L_WRIST": (139, 50, 133),
-        "L_FINGERS": (144, 50, 115),
-        "L_HIP": (94, 50, 138), "L_KNEE": (96, 50, 78), "L_ANKLE": (97, 50, 16), "L_TOE": (97, 26, 6),
-    }
-    for name in [k for k in j if k.startswith("L_")]:
-        x, y, z = j[name]
-        j["R_" + name[2:]] = (_mirror(x), y, z)
-    bones = [Bone("PELVIS", "NECK", "SPINE"), Bone("NECK", "HEAD", "HEAD")]
-    for s in ("L_", "R_"):
-        bones += [
-            Bone("NECK", s + "SHOULDER", s + "CLAVICLE"), Bone(s + "SHOULDER", s + "ELBOW", s + "UPPERARM"),
-            Bone(s + "ELBOW", s + "WRIST", s + "FOREARM"), Bone(s + "WRIST", s + "FINGERS", s + "HAND"),
-        ]
-    for s in ("L_", "R_"):
-        bones += [
-            Bone("PELVIS", s + "HIP", s + "PELVIS"), Bone(s + "HIP", s + "KNEE", s + "THIGH"),
-            Bone(s + "KNEE", s + "ANKLE", s + "SHIN"), Bone(s + "ANKLE", s + "TOE", s + "FOOT"),
-        ]
-    return BoneSkeleton(j, bones)
 
 
 def mannequin_limb(bone_label: str) -> str:
@@ -102,28 +82,6 @@ def mannequin_limb(bone_label: str) -> str:
     if bone_label == "HEAD":
         return "HEAD"
     return bone_label[:2] + ("ARM" if bone_label.endswith(("UPPERARM", "FOREARM", "HAND")) else "LEG")
-
-
-# (bone name, start, end, radius at start, radius at end, y squash, bone-rod radius)
-def _mannequin_parts(bones: BoneSkeleton):
-    J = bones.joints
-    parts = [
-        ("SPINE", (MID_X, 50, 136), (MID_X, 50, 226), 21, 25, 0.62, 0),
-        ("HEAD", (MID_X, 50, 230), (MID_X, 50, 250), 8, 8, 1.0, 0),
-        ("HEAD", (MID_X, 50, 266), (MID_X, 50, 272), 17, 17, 0.95, 0),
-    ]
-    for s in ("L_", "R_"):
-        parts += [
-            (s + "CLAVICLE", J["NECK"] + (0, 0, -6), J[s + "SHOULDER"], 9, 10, 0.9, 0),
-            (s + "UPPERARM", J[s + "SHOULDER"], J[s + "ELBOW"], 9, 7, 1.0, 2.5),
-            (s + "FOREARM", J[s + "ELBOW"], J[s + "WRIST"], 7, 5, 1.0, 2.0),
-            (s + "HAND", J[s + "WRIST"], J[s + "FINGERS"], 5, 4, 0.6, 0),
-            (s + "PELVIS", J["PELVIS"], J[s + "HIP"], 13, 12, 0.8, 0),
-            (s + "THIGH", J[s + "HIP"], J[s + "KNEE"], 12, 9, 1.0, 3.5),
-            (s + "SHIN", J[s + "KNEE"], J[s + "ANKLE"], 8, 6, 1.0, 2.5),
-            (s + "FOOT", J[s + "ANKLE"], J[s + "TOE"], 6, 5, 1.0, 0),
-        ]
-    return parts
 
 
 def mannequin() -> Sample:
@@ -162,48 +120,10 @@ def part_connectivity(sample: Sample, min_thinness: float = 0.5, progress=None):
     return conn.grouped()
 
 
-def _scaled(p, scale) -> tuple[float, ...]:
-    """A mannequin-voxel position on a grid ``scale`` times finer (voxel centres stay centres)."""
-    return tuple(float(v) for v in (np.asarray(p, float) + 0.5) * scale - 0.5)
-
-
 def _mannequin(scale: np.ndarray, name: str, progress=None) -> Sample:
     shape = tuple(int(round(n * f)) for n, f in zip(MANNEQUIN_SHAPE, scale))
-    small = mannequin_bones()
-    bones = small if (scale == 1).all() else \
-        BoneSkeleton({k: _scaled(v, scale) for k, v in small.joints.items()}, small.bones)
-    vol = np.zeros(shape, np.uint8, order="F")
-    part = np.zeros(shape, np.uint8, order="F")
-    best = np.full(shape, -np.inf, np.float32, order="F")
-    parts = _mannequin_parts(small)
-    for k, (label, a, b, ra, rb, squash, rod) in enumerate(parts):
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        r = max(ra, rb)
-        lo = np.maximum(np.floor((np.minimum(a, b) - r - 0.5) * scale - 0.5), 0).astype(int)
-        hi = np.minimum(np.ceil((np.maximum(a, b) + r + 1.5) * scale - 0.5), np.array(shape) - 1).astype(int)
-        # the part is built in mannequin-voxel units at this grid's voxel centres
-        x, y, z = np.meshgrid(*((np.arange(lo[i], hi[i] + 1, dtype=np.float64) + 0.5) / scale[i] - 0.5
-                                for i in range(3)), indexing="ij")
-        ab = b - a
-        length = float(np.linalg.norm(ab))
-        t = np.clip(((x - a[0]) * ab[0] + (y - a[1]) * ab[1] + (z - a[2]) * ab[2]) / length**2, 0, 1)
-        dx, dy, dz = x - (a[0] + t * ab[0]), (y - (a[1] + t * ab[1])) / squash, z - (a[2] + t * ab[2])
-        d = np.sqrt(dx * dx + dy * dy + dz * dz)
-        radius = ra + (rb - ra) * t
-        depth = (radius - d).astype(np.float32)
-        sl = tuple(slice(lo[i], hi[i] + 1) for i in range(3))
-        win = (depth > 0) & (depth > best[sl])
-        stripe = ((t * length) // 5).astype(int) % 2 == 0
-        tissue = np.where(depth < 1.5, SKIN, np.where(depth < 4, FAT, np.where(stripe, MUSCLE_A, MUSCLE_B)))
-        if rod:
-            tissue = np.where(d < rod, BONE, tissue)
-        if label == "HEAD" and k == 2:
-            tissue = np.where(depth < 1.5, SKIN, np.where(depth < 4, SKULL, np.where(stripe, BRAIN, BRAIN + 12)))
-        best[sl] = np.where(win, depth, best[sl])
-        vol[sl] = np.where(win, tissue, vol[sl])
-        part[sl] = np.where(win, bones.index(label) + 1, part[sl])
-        if progress is not None:
-            progress(k + 1, len(parts))
+    bones = mannequin_bones_at(scale)
+    vol, part = paint_mannequin(bones, scale, shape, progress=progress)
     return Sample(name, vol, bones, part)
 
 

@@ -28,7 +28,7 @@ import numba
 import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
-from volanim_core.progress import CancelFn, ProgressFn, Reporter
+from volanim_core.progress import CancelFn, Clock, Pacer, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
 from volanim_core.reconstruct._clip_kernels import count_outside
 
@@ -107,6 +107,7 @@ def reconstruct(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     speedups: Speedups = ALL,
+    clock: Clock = time.perf_counter,
 ) -> Reconstruction:
     """Re-grow a volume from the spheres of a ``.tskel`` frame.
 
@@ -144,6 +145,9 @@ def reconstruct(
         raises :class:`~volanim_core.errors.Cancelled`.
     speedups : Speedups
         Optimisations to switch off, to measure them (:mod:`.speedups`); the result does not depend on it.
+    clock : callable
+        Seconds (``time.perf_counter``): sizes the launches (:class:`~volanim_core.progress.Pacer`) and
+        times the call (``stats['seconds']``). The result does not depend on it; a test passes a fake one.
 
     Returns
     -------
@@ -158,7 +162,7 @@ def reconstruct(
     >>> int((r.volume > 0).sum()), r.origin   # voxels strictly within 2 of the centre: 3x3x3
     (27, (3, 3, 3))
     """
-    t0 = time.perf_counter()
+    t0 = clock()
     report = Reporter(progress, cancel)
     plan = plan_frame(tskel, mode, source=source, kernel=kernel, value=value, bounds=bounds, padding=padding,
                       neighbours=neighbours, speedups=speedups)
@@ -178,23 +182,18 @@ def reconstruct(
     try:
         total = 2 * nz if mode == "sampled" else nz  # sampling is a second pass: report and cancel in it too
         report(0, total)
-        z0, chunk = 0, max(nthreads * 8, nz // 16)  # a first, small launch measures the pace ...
-        while z0 < nz:
-            z1 = min(nz, z0 + chunk)
-            started = time.perf_counter()
+        # a first, small launch measures the pace; the next ones last about LAUNCH_SECONDS each
+        pacer = Pacer(first=max(nthreads * 8, nz // 16), least=nthreads * 4, seconds=LAUNCH_SECONDS, clock=clock)
+        for z0, z1 in pacer.spans(nz):
             K.fill_slices(out, scratch, z0, z1, nthreads, plan.offsets, plan.ids, plan.centres, plan.r2s, plan.radii,
                           plan.values, plan.metric, _MODE_CODE[mode], plan.plane_start, plan.planes, plan.max_planes,
                           row_lo, row_hi, filled, visits, speedups.box_sweep, K.AHEAD if speedups.prefetch else 0)
             report(z1, total)
-            # ... and the next ones last about LAUNCH_SECONDS each: progress and cancel stay that responsive,
-            # and a fast call is not cut into many launches (each ends on its slowest thread)
-            pace = (z1 - z0) / max(time.perf_counter() - started, 1e-6)
-            z0, chunk = z1, max(nthreads * 4, int(pace * LAUNCH_SECONDS))
         if mode == "sampled":
             to_source = np.eye(4) if source_geometry is None else tskel.geometry.index_map(source_geometry)
             minv = np.concatenate([plan.minv_rest, np.linalg.inv(plan.table[len(plan.minv_rest):])])  # blended: rigid
             out = sample_source(out, source, _grid_to_source(minv, plan.origin, to_source), kernel,
-                                (row_lo, row_hi), nthreads, chunk, lambda done: report(nz + done, total))
+                                (row_lo, row_hi), nthreads, pacer.size, lambda done: report(nz + done, total))
     finally:
         numba.set_num_threads(previous)
 
@@ -204,7 +203,7 @@ def reconstruct(
                                        CLIP_ROW_BUDGET) if len(tskel) and not fits else (0.0, False)
     stats = _stats(len(tskel), filled, visits, int(round(clipped)), out if mode == "hotspot" else None)
     stats["clipped_estimated"] = bool(estimated)
-    stats["seconds"] = time.perf_counter() - t0
+    stats["seconds"] = clock() - t0
     volume = out.transpose(2, 1, 0, 3) if out.ndim == 4 else out.T  # [x, y, z] view: no copy
     lo = plan.bounds.lo
     return Reconstruction(volume, tuple(int(v) for v in lo), stats, plan.tskel.geometry.shifted(lo))

@@ -137,7 +137,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                  source_geometry=None, kernel: int = 1, padding: int = 2, fps: float = 24.0,
                  every_frame_as: str | None = None, workers: int | None = None, scheduler=None,
                  force: bool = False, replace_other: bool = False, threads_per_worker: int = 1,
-                 on_frame=None) -> SequenceReport:
+                 on_frame=None, frame_seconds=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
     ``source_geometry``: where the source's voxels are (:func:`reconstruct`); the store records the
@@ -146,6 +146,9 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
     ``on_frame(record, done, total)`` after each finished frame (progress).
     ``replace_other``: a store of another sequence at ``out`` is replaced instead of refused (a
     cache, like the studio's movie); the same sequence still resumes, and ``--force`` redoes it.
+    ``frame_seconds(record) -> float``: what a finished frame cost, for sizing Dask's tasks
+    (:func:`frames_per_task`); default the ``seconds`` its worker measured. The frames never depend on
+    it; a test passes a constant, so the tasks are known whatever the machine's load.
     """
     if not frames:
         raise ValueError("no frames to reconstruct")
@@ -216,7 +219,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                 store.record(out, *recs)  # one fsync a task, not one a frame
                 for rec in recs:
                     records[rec["index"]] = rec
-                    seconds.append(rec["seconds"])
+                    seconds.append(rec["seconds"] if frame_seconds is None else frame_seconds(rec))
                     if on_frame is not None:
                         on_frame(rec, len(records), total)
     return SequenceReport(bounds, dtype.name, [records[i] for i in range(total)], len(done), len(todo),

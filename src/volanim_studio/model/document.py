@@ -137,7 +137,7 @@ class Document:
 
     @thinness.setter
     def thinness(self, value: float) -> None:
-        value = float(value)
+        value = float(value) + 0.0  # -0.0 is 0.0: a project says the same number it was saved with
         if not np.isfinite(value):
             raise ValueError(f"thinness must be a finite number, got {value!r}")
         if value == self._thinness:

@@ -79,10 +79,22 @@ def write_project(doc, path) -> dict:
         "sha256": {key: digest for key, (_, digest) in stored.items()},
         **document_state.save_all(doc, path),
     }
-    bundle.commit(path, data)
+    bundle.commit(path, numbers_as_values(data))
     written = {"project": str(path), "bones": None, "mskel": None, "connect": None}
     written.update({key: str((path.parent / rel).resolve()) for key, (rel, _) in stored.items()})
     return written
+
+
+def numbers_as_values(data):
+    """``data`` with every -0.0 made 0.0: a project's numbers mean their value, and JSON text that says
+    ``-0.0`` for what a reopened document holds as ``0.0`` would read as a change (docs/formats.md#project)."""
+    if isinstance(data, float):
+        return data + 0.0
+    if isinstance(data, dict):
+        return {k: numbers_as_values(v) for k, v in data.items()}
+    if isinstance(data, list | tuple):
+        return [numbers_as_values(v) for v in data]
+    return data
 
 
 def _expect(path, data: dict, key: str, kinds, what: str):

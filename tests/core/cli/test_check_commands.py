@@ -146,6 +146,7 @@ def test_report_refuses_a_frame_of_other_bones(made, tmp_path):
 
 
 # spec: docs/formats.md#keys
+@pytest.mark.long("keyframes to frames to a scan, as the CLI runs them: the scan names the torn frame")
 def test_keys_write_the_timeline_frames_and_scan_finds_the_torn_one(made, tmp_path):
     d = made
     r = run("keys", d / "mannequin.keys", "--bones", d / "mannequin.bones", "-o", tmp_path / "wave")

@@ -23,6 +23,7 @@ def scan(tmp_path_factory):
     return folder, vol
 
 
+@pytest.mark.slow
 def test_build_apply_sort_remap_merge_render(scan):
     folder, vol = scan
     steps = [

@@ -17,6 +17,7 @@ def made(skeletonized_mannequin):
     return skeletonized_mannequin
 
 
+@pytest.mark.slow
 def test_autorig_writes_the_humanoids_bones_and_a_posable_connect(made):
     out = volanim("autorig", made / "m.mskel", "--template", "humanoid", "-o", made / "p.bones",
                   "--connect", made / "p.connect", "--volume", made / "mannequin.VOL")

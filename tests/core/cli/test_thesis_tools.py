@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from runnable import volanim
 from volanim_core import io
@@ -33,6 +34,7 @@ def test_diff_reports_changed_values_and_a_summary(tmp_path):
 
 
 # spec: docs/formats.md#skel
+@pytest.mark.slow
 def test_a_thesis_skel_is_written_and_read_by_every_skeleton_tool(skeletonized_mannequin):
     d = skeletonized_mannequin
     r = volanim("skeletonize", d / "mannequin.VOL", "--min-thinness", "0.5", "-o", d / "m.skel")

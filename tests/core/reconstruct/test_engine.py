@@ -288,20 +288,50 @@ def test_bad_arguments():
         reconstruct(t, mode="sampled", source=np.zeros((2, 2, 2)), kernel=4)
 
 
-def test_a_fast_call_is_one_launch_after_the_first_and_a_slow_one_reports_often(monkeypatch):
+class FakeClock:
+    """Each reading is ``step`` seconds after the one before: every launch seems to take ``step``."""
+
+    def __init__(self, step: float):
+        self.now, self.step = 0.0, step
+
+    def __call__(self) -> float:
+        self.now += self.step
+        return self.now
+
+
+def test_a_fast_call_is_one_launch_after_the_first_and_a_slow_one_reports_often():
     """Launches are sized to last LAUNCH_SECONDS after a small first one: few for a fast call (each
-    launch waits for its slowest thread), many -- progress and cancel -- for a slow one."""
+    launch waits for its slowest thread), many -- progress and cancel -- for a slow one. The pace is read
+    off an injected clock, so the launches are exact whatever the machine's load."""
+    import numba
+
     from volanim_core.reconstruct import engine as rec
 
     t = Tskel([BoneSegment((0, 0, 0), (0, 0, 300))], np.eye(4)[None], [[5, 5, z] for z in range(0, 300, 2)],
               [3.0] * 150, None, [0] * 150)
+    threads = min(2, numba.config.NUMBA_NUM_THREADS)
     calls = []
-    reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d))
-    assert len(calls) <= 3  # 0, the first launch, the rest
-    monkeypatch.setattr(rec, "LAUNCH_SECONDS", 0.0)
+    fast = reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d), threads=threads,
+                       clock=FakeClock(1e-6))
+    nz = fast.volume.shape[2]
+    first = max(threads * 8, nz // 16)
+    assert calls == [0, first, nz]  # the first launch, then the rest in one
     calls.clear()
-    r = reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d), threads=2)
-    assert len(calls) > 10 and calls == sorted(calls) and calls[-1] == r.volume.shape[2]
+    slow = reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d), threads=threads, clock=FakeClock(1.0))
+    # a launch of L slices took 1 s: the next is L * LAUNCH_SECONDS long, never under 4 per thread
+    step = max(threads * 4, int(first * rec.LAUNCH_SECONDS))
+    assert calls == [0, *range(first, nz, step), nz] and len(calls) > 10
+    assert np.array_equal(slow.volume, fast.volume)  # launches change nothing in the result
+
+
+def test_launches_cover_the_grid_in_order_with_the_real_clock():
+    """The same with the machine's own clock: however the launches fall, progress only moves forward and
+    ends at the last slice (no count: it depends on the machine's load)."""
+    t = Tskel([BoneSegment((0, 0, 0), (0, 0, 300))], np.eye(4)[None], [[5, 5, z] for z in range(0, 300, 2)],
+              [3.0] * 150, None, [0] * 150)
+    calls = []
+    r = reconstruct(t, mode="bone", progress=lambda d, n: calls.append(d))
+    assert calls[0] == 0 and calls == sorted(set(calls)) and calls[-1] == r.volume.shape[2]
 
 
 def test_progress_and_cancel():

@@ -119,6 +119,7 @@ def test_the_camera_stays_fixed_across_frames_and_workers(tmp_path):
     assert not np.array_equal(pics[0], pics[3])  # the ball does
 
 
+@pytest.mark.long("the one proof that a movie is encoded (imageio-ffmpeg) with its frames, size and rate")
 def test_a_movie_has_its_frames_size_and_rate(tmp_path):
     seq = make_sequence(tmp_path / "s.zarr", frames=5)
     assert main(["render", str(seq), "-o", str(tmp_path / "m.mp4"), "--size", "320x240", "--workers", "1"]) == 0
@@ -154,6 +155,7 @@ def test_a_rerun_draws_only_the_missing_pictures_and_other_settings_redraw(tmp_p
 
 
 # spec: docs/formats.md#tf
+@pytest.mark.long("a render from a file with a .tf and a saved camera, compared with the voxels")
 def test_one_volume_file_to_a_png_with_a_transfer_function_and_a_saved_camera(tmp_path, capsys):
     io.write_volume(tmp_path / "b.vti", ball(radius=15, value=200), Geometry(origin=(5, 5, 5)))
     tf = TransferFunction([0, 100, 255], [[0, 0, 0, 0], [1, 0, 0, 0.2], [1, 0, 0, 1]])

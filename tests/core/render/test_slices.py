@@ -46,6 +46,7 @@ def test_a_slice_of_nibabels_scan_is_nibabels_voxels(tmp_path):
     assert len(np.unique(expected)) > 50  # a real picture, not one flat grey
 
 
+@pytest.mark.long("every axis of the slice view against the named 3-D views: one voxel placed, six pictures")
 def test_every_axis_puts_a_voxel_where_the_named_views_see_it(tmp_path):
     vol = np.zeros((5, 6, 7), np.uint8)
     vol[1, 2, 3] = 200

@@ -49,9 +49,11 @@ def frames_of(path) -> list[np.ndarray]:
     return [np.asarray(f) for f in store.open_frames(path)[:]]
 
 
+@pytest.mark.long("the one proof that a real Dask cluster (loopback) makes the frames one worker and a local pool make")
 def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_path, conn):
     """24 short frames: Dask gets them several to a task once the first are timed (a task costs the
-    workers milliseconds of scheduling), and that changes nothing in the frames."""
+    workers milliseconds of scheduling), and that changes nothing in the frames. Each frame counts as
+    0.1 s here (``frame_seconds``), so the tasks are known whatever the machine's load."""
     from distributed import Client, LocalCluster, get_task_stream
 
     walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))
@@ -60,10 +62,13 @@ def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_pat
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster, Client(cluster) as client:
         with get_task_stream(client) as tasks:
-            dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client)
+            dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client,
+                                frame_seconds=lambda rec: 0.1)
         ran_on = {w["host"] for w in client.scheduler_info()["workers"].values()}
     assert ran_on == {"127.0.0.1"} and dask.workers == "Dask, 2 workers"
-    assert 4 < len(tasks.data) < 24  # the first four alone, then batches
+    # 4 in flight (2 a worker), one frame each until one is timed; then 0.5 s / 0.1 s = 5 frames a task,
+    # the last tasks splitting what is left four ways: 1 1 1 1, then 5 4 3 2 2 1 1 1 1
+    assert len(tasks.data) == 13
     a, b, c = (frames_of(tmp_path / f"{n}.zarr") for n in ("one", "two", "dask"))
     assert len(a) == 24 and all(np.array_equal(x, y) and np.array_equal(x, z) for x, y, z in zip(a, b, c))
     assert [r["sha256"] for r in one.records] == [r["sha256"] for r in dask.records]
@@ -130,6 +135,7 @@ def test_a_run_that_cannot_fit_says_how_large_its_largest_frame_is(tmp_path, con
 
 
 # spec: docs/formats.md#zarr
+@pytest.mark.long("kill -9 of a real sequence run, then the same command: nothing finished is lost or redone")
 def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
     frames = tmp_path / "frames"
     conn = io.read_connect(CONNECT)
@@ -225,6 +231,8 @@ def test_a_scheduler_that_cannot_be_reached_is_named_and_announced(tmp_path, cap
     import socket
 
     import dask
+    import distributed  # noqa: F401 -- first: its import adds dask's "distributed" config, which a
+    # dask.config.set made before it would take away again on leaving (every later LocalCluster: KeyError)
 
     with socket.socket() as s:  # a free port on the loopback interface: nothing listens there
         s.bind(("127.0.0.1", 0))

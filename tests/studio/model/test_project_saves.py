@@ -88,6 +88,7 @@ class Saver:
 
 
 # spec: docs/formats.md#project
+@pytest.mark.long("kill -9 during a project save: the old or the new project opens, never neither")
 @pytest.mark.parametrize("trials", [40])
 def test_project_save_survives_kill_9_at_any_moment(tmp_path, doc, trials):
     path = tmp_path / "session.volanim"

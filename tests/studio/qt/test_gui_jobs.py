@@ -27,6 +27,7 @@ def test_cancel_leaves_the_gui_responsive(qtbot, window, tmp_path):
     assert window.scene.shown_points == window.doc.visible_count
 
 
+@pytest.mark.long("closing the window while a job runs waits for the worker: teardown never destroys a running one")
 def test_close_while_a_job_runs_waits_for_it_instead_of_aborting(qtbot):
     """Closing used to wait 5 s and then destroy the running QThread: SIGABRT for the whole app."""
     import time

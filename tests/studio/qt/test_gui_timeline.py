@@ -183,6 +183,7 @@ def test_render_a_movie_of_the_keys_with_the_views_camera_and_save_the_view(qtbo
     assert not list(tmp_path.glob("*bad*")) and not list(tmp_path.glob(".bad*"))
 
 
+@pytest.mark.long("a movie cancelled mid-render, then rendered whole: cancel leaves no worker and no half file behind")
 def test_cancel_a_movie_and_render_it_again(qtbot, rigged, tmp_path):
     from PySide6.QtWidgets import QPushButton
 
@@ -244,6 +245,7 @@ def body_in_view(w) -> float:
     return float(inside.mean())
 
 
+@pytest.mark.long("a real clip played in the studio: the view and the movie follow the body")
 def test_the_view_and_the_movie_follow_the_walking_body(qtbot, rigged, tmp_path):
     """Before: at frames 601 and 746 of the walk the view was empty (the figure had walked out of it)
     while the status bar said healthy, and a movie from the studio lost the walker the same way."""
