@@ -32,3 +32,18 @@ def test_outcomes_are_read_from_the_report_pytest_writes(tmp_path):
                     "test_three.py"], cwd=tmp_path, capture_output=True)
     assert outcomes(junit) == {"test_three::test_ok": "passed", "test_three::test_bad": "failed",
                                "test_three::test_skipped": "skipped"}
+
+
+def test_every_dask_cluster_a_test_starts_listens_on_a_free_port():
+    """Two xdist workers each starting a LocalCluster at once: dashboard_address=None still meant Dask's default
+    port 8787, and the second cluster failed ("Port 8787 is already in use") when they overlapped. A cluster a
+    test starts asks for a free loopback port ("127.0.0.1:0")."""
+    import re
+    from pathlib import Path
+
+    found = []
+    for path in Path(__file__).parent.rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        for m in re.finditer(r"LocalCluster\((.*?)\) as", text, flags=re.S):
+            found.append((path.name, 'dashboard_address="127.0.0.1:0"' in m[1]))
+    assert len(found) >= 3 and all(ok for _, ok in found), found

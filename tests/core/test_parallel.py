@@ -40,7 +40,7 @@ def test_a_dask_worker_reuses_freed_memory():
     from distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+                      dashboard_address="127.0.0.1:0") as cluster, Client(cluster) as client:
         # Dask starts its workers with MALLOC_TRIM_THRESHOLD_=65536 (distributed.nanny.pre-spawn-environ)
         assert client.run(lambda: __import__("os").environ.get("MALLOC_TRIM_THRESHOLD_"))
         with executor(faults_of_reused_arrays, None, nothing, scheduler=client) as (submit, _, _n):

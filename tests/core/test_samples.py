@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy import ndimage
 
 from volanim_core import io, samples
@@ -86,6 +87,7 @@ def test_colour_mannequin_is_the_mannequin_in_colour():
     assert len(unique_colours(colour.volume)[0]) > 10_000  # grain: a palette has to be built
 
 
+@pytest.mark.long("the thesis-scale sample (46 M voxels) is the mannequin on a finer grid")
 def test_large_mannequin_is_the_mannequin_on_a_finer_grid(tmp_path):
     """The thesis's half-size Visible Human scale; its .connect reconstructs the body."""
     from volanim_core.reconstruct.engine import reconstruct

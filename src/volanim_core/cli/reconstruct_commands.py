@@ -1,5 +1,5 @@
 """Posing and reconstruction subcommands: connect, pose, connect2tskel,
-connect2identitytskel, sorttskel, bounds, reconstruct."""
+connect2identitytskel, sorttskel, bounds, reconstruct, compare."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ from volanim_core.rig.attach import METHODS
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.pose import pose_matrices, root_bones
 from volanim_core.rig.skinning import transform_table
-from volanim_core.rig.tskel_tools import connect_to_tskel, identity_tskel, sort_tskel
+from volanim_core.rig.tskel_tools import check_root_order, connect_to_tskel, identity_tskel, sort_tskel
 
 from ._common import (
     add_command,
@@ -147,6 +147,51 @@ def _reconstruct(args):
               f"({100 * lost / max(rest.stats['filled'], 1):.2f} %)")
 
 
+def _compare(args):
+    """``compare OURS (TRUTH | --sample NAME --pose P)``: how far a posed volume is from its true shape."""
+    import json
+
+    from volanim_core.geometry import IDENTITY
+    from volanim_core.io import read_scan
+    from volanim_core.reconstruct.shape import compare_shapes
+    from volanim_core.rig.pose import posed_joints
+
+    if (args.truth is None) == (args.sample is None):
+        raise ValueError("give the true volume (TRUTH) or --sample NAME --pose P.trans, not both or neither")
+    trans = read_trans(args.pose) if args.pose else None
+    bones = read_bones(args.bones) if args.bones else None
+    if args.sample is not None:
+        from volanim_core.posed_truth import posed_sample
+
+        if trans is None:
+            raise ValueError("--sample needs --pose: the .trans the reconstruction was posed with")
+        made = posed_sample(args.sample, trans.matrices)
+        truth, truth_geometry = made.volume, IDENTITY.shifted(made.origin)
+        bones = bones or made.bones
+    else:
+        truth, truth_geometry, _ = read_scan(args.truth, colour=True)
+    ours, ours_geometry, _ = read_scan(args.ours, colour=True)
+    base = bones.geometry if bones is not None else truth_geometry
+    at = [_offset(g, base, f) for g, f in ((ours_geometry, args.ours), (truth_geometry, args.truth or args.sample))]
+    joints = segments = None
+    if bones is not None and trans is not None:
+        check_root_order(root_bones(bones), trans.bones)
+        joints = posed_joints(bones, trans.matrices)
+        segments = {b.label: (joints[b.proximal], joints[b.distal]) for b in bones.bones}
+    report = compare_shapes(ours, truth, ours_origin=at[0], truth_origin=at[1], spacing=base.spacing,
+                            joints=joints, segments=segments, tissue=args.tissue)
+    print(json.dumps(report.as_dict(), indent=2) if args.json else report.summary())
+
+
+def _offset(geometry, base, name) -> tuple[int, int, int]:
+    """Where a volume's voxel [0, 0, 0] lies in the frame's grid ``base`` (same spacing and axes)."""
+    m = geometry.index_map(base)
+    if not np.allclose(m[:3, :3], np.eye(3), atol=1e-6) or not np.allclose(m[3, :3], np.rint(m[3, :3]), atol=1e-3):
+        raise ValueError(f"{name}: its voxels are not the frame's (other spacing, axes or a part-voxel shift); "
+                         "resample it onto the frame's grid first")
+    return tuple(int(v) for v in np.rint(m[3, :3]))
+
+
 def register(sub) -> None:
     p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
                     ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
@@ -216,3 +261,17 @@ def register(sub) -> None:
     p.add_argument("--loss", action="store_true", help="also report voxel loss against the identity frame")
     add_joints(p, "the .tskel's (rigid when it records none)")
     p.add_argument("-o", "--output", required=True, help=".vti/.nrrd keep the origin; .vol/.VOL: it is printed")
+
+    p = add_command(sub, "compare", "How far a posed volume is from its true shape: Dice, the largest wrong blobs, "
+                    "surface distance, tissue (the mannequins' truth: volanim samples NAME --pose).",
+                    ("volanim compare arm.vti --sample mannequin --pose arm.trans --tissue",
+                     "volanim compare arm-smooth.vti --sample mannequin --pose arm.trans --json"),
+                    _compare)
+    p.add_argument("ours", help="the posed volume (a reconstruction)")
+    p.add_argument("truth", nargs="?", help="the true posed volume on the same voxel grid (samples NAME --pose)")
+    p.add_argument("--sample", choices=("mannequin", "mannequin-large", "mannequin-colour"),
+                   help="make the truth here: this mannequin posed by --pose")
+    p.add_argument("--pose", metavar="TRANS", help="the .trans the volume was posed with (joints: where blobs are)")
+    p.add_argument("--bones", help="the .bones of --pose (default: the sample's): blobs named by joint and bone")
+    p.add_argument("--tissue", action="store_true", help="also compare values (a sampled reconstruction)")
+    p.add_argument("--json", action="store_true", help="the figures as JSON")

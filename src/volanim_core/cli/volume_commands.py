@@ -247,12 +247,35 @@ def _voxelize(args):
 
 
 def _samples(args):
+    if args.pose:
+        return _posed_sample(args)
     for name in (*samples.NAMES, *samples.FILE_SAMPLES) if args.name == "all" else [args.name]:
         bar = TextProgress(f"making {name}")
         written = samples.write_sample(name, args.output, progress=bar)
         bar.close()
         for path in written:
             print(f"wrote {path}")
+
+
+def _posed_sample(args):
+    """``samples NAME --pose P.trans -o truth.vti``: the mannequin's true shape in that pose (posed_truth)."""
+    from volanim_core.geometry import IDENTITY
+    from volanim_core.io import read_trans
+    from volanim_core.posed_truth import POSABLE, posed_sample
+    from volanim_core.rig.pose import root_bones
+    from volanim_core.rig.tskel_tools import check_root_order
+
+    if args.name not in POSABLE:
+        raise ValueError(f"--pose: only the mannequins have a posed truth ({', '.join(POSABLE)}), not {args.name}")
+    if Path(args.output).is_dir() or args.output in (".", ""):
+        raise ValueError(f"--pose writes one volume: -o names it (truth.vti, .nrrd, ...), not the folder {args.output}")
+    trans = read_trans(args.pose)
+    bar = TextProgress(f"posing {args.name}")
+    truth = posed_sample(args.name, trans.matrices, progress=bar)
+    bar.close()
+    check_root_order(root_bones(truth.bones), trans.bones)
+    save(args.output, truth.volume, IDENTITY.shifted(truth.origin))
+    print(f"the {args.name}'s capsules posed by {args.pose}: voxel [0, 0, 0] is {truth.origin} of the rest grid")
 
 
 def _io(p, output=True):
@@ -390,4 +413,7 @@ def register(sub) -> None:
                     "the ant mesh, or all.",
                     "volanim samples all -o .", _samples)
     p.add_argument("name", choices=(*samples.NAMES, *samples.FILE_SAMPLES, "all"))
-    p.add_argument("-o", "--output", default=".", help="folder (default: current)")
+    p.add_argument("--pose", metavar="TRANS", help="a mannequin's true shape in this pose (a .trans of its bones): "
+                   "each body part moved whole by its bone, the volume to compare a reconstruction with "
+                   "(volanim compare); -o then names that volume: samples mannequin --pose arm.trans -o truth.vti")
+    p.add_argument("-o", "--output", default=".", help="folder (default: current); with --pose, the volume file")

@@ -7,6 +7,7 @@
     sampling.py ........ sampled mode, grey or colour; neighbours.py the overdraw cut's neighbour lists
     breakage.py ........ cracks, stumps and torn-off pieces of a posed frame (_label_kernels.py: pieces
                          found on x-runs, nogil); scan.py many frames; bend.py how a bent joint keeps shape
+    shape.py ........... a posed volume against its true shape: Dice, the largest wrong blobs, surface distance
 """
 
 from volanim_core.reconstruct.engine import MODES, Reconstruction, grid_bounds, reconstruct

@@ -110,6 +110,7 @@ def test_mirror_with_other_bones_is_refused_and_writes_nothing(made, tmp_path):
     assert not (tmp_path / "out.connect").exists()
 
 
+@pytest.mark.long("report: exit status and JSON against a reconstruction (a fresh clone compiles kernels here, once)")
 def test_report_exit_status_and_json_match_the_pose(made):
     d = made
     ok = run("report", d / "m.connect", d / "torn.trans", "--json", "--bones", d / "mannequin.bones")

@@ -108,6 +108,7 @@ def test_transform_files_move_the_joints_where_ours_go(scan, tmp_path, fmt):
             assert np.allclose(tx.GetInverse().TransformPoint(tuple(rest)), posed, atol=1e-6)
 
 
+@pytest.mark.long("3D Slicer's own resampling of our displacement field gives our sampled pose")
 def test_displacement_field_resamples_the_scan_into_our_sampled_pose(scan, tmp_path):
     frame = scan / "wave" / "mannequin.0012.trans"
     field = tmp_path / "field.nrrd"

@@ -251,6 +251,7 @@ def test_render_refusals(tmp_path, capsys):
         assert f"argument {bad[0]}" in capsys.readouterr().err
 
 
+@pytest.mark.long("the one proof that a real Dask cluster (loopback) renders the frames a local render makes")
 def test_a_dask_cluster_draws_the_same_pictures(tmp_path):
     from distributed import Client, LocalCluster
 
@@ -259,7 +260,7 @@ def test_a_dask_cluster_draws_the_same_pictures(tmp_path):
     settings = RenderSettings(named_view("side", inputs.lo, inputs.hi), preset="bone", size=(160, 120))
     render(inputs, settings, tmp_path / "local", workers=1)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+                      dashboard_address="127.0.0.1:0") as cluster, Client(cluster) as client:
         rep = render(inputs, settings, tmp_path / "dask", scheduler=client)
     assert rep.workers == "Dask, 2 workers" and rep.drawn == 3
     for n in (100, 102, 104):

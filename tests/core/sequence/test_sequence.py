@@ -60,7 +60,7 @@ def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_pat
     one = run_sequence(conn, walk, tmp_path / "one.zarr", mode="bone", workers=1)
     two = run_sequence(conn, walk, tmp_path / "two.zarr", mode="bone", workers=2)
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+                      dashboard_address="127.0.0.1:0") as cluster, Client(cluster) as client:
         with get_task_stream(client) as tasks:
             dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client,
                                 frame_seconds=lambda rec: 0.1)

@@ -174,6 +174,7 @@ w.close()
 """
 
 
+@pytest.mark.long("the one proof that picking lands on the clicked point on a high-DPI screen")
 def test_picking_at_device_pixel_ratio_2(tmp_path):
     script = tmp_path / "hidpi.py"
     script.write_text(HIDPI_SCRIPT)

@@ -1,0 +1,136 @@
+"""Posed bodies against their true shape (#60): every joint and angle, every method, one run.
+
+    mannequin (and mannequin-large with --large): the default pipeline's connectivity
+        (skeletonize at thinness 0.5, connect to the nearest bone: what `volanim connect` gives)
+    for each joint and angle and method (rigid: today's default; smooth: --joints smooth, blend 1):
+        bone-mode reconstruction --compare_shapes--> posed_sample (the capsules posed by the same matrices)
+        Dice, the largest extra and missing blob (opened by one voxel) as % of the moved limb's voxels,
+        surface distance p95 (voxels)
+    goals (#60): Dice >= 0.995, largest blob <= 0.5 % of the moved limb, p95 <= 1.5 voxels
+
+Run: .venv/bin/python benchmarks/bench_shape.py [--large] [--step 15] [--joints "shoulder abduction,hip flexion"]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+#: joint -> (bone turned, largest angle, rotation of angle a in degrees given the bone's unit axis u)
+JOINTS = {
+    "shoulder abduction": ("L_UPPERARM", 150, lambda a, u: (0, -a, 0)),
+    "shoulder flexion": ("L_UPPERARM", 150, lambda a, u: (-a, 0, 0)),
+    "hip flexion": ("R_THIGH", 120, lambda a, u: (-a, 0, 0)),
+    "elbow": ("L_FOREARM", 150, lambda a, u: (-a, 0, 0)),
+    "knee": ("L_SHIN", 150, lambda a, u: (a, 0, 0)),
+    "neck": ("HEAD", 60, lambda a, u: (-a, 0, 0)),
+    "spine twist": ("SPINE", 60, lambda a, u: (0, 0, a)),
+    "forearm twist": ("L_FOREARM", 90, lambda a, u: Rotation.from_rotvec(u * np.radians(a)).as_matrix()),
+}
+METHODS = ("rigid", "smooth")
+GOALS = {"dice": 0.995, "blob": 0.5, "p95": 1.5}
+
+
+def default_connectivity(sample):
+    """What a user's pipeline gives: skeletonize (thinness >= 0.5), then every point to its nearest bone."""
+    from volanim_core.rig.attach import connect_nearest
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    return connect_nearest(skeletonize(sample.mask, min_thinness=0.5), sample.bones)
+
+
+def limb_voxels(sample, bone: str) -> int:
+    """The rest voxels of the moved bone and every bone below it: the limb a pose moves."""
+    bones = sample.bones
+    moved, grew = {bone}, True
+    while grew:
+        below = {b.label for b in bones.bones if b.proximal in
+                 {bones.bones[bones.index(m)].distal for m in moved}} - moved
+        grew = bool(below)
+        moved |= below
+    labels = [bones.index(n) + 1 for n in moved]
+    return int(np.isin(sample.part, labels).sum())
+
+
+def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
+    from volanim_core.posed_truth import posed_sample
+    from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.reconstruct.shape import compare_shapes
+    from volanim_core.rig.pose import pose_matrices, posed_joints
+    from volanim_core.rig.skinning import Joints
+
+    conn = default_connectivity(sample)
+    bones = sample.bones
+    rows = []
+    for label in joints:
+        bone, top, rotation = JOINTS[label]
+        b = bones.bones[bones.index(bone)]
+        axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
+        u = axis / np.linalg.norm(axis)
+        limb = limb_voxels(sample, bone)
+        for angle in range(0, top + 1, step):
+            m = pose_matrices(bones, {bone: rotation(angle, u)})
+            truth = posed_sample(name, m)
+            at = posed_joints(bones, m)
+            segments = {s.label: (at[s.proximal], at[s.distal]) for s in bones.bones}
+            for method in METHODS:
+                t0 = time.perf_counter()
+                r = reconstruct(conn.with_joints(Joints(method)).posed(m), mode="bone")
+                seconds = time.perf_counter() - t0
+                rep = compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin,
+                                     joints=at, segments=segments)
+                blobs = [b for b in (rep.largest_extra, rep.largest_missing) if b is not None]
+                worst = max(blobs, key=lambda b: b.voxels) if blobs else None
+                rows.append({"body": name, "joint": label, "angle": angle, "method": method, "dice": rep.dice,
+                             "extra": rep.largest_extra.voxels if rep.largest_extra else 0,
+                             "missing": rep.largest_missing.voxels if rep.largest_missing else 0,
+                             "blob %": 100 * (worst.voxels if worst else 0) / limb,
+                             "near": worst.near if worst else "", "p95": rep.surface_p95, "seconds": seconds})
+    return rows
+
+
+def meets(row: dict) -> bool:
+    return row["dice"] >= GOALS["dice"] and row["blob %"] <= GOALS["blob"] and row["p95"] <= GOALS["p95"]
+
+
+def print_table(rows: list[dict]) -> None:
+    print("| body | joint | angle | " + " | ".join(f"{m}: Dice / extra / missing / blob % limb / p95" for m in METHODS)
+          + " |")
+    print("|---|---|---|" + "---|" * len(METHODS))
+    keyed = {(r["body"], r["joint"], r["angle"], r["method"]): r for r in rows}
+    for body, joint, angle in dict.fromkeys((r["body"], r["joint"], r["angle"]) for r in rows):
+        cells = []
+        for m in METHODS:
+            r = keyed[(body, joint, angle, m)]
+            mark = "" if meets(r) else " ✗"
+            cells.append(f"{r['dice']:.4f} / {r['extra']} / {r['missing']} / {r['blob %']:.2f} / {r['p95']:.1f}{mark}")
+        print(f"| {body} | {joint} | {angle} | " + " | ".join(cells) + " |")
+    print()
+    for m in METHODS:
+        mine = [r for r in rows if r["method"] == m]
+        print(f"{m}: {sum(meets(r) for r in mine)} of {len(mine)} rows meet every goal "
+              f"(Dice >= {GOALS['dice']}, blob <= {GOALS['blob']} % of the limb, p95 <= {GOALS['p95']}); "
+              f"worst Dice {min(r['dice'] for r in mine):.4f}, largest blob {max(r['blob %'] for r in mine):.2f} %, "
+              f"worst p95 {max(r['p95'] for r in mine):.1f}; {np.median([r['seconds'] for r in mine]):.2f} s a frame")
+
+
+def main() -> None:
+    from volanim_core import samples
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--large", action="store_true", help="mannequin-large too")
+    parser.add_argument("--step", type=int, default=15, help="degrees between angles (default 15)")
+    parser.add_argument("--joints", default=",".join(JOINTS), help="comma-separated joints (default: all)")
+    args = parser.parse_args()
+    joints = [j.strip() for j in args.joints.split(",")]
+    rows = rows_for("mannequin", samples.mannequin(), args.step, joints)
+    if args.large:
+        rows += rows_for("mannequin-large", samples.mannequin_large(), args.step, joints)
+    print_table(rows)
+
+
+if __name__ == "__main__":
+    main()
