@@ -24,6 +24,8 @@ class Preview:
     mode: str
     report: BreakageReport | None = None
     rest_parts: RestParts | None = None  # what the report used, for the caller to keep
+    joints: dict | None = None  # the posed joints it was made for: playing, the bones drawn are these
+    frame: int | None = None  # the timeline frame it shows (None: not a frame of the timeline)
 
     @property
     def spacing(self) -> tuple[float, float, float]:

@@ -120,6 +120,7 @@ SETTINGS: dict[str, Setting] = {
     "mode": Setting(Mode.VIEW, mode, "the interaction mode (View, Bones, Root order, Cube, Lasso, Pose)"),
     "dragging": Setting(False, flag, "a slider is held: the scene draws light, previews wait for the release",
                         saved=False),
+    "playing": Setting(False, flag, "the timeline plays: the bones drawn are the drawn body's frame's", saved=False),
 }
 
 

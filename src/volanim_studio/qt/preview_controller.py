@@ -134,6 +134,9 @@ class PreviewController(Controller):
         except ValueError as exc:
             self.doc.message(str(exc))
             return
+        # what it shows: playing, the scene draws these bones with it, never the newer pose's
+        p.joints = self.doc.pose.posed_joints()
+        p.frame = self.doc.settings.current_frame if self.doc.timeline.active else None
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
         self.live_timings.append(time.perf_counter() - t0)
 

@@ -1,6 +1,7 @@
 """The timeline's actions: load clips, play, step, key, scan for breakage, export frames.
 
-    Play --> QTimer --> frame = start + elapsed * fps  (a slow preview drops frames, never lags)
+    Play --> QTimer --> frame = start + elapsed * fps  (a slow preview drops frames, never lags; the bones
+         drawn are the drawn body's frame's: settings.playing, the scene's PoseLayer)
          --> settings.current_frame --> Timeline.show_frame --> pose --> live preview (coalesced)
     Pause / scrub released --> the full preview with its report (in Pose mode)
     Scan --> JobRunner(scan_frames) --> ScanDialog (worst first; double-click jumps to the frame)
@@ -122,6 +123,7 @@ class TimelineController(Controller):
             return
         self.doc.settings.mode = Mode.POSE  # playing shows the posed preview
         self.doc.settings.dragging = True  # held while playing: live previews follow, a full one is cancelled
+        self.doc.settings.playing = True  # the bones drawn wait for the body of their frame
         self.shown_frames = []
         self._start = (time.perf_counter(), self.doc.settings.current_frame)
         self._play.start(max(5, int(1000 / tl.frame_rate)))
@@ -132,6 +134,7 @@ class TimelineController(Controller):
             return
         self._play.stop()
         self._sync_button()
+        self.doc.settings.playing = False  # the bones follow the pose again (the scene draws the frame's)
         self.doc.settings.dragging = False  # the full preview with its report, of the frame stopped on
 
     def _tick(self) -> None:

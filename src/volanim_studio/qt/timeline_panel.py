@@ -126,6 +126,7 @@ class TimelinePanel(QWidget):
         doc.events.timeline.connect(lambda **_: self.refresh())
         doc.events.bones.connect(lambda **_: self.refresh())
         doc.settings.events.current_frame.connect(lambda **_: self._show_info())
+        doc.events.preview.connect(lambda **_: self._show_info())  # playing: the frame the body shows
         self.refresh()
 
     def _option(self, **option) -> None:
@@ -165,4 +166,8 @@ class TimelinePanel(QWidget):
             text = f"keyed: {tl.frame_count} frames · {tl.frame_rate:.4g} fps" + (" · key" if f in tl.keys else "")
         else:
             text = "no animation: load a BVH or .trans frames, or set keys"
+        p = self.doc.preview
+        if self.doc.settings.playing and p is not None and p.frame is not None and p.frame != f:
+            # frames are dropped to keep up; the body and its bones are the same frame, which is said
+            text += f" · body at {tl.frame_number(p.frame) if tl.clip is not None else p.frame}"
         self.info.setText(text)

@@ -1,6 +1,7 @@
 """The pose stage of the scene: posed bones and preview reconstructions.
 
-    doc.events.pose --> posed bones and their axes (x-ray layer)
+    doc.events.pose --> posed bones and their axes (x-ray layer); while the timeline plays, the bones of
+                        the preview drawn (its ``joints``), so bones and body are always one frame
     doc.events.preview, settings.show_rest / slices --> draw(): the preview (or the rest pose's, to compare)
     doc.events.preview (with a report) --> the stumps' red boxes
 
@@ -55,16 +56,25 @@ class PoseLayer:
         view.doc.settings.events.show_rest.connect(lambda **_: self.draw())
         view.doc.settings.events.slices.connect(lambda **_: self.draw())
         view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
+        # stopped: the bones follow the pose again (drawn now, not at the next pose change)
+        view.doc.settings.events.playing.connect(lambda value: None if value else self.on_pose_changed())
 
     def on_pose_changed(self, **_) -> None:
         view = self.view
         view.plotter.remove_actor("stumps", render=False)  # they were where the previous pose put them
         if not view.posing:
             return
+        p = view.doc.preview
+        if view.doc.settings.playing and p is not None and p.joints is not None:
+            return  # playing: the bones wait for the body of their frame (draw() puts them with it)
+        self.draw_bones(view.doc.pose.posed_joints())
+
+    def draw_bones(self, pj: dict) -> None:
+        """The posed bones through the joints ``pj`` (name -> rest-grid voxels), and the working bone's axes."""
+        view = self.view
         view.xray.remove("posed_bones")
         bones = view.doc.bones
         if len(bones):
-            pj = view.doc.pose.posed_joints()
             poly = bone_lines(view.world(np.array([[pj[b.proximal], pj[b.distal]] for b in bones.bones])))
             poly.cell_data["rgb"] = label_table(len(bones))[1:]
             # over the preview (x-ray): the bones the user poses and clicks are never hidden inside it
@@ -109,6 +119,8 @@ class PoseLayer:
             except ValueError as exc:
                 doc.message(str(exc))
                 return
+        if p is not None and doc.settings.playing and p.joints is not None and self.view.posing:
+            self.draw_bones(p.joints)  # the body's own frame: bones and body never show two frames
         if p is None:
             self.clear()
         elif p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest

@@ -299,3 +299,56 @@ def test_the_view_and_the_movie_follow_the_walking_body(qtbot, rigged, tmp_path)
         drawn[follow] = [int((np.abs(m.astype(int) - background).max(axis=2) > 12).sum()) for m in movie]
     assert min(drawn[True]) > 300, drawn  # every frame shows the walker
     assert drawn[False][-1] < 50, drawn  # the view's own camera lost it
+
+
+def _drawn_bones(w) -> np.ndarray:
+    """The posed bones' segments as drawn, (n, 2, 3) in rest-grid voxels."""
+    mapper = w.scene.xray.actors["posed_bones"].GetMapper()
+    mapper.Update()  # its input is a pipeline's output: up to date at the next render, or now
+    return np.asarray(mapper.dataset.points).reshape(-1, 2, 3) / w.scene.spacing
+
+
+def _on_the_body(w, segments) -> float:
+    """The share of points along the drawn bones inside the drawn (live, half-resolution) body."""
+    p = w.doc.preview
+    vol = p.reconstruction.volume > 0
+    t = np.linspace(0.1, 0.9, 9)[None, :, None]
+    pts = (segments[:, :1] + t * (segments[:, 1:] - segments[:, :1])).reshape(-1, 3)
+    idx = np.rint((pts - p.origin_voxels) / p.factor).astype(int)
+    inside = np.all((idx >= 0) & (idx < vol.shape), axis=1)
+    hit = np.zeros(len(idx), bool)
+    hit[inside] = vol[tuple(idx[inside].T)]
+    return float(hit.mean())
+
+
+def test_playing_the_bones_drawn_are_the_drawn_body_s_frame(qtbot, rigged):
+    """#60: while the timeline played, the bones were drawn at each new frame's pose at once and the body
+    when its live preview came, frames later (35 % of the points along the bones lay on the drawn body).
+    Playing, the bones drawn are the preview's own; frames are dropped, never shown half. Driven frame by
+    frame here (what the play timer's tick does), so the interleavings are known: a frame whose preview has
+    not run yet, two frames in one pass of the event loop, and the preview of the newest."""
+    w = rigged
+    assert w.timeline.load_bvh(WALK)
+    w.set_mode(Mode.POSE)
+    w.timeline.play()
+    w.timeline._play.setInterval(3_600_000)  # the ticks are this test's: the player waits an hour between its own
+    assert w.doc.settings.playing and w.timeline.playing
+    for frame in (40, 80, 120, 160, 200):
+        w.doc.settings.current_frame = frame  # the pose changes now; its live preview comes at the next pass
+        drawn = w.doc.preview
+        if drawn is not None and drawn.joints is not None:  # the bones stay with the body on screen
+            bones = _drawn_bones(w)
+            want = np.array([[drawn.joints[b.proximal], drawn.joints[b.distal]] for b in w.doc.bones.bones])
+            assert np.allclose(bones, want, atol=1e-4), f"frame {frame}: bones ahead of the body"
+        w.doc.settings.current_frame = frame + 10  # a second frame before the event loop runs: dropped
+        qtbot.waitUntil(lambda f=frame: w.doc.preview is not None and w.doc.preview.frame == f + 10, timeout=10_000)
+        bones = _drawn_bones(w)
+        pj = w.doc.pose.posed_joints()  # frame + 10's pose, which the preview drawn shows
+        want = np.array([[pj[b.proximal], pj[b.distal]] for b in w.doc.bones.bones])
+        assert np.allclose(bones, want, atol=1e-4)
+        assert _on_the_body(w, bones) > 0.9, f"frame {frame + 10}: the bones are not on the body drawn"
+    w.timeline.stop()
+    assert not w.doc.settings.playing
+    bones = _drawn_bones(w)  # stopped: the bones follow the pose again
+    pj = w.doc.pose.posed_joints()
+    assert np.allclose(bones, [[pj[b.proximal], pj[b.distal]] for b in w.doc.bones.bones], atol=1e-4)
