@@ -48,7 +48,8 @@ demo: install
 	fi
 
 # Two tiers, as napari and scikit-image have them (README, "Testing"). Two pytest-xdist workers, each
-# with its own virtual display (pytest-xvfb); hypothesis draws the same examples every run (tests/conftest.py).
+# with its own virtual display (pytest-xvfb); no test depends on another having run in the same process
+# (xdist may put them on different workers); hypothesis draws the same examples every run (tests/conftest.py).
 #   make test      every unit, model, GUI and CLI test that proves a behaviour: under 10 minutes on 2 cores
 #   make test-all  everything: also the `slow` tier (the README and --help chains, the fault corpus,
 #                  disk-full, real clips, Visible-Human scale, long property runs); what .ci/run runs

@@ -7,6 +7,8 @@
         Dice, the largest extra and missing blob (opened by one voxel) as % of the moved limb's voxels,
         surface distance p95 (voxels)
     goals (#60): Dice >= 0.995, largest blob <= 0.5 % of the moved limb, p95 <= 1.5 voxels
+    the report's lumps (reconstruct/lumps.py, no truth) against the truth's extra blobs: a row has a true
+    lump when its largest extra blob is >= 0.5 % of the limb; recall and precision of the flags (rigid)
 
 Run: .venv/bin/python benchmarks/bench_shape.py [--large] [--step 15] [--joints "shoulder abduction,hip flexion"]
 """
@@ -42,7 +44,7 @@ def default_connectivity(sample):
     return connect_nearest(skeletonize(sample.mask, min_thinness=0.5), sample.bones)
 
 
-def limb_voxels(sample, bone: str) -> int:
+def moved_limb_voxels(sample, bone: str) -> int:
     """The rest voxels of the moved bone and every bone below it: the limb a pose moves."""
     bones = sample.bones
     moved, grew = {bone}, True
@@ -57,20 +59,26 @@ def limb_voxels(sample, bone: str) -> int:
 
 def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
     from volanim_core.posed_truth import posed_sample
+    from volanim_core.reconstruct.breakage import RestParts
     from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.reconstruct.lumps import bone_reach, find_lumps, limb_voxels
     from volanim_core.reconstruct.shape import compare_shapes
     from volanim_core.rig.pose import pose_matrices, posed_joints
     from volanim_core.rig.skinning import Joints
 
     conn = default_connectivity(sample)
     bones = sample.bones
+    rest = RestParts.of(conn)
+    rest_segments = [(b.proximal, b.distal) for b in conn.bones]
+    reach = bone_reach(rest_segments, *rest.voxels)
+    limbs = limb_voxels(rest_segments, rest.voxels[1])
     rows = []
     for label in joints:
         bone, top, rotation = JOINTS[label]
         b = bones.bones[bones.index(bone)]
         axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
         u = axis / np.linalg.norm(axis)
-        limb = limb_voxels(sample, bone)
+        limb = moved_limb_voxels(sample, bone)
         for angle in range(0, top + 1, step):
             m = pose_matrices(bones, {bone: rotation(angle, u)})
             truth = posed_sample(name, m)
@@ -82,13 +90,17 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
                 seconds = time.perf_counter() - t0
                 rep = compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin,
                                      joints=at, segments=segments)
+                lumps = find_lumps(r.volume, r.origin, m, rest_segments, reach, rest.rest_bone.volume,
+                                   rest.rest_bone.origin, at, limbs) if method == "rigid" else []
                 blobs = [b for b in (rep.largest_extra, rep.largest_missing) if b is not None]
                 worst = max(blobs, key=lambda b: b.voxels) if blobs else None
                 rows.append({"body": name, "joint": label, "angle": angle, "method": method, "dice": rep.dice,
                              "extra": rep.largest_extra.voxels if rep.largest_extra else 0,
                              "missing": rep.largest_missing.voxels if rep.largest_missing else 0,
                              "blob %": 100 * (worst.voxels if worst else 0) / limb,
-                             "near": worst.near if worst else "", "p95": rep.surface_p95, "seconds": seconds})
+                             "near": worst.near if worst else "", "p95": rep.surface_p95, "seconds": seconds,
+                             "flagged": lumps[0].voxels if lumps else 0, "flagged near": lumps[0].near if lumps else "",
+                             "true lump": (rep.largest_extra.voxels if rep.largest_extra else 0) / limb >= 0.005})
     return rows
 
 
@@ -117,6 +129,22 @@ def print_table(rows: list[dict]) -> None:
               f"worst p95 {max(r['p95'] for r in mine):.1f}; {np.median([r['seconds'] for r in mine]):.2f} s a frame")
 
 
+def print_lumps(rows: list[dict]) -> None:
+    """The report's lumps (no truth) against the truth's: recall and precision over the rigid rows."""
+    for body in dict.fromkeys(r["body"] for r in rows):
+        mine = [r for r in rows if r["method"] == "rigid" and r["body"] == body]
+        true = [r for r in mine if r["true lump"]]
+        flagged = [r for r in mine if r["flagged"]]
+        hit = [r for r in true if r["flagged"]]
+        print(f"{body}, rigid: the report flags a lump on {len(flagged)} of {len(mine)} rows; {len(true)} rows have a "
+              f"true lump (an extra blob >= 0.5 % of the limb): recall {len(hit)}/{len(true)}, precision "
+              f"{len([r for r in flagged if r['true lump']])}/{len(flagged)}")
+        for r in mine:
+            if r["flagged"] and not r["true lump"] or r["true lump"] and not r["flagged"]:
+                print(f"  {r['joint']} {r['angle']}: flagged {r['flagged']} voxels near {r['flagged near'] or '-'}, "
+                      f"true extra blob {r['extra']} voxels")
+
+
 def main() -> None:
     from volanim_core import samples
 
@@ -130,6 +158,8 @@ def main() -> None:
     if args.large:
         rows += rows_for("mannequin-large", samples.mannequin_large(), args.step, joints)
     print_table(rows)
+    print()
+    print_lumps(rows)
 
 
 if __name__ == "__main__":

@@ -62,6 +62,7 @@ class BreakageReport:
     pieces: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid) of torn-off parts
     stumps: list = field(default_factory=list)  # Stump, largest first
     rest_pieces: int = 1  # the body's pieces at rest: pieces the pose keeps apart are not breakage
+    lumps: list = field(default_factory=list)  # Lump (lumps.py), largest first: flesh carried off (rigid frames)
     source_coverage: tuple[int, int] | None = None  # (covered at rest, object voxels) of the scan, when given
 
     @property
@@ -83,9 +84,11 @@ class BreakageReport:
         if self.stumps:
             s = self.stumps[0]
             return f"STUMP left behind near {s.joint}: {s.points} points of {s.attached} lie along {s.lies_along}"
+        first = self.lumps[0] if self.lumps else None
+        lump = f"; but a lump near {first.near}: {first.voxels} voxels carried off" if first else ""
         if self.rest_pieces > 1:
-            return f"healthy: nothing torn off (the rest pose too is {self.rest_pieces:,} pieces), no stump"
-        return "healthy: one piece, no stump"
+            return f"healthy: nothing torn off (the rest pose too is {self.rest_pieces:,} pieces), no stump{lump}"
+        return f"healthy: one piece, no stump{lump}"
 
     def lines(self) -> list[str]:
         out = [f"{len(self.components)} connected component(s)"
@@ -94,6 +97,7 @@ class BreakageReport:
                + (f"; {self.rest_pieces:,} at rest" if self.rest_pieces > 1 else ""),
                *(f"piece of {n} voxels torn off near {j}" for n, j, _ in self.pieces[:5]),
                *(s.text() for s in self.stumps[:5]),
+               *(lump.text() for lump in self.lumps[:5]),
                f"{self.posed_voxels} voxels, {self.loss_percent:+.2f} % loss against the rest pose "
                f"({self.lost_voxels} rest voxels not covered in the pose)",
                f"{self.cracks} cracks (sphere pairs of different bones that touched at rest and part in the pose)",
@@ -340,6 +344,7 @@ class RestParts:
     pairs: tuple
     piece: np.ndarray | None = None  # per rest voxel, the rest piece it belongs to (1..pieces)
     pieces: int = 1  # how many 26-connected pieces the body is at rest
+    reach: tuple | None = None  # each bone's reach and limb (lumps.py), made by the first report that needs them
 
     @classmethod
     def of(cls, conn: Connectivity, cancel=None) -> RestParts:
@@ -360,7 +365,7 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     ----------
     tskel : the posed frame
     joints, posed_joints : joint name -> rest / posed position
-    posed : the frame's reconstruction, already made (bone or any mode), reused
+    posed : the frame's bone-mode reconstruction, already made, reused
     rest : :class:`RestParts` of the frame's connectivity, when the caller keeps them (made when None)
     cancel : callable, optional
         ``cancel() -> True`` raises :class:`~volanim_core.errors.Cancelled` between phases.
@@ -383,6 +388,8 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     report = BreakageReport([n for n, _, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
                             cracks=len(gaps), stumps=stumps(tskel, joints), rest_pieces=rest.pieces)
+    if not tskel.joints.smooth:  # a blended voxel has no one bone to follow back
+        report.lumps = _lumps(tskel, posed, rest, {n: posed_joints.get(n, joints[n]) for n in joints})
     names = list(joints)
     posed_pos = np.array([posed_joints.get(n, joints[n]) for n in names], np.float64) if names else None
     for size, centroid, k in parts:
@@ -403,3 +410,15 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
                 report.joints.append(JointLoss(n, int(counts[k]), np.asarray(joints[n]),
                                                np.asarray(posed_joints.get(n, joints[n])), float(weight[k])))
     return report
+
+
+def _lumps(tskel: Tskel, posed: Reconstruction, rest: RestParts, posed_joints: dict) -> list:
+    """Flesh the pose carried off (:mod:`.lumps`); ``posed`` must be the bone-mode reconstruction."""
+    from volanim_core.reconstruct.lumps import bone_reach, find_lumps, limb_voxels
+
+    segments = [(b.proximal, b.distal) for b in tskel.bones]
+    if rest.reach is None:
+        rest.reach = bone_reach(segments, *rest.voxels), limb_voxels(segments, rest.voxels[1])
+    reach, limbs = rest.reach
+    return find_lumps(posed.volume, posed.origin, np.asarray(tskel.matrices, np.float64), segments, reach,
+                      rest.rest_bone.volume, rest.rest_bone.origin, posed_joints, limbs)

@@ -89,6 +89,8 @@ def report_json(rep: BreakageReport) -> dict:
            "pieces": [{"voxels": int(n), "near": j, "at": [round(float(v), 3) for v in c]} for n, j, c in rep.pieces],
            "stumps": [{"points": s.points, "near": s.joint, "attached": s.attached, "lies_along": s.lies_along}
                       for s in rep.stumps],
+           "lumps": [{"voxels": lump.voxels, "near": lump.near, "at": [round(float(v), 3) for v in lump.centre]}
+                     for lump in rep.lumps],
            "joints": [{"name": j.name, "cracks": j.lost, "gap": round(j.gap, 3)} for j in rep.joints]}
     if rep.source_coverage is not None:
         covered, total = rep.source_coverage

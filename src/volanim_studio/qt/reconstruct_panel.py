@@ -108,6 +108,10 @@ class ReconstructPanel(QWidget):
                                    f"(connect them to {s.lies_along})")
             item.setData(Qt.UserRole, s.joint)
             self.joints.addItem(item)
+        for lump in r.lumps:
+            item = QListWidgetItem(f"lump: {lump.voxels} voxels of flesh carried off near {lump.near}")
+            item.setData(Qt.UserRole, lump.near)
+            self.joints.addItem(item)
         total = max(sum(j.gap for j in r.joints), 1e-9)
         for j in r.joints:
             item = QListWidgetItem(f"{j.name}: {j.lost} cracks ({100 * j.gap / total:.0f} % of the opening)")

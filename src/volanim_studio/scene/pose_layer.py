@@ -3,7 +3,7 @@
     doc.events.pose --> posed bones and their axes (x-ray layer); while the timeline plays, the bones of
                         the preview drawn (its ``joints``), so bones and body are always one frame
     doc.events.preview, settings.show_rest / slices --> draw(): the preview (or the rest pose's, to compare)
-    doc.events.preview (with a report) --> the stumps' red boxes
+    doc.events.preview (with a report) --> the stumps' red boxes, the lumps' white ones
 
 Owned by :class:`~volanim_studio.scene.view.SceneView`. Full previews are
 volumes with a transfer function per mode (``volanim_core.render``); live
@@ -32,6 +32,7 @@ from volanim_core.render.volume_style import (
 from volanim_core.rig.pose import apply_matrices
 
 STUMP_COLOUR = "#ff3030"
+LUMP_COLOUR = "#ffffff"  # flesh carried off (reconstruct/lumps.py): white over a black halo, seen on any bone colour
 AXIS_COLOURS = ((230, 60, 60), (60, 200, 80), (70, 120, 255))  # x, y, z: the Pose tab names them so
 
 
@@ -62,6 +63,8 @@ class PoseLayer:
     def on_pose_changed(self, **_) -> None:
         view = self.view
         view.plotter.remove_actor("stumps", render=False)  # they were where the previous pose put them
+        view.plotter.remove_actor("lumps", render=False)
+        view.plotter.remove_actor("lumps_halo", render=False)
         if not view.posing:
             return
         p = view.doc.preview
@@ -136,6 +139,19 @@ class PoseLayer:
         if p is not None and p.report is None:
             return  # a live preview: the marks of the last report stay until the pose changes
         view.plotter.remove_actor("stumps", render=False)
+        view.plotter.remove_actor("lumps", render=False)
+        view.plotter.remove_actor("lumps_halo", render=False)
+        lumps = [] if p is None else p.report.lumps
+        if lumps:  # a white box around each lump: flesh the pose carried off
+            boxes = []
+            for lump in lumps:
+                lo, hi = view.world(lump.lo[None] - 1)[0], view.world(lump.hi[None] + 1)[0]
+                boxes.append(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).extract_all_edges())
+            edges = pv.merge(boxes)
+            view.plotter.add_mesh(edges, color="black", line_width=6, name="lumps_halo", render=False,
+                                  reset_camera=False, pickable=False)
+            view.plotter.add_mesh(edges.copy(), color=LUMP_COLOUR, line_width=2, name="lumps", render=False,
+                                  reset_camera=False, pickable=False)
         stumps = [] if p is None else p.report.stumps
         if stumps:
             # a red box around each stump: its spheres sit inside the preview, which would hide points

@@ -219,3 +219,27 @@ def test_one_typed_angle_is_one_undo_step_and_ctrl_z_reaches_it_from_the_field(q
     qtbot.keyClick(spin, Qt.Key_Z, Qt.ControlModifier)
     assert np.allclose(w.doc.pose.angles_of(arm), (0, 0, 0)) and spin.value() == 0
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+
+
+def test_the_lump_under_a_raised_arm_is_said_listed_and_boxed(qtbot, posed_window, tmp_path):
+    """#60: L_UPPERARM raised 90 degrees with the bundled (nearest-bone) attachments: the armpit's flesh hangs
+    under the arm and the report said "healthy". Now the verdict names the lump, the Reconstruct tab lists it
+    (a click goes to the shoulder) and a white box with a black halo marks it in 3-D."""
+    w = posed_window
+    doc = w.doc
+    doc.select_bones([doc.bones.index("L_UPPERARM")])
+    drag(qtbot, w, 1, range(0, -91, -10))
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    r = doc.preview.report
+    assert r.healthy and r.lumps and r.lumps[0].near == "L_SHOULDER"
+    for label in (w.verdict_label, w.pose_panel.verdict):
+        assert "lump near L_SHOULDER" in label.text()
+    items = [w.reconstruct_panel.joints.item(i) for i in range(w.reconstruct_panel.joints.count())]
+    lump_items = [i for i in items if i.text().startswith("lump:")]
+    assert lump_items and lump_items[0].data(Qt.UserRole) == "L_SHOULDER"
+    box = np.reshape(w.plotter.renderer.actors["lumps"].GetBounds(), (3, 2))
+    centre = w.scene.world(r.lumps[0].centre[None])[0]
+    assert (box[:, 0] <= centre).all() and (box[:, 1] >= centre).all()
+    w.plotter.screenshot(str(tmp_path / "lump.png"))
+    w.pose_panel.sliders[1].setValue(0)  # back at rest: the marks go with the pose change
+    assert "lumps" not in w.plotter.renderer.actors and "lumps_halo" not in w.plotter.renderer.actors

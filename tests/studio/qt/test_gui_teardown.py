@@ -5,7 +5,12 @@ from __future__ import annotations
 import pytest
 
 pytestmark = pytest.mark.gui
-DESTROYED: list[str] = []
+
+# Two tests of their own session: the second reads what the first one's teardown did, so they must run in
+# one process, in this order (as two tests of this module, two xdist workers split them now and then, and
+# the second failed: the flake check caught it).
+PAIR = """
+DESTROYED = []
 
 
 def test_a_window_is_opened_and_left_to_pytest_qt(qtbot):
@@ -21,6 +26,23 @@ def test_a_window_is_opened_and_left_to_pytest_qt(qtbot):
 def test_the_previous_window_is_gone_before_this_test_runs_an_event_loop():
     # no event loop has run since the previous test: only its own teardown can have deleted it
     assert DESTROYED == ["window"]
+"""
+
+
+def test_a_test_s_window_is_destroyed_in_its_own_teardown(tmp_path):
+    """The pair in a session of its own, with the studio tests' teardown (``widgets_deleted_in_their_own_test``)."""
+    import subprocess
+    import sys
+
+    from paths import REPO
+
+    (tmp_path / "test_pair.py").write_text(PAIR)
+    (tmp_path / "conftest.py").write_text(f"import sys\nsys.path.insert(0, {str(REPO / 'tests')!r})\n"
+                                          "from studio.conftest import widgets_deleted_in_their_own_test  # noqa\n")
+    plugins = ["-p", "no:cacheprovider", "-p", "no:napari", "-p", "no:npe2", "-p", "no:napari-plugin-engine"]
+    r = subprocess.run([sys.executable, "-m", "pytest", "-q", *plugins, "-o", "addopts=", "test_pair.py"],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0 and "2 passed" in r.stdout, r.stdout[-3000:] + r.stderr[-3000:]
 
 
 def _surface_wrappers() -> list:

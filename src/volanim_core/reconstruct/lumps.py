@@ -1,0 +1,166 @@
+"""Flesh a pose carried where its bone cannot carry it (lumps), found without the body's true shape.
+
+    rest owner voxels (RestParts.voxels, rigid joints: each voxel's bone)
+      --> each bone's reach: 1.3 x the 75th percentile of its own rest voxels' distance to its segment, + 1
+    posed bone volume: each voxel q, its owner b, the rest point it came from p = [q 1] M_b^-1
+      carried ....... p lay beyond b's reach but within another bone c's (the nearest such c)
+      moved away .... c would have kept that flesh at [p 1] M_c, more than 1.5 voxels from q
+      nobody's own .. no bone k's own rest flesh lands on q ([q 1] M_k^-1 is owned by k at rest)
+    --> opened by one voxel (a one-voxel rim is not a lump), 26-connected pieces, largest first
+    --> kept when at least SHARE of the limb that carried it (its bone and the bones below, at rest)
+    --> Lump(voxels, the posed joint nearest its centre, centre)
+
+Why: the nearest-bone connect gives a limb the torso's flesh next to its joint (the armpit, the groin).
+When the limb turns, that flesh turns with it and hangs beside the body: the lump a person sees under a
+raised arm, which cracks, stumps, pieces and volume do not see. A bone's reach is where its own flesh
+lies at rest; flesh from another bone's reach that the pose moved away from that bone, to a place no
+bone's own flesh is, is a lump. Measured against the mannequin's true shape (benchmarks/bench_shape.py,
+the README): on the 70 rigid poses of every joint it names the rows whose largest extra blob is 0.5 % of
+the moved limb or more, and nearly no other. Frames with smooth joints are not judged (a blended voxel
+has no one bone to follow back).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from volanim_core.reconstruct.shape import OPENING, PIECES
+
+REACH_PERCENTILE, REACH_SCALE, REACH_MARGIN = 75, 1.3, 1.0
+MOVED = 1.5  # voxels: flesh its host bone would have kept within this of where it is was not moved away
+MIN_VOXELS = 20  # smaller pieces are the rasterisation's, not a lump a person sees
+SHARE = 0.005  # of the carrying limb's voxels: #60's bar for a lump a person sees (a fist under an arm is 6 %)
+
+
+@dataclass
+class Lump:
+    voxels: int
+    near: str  # the posed joint nearest its centre
+    centre: np.ndarray  # rest-grid voxels, posed frame
+    lo: np.ndarray | None = None  # its box, the same voxels (the studio draws it)
+    hi: np.ndarray | None = None
+
+    def __eq__(self, other) -> bool:  # two reports of one frame compare equal (the arrays element by element)
+        return isinstance(other, Lump) and (self.voxels, self.near) == (other.voxels, other.near) and all(
+            np.array_equal(a, b) for a, b in ((self.centre, other.centre), (self.lo, other.lo), (self.hi, other.hi)))
+
+    def text(self) -> str:
+        return f"lump near {self.near}: {self.voxels} voxels of flesh carried off where no bone's own flesh is"
+
+
+def segment_distance(points: np.ndarray, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
+    """Euclidean distance of each point to the segment ``p0``-``p1``."""
+    ab = np.asarray(p1, float) - np.asarray(p0, float)
+    t = np.clip((points - p0) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0)
+    return np.linalg.norm(points - (p0 + t[:, None] * ab), axis=1)
+
+
+def bone_reach(segments: list[tuple[np.ndarray, np.ndarray]], voxels: np.ndarray, bone: np.ndarray) -> np.ndarray:
+    """Each bone's reach (voxels from its segment) from its own rest voxels: ``(B,)``."""
+    reach = np.full(len(segments), REACH_MARGIN)
+    for b, (p0, p1) in enumerate(segments):
+        own = voxels[bone == b].astype(np.float64)
+        if len(own):
+            reach[b] = REACH_SCALE * np.percentile(segment_distance(own, p0, p1), REACH_PERCENTILE) + REACH_MARGIN
+    return reach
+
+
+def limb_voxels(segments, bone: np.ndarray) -> np.ndarray:
+    """Each bone's limb at rest: its own voxels and those of every bone below it (a bone whose proximal
+    joint is its distal one, and so on): ``(B,)``."""
+    own = np.bincount(bone, minlength=len(segments)).astype(np.int64)
+    children = [[c for c, (p0, _) in enumerate(segments) if c != b and np.allclose(p0, segments[b][1])]
+                for b in range(len(segments))]
+    out = np.zeros(len(segments), np.int64)
+    for b in range(len(segments)):
+        todo, seen = [b], set()
+        while todo:
+            k = todo.pop()
+            if k not in seen:
+                seen.add(k)
+                todo.extend(children[k])
+        out[b] = own[sorted(seen)].sum()
+    return out
+
+
+def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, reach: np.ndarray,
+               rest_owner: np.ndarray, rest_origin, joints: dict[str, np.ndarray],
+               limbs: np.ndarray | None = None) -> list[Lump]:
+    """The lumps of a rigid frame (see the module docstring), largest first.
+
+    Parameters
+    ----------
+    posed_bone : (X, Y, Z) ints
+        The frame's bone-mode reconstruction (bone + 1 per voxel), its voxel [0, 0, 0] at ``origin``.
+    matrices : (B, 4, 4)
+        The frame's bone matrices, rest voxels -> posed (``[x y z 1] @ M``).
+    segments : list of (proximal, distal)
+        Each bone's rest segment (the ``Root:`` records).
+    reach : (B,)
+        :func:`bone_reach` of the connectivity.
+    rest_owner : (X, Y, Z) ints
+        The rest frame's bone-mode reconstruction (bone + 1), its voxel [0, 0, 0] at ``rest_origin``.
+    joints : dict
+        Posed joint positions, to name each lump's place.
+    limbs : (B,), optional
+        :func:`limb_voxels` of the connectivity: a lump is kept when it is SHARE of the limb that carried it
+        (None: every piece of MIN_VOXELS or more).
+    """
+    q = np.argwhere(posed_bone > 0)
+    own = posed_bone[tuple(q.T)].astype(np.int64) - 1
+    qf = q.astype(np.float64) + np.asarray(origin, np.float64)
+    inverse = np.linalg.inv(matrices)
+    rest = np.empty_like(qf)
+    beyond = np.zeros(len(q), bool)
+    for b in np.unique(own):  # where each voxel's flesh lay at rest, and whether its own bone reaches there
+        sel = own == b
+        rest[sel] = qf[sel] @ inverse[b, :3, :3] + inverse[b, 3, :3]
+        beyond[sel] = segment_distance(rest[sel], *segments[b]) > reach[b]
+    cand = np.flatnonzero(beyond)
+    if not len(cand):
+        return []
+    d = np.stack([segment_distance(rest[cand], *segments[c]) for c in range(len(segments))], axis=1)
+    inside = d <= reach[None, :]
+    host = np.argmin(np.where(inside, d, np.inf), axis=1)
+    keep = inside.any(axis=1)  # within another bone's reach at rest: that bone's flesh, carried
+    kept_at = np.empty((len(cand), 3))
+    for c in np.unique(host):
+        sel = host == c
+        kept_at[sel] = rest[cand[sel]] @ matrices[c, :3, :3] + matrices[c, 3, :3]
+    keep &= np.linalg.norm(kept_at - qf[cand], axis=1) > MOVED  # ... and moved away from it
+    cand = cand[keep]
+    rest_origin = np.asarray(rest_origin, np.int64)
+    for k in range(len(segments)):  # a bone whose own rest flesh lands here: overlap, not a lump
+        if not len(cand):
+            break
+        at = np.rint(qf[cand] @ inverse[k, :3, :3] + inverse[k, 3, :3]).astype(np.int64) - rest_origin
+        ok = np.all((at >= 0) & (at < rest_owner.shape), axis=1)
+        theirs = np.zeros(len(cand), bool)
+        theirs[ok] = rest_owner[tuple(at[ok].T)] == k + 1
+        cand = cand[~(theirs & (own[cand] != k))]
+    if not len(cand):
+        return []
+    flagged = np.zeros(posed_bone.shape, bool)
+    flagged[tuple(q[cand].T)] = True
+    labels, n = ndimage.label(ndimage.binary_opening(flagged, OPENING), PIECES)
+    if not n:
+        return []
+    sizes = np.bincount(labels.ravel())[1:]
+    names = list(joints)
+    at = np.array([joints[n] for n in names], np.float64) if names else None
+    lumps = []
+    for k in np.argsort(-sizes, kind="stable"):
+        if sizes[k] < MIN_VOXELS:
+            break
+        if limbs is not None:  # the limb that carried it: its voxels' most common owner's
+            carrier = np.bincount(posed_bone[labels == k + 1].astype(np.int64) - 1).argmax()
+            if sizes[k] < SHARE * limbs[carrier]:
+                continue
+        where = np.argwhere(labels == k + 1) + np.asarray(origin, np.float64)
+        centre = where.mean(axis=0)
+        near = names[int(((at - centre) ** 2).sum(axis=1).argmin())] if names else ""
+        lumps.append(Lump(int(sizes[k]), near, centre, where.min(axis=0), where.max(axis=0)))
+    return lumps

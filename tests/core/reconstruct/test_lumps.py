@@ -1,0 +1,75 @@
+"""Lumps: flesh a pose carried where its bone cannot carry it, found without the true shape (lumps.py),
+checked against the mannequin's true shape (posed_truth, compare_shapes)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import io
+from volanim_core.posed_truth import posed_sample
+from volanim_core.reconstruct.breakage import RestParts, breakage_report
+from volanim_core.reconstruct.shape import compare_shapes
+from volanim_core.rig.pose import pose_matrices, posed_joints
+from volanim_core.rig.skinning import Joints
+
+
+@pytest.fixture(scope="module")
+def rig():
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")  # the default pipeline's: nearest bone
+    return conn, io.read_bones(ASSETS / "mannequin.bones"), RestParts.of(conn)
+
+
+def _report(rig, rotations, joints=None):
+    conn, bones, rest = rig
+    m = pose_matrices(bones, rotations)
+    c = conn if joints is None else conn.with_joints(joints)
+    return breakage_report(c.posed(m), dict(bones.joints), posed_joints(bones, m), rest=None if joints else rest), m
+
+
+def test_the_lump_under_a_raised_arm_is_flagged_where_the_true_shape_has_it(rig):
+    """#60's case: L_UPPERARM raised 90 degrees. The nearest-bone connect gave the arm the armpit's flesh;
+    it hangs under the arm (the true shape's largest extra blob). The report names it near the shoulder,
+    about that size, and the verdict says so while the pose stays healthy (nothing torn, no stump)."""
+    rep, m = _report(rig, {"L_UPPERARM": (0, -90, 0)})
+    assert rep.healthy and rep.lumps and rep.lumps[0].near == "L_SHOULDER"
+    assert "lump near L_SHOULDER" in rep.verdict and any("lump near L_SHOULDER" in line for line in rep.lines())
+    from volanim_core.reconstruct.engine import reconstruct
+
+    posed = reconstruct(rig[0].posed(m), mode="bone")
+    truth = posed_sample("mannequin", m)
+    blob = compare_shapes(posed.volume, truth.volume, ours_origin=posed.origin, truth_origin=truth.origin).largest_extra
+    assert 0.6 * blob.voxels < rep.lumps[0].voxels < 1.2 * blob.voxels  # 736 flagged, 946 true
+    assert np.linalg.norm(rep.lumps[0].centre - np.array(blob.centre)) < 8
+
+
+@pytest.mark.parametrize("rotations", [{}, {"L_FOREARM": (-90, 0, 0)}, {"L_SHIN": (120, 0, 0)},
+                                       {"L_FOREARM": (0, 0, 0), "HEAD": (-30, 0, 0)}])
+def test_poses_whose_true_shape_has_no_lump_have_none(rig, rotations):
+    """The rest pose, a bent elbow and knee, a nodding head: the true shape has no extra blob of 0.5 % of the
+    limb, and the report flags nothing."""
+    rep, _ = _report(rig, rotations)
+    assert rep.lumps == [] and "lump" not in rep.verdict
+
+
+def test_frames_with_smooth_joints_are_not_judged(rig):
+    rep, _ = _report(rig, {"L_UPPERARM": (0, -90, 0)}, Joints("smooth"))
+    assert rep.lumps == []
+
+
+def test_a_limb_is_its_bone_and_every_bone_below_it():
+    from volanim_core.reconstruct.lumps import limb_voxels
+
+    a, b, c, d = (np.array(p, float) for p in ((0, 0, 0), (0, 0, 10), (0, 0, 20), (5, 0, 10)))
+    segments = [(a, b), (b, c), (b, d), (c, c + 1)]  # a trunk, two children at its end, a grandchild
+    bone = np.array([0] * 5 + [1] * 3 + [2] * 2 + [3] * 7)
+    assert limb_voxels(segments, bone).tolist() == [17, 10, 2, 7]
+
+
+def test_report_json_lists_the_lumps(rig):
+    from volanim_core.reconstruct.checks import report_json
+
+    rep, _ = _report(rig, {"L_UPPERARM": (0, -90, 0)})
+    lumps = report_json(rep)["lumps"]
+    assert lumps[0]["near"] == "L_SHOULDER" and lumps[0]["voxels"] == rep.lumps[0].voxels and len(lumps[0]["at"]) == 3
