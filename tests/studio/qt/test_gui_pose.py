@@ -64,7 +64,7 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     assert np.array_equal(p.reconstruction.volume, direct.volume)
     text = w.reconstruct_panel.report.text()
     assert "healthy: one piece" in text and "cracks" in text and "hotspot" in text
-    assert w.reconstruct_panel.joints.count() == len(p.report.joints) + len(p.report.pieces)
+    assert w.reconstruct_panel.joints.count() == len(p.report.joints) + len(p.report.pieces) + len(p.report.lumps)
     actor = w.scene.pose_layer.preview_actor
     assert actor is not None and actor.GetVisibility()
     # the CPU ray caster on software OpenGL (this machine: llvmpipe under Xvfb), the smart mapper on a GPU
