@@ -52,7 +52,7 @@ demo: install
 # (xdist may put them on different workers); hypothesis draws the same examples every run (tests/conftest.py).
 #   make test      every unit, model, GUI and CLI test that proves a behaviour: under 10 minutes on 2 cores
 #   make test-all  everything: also the `slow` tier (the README and --help chains, the fault corpus,
-#                  disk-full, real clips, Visible-Human scale, long property runs); what .ci/run runs
+#                  disk-full, Visible-Human scale, long property runs, the longest CLI chains); what .ci/run runs
 #   make flake     the default tier FLAKE_RUNS times under a CPU load: any test whose result changes
 #   make explore   the property tests drawing new examples (HYPOTHESIS_PROFILE=explore)
 PYTEST_WORKERS ?= 2
