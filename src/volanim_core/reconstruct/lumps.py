@@ -28,6 +28,8 @@ import numpy as np
 from scipy import ndimage
 
 from volanim_core.reconstruct.shape import OPENING, PIECES
+from volanim_core.rig.attach import segment_distances
+from volanim_core.rig.skinning import segment_distance
 
 REACH_PERCENTILE, REACH_SCALE, REACH_MARGIN = 75, 1.3, 1.0
 MOVED = 1.5  # voxels: flesh its host bone would have kept within this of where it is was not moved away
@@ -49,13 +51,6 @@ class Lump:
 
     def text(self) -> str:
         return f"lump near {self.near}: {self.voxels} voxels of flesh carried off where no bone's own flesh is"
-
-
-def segment_distance(points: np.ndarray, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
-    """Euclidean distance of each point to the segment ``p0``-``p1``."""
-    ab = np.asarray(p1, float) - np.asarray(p0, float)
-    t = np.clip((points - p0) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0)
-    return np.linalg.norm(points - (p0 + t[:, None] * ab), axis=1)
 
 
 def bone_reach(segments: list[tuple[np.ndarray, np.ndarray]], voxels: np.ndarray, bone: np.ndarray) -> np.ndarray:
@@ -122,7 +117,7 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
     cand = np.flatnonzero(beyond)
     if not len(cand):
         return []
-    d = np.stack([segment_distance(rest[cand], *segments[c]) for c in range(len(segments))], axis=1)
+    d = segment_distances(rest[cand], np.array([[p0, p1] for p0, p1 in segments], np.float64))
     inside = d <= reach[None, :]
     host = np.argmin(np.where(inside, d, np.inf), axis=1)
     keep = inside.any(axis=1)  # within another bone's reach at rest: that bone's flesh, carried
@@ -143,8 +138,14 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
         cand = cand[~(theirs & (own[cand] != k))]
     if not len(cand):
         return []
-    flagged = np.zeros(posed_bone.shape, bool)
-    flagged[tuple(q[cand].T)] = True
+    # opened and labelled in the flagged voxels' box only (a margin of 1 for the opening), not the whole grid
+    lo = np.maximum(q[cand].min(axis=0) - 1, 0)
+    hi = np.minimum(q[cand].max(axis=0) + 2, posed_bone.shape)
+    box = tuple(slice(a, b) for a, b in zip(lo, hi))
+    flagged = np.zeros(tuple(hi - lo), bool)
+    flagged[tuple((q[cand] - lo).T)] = True
+    posed_bone = posed_bone[box]
+    origin = np.asarray(origin, np.float64) + lo
     labels, n = ndimage.label(ndimage.binary_opening(flagged, OPENING), PIECES)
     if not n:
         return []

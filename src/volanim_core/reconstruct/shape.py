@@ -142,21 +142,15 @@ def _nearest(points: np.ndarray, named: dict[str, np.ndarray]) -> tuple[list[str
     return names, cKDTree(np.array([np.asarray(named[n], float) for n in names])).query(points)[1]
 
 
-def _segment_distance2(points: np.ndarray, p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
-    ab = np.asarray(p1, float) - np.asarray(p0, float)
-    t = np.clip((points - p0) @ ab / max(float(ab @ ab), 1e-12), 0, 1)
-    return ((points - (p0 + t[:, None] * ab)) ** 2).sum(-1)
-
-
 def _nearest_segment(points: np.ndarray, segments: dict) -> tuple[list[str], np.ndarray]:
+    """Each point's nearest bone segment (ties: the first named), as the nearest-bone connect finds it."""
+    from volanim_core.rig.attach import segment_distances
+
     names = list(segments)
-    best = np.full(len(points), np.inf)
-    which = np.zeros(len(points), int)
-    for k, n in enumerate(names):
-        p0, p1 = (np.asarray(p, float) for p in segments[n])
-        d2 = _segment_distance2(points, p0, p1)
-        closer = d2 < best
-        best[closer], which[closer] = d2[closer], k
+    segs = np.array([[np.asarray(p, float) for p in segments[n]] for n in names])
+    which = np.empty(len(points), np.int64)
+    for s in range(0, len(points), 65536):  # bounded memory: (chunk, B, 3) at a time
+        which[s:s + 65536] = segment_distances(points[s:s + 65536], segs).argmin(1)
     return names, which
 
 
