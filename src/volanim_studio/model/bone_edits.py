@@ -26,6 +26,34 @@ from .undo import Command
 SNAP_DISTANCE = 0.5  # voxels: a click this close to a joint reuses it
 
 
+def followed_selection(old: BoneSkeleton, new: BoneSkeleton, selected) -> tuple[int, ...]:
+    """The rows in ``new`` of the bones selected (rows ``selected``) in ``old``: a bone is who it is, not
+    the row it was in (#61: after a reorder or *Open connections…* the working bone kept its row and
+    silently became another bone, and the next connect attached points to it).
+
+    A bone is found by its joints' names (proximal, distal), or, when those are gone, by their places (a
+    rename of joints, a named chain, and their undo, keep every joint where it was). A selected bone that
+    is not in ``new`` leaves the selection.
+    """
+    rows = {(b.proximal, b.distal): i for i, b in enumerate(new.bones)}
+    places = {}
+    for i, b in enumerate(new.bones):
+        places.setdefault(_place(new, b), i)
+    out = []
+    for i in selected:
+        if 0 <= i < len(old.bones):
+            b = old.bones[i]
+            row = rows.get((b.proximal, b.distal), places.get(_place(old, b)))
+            if row is not None and row not in out:
+                out.append(row)
+    return tuple(out)  # in the old order: the working bone (the first) stays the first
+
+
+def _place(skeleton: BoneSkeleton, bone: Bone) -> tuple:
+    return tuple(tuple(np.round(np.asarray(skeleton.joints[j], np.float64), 6).tolist())
+                 for j in (bone.proximal, bone.distal)) if bone.proximal in skeleton.joints and bone.distal in skeleton.joints else (bone.proximal, bone.distal)
+
+
 class BoneEdits:
     """Undoable edits of ``doc.bones``."""
 
@@ -58,8 +86,8 @@ class BoneEdits:
         self.doc.undo.push(Command(label, redo, undo))
 
     def _set_bones(self, bones: BoneSkeleton) -> None:
+        self.doc.selected_bones = followed_selection(self.doc.bones, bones, self.doc.selected_bones)
         self.doc.bones = bones
-        self.doc.selected_bones = tuple(i for i in self.doc.selected_bones if i < len(bones))
         if self.doc.picked_joint not in bones.joints:
             self.doc.picked_joint = None  # renamed or removed (an undo of a rename)
         self.doc.events.bones.emit()

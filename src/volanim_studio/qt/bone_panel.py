@@ -108,11 +108,12 @@ class BonePanel(QWidget):
         self.tree.blockSignals(False)
 
     def _selection_edited(self) -> None:
-        rows = [self.tree.indexOfTopLevelItem(it) for it in self.tree.selectedItems()]
-        self.doc.select_bones(rows)
+        # an item names its bone (its index in doc.bones when the list was drawn), not its row: a drop moves
+        # rows, and selects, before the reorder reaches the model (#61: HEAD became L_UPPERARM)
+        self.doc.select_bones([it.data(0, Qt.UserRole) for it in self.tree.selectedItems()])
 
     def _item_edited(self, item: QTreeWidgetItem, column: int) -> None:
-        row = self.tree.indexOfTopLevelItem(item)
+        row = item.data(0, Qt.UserRole)
         bone = self.doc.bones.bones[row]
         text = item.text(column)
         try:

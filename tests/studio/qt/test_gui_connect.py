@@ -287,3 +287,31 @@ def test_the_cube_counts_its_points_and_shift_click_chooses_the_working_bone(qtb
     r = clickable_point(window, (J["L_ELBOW"] + J["L_WRIST"]) / 2)
     click(qtbot, window, window.scene.display_of_point(r))
     assert window.doc.working_bone == forearm
+
+
+def test_the_working_bone_stays_the_bone_after_a_drag_and_open_connections(qtbot, window, tmp_path):
+    """#61 item 1: HEAD chosen, rows dragged, then a connections file in another order: the cube still
+    connects to HEAD (it used to keep the row and connect to L_CLAVICLE)."""
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    doc, tree = window.doc, window.bone_panel.tree
+    head = doc.bones.index("HEAD")
+    tree.setCurrentItem(tree.topLevelItem(head))  # the user clicks HEAD's row
+    assert doc.working_bone == head
+    item = tree.takeTopLevelItem(head)  # what the drop does: HEAD's row moved below the left clavicle...
+    tree.insertTopLevelItem(3, item)
+    tree.setCurrentItem(item)
+    tree.reordered.emit([tree.topLevelItem(i).data(0, Qt.UserRole) for i in range(tree.topLevelItemCount())])
+    assert doc.bones.bones[doc.working_bone].label == "HEAD" and doc.working_bone == 3
+    assert [it.text(1) for it in tree.selectedItems()] == ["HEAD"]
+    assert "HEAD" in window.connect_panel.working.text()
+    flipped = samples.mannequin_bones()
+    flipped.bones = flipped.bones[::-1]
+    io.write_connections(tmp_path / "flipped.connections", flipped)
+    assert window.files.open_connections(tmp_path / "flipped.connections")
+    assert doc.bones.bones[doc.working_bone].label == "HEAD"
+    assert [it.text(1) for it in tree.selectedItems()] == ["HEAD"]
+    qtbot.keyClick(window, Qt.Key_K)
+    doc.set_cube(np.asarray(J["HEAD"], float) - (0, 0, 12))
+    qtbot.mouseClick(window.connect_panel.cube_connect, Qt.LeftButton)
+    got = {doc.bones.bones[b].label for b in doc.attachments.bone[doc.attachments.bone >= 0]}
+    assert got == {"HEAD"}
