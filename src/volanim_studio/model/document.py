@@ -310,6 +310,11 @@ class Document:
         self.undo.mark_clean()
         self.events.project.emit(path=None)
 
+    def check_savable(self) -> None:
+        """Raise ValueError (in words for the status bar) when there is no project to save yet."""
+        if self.skeleton is None and not len(self.bones):
+            raise ValueError("nothing to save yet: open a volume, a demo or a project first (File menu)")
+
     def save_project(self, path) -> Path:
         """Save the project as one unit: ``NAME.volanim`` and its data files in ``NAME.volanim.d/``.
 
@@ -317,8 +322,7 @@ class Document:
         and the skeleton are stored under content names; the manifest is
         replaced last (see :mod:`volanim_studio.model.project`).
         """
-        if self.skeleton is None and not len(self.bones):
-            raise ValueError("nothing to save yet: open a volume, a demo or a project first (File menu)")
+        self.check_savable()
         path = Path(path)
         if path.suffix != ".volanim":
             path = path.with_suffix(".volanim")

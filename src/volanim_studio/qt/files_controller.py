@@ -306,6 +306,11 @@ class FilesController(Controller):
 
     # -------------------------------------------------------------- saving
     def save_project(self, ask: bool = False, path=None) -> Path | None:
+        try:
+            self.doc.check_savable()
+        except ValueError as exc:  # said before asking for a name, not after it (#61)
+            self.doc.message(str(exc))
+            return None
         if path is None:
             path = self.doc.project_path
             cached = bool(path) and autosave.in_recovery_area(path)  # pruned after a week: never saved there

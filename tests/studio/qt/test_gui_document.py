@@ -209,3 +209,22 @@ def test_the_studio_opens_a_thesis_skel_and_shows_all_of_it(window, tmp_path):
     path = window.files.save_project(path=tmp_path / "thesis.volanim")
     window.files.open_project(path)
     assert window.doc.visible_count == len(at)
+
+
+def test_ctrl_s_with_nothing_loaded_says_so_without_asking_for_a_name(qtbot, monkeypatch):
+    """#61 item 6: it asked for a file name, then said there was nothing to save."""
+    from PySide6.QtWidgets import QFileDialog
+
+    from ..conftest import new_window
+
+    asked = []
+    monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (asked.append(a) or ("", "")))
+    w = new_window(qtbot)
+    w.activateWindow()
+    qtbot.waitUntil(w.isActiveWindow, timeout=5000)
+    qtbot.keyClick(w, Qt.Key_S, Qt.ControlModifier)
+    assert not asked
+    assert w.statusBar().currentMessage().startswith("nothing to save yet")
+    qtbot.keyClick(w, Qt.Key_S, Qt.ControlModifier | Qt.ShiftModifier)  # Save as… too
+    assert not asked
+    w.close()
