@@ -24,6 +24,7 @@ from .. import tasks
 from ..model import autosave
 from ..model.project import apply_project, read_project
 from .controller import FAILED, Controller
+from .look_dialog import LookDialog
 from .threshold_dialog import ThresholdDialog
 from .worker import Worker
 
@@ -61,13 +62,16 @@ class FilesController(Controller):
         return self._read_then_view(path, "View", lambda: read_look(path, size=SIZE),
                                     lambda look: QuickLookWindow(path, look, self.window), f"Viewing {Path(path).name}")
 
-    def view_file_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(
-            self.window, "View volume or mesh", self.folder(),
-            f"Volumes and meshes ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl);;"
-            "Sequences: the zarr.json inside NAME.zarr (zarr.json volanim-plan.json);;All files (*)")
-        if path:
-            self.view_file(path)
+    def view_file_dialog(self) -> LookDialog:
+        """Ask for a volume, a mesh or a sequence (its ``NAME.zarr`` folder, or the ``zarr.json`` in it), then
+        :meth:`view_file` it. Not modal: the dialog (``look_dialog``) is returned and kept while it is open."""
+        dialog = LookDialog(self.window, "View volume, mesh or sequence", self.folder(),
+                            f"Volumes, meshes and sequences ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl *.zarr "
+                            "zarr.json);;All files (*)")
+        dialog.finished.connect(lambda _: dialog.chosen and self.view_file(dialog.chosen))
+        self.look_dialog = dialog
+        dialog.open()
+        return dialog
 
     def view_slices(self, path) -> Worker | None:
         """Read any volume in the background and show it one slice at a time in a window of its own

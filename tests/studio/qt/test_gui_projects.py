@@ -176,3 +176,42 @@ def test_view_volume_or_mesh_opens_a_window_of_its_own_and_leaves_the_document(q
     viewer = viewer_opened(window, qtbot, window.files.view_file, tmp_path / "walk.zarr" / "zarr.json")
     assert viewer is not None and "frame 100" in viewer.what and "body" in viewer.plotter.renderer.actors
     viewer.close()
+
+
+def test_file_view_takes_a_sequence_folder_as_chosen(qtbot, window, tmp_path):
+    """#61 item 8: choosing NAME.zarr in File → View (selected and Open, or double-clicked) views the
+    sequence; it used to step into the folder and wait for its zarr.json."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtWidgets import QDialogButtonBox, QListView
+
+    from core.render.test_render import make_sequence
+
+    make_sequence(tmp_path / "walk.zarr", frames=2)
+    before = window.files.open_viewers()
+    dialog = window.files.view_file_dialog()
+    dialog.setDirectory(str(tmp_path))
+    dialog.selectFile("walk.zarr")
+    qtbot.mouseClick(dialog.findChild(QDialogButtonBox).button(QDialogButtonBox.Open), Qt.LeftButton)
+    assert not dialog.isVisible() and dialog.chosen == str(tmp_path / "walk.zarr")
+    qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
+    viewer = [v for v in window.files.open_viewers() if v not in before][-1]
+    assert "frame 100" in viewer.what and "body" in viewer.plotter.renderer.actors
+    viewer.close()
+    dialog = window.files.view_file_dialog()  # a double-click on the folder in the list chooses it too
+    dialog.setDirectory(str(tmp_path))
+    view = dialog.findChild(QListView, "listView")
+    model = view.model()
+
+    def folder_index():
+        index = model.index(str(tmp_path / "walk.zarr"))  # the dialog's file system model fills in a thread
+        return index if index.isValid() and not view.visualRect(index).isEmpty() else None
+
+    qtbot.waitUntil(lambda: folder_index() is not None, timeout=5000)
+    at = view.visualRect(folder_index()).center()
+    qtbot.mouseClick(view.viewport(), Qt.LeftButton, pos=at)  # a double-click is a click, then a second one
+    qtbot.mouseDClick(view.viewport(), Qt.LeftButton, pos=at)
+    qtbot.waitUntil(lambda: not dialog.isVisible(), timeout=5000)
+    assert not dialog.isVisible() and dialog.chosen == str(tmp_path / "walk.zarr")
+    qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
+    for v in window.files.open_viewers():
+        v.close()
