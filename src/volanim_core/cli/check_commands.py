@@ -72,6 +72,7 @@ def _report(args):
 def _scan(args):
     from volanim_core.motion.frame_files import frame_number
     from volanim_core.reconstruct.checks import scan, scan_json
+    from volanim_core.reconstruct.scan import scan_summary
 
     conn = joints_of(args, read_connect(args.connect))
     frames = [read_trans(p) for p in args.frames]
@@ -84,8 +85,7 @@ def _scan(args):
     if args.json:
         print(json.dumps(scan_json(verdicts), indent=1))
     else:
-        print(f"{len(verdicts)} frames scanned: {len(bad)} broken (a piece torn off or a stump left behind), "
-              f"{sum(v.cracks > 0 for v in verdicts)} with cracks; worst first")
+        print(f"{scan_summary(verdicts)}; worst first")
         for v in verdicts[:args.top]:
             print(f"  frame {v.frame}: {v.pieces} piece(s) ({v.rest_pieces} at rest), {v.detached} voxels "
                   f"detached, {v.stump} stump points, {v.cracks} cracks"

@@ -39,7 +39,9 @@ class FrameVerdict:
 
     @property
     def healthy(self) -> bool:
-        return self.pieces <= self.rest_pieces and self.cracks == 0 and self.stump == 0
+        """Not :attr:`broken`: one rule, said the same way by ``volanim scan``, the studio's scan and a
+        frame's report (#61: the studio counted a frame with cracks alone as unhealthy, the command did not)."""
+        return not self.broken
 
     @property
     def broken(self) -> bool:
@@ -83,6 +85,13 @@ def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints
                                 sum(b.points for b in behind), rest_pieces))
     report(len(frames), len(frames))
     return out
+
+
+def scan_summary(verdicts: list[FrameVerdict]) -> str:
+    """The one sentence ``volanim scan`` and the studio's scan both open with."""
+    broken = sum(v.broken for v in verdicts)
+    return (f"{len(verdicts)} frames scanned: {broken} broken (a piece torn off or a stump left behind), "
+            f"{sum(v.cracks > 0 for v in verdicts)} with cracks")
 
 
 def worst_first(verdicts: list[FrameVerdict]) -> list[FrameVerdict]:

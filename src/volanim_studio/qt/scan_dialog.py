@@ -5,6 +5,8 @@ from __future__ import annotations
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import QDialog, QLabel, QTableWidget, QTableWidgetItem, QVBoxLayout
 
+from volanim_core.reconstruct.scan import scan_summary
+
 COLUMNS = ("frame", "pieces", "detached voxels", "stump points", "cracks", "gap (voxels)", "worst joint")
 
 
@@ -30,10 +32,8 @@ class ScanDialog(QDialog):
     def show_verdicts(self, verdicts, label=str) -> None:
         """``verdicts`` worst first; ``label(frame)`` is the number shown (the clip's own numbering)."""
         self.frames = [v.frame for v in verdicts]
-        bad = sum(not v.healthy for v in verdicts)
-        self.summary.setText(f"{len(verdicts)} frames scanned (half-resolution pieces, exact cracks); {bad} with "
-                             "cracks, stumps or detached pieces. Double-click a frame to show it, then F5 for its "
-                             "full report.")
+        self.summary.setText(f"{scan_summary(verdicts)} (half-resolution pieces, exact cracks). Double-click a "
+                             "frame to show it, then F5 for its full report.")
         self.table.setRowCount(len(verdicts))
         for row, v in enumerate(verdicts):
             cells = (label(v.frame), v.pieces, v.detached, v.stump, v.cracks, f"{v.gap:.1f}", v.worst_joint or "—")

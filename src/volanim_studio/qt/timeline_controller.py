@@ -23,7 +23,7 @@ from volanim_core import io
 from volanim_core.io.volume_files import to_grey
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frame_files import write_frames
-from volanim_core.reconstruct.scan import scan_frames, worst_first
+from volanim_core.reconstruct.scan import scan_frames, scan_summary, worst_first
 from volanim_core.render.camera import Camera
 
 from ..model.settings import Mode
@@ -245,9 +245,8 @@ class TimelineController(Controller):
             self.scan_dialog.jump.connect(lambda f: self.go(f))
         self.scan_dialog.show_verdicts(self.last_scan, self.doc.timeline.frame_number)
         self.scan_dialog.show()
-        bad = [v for v in verdicts if not v.healthy]
         w = self.last_scan[0]
-        self.doc.message(f"Scanned {len(verdicts)} frames: {len(bad)} with cracks or pieces; worst frame "
+        self.doc.message(f"{scan_summary(verdicts)}; worst frame "
                          f"{self.doc.timeline.frame_number(w.frame)} ({w.pieces} piece(s), {w.cracks} cracks"
                          + (f" near {w.worst_joint}" if w.worst_joint else "") + ").")
 

@@ -8,6 +8,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT licence
+from runnable import run_in_process
 from volanim_core import io
 from volanim_studio.model.modes import Mode
 from volanim_studio.qt.mapping_dialog import UNMAPPED
@@ -126,7 +127,9 @@ def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
     w.timeline.scan()
     qtbot.waitUntil(lambda: not w.busy and w.timeline.last_scan is not None, timeout=JOB_TIMEOUT_MS)
     assert sorted(v.frame for v in w.timeline.last_scan) == list(range(12))
-    assert w.timeline.scan_dialog.table.rowCount() == 12 and "Scanned 12 frames" in w.statusBar().currentMessage()
+    assert w.timeline.scan_dialog.table.rowCount() == 12
+    scanned = w.statusBar().currentMessage()
+    assert scanned.startswith("12 frames scanned: ")
     worst = w.timeline.scan_dialog.frames[0]
     w.timeline.scan_dialog.table.cellDoubleClicked.emit(0, 0)
     assert doc.settings.current_frame == worst
@@ -136,6 +139,13 @@ def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
     files = sorted((tmp_path / "wave").glob("keys.*.trans"))
     assert len(files) == 12 and len(list((tmp_path / "wave").glob("*.tskel"))) == 12
     assert np.allclose(io.read_trans(files[-1]).matrices, tl.matrices([11])[0], atol=1e-5)
+    # #61 item 10: volanim scan and the studio's scan open with the same sentence, for the same frames
+    doc.attachments.save(tmp_path / "wave.connect")
+    cli = run_in_process(["scan", str(tmp_path / "wave.connect"), *map(str, files)], tmp_path)
+    said = cli.stdout.splitlines()[0].removesuffix("; worst first")
+    assert said.startswith("12 frames scanned: 0 broken")
+    assert w.timeline.scan_dialog.summary.text().startswith(said)
+    assert scanned.startswith(said)
 
     # the keys live in the project: save, reopen in a fresh window's model
     assert w.files.save_project(path=tmp_path / "wave.volanim")
@@ -352,3 +362,19 @@ def test_playing_the_bones_drawn_are_the_drawn_body_s_frame(qtbot, rigged):
     bones = _drawn_bones(w)  # stopped: the bones follow the pose again
     pj = w.doc.pose.posed_joints()
     assert np.allclose(bones, [[pj[b.proximal], pj[b.distal]] for b in w.doc.bones.bones], atol=1e-4)
+
+
+def test_the_scan_window_says_cracks_alone_are_not_broken(qtbot, window):
+    """#61 item 10: the studio counted a frame with cracks alone as unhealthy ("1 with cracks, stumps or
+    detached pieces"), volanim scan as not broken. One rule (FrameVerdict.broken), said the same way."""
+    from volanim_core.reconstruct.scan import FrameVerdict
+    from volanim_studio.qt.scan_dialog import ScanDialog
+
+    cracked = FrameVerdict(frame=3, pieces=1, detached=0, cracks=4, gap=2.5, worst_joint="L_ELBOW")
+    torn = FrameVerdict(frame=7, pieces=2, detached=120, cracks=0, gap=0.0, worst_joint="")
+    assert cracked.healthy and not cracked.broken and torn.broken and not torn.healthy
+    dialog = ScanDialog(window)
+    qtbot.addWidget(dialog)
+    dialog.show_verdicts([torn, cracked])
+    assert dialog.summary.text().startswith(
+        "2 frames scanned: 1 broken (a piece torn off or a stump left behind), 1 with cracks")
