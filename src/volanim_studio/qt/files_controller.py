@@ -251,6 +251,7 @@ class FilesController(Controller):
             self.doc.undo.mark_clean()  # as saved: loading its bones is not an edit to save
             self.doc.message(f"Opened {Path(path).name}.")
             done(True)
+            self.window.previews.show_body()  # opened in Pose mode: its body, not its bones alone
 
         worker = None
         if data.get("volume"):

@@ -16,7 +16,6 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractSpinBox,
     QDockWidget,
-    QLabel,
     QMainWindow,
     QMessageBox,
     QTabWidget,
@@ -40,6 +39,7 @@ from .preview_controller import PreviewController
 from .propose_dialog import ProposeController
 from .reconstruct_panel import ReconstructPanel
 from .session_controller import SessionController
+from .status_line import ElidedLabel, StatusLine
 from .timeline_controller import TimelineController
 from .timeline_panel import TimelinePanel
 from .verdict_label import VerdictLabel
@@ -133,10 +133,10 @@ class MainWindow(QMainWindow):
         timeline_dock.setWidget(self.timeline_panel)
         timeline_dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
         self.addDockWidget(Qt.BottomDockWidgetArea, timeline_dock)
-        self.point_label = QLabel("")
+        self.point_label = ElidedLabel()
         self.verdict_label = VerdictLabel(self.doc)
-        self.statusBar().addPermanentWidget(self.verdict_label)
-        self.statusBar().addPermanentWidget(self.point_label)
+        # the message first, whole; then the verdict, then the point, cut with "…" when short of room (#61)
+        self.status_line = StatusLine(self.statusBar(), [self.verdict_label, self.point_label])
         self._build_actions()
         self.doc.events.message.connect(lambda text: self.statusBar().showMessage(text, 15000))
         self.doc.events.picked.connect(self._on_picked_changed)

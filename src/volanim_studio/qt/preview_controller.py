@@ -40,7 +40,7 @@ class PreviewController(Controller):
         ev.pose_settled.connect(lambda **_: self._settled())
         st.dragging.connect(self._on_dragging)
         st.current_frame.connect(lambda **_: self.live_preview_soon() if self.doc.timeline.active else None)
-        st.mode.connect(lambda value: self._live_timer.stop() if value != Mode.POSE else None)
+        st.mode.connect(self._on_mode)
         self._again = QTimer(window)  # a preview asked for while a job runs: made once it has ended
         self._again.setSingleShot(True)
         self._again.setInterval(50)
@@ -71,6 +71,17 @@ class PreviewController(Controller):
         """In Pose mode with something attached: what full previews follow."""
         bone = self.doc.attachments.bone
         return self.doc.settings.mode == Mode.POSE and len(bone) > 0 and bool((bone >= 0).any())
+
+    def _on_mode(self, value) -> None:
+        if value != Mode.POSE:
+            self._live_timer.stop()
+
+    def show_body(self) -> None:
+        """A project or a recovered session opened in Pose mode: its full preview, once no job runs (#61: it
+        showed the bones alone until F5). Entering Pose mode by hand starts nothing: the rest pose is the
+        body the user sees, and the first pose change previews."""
+        if self.doc.preview is None:
+            self._preview_when_idle()
 
     def _on_dragging(self, value: bool) -> None:
         """Held (a pose slider, the timeline scrubbed or playing): a running full preview is cancelled, a

@@ -6,9 +6,8 @@
 
 from __future__ import annotations
 
-from PySide6.QtWidgets import QLabel
-
 from ..model.document import Document
+from .status_line import ElidedLabel
 
 COLOURS = {"healthy": "#2e9d4f", "broken": "#d33c3c", "stale": "#8a8a8a"}
 
@@ -19,12 +18,13 @@ def verdict_html(report) -> str:
     return f"<b style='color:{colour}'>{report.verdict}</b>"
 
 
-class VerdictLabel(QLabel):
+class VerdictLabel(ElidedLabel):
     def __init__(self, doc: Document, parent=None):
-        super().__init__("", parent)
+        super().__init__(parent)
         self.doc = doc
         self._report = None
-        self.setToolTip("The breakage verdict of the last full preview (F5); the Reconstruct tab has the report.")
+        self.base_tip = ("The breakage verdict of the last full preview (F5); the Reconstruct tab has the report.")
+        self.setToolTip(self.base_tip)
         doc.events.preview.connect(self._on_preview)
         doc.events.pose.connect(self._on_pose)
 
@@ -35,9 +35,9 @@ class VerdictLabel(QLabel):
             self.setText("")
         elif p.report is not None:
             self._report = p.report
-            self.setText(verdict_html(p.report))
+            self.set_styled(p.report.verdict, COLOURS["healthy" if p.report.healthy else "broken"], bold=True)
 
     def _on_pose(self, **_) -> None:
         if self._report is not None:
-            self.setText(f"<span style='color:{COLOURS['stale']}'>{self._report.verdict} "
-                         "(before the last pose change: F5 checks again)</span>")
+            self.set_styled(f"{self._report.verdict} (before the last pose change: F5 checks again)",
+                            COLOURS["stale"])

@@ -243,3 +243,59 @@ def test_the_lump_under_a_raised_arm_is_said_listed_and_boxed(qtbot, posed_windo
     w.plotter.screenshot(str(tmp_path / "lump.png"))
     w.pose_panel.sliders[1].setValue(0)  # back at rest: the marks go with the pose change
     assert "lumps" not in w.plotter.renderer.actors and "lumps_halo" not in w.plotter.renderer.actors
+
+
+def test_a_project_opened_in_pose_mode_shows_its_body_not_only_its_bones(qtbot, posed_window, tmp_path):
+    """#61 item 2: a recovered (or opened) session in Pose mode drew the posed bones and no body until F5
+    or a pose change. The body the window draws is the core's reconstruction of the saved pose."""
+    from volanim_studio.qt.main_window import MainWindow
+
+    from ..conftest import open_project
+
+    w = posed_window
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -45, 0), merge=False)
+    qtbot.keyClick(w, Qt.Key_P)
+    assert w.mode == Mode.POSE
+    path = w.files.save_project(path=tmp_path / "posed.volanim")
+    other = MainWindow()
+    qtbot.addWidget(other)
+    other.resize(1200, 800)
+    other.show()
+    assert open_project(qtbot, other, path)
+    assert other.mode == Mode.POSE
+    qtbot.waitUntil(lambda: not other.busy and other.doc.preview is not None, timeout=JOB_TIMEOUT_MS)
+    actor = other.scene.pose_layer.preview_actor
+    assert actor is not None and actor.GetVisibility()
+    direct = reconstruct(w.doc.pose.tskel(), mode=other.doc.preview.mode)
+    assert np.array_equal(other.doc.preview.reconstruction.volume > 0, direct.volume > 0)
+    other.doc.undo.mark_clean()
+    other.close()
+
+
+def test_the_status_bar_message_is_whole_beside_a_verdict_and_a_point(qtbot, posed_window, tmp_path):
+    """#61 item 5: the verdict and the picked point's line cut the message ("…Then read the breaka"). The
+    message now has its whole width; the labels are cut with "…" in what is left, whole in their tooltips,
+    and whole again once the message is gone."""
+    w = posed_window
+    w.resize(900, 700)
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -90, 0), merge=False)
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.report is not None,
+                    timeout=JOB_TIMEOUT_MS)
+    w.doc.pick_point(0)
+    message = ("Previewed the pose at full resolution in bone mode: the body is drawn where the bones put it. "
+               "Then read the breakage report")
+    w.doc.message(message)
+    qtbot.wait(10)
+    bar = w.statusBar()
+    left = min(label.geometry().left() for label in (w.verdict_label, w.point_label) if label.width() > 0) \
+        if any(label.width() > 0 for label in (w.verdict_label, w.point_label)) else bar.width()
+    assert bar.currentMessage() == message
+    assert bar.fontMetrics().horizontalAdvance(message) < left, "the message is drawn whole, left of the labels"
+    cut = [label for label in (w.verdict_label, w.point_label) if label.shown_text() != label.plain]
+    assert cut and all(label.toolTip() == label.plain for label in cut)
+    assert "bone " in w.point_label.text() and w.verdict_label.plain == w.doc.preview.report.verdict
+    bar.grab().save(str(tmp_path / "status-with-message.png"))
+    bar.clearMessage()
+    qtbot.wait(10)
+    assert w.verdict_label.shown_text() == w.verdict_label.plain  # the verdict whole again

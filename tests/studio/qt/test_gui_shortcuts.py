@@ -44,6 +44,6 @@ def test_an_empty_studio_answers_f5_and_ctrl_s_in_words_and_writes_nothing(qtbot
     out = tmp_path / "out"
     out.mkdir()
     assert w.files.save_project(path=out / "empty.volanim") is None
-    assert "nothing to save yet" in w.last_error
+    assert "nothing to save yet" in w.statusBar().currentMessage()  # said, with no dialog (#61)
     assert list(out.iterdir()) == [] and not w.busy
     w.close()

@@ -1,0 +1,111 @@
+"""The status bar: the newest message whole, the verdict and the picked point in what is left.
+
+    doc.events.message --showMessage--> the message (15 s)
+    messageChanged, a resize --fit--> each permanent label's width: the message's own width first, then the
+        verdict, then the point; a label with less room than its text draws it cut with "…" (its tooltip
+        and ``text()`` keep all of it)
+
+Why: QStatusBar gives its permanent widgets their full width and the message what is left, so a long
+verdict and a picked point's line cut the message the user had to read ("…Then read the breaka", #61).
+"""
+
+from __future__ import annotations
+
+import html
+
+from PySide6.QtCore import QEvent, QObject, QSize, Qt
+from PySide6.QtGui import QColor, QFontMetrics, QPainter
+from PySide6.QtWidgets import QLabel, QStatusBar
+
+GAP = 24  # pixels between the message and the labels (the bar's own margins and grip)
+
+
+class ElidedLabel(QLabel):
+    """A one-line label that may be given less width than its text: it draws the text cut with "…".
+    ``set_styled(text, colour, bold)``; ``text()`` stays the whole text (rich text when styled)."""
+
+    def __init__(self, parent=None):
+        super().__init__("", parent)
+        self._plain, self._colour, self._bold = "", None, False
+        self.base_tip = ""  # the tooltip when the whole text shows
+        self.changed = lambda: None  # the status line fits the labels again when a text changes
+
+    def set_styled(self, text: str, colour: str | None = None, bold: bool = False) -> None:
+        self._plain, self._colour, self._bold = text, colour, bold
+        body = html.escape(text)
+        if colour:
+            body = f"<span style='color:{colour}'>{body}</span>"
+        self.setText(f"<b>{body}</b>" if bold else body)
+
+    def setText(self, text: str) -> None:  # noqa: N802 (Qt name): plain setText keeps the plain copy
+        if not any(tag in text for tag in ("<b>", "<span")):
+            self._plain, self._colour, self._bold = text, None, False
+        super().setText(text)
+        self.changed()
+
+    @property
+    def plain(self) -> str:
+        return self._plain
+
+    def _metrics(self) -> QFontMetrics:
+        font = self.font()
+        font.setBold(self._bold)
+        return QFontMetrics(font)
+
+    def natural_width(self) -> int:
+        return self._metrics().horizontalAdvance(self._plain) + 8 if self._plain else 0
+
+    def minimumSizeHint(self) -> QSize:  # noqa: N802 (Qt name): may shrink to nothing
+        return QSize(0, super().minimumSizeHint().height())
+
+    def sizeHint(self) -> QSize:  # noqa: N802
+        return QSize(self.natural_width(), super().sizeHint().height())
+
+    def paintEvent(self, event) -> None:  # noqa: N802
+        painter = QPainter(self)
+        font = self.font()
+        font.setBold(self._bold)
+        painter.setFont(font)
+        painter.setPen(QColor(self._colour) if self._colour else self.palette().windowText().color())
+        shown = painter.fontMetrics().elidedText(self._plain, Qt.ElideRight, max(self.width() - 4, 0))
+        painter.drawText(self.rect().adjusted(2, 0, -2, 0), Qt.AlignVCenter | Qt.AlignLeft, shown)
+
+    def shown_text(self) -> str:
+        """What is drawn now (the text, cut to the width it has)."""
+        return self._metrics().elidedText(self._plain, Qt.ElideRight, max(self.width() - 4, 0))
+
+
+def fit(bar: QStatusBar, labels: list[ElidedLabel]) -> None:
+    """Give the bar's message its whole width, then ``labels`` (in priority order) what is left."""
+    message = bar.currentMessage()
+    room = bar.width() - GAP
+    if message:
+        room -= bar.fontMetrics().horizontalAdvance(message) + GAP
+    for label in labels:
+        want = label.natural_width()
+        width = max(0, min(want, room))
+        label.setMaximumWidth(width)
+        label.setToolTip(label.plain if width < want else label.base_tip)
+        room -= width
+    bar.setToolTip(message)
+
+
+class StatusLine(QObject):
+    """Keeps ``labels`` (permanent widgets of ``bar``, in priority order) fitted around the message."""
+
+    def __init__(self, bar: QStatusBar, labels: list[ElidedLabel]):
+        super().__init__(bar)
+        self.bar, self.labels = bar, labels
+        for label in labels:
+            bar.addPermanentWidget(label)
+            label.changed = self.fit
+        bar.messageChanged.connect(lambda _: self.fit())
+        bar.installEventFilter(self)
+
+    def fit(self) -> None:
+        fit(self.bar, self.labels)
+
+    def eventFilter(self, watched, event) -> bool:  # noqa: N802 (Qt name)
+        if event.type() == QEvent.Resize:
+            self.fit()
+        return False
