@@ -31,7 +31,7 @@ from volanim_core.render.volume_style import (
 )
 from volanim_core.rig.pose import apply_matrices
 
-STUMP_COLOUR = "#ff3030"
+STUMP_COLOUR = "#ff3030"  # over a black halo, seen on a red bone colour too
 LUMP_COLOUR = "#ffffff"  # flesh carried off (reconstruct/lumps.py): white over a black halo, seen on any bone colour
 AXIS_COLOURS = ((230, 60, 60), (60, 200, 80), (70, 120, 255))  # x, y, z: the Pose tab names them so
 
@@ -63,6 +63,7 @@ class PoseLayer:
     def on_pose_changed(self, **_) -> None:
         view = self.view
         view.plotter.remove_actor("stumps", render=False)  # they were where the previous pose put them
+        view.plotter.remove_actor("stumps_halo", render=False)
         view.plotter.remove_actor("lumps", render=False)
         view.plotter.remove_actor("lumps_halo", render=False)
         if not view.posing:
@@ -139,6 +140,7 @@ class PoseLayer:
         if p is not None and p.report is None:
             return  # a live preview: the marks of the last report stay until the pose changes
         view.plotter.remove_actor("stumps", render=False)
+        view.plotter.remove_actor("stumps_halo", render=False)
         view.plotter.remove_actor("lumps", render=False)
         view.plotter.remove_actor("lumps_halo", render=False)
         lumps = [] if p is None else p.report.lumps
@@ -160,7 +162,11 @@ class PoseLayer:
                 lo = view.world(st.posed.min(0)[None] - st.margin)[0]
                 hi = view.world(st.posed.max(0)[None] + st.margin)[0]
                 boxes.append(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).extract_all_edges())
-            view.plotter.add_mesh(pv.merge(boxes), color=STUMP_COLOUR, line_width=3, name="stumps", render=False,
+            # over a black halo: a red line alone vanished on a red bone colour (#61)
+            edges = pv.merge(boxes)
+            view.plotter.add_mesh(edges, color="black", line_width=7, name="stumps_halo", render=False,
+                                  reset_camera=False, pickable=False)
+            view.plotter.add_mesh(edges.copy(), color=STUMP_COLOUR, line_width=3, name="stumps", render=False,
                                   reset_camera=False, pickable=False)
         view.apply_stage()
         view.render()

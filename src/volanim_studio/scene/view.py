@@ -44,7 +44,7 @@ class SceneView:
     """
 
     EDIT_ACTORS = ("cloud", "bones", "joints", "selected", "picked", "cube", *NAME_ACTORS)
-    POSE_ACTORS = ("preview", "posed_bones", "slices", "stumps", "rot_axes")
+    POSE_ACTORS = ("preview", "posed_bones", "slices", "stumps", "stumps_halo", "lumps", "lumps_halo", "rot_axes")
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
         self.plotter = plotter

@@ -100,7 +100,7 @@ def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
     assert "healthy: one piece" in w.reconstruct_panel.report.text()
 
 
-def test_a_stump_is_the_verdict_in_the_status_bar_the_pose_tab_and_in_3d(qtbot, posed_window):
+def test_a_stump_is_the_verdict_in_the_status_bar_the_pose_tab_and_in_3d(qtbot, posed_window, tmp_path):
     """Shoulder points on the torso, arm raised 90 degrees: one piece, so the report said "healthy"
     while a piece of the upper arm stayed at the shoulder, and only in the Reconstruct tab (issue #18)."""
     w = posed_window
@@ -122,6 +122,28 @@ def test_a_stump_is_the_verdict_in_the_status_bar_the_pose_tab_and_in_3d(qtbot, 
     lo, hi = (w.scene.world(f(r.stumps[0].posed, axis=0)[None])[0] for f in (np.min, np.max))
     b = np.reshape(marks.GetBounds(), (3, 2))
     assert marks.GetVisibility() and (b[:, 0] <= lo).all() and (b[:, 1] >= hi).all()  # a box around the stump
+    # #61 item 4: the red box vanished on a red bone colour (the torso's, here). Its lines run over a black
+    # halo: of the pixels the box changes, every red one has a dark one within two pixels
+    import imageio.v3 as iio
+    from scipy import ndimage
+
+    def picture():
+        w.plotter.render()
+        return np.asarray(w.plotter.screenshot(return_img=True))[..., :3].astype(int)
+
+    with_box = picture()
+    iio.imwrite(tmp_path / "stump-box.png", with_box.astype(np.uint8))
+    box_actors = [a for n, a in w.plotter.renderer.actors.items() if n.startswith("stumps")]
+    for a in box_actors:
+        a.SetVisibility(False)
+    without = picture()
+    for a in box_actors:
+        a.SetVisibility(True)
+    changed = np.abs(with_box - without).max(axis=-1) > 30
+    red = changed & (with_box[..., 0] > 200) & (with_box[..., 1] < 90) & (with_box[..., 2] < 90)
+    dark = changed & (with_box.max(axis=-1) < 50)
+    assert red.sum() > 20
+    assert (red & ~ndimage.binary_dilation(dark, iterations=2)).sum() <= 0.05 * red.sum()
     w.pose_panel.sliders[1].setValue(-80)  # the pose changes: the verdict is stale, the marks go
     assert "F5 checks again" in w.verdict_label.text() and "stumps" not in w.plotter.renderer.actors
     doc.attachments.assign(near, ua)  # the fix
