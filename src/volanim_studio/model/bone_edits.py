@@ -50,8 +50,11 @@ def followed_selection(old: BoneSkeleton, new: BoneSkeleton, selected) -> tuple[
 
 
 def _place(skeleton: BoneSkeleton, bone: Bone) -> tuple:
+    """Where a bone's joints are (rounded), or its joint names when the skeleton lacks one."""
+    if bone.proximal not in skeleton.joints or bone.distal not in skeleton.joints:
+        return (bone.proximal, bone.distal)
     return tuple(tuple(np.round(np.asarray(skeleton.joints[j], np.float64), 6).tolist())
-                 for j in (bone.proximal, bone.distal)) if bone.proximal in skeleton.joints and bone.distal in skeleton.joints else (bone.proximal, bone.distal)
+                 for j in (bone.proximal, bone.distal))
 
 
 class BoneEdits:

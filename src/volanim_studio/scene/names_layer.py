@@ -1,7 +1,8 @@
 """Names in the viewport, the joint or bone under the cursor, and the line of the bone being built.
 
     doc.events.bones / picked, settings.names_visible --> joint labels (white), named bones' labels
-        (their colour), the picked joint ringed in cyan
+        (grey, italic), each laid out beside its place before every render (label_layout: every name
+        shown, none over another), the picked joint ringed in cyan
     mouse move (no button held) --> the joint or bone under the cursor, drawn yellow, named in the
         status bar; in Bones mode with a chain started, a line from its last joint to the cursor
 
@@ -14,9 +15,11 @@ from collections.abc import Callable
 
 import numpy as np
 import pyvista as pv
+from vtkmodules.vtkRenderingCore import vtkTextActor
 
 from volanim_core.render.bone_colours import bone_colour
 
+from . import label_layout
 from .pose_layer import bone_lines
 
 HOVER = "#ffe14d"
@@ -30,7 +33,10 @@ class NamesLayer:
         self.hovered: tuple[str, object] | None = None  # ("joint", name) or ("bone", index)
         self.shown_names: list[str] = []  # the joint and bone names drawn, in that order
         # pyvista files label actors under names of its own (not ``name=``): kept here to remove and hide
-        self.label_actors: list = []
+        self.label_actors: list = []  # one vtkTextActor a label, laid out by label_layout
+        self.label_boxes = np.zeros((0, 4))  # where they were put at the last render (display pixels)
+        self.joint_labels = 0
+        self._labels = None  # (joint world points, names, bone middles, bone names) while names show
         #: where the chain being built continues from (voxels), or None; the window sets it to the
         #: Bones mode's ``pending_position``
         self.pending: Callable[[], np.ndarray | None] = lambda: None
@@ -39,32 +45,67 @@ class NamesLayer:
         doc.events.picked.connect(self._on_picked)
         view.settings.events.names_visible.connect(self.update_labels)
         view.plotter.iren.add_observer("MouseMoveEvent", self._on_move)
+        view.plotter.renderer.AddObserver("StartEvent", self._lay_out)
 
     # ---------------------------------------------------------------- labels
     def update_labels(self, **_) -> None:
         view, plotter = self.view, self.view.plotter
         for actor in self.label_actors:
             plotter.remove_actor(actor, render=False)
-        self.label_actors = []
+        self.label_actors, self._labels = [], None
         bones = view.doc.bones
         self.shown_names = []
         if view.settings.names_visible and len(bones.joints):
             names = list(bones.joints)
-            self.shown_names = names + [b.name for b in bones.bones if b.name]
-            self.label_actors.append(plotter.add_point_labels(
-                view.world(np.array([bones.joints[n] for n in names])).astype(np.float32), names, font_size=13,
-                text_color="white", shape=None, show_points=False, always_visible=True, render=False,
-                reset_camera=False, justification_vertical="bottom", shadow=True))
             named = [i for i, b in enumerate(bones.bones) if b.name]
-            if named:
-                mid = view.world(bones.segments()[named].mean(1)).astype(np.float32)
-                self.label_actors.append(plotter.add_point_labels(
-                    mid, [bones.bones[i].name for i in named], font_size=11, bold=False, italic=True,
-                    text_color="#d0d0d0", shape=None, show_points=False, always_visible=True, render=False,
-                    reset_camera=False, shadow=True))
+            self.shown_names = names + [bones.bones[i].name for i in named]
+            joints = view.world(np.array([bones.joints[n] for n in names]))
+            mids = view.world(bones.segments()[named].mean(1)) if named else np.zeros((0, 3))
+            self._labels = (joints, names, mids, [bones.bones[i].name for i in named])
+            self._lay_out()
         self.hovered = None
         plotter.remove_actor("hover", render=False)
         self._on_picked()
+
+    def _lay_out(self, *_) -> None:
+        """Every name beside its joint (or its bone's middle), none over another (scene/label_layout.py):
+        laid out again before each render, since a turn of the camera moves them all on screen."""
+        if self._labels is None:
+            return
+        view, plotter = self.view, self.view.plotter
+        joints, names, mids, bone_names = self._labels
+        xy, _ = view.project_world(joints)
+        groups = label_layout.merge_coincident(xy, names)
+        self.joint_labels = len(groups)  # label_actors[:joint_labels] name joints, the rest bones
+        texts = [t for t, _ in groups] + bone_names
+        anchors = np.vstack([xy[[m[0] for _, m in groups]], view.project_world(mids)[0] if len(mids) else
+                             np.zeros((0, 2))])
+        if [a.GetInput() for a in self.label_actors] != texts:  # new names: new actors
+            for actor in self.label_actors:
+                plotter.remove_actor(actor, render=False)
+            self.label_actors = [self._text_actor(t, bone=k >= len(groups)) for k, t in enumerate(texts)]
+        sizes = np.array([self._size(a) for a in self.label_actors], np.float64).reshape(-1, 2)
+        self.label_boxes = label_layout.place(anchors, sizes)
+        for actor, box in zip(self.label_actors, self.label_boxes):
+            actor.SetPosition(float(box[0]), float(box[1]))
+            actor.SetVisibility(not view.posing)
+
+    def _text_actor(self, text: str, bone: bool):
+        actor = vtkTextActor()
+        actor.SetInput(text)
+        prop = actor.GetTextProperty()
+        prop.SetFontSize(11 if bone else 13)
+        prop.SetItalic(bone)
+        prop.SetColor(*((0.82, 0.82, 0.82) if bone else (1.0, 1.0, 1.0)))
+        prop.SetShadow(True)
+        actor.SetPickable(False)
+        self.view.plotter.add_actor(actor, reset_camera=False, name=f"label:{text}", pickable=False, render=False)
+        return actor
+
+    def _size(self, actor) -> tuple[float, float]:
+        box = [0.0] * 4
+        actor.GetBoundingBox(self.view.plotter.renderer, box)
+        return box[1] - box[0], box[3] - box[2]
 
     def show(self, on: bool) -> None:
         """The labels' part of the stage switch (the named actors follow ``SceneView.EDIT_ACTORS``)."""

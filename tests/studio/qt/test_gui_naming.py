@@ -36,7 +36,7 @@ def test_build_a_chain_with_a_line_to_the_cursor_then_name_it_in_one_line(qtbot,
     qtbot.keyClick(window, Qt.Key_Escape)
     assert "chain_preview" not in actors()  # the chain ended: no line
     labels = window.scene.names.label_actors
-    assert len(window.doc.bones) == 2 and len(labels) == 1 and labels[0] in actors().values()
+    assert len(window.doc.bones) == 2 and len(labels) == 3 and all(a in actors().values() for a in labels)
     qtbot.keyClick(window, Qt.Key_F2, Qt.ControlModifier)  # the selected (last built) bone's chain
     box = window.naming.box
     assert box.isVisible() and "3 joints" in box.labelText()
@@ -132,3 +132,55 @@ def test_the_readme_walkthrough_builds_and_names_the_mannequin_in_about_36_actio
         assert np.linalg.norm(p - want.joints[n]) < 20, n  # near the real joints (a skeleton ends short of a tip)
     act(3)  # Ctrl+S, type a file name, Enter
     assert actions == 36, actions
+
+
+def test_every_joint_is_named_and_no_name_covers_another(qtbot, window, tmp_path):
+    """#61 item 3: on the hand-built mannequin R_SHOULDER and R_HIP had no label (VTK's placement dropped
+    labels that overlapped), and two joints at one place printed over each other ("R_HIPPELVIS_HIP")."""
+    import copy
+
+    import imageio.v3 as iio
+
+    from volanim_core.rig.bones import Bone
+
+    from ..conftest import front_view
+
+    bones = copy.deepcopy(samples.mannequin_bones())
+    bones.joints["PELVIS_HIP"] = np.array(bones.joints["R_HIP"], float)  # a proposed rig's second hip joint
+    bones.bones.append(Bone("PELVIS", "PELVIS_HIP", ""))
+    window.doc.bone_edits.set_bones(bones)
+    front_view(window)
+    window.plotter.render()
+    names = window.scene.names
+    texts = [a.GetInput() for a in names.label_actors]
+    shown = {n for t in texts for n in t.split(" / ")}
+    assert set(bones.joints) <= shown and "R_HIP / PELVIS_HIP" in texts  # and the named bones' names
+    boxes = names.label_boxes
+    assert len(boxes) == len(texts)
+    for i in range(len(boxes)):  # no two labels overlap
+        for k in range(i + 1, len(boxes)):
+            a, b = boxes[i], boxes[k]
+            assert min(a[2], b[2]) <= max(a[0], b[0]) or min(a[3], b[3]) <= max(a[1], b[1]), (texts[i], texts[k])
+    joint_texts = texts[:names.joint_labels]
+    xy, _ = window.scene.project_world(window.scene.world(np.array([bones.joints[t.split(" / ")[0]]
+                                                                      for t in joint_texts])))
+    centre = (boxes[:len(joint_texts), :2] + boxes[:len(joint_texts), 2:]) / 2
+    assert (np.linalg.norm(centre - xy, axis=1) < 90).all()  # each beside its joint
+    iio.imwrite(tmp_path / "joint-names.png", np.asarray(window.plotter.screenshot(return_img=True)))
+    window.plotter.camera.azimuth = 60  # the camera turns: laid out again, still apart
+    window.plotter.render()
+    turned = names.label_boxes
+    assert not np.allclose(turned, boxes)
+
+
+def test_names_are_laid_out_before_the_window_has_a_picture():
+    """A window not shown yet projects joints to no number: each stands alone, beside where it will be (a
+    project opened in such a window used to stop half-way, its labels' layout raising)."""
+    from volanim_studio.scene import label_layout
+
+    xy = np.full((3, 2), np.nan)
+    assert [m for _, m in label_layout.merge_coincident(xy, ["A", "B", "C"])] == [[0], [1], [2]]
+    assert label_layout.place(xy, np.ones((3, 2))).shape == (3, 4)
+    near = np.array([[10.0, 10.0], [11.0, 10.5], [60.0, 10.0]])
+    assert [t for t, _ in label_layout.merge_coincident(near, ["R_HIP", "PELVIS_HIP", "L_HIP"])] == [
+        "R_HIP / PELVIS_HIP", "L_HIP"]
