@@ -31,16 +31,17 @@ class ElidedLabel(QLabel):
         self.changed = lambda: None  # the status line fits the labels again when a text changes
 
     def set_styled(self, text: str, colour: str | None = None, bold: bool = False) -> None:
-        self._plain, self._colour, self._bold = text, colour, bold
         body = html.escape(text)
         if colour:
             body = f"<span style='color:{colour}'>{body}</span>"
-        self.setText(f"<b>{body}</b>" if bold else body)
+        self._show(text, colour, bold, f"<b>{body}</b>" if bold else body)
 
-    def setText(self, text: str) -> None:  # noqa: N802 (Qt name): plain setText keeps the plain copy
-        if not any(tag in text for tag in ("<b>", "<span")):
-            self._plain, self._colour, self._bold = text, None, False
-        super().setText(text)
+    def setText(self, text: str) -> None:  # noqa: N802 (Qt name): plain text, as a QLabel takes it
+        self._show(text, None, False, text)
+
+    def _show(self, plain: str, colour: str | None, bold: bool, shown: str) -> None:
+        self._plain, self._colour, self._bold = plain, colour, bold
+        super().setText(shown)
         self.changed()
 
     @property

@@ -62,10 +62,8 @@ class PoseLayer:
 
     def on_pose_changed(self, **_) -> None:
         view = self.view
-        view.plotter.remove_actor("stumps", render=False)  # they were where the previous pose put them
-        view.plotter.remove_actor("stumps_halo", render=False)
-        view.plotter.remove_actor("lumps", render=False)
-        view.plotter.remove_actor("lumps_halo", render=False)
+        for name in ("stumps", "lumps"):  # they were where the previous pose put them
+            self._marks(name, [], "", 0)
         if not view.posing:
             return
         p = view.doc.preview
@@ -139,37 +137,33 @@ class PoseLayer:
         p = view.doc.preview
         if p is not None and p.report is None:
             return  # a live preview: the marks of the last report stay until the pose changes
-        view.plotter.remove_actor("stumps", render=False)
-        view.plotter.remove_actor("stumps_halo", render=False)
-        view.plotter.remove_actor("lumps", render=False)
-        view.plotter.remove_actor("lumps_halo", render=False)
         lumps = [] if p is None else p.report.lumps
-        if lumps:  # a white box around each lump: flesh the pose carried off
-            boxes = []
-            for lump in lumps:
-                lo, hi = view.world(lump.lo[None] - 1)[0], view.world(lump.hi[None] + 1)[0]
-                boxes.append(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).extract_all_edges())
-            edges = pv.merge(boxes)
-            view.plotter.add_mesh(edges, color="black", line_width=6, name="lumps_halo", render=False,
-                                  reset_camera=False, pickable=False)
-            view.plotter.add_mesh(edges.copy(), color=LUMP_COLOUR, line_width=2, name="lumps", render=False,
-                                  reset_camera=False, pickable=False)
         stumps = [] if p is None else p.report.stumps
-        if stumps:
-            # a red box around each stump: its spheres sit inside the preview, which would hide points
-            boxes = []
-            for st in stumps:
-                lo = view.world(st.posed.min(0)[None] - st.margin)[0]
-                hi = view.world(st.posed.max(0)[None] + st.margin)[0]
-                boxes.append(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).extract_all_edges())
-            # over a black halo: a red line alone vanished on a red bone colour (#61)
-            edges = pv.merge(boxes)
-            view.plotter.add_mesh(edges, color="black", line_width=7, name="stumps_halo", render=False,
-                                  reset_camera=False, pickable=False)
-            view.plotter.add_mesh(edges.copy(), color=STUMP_COLOUR, line_width=3, name="stumps", render=False,
-                                  reset_camera=False, pickable=False)
+        # a white box around each lump (flesh the pose carried off); a red one around each stump (its spheres
+        # sit inside the preview, which would hide points)
+        self._marks("lumps", [(lump.lo - 1, lump.hi + 1) for lump in lumps], LUMP_COLOUR, 2)
+        self._marks("stumps", [(st.posed.min(0) - st.margin, st.posed.max(0) + st.margin) for st in stumps],
+                    STUMP_COLOUR, 3)
         view.apply_stage()
         view.render()
+
+    def _marks(self, name: str, boxes, colour: str, width: int) -> None:
+        """Boxes (rest-grid voxels ``(lo, hi)``) drawn as ``name``: coloured lines over a black halo
+        (``name_halo``), seen on any bone colour (#61: a red line alone vanished on a red body part)."""
+        plotter = self.view.plotter
+        plotter.remove_actor(name, render=False)
+        plotter.remove_actor(f"{name}_halo", render=False)
+        if not boxes:
+            return
+        edges = []
+        for lo, hi in boxes:
+            lo, hi = self.view.world(np.asarray(lo)[None])[0], self.view.world(np.asarray(hi)[None])[0]
+            edges.append(pv.Box(bounds=(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])).extract_all_edges())
+        edges = pv.merge(edges)
+        plotter.add_mesh(edges, color="black", line_width=width + 4, name=f"{name}_halo", render=False,
+                         reset_camera=False, pickable=False)
+        plotter.add_mesh(edges.copy(), color=colour, line_width=width, name=name, render=False,
+                         reset_camera=False, pickable=False)
 
     def _image(self, volume, origin_voxels, spacing_voxels) -> pv.ImageData:
         world_origin = self.view.world(origin_voxels)
