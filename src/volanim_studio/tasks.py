@@ -92,7 +92,7 @@ def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> d
     return out
 
 
-def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spacing=(1.0, 1.0, 1.0),
+def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, kernel: int = 1, spacing=(1.0, 1.0, 1.0),
                  style: str = "surface", size=(640, 480), fps: float = 24.0, frame_numbers: bool = False,
                  background: str = "#1e1f24", workers: int | None = None, follow: bool = False, progress=None,
                  cancel=None) -> dict:
@@ -101,6 +101,9 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
 
     ``follow``: each frame's camera is ``camera`` moved with the body (``RenderInputs.follow``: its
     direction and distance kept, centred on the frame's smoothed filled box), as the timeline follows it.
+
+    A colour ``source`` gives a colour movie: the sequence holds its palette indices and the render draws
+    them in the palette's colours (:mod:`volanim_core.colour.indexed`).
 
     The sequence is kept beside the movie (``.NAME.zarr``) until the movie is written, and the render's
     pictures likewise, so a cancelled run picks up where it stopped when started again with the same pose.
@@ -129,8 +132,9 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
     report(0, total)
     cache = out.parent / f".{out.name}.zarr"  # the same frames resume; another pose replaces it
     workers = workers or default_workers()
-    run_sequence(conn, frames, cache, mode=mode, source=source if mode == "sampled" else None, fps=fps,
-                 workers=workers, replace_other=True, on_frame=lambda rec, done, n: report(done, total))
+    seq = run_sequence(conn, frames, cache, mode=mode, source=source if mode == "sampled" else None, kernel=kernel,
+                       fps=fps, workers=workers, replace_other=True,
+                       on_frame=lambda rec, done, n: report(done, total))
     inputs = replace(open_inputs([cache]), spacing=tuple(float(s) for s in spacing))  # the studio's world
     if follow:
         inputs = replace(inputs, frames=inputs.follow("front", size[0] / size[1], base=camera))
@@ -140,4 +144,5 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, spa
     rep = render(inputs, settings, out, fps=fps, workers=workers, isolate=True,
                  on_frame=lambda number, done, n: report(len(frames) + done, total))
     shutil.rmtree(cache, ignore_errors=True)
-    return {"out": out, "frames": len(frames), "seconds": time.perf_counter() - t0, "workers": rep.workers}
+    return {"out": out, "frames": len(frames), "seconds": time.perf_counter() - t0, "workers": rep.workers,
+            "colours": seq.colours}

@@ -57,7 +57,7 @@ def _sequence(args):
         frames += melt(frames, args.melt)
     elif args.teleport:
         frames += teleport(conn, frames, args.teleport, down=args.down)
-    source, source_geometry = load_source(args, conn)
+    source, source_geometry = load_source(args, conn, colour=True)  # a colour scan: a colour sequence
     workers = local_workers(args)
     rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_geometry=source_geometry,
                        kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
@@ -65,6 +65,8 @@ def _sequence(args):
                        threads_per_worker=args.threads_per_worker, on_frame=FrameProgress())
     print(file=sys.stderr)
     print(format_report(rep))
+    if rep.colours:
+        print(rep.colours)
     print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "
           f"origin {rep.bounds.lo}; {rep.computed} made, {rep.skipped} already complete; {rep.workers}; "
           f"{rep.seconds:.1f} s")
@@ -134,7 +136,8 @@ def register(sub) -> None:
                     "for all frames, resumable, on all local cores or a Dask cluster.", EXAMPLE, _sequence)
     p.add_argument("connect", help="the .connect every frame uses")
     p.add_argument("frames", nargs="+", help=".trans or .tskel files (numbered NAME.0000.trans ...), or one .bvh")
-    p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
+    p.add_argument("--source", help="rest-pose volume, grey or colour (needed for --mode sampled; a colour one "
+                                    "makes a colour sequence: palette indices, the palette in the store)")
     add_dims(p)  # --dims for a headerless .vol source, --series for a DICOM folder of several
     p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")

@@ -210,16 +210,21 @@ def render_task(job: RenderJob | None, ref: FrameRef) -> tuple[int, np.ndarray]:
         if _RENDERER is not None:
             _RENDERER.close()
         _RENDERER, _JOB = Renderer(job.settings), job  # one plotter per worker, reused for every frame
-    volume, origin = read_frame(ref, job.dims)
+    volume, origin = read_frame(ref, job.dims, colour=job.settings.transfer is None)
     return ref.number, _RENDERER.render(volume, origin, ref.number, camera=ref.camera)
 
 
-def read_frame(ref: FrameRef, dims=None) -> tuple[np.ndarray, tuple]:
-    """One input frame as ``(volume [x, y, z], origin in voxels)``."""
+def read_frame(ref: FrameRef, dims=None, colour: bool = True) -> tuple[np.ndarray, tuple]:
+    """One input frame as ``(volume [x, y, z], origin in voxels)``. A colour sequence's frame is its
+    colours ``[x, y, z, 3]`` (its indices through its palette), or with ``colour=False`` its indices
+    (what a user's transfer function over the palette reads: ``render --tf``)."""
     if ref.index >= 0:
-        from volanim_core.sequence import store
+        from volanim_core.sequence.checked import read_store
 
-        return store.read_frame(ref.path, ref.index), store.origin(ref.path)
+        seq = read_store(ref.path)
+        if colour and seq.palette is not None:
+            return seq.read_colour(ref.index), seq.origin_xyz
+        return seq.read_frame(ref.index), seq.origin_xyz
     volume, origin, *_ = _read(ref.path, dims)
     return volume, origin
 

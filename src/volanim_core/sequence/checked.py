@@ -1,7 +1,8 @@
 """A sequence store's metadata, checked once, before anything is indexed or allocated; frames read verified.
 
     OUT.zarr/volanim-plan.json     --> plan: key, frames (1..MAX_FRAMES), numbers (one per frame), mode
-    OUT.zarr/zarr.json             --> attributes "volanim" (origin_xyz: 3 numbers) and "ome" (time scale > 0)
+    OUT.zarr/zarr.json             --> attributes "volanim" (origin_xyz: 3 numbers; a colour sequence's palette:
+                                       256 [r, g, b]) and "ome" (time scale > 0)
     OUT.zarr/0/zarr.json           --> the array: (T = frames, Z, Y, X) sizes >= 1 that fit in memory, its
                                        chunks no larger than a frame, a dtype volanim writes
     OUT.zarr/volanim-frames.jsonl  --> the finished frames' records (index, sha256, region, box, ...)
@@ -47,6 +48,7 @@ class Store:
     origin_xyz: tuple[int, int, int]
     seconds_per_frame: float
     done: dict  # index -> its manifest record, for every frame recorded complete
+    palette: np.ndarray | None = None  # a colour sequence's (256, 3) uint8 colours, one per index; else None
 
     @property
     def frames(self) -> int:
@@ -71,6 +73,12 @@ class Store:
                                   f"sha256 in {FRAMES_FILE}: its shard in 0/ is missing or was changed; "
                                   "rerun `volanim sequence` with --force to make it again")
         return zyx.T
+
+    def read_colour(self, index: int) -> np.ndarray:
+        """A colour sequence's frame ``index`` as ``[x, y, z, 3]`` colours: its indices through its palette."""
+        if self.palette is None:
+            raise ValueError(f"{self.path} is not a colour sequence (it has no palette)")
+        return self.palette[self.read_frame(index)]
 
     def verified(self, index: int) -> bool:
         """Whether :meth:`read_frame` can verify this frame (its record has the region it hashed)."""
@@ -139,6 +147,10 @@ def _read_store(path: Path) -> Store:
     _need(group_file, isinstance(origin, list) and len(origin) == 3 and all(
         _number(v) and abs(v) < 2**31 for v in origin),
         f"\"volanim\": \"origin_xyz\" must be 3 numbers, got {origin!r}")
+    palette = ours.get("palette")
+    _need(group_file, palette is None or (isinstance(palette, list) and len(palette) == 256 and all(
+        isinstance(c, list) and len(c) == 3 and all(_int(v) and 0 <= v <= 255 for v in c) for c in palette)),
+        "\"volanim\": \"palette\" must be 256 colours [r, g, b] of 0..255")
     try:
         scale = attrs["ome"]["multiscales"][0]["datasets"][0]["coordinateTransformations"][0]["scale"]
     except (KeyError, IndexError, TypeError):
@@ -155,13 +167,16 @@ def _read_store(path: Path) -> Store:
     _need(array_file, shape[0] == frames, f"\"shape\" holds {shape[0]} frames, the plan {frames}")
     dtype = array.get("data_type")
     _need(array_file, dtype in DTYPES, f"\"data_type\" must be one of {', '.join(DTYPES)}, got {dtype!r}")
+    _need(array_file, palette is None or dtype == "uint8", f"a colour sequence's \"data_type\" is uint8 (palette "
+          f"indices), got {dtype!r}")
     z, y, x = checked_grid(array_file, shape[:0:-1], np.dtype(dtype).itemsize, what="\"shape\"")[::-1]
     for where, chunks in _chunk_shapes(array):
         _need(array_file, isinstance(chunks, list) and len(chunks) == 4 and all(
             _int(c) and 1 <= c <= min(MAX_AXIS, 2 * max(n, 128)) for c, n in zip(chunks, [1, z, y, x])),
             f"{where} must be 4 sizes no larger than a frame's, got {chunks!r}")
     return Store(path, key, tuple(numbers), mode, (z, y, x), np.dtype(dtype), tuple(int(v) for v in origin),
-                 float(scale[0]), _manifest(path, frames, (z, y, x)))
+                 float(scale[0]), _manifest(path, frames, (z, y, x)),
+                 None if palette is None else np.asarray(palette, np.uint8))
 
 
 def _chunk_shapes(array: dict):

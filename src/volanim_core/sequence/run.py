@@ -2,6 +2,7 @@
 
     frames --shared bounds (tskelbounds over all frames + padding)--> one grid, one origin
     plan key (connectivity, frames, mode, kernel, padding, source) --> new store, or resume the old one
+    a colour source --colour.indexed--> palette indices (sequenced) + the palette (in the store's attributes)
     frames not in the manifest --executor.submit(reconstruct_frames)--> stats --> manifest (driver only)
 
 The executor (``volanim_core.parallel``) is this process (1 worker), a local
@@ -20,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.colour.indexed import index_colours, indexed_error
 from volanim_core.limits import available_bytes, human_bytes
 from volanim_core.parallel import executor
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
@@ -41,6 +43,7 @@ class SequenceReport:
     seconds: float
     rest_filled: int  # the rest pose's filled voxels in the same mode (for loss)
     workers: str = ""
+    colours: str = ""  # a colour source: its palette (how many colours, exact or the quantisation's error)
 
 
 MAX_PADDING = 256  # voxels around the bodies; 10^4 made a grid of terabytes before anything refused it
@@ -161,10 +164,16 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
         check_frame_pattern(every_frame_as)
     if mode == "sampled" and source is None:
         raise ValueError("sampled mode needs the source volume (--source)")
-    if source is not None and np.ndim(source) != 3:
-        raise ValueError("a sequence samples a grey source (one value a voxel); for a colour volume make an "
-                         "index volume with 'volanim palette build' and 'palette apply', sequence that, and "
-                         "render it with the palette's transfer function ('volanim alpha merge', render --tf)")
+    palette, colours = None, ""
+    if source is not None and np.ndim(source) == 4:  # colour: indices sequenced, the palette in the store
+        if kernel != 1:
+            raise ValueError(f"a colour source is sequenced as palette indices, read at the nearest voxel "
+                             f"(kernel 1): indices cannot be averaged, got kernel {kernel}")
+        indexed = index_colours(source)
+        colours = describe_palette(indexed, source)
+        source, palette = indexed.indices, indexed.palette
+    elif source is not None and np.ndim(source) != 3:
+        raise ValueError(f"a source is a grey [x, y, z] or colour [x, y, z, 3] volume, got shape {np.shape(source)}")
     if isinstance(padding, bool) or not isinstance(padding, int | np.integer) or not 0 <= padding <= MAX_PADDING:
         raise ValueError(f"padding must be a whole number of voxels 0..{MAX_PADDING}, got {padding!r}")
     t0 = time.perf_counter()
@@ -177,6 +186,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
     if scheduler is None:
         check_memory(max(grids, key=lambda g: np.prod(g.shape, dtype=np.int64)), dtype, n_workers, source)
     key = plan_key(conn, frames, mode, kernel, padding, source, source_geometry)
+    if palette is not None:  # the same indices under other colours are another sequence
+        key = hashlib.blake2b((key + palette.tobytes().hex()).encode(), digest_size=16).hexdigest()
     plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
             "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
     old = store.read_plan(out) if out.exists() else None
@@ -192,7 +203,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                              "pass --force to replace it, or choose another -o")
         rest = plan["rest_filled"] = _rest_filled(conn)  # once per store: a resumed run does not redo it
         store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps,
-                     geometry=conn.geometry.shifted(bounds.lo))
+                     geometry=conn.geometry.shifted(bounds.lo), palette=palette)
         done = {}
     if every_frame_as:
         Path(every_frame_as).parent.mkdir(parents=True, exist_ok=True)
@@ -223,7 +234,16 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                     if on_frame is not None:
                         on_frame(rec, len(records), total)
     return SequenceReport(bounds, dtype.name, [records[i] for i in range(total)], len(done), len(todo),
-                          time.perf_counter() - t0, rest, label)
+                          time.perf_counter() - t0, rest, label, colours)
+
+
+def describe_palette(indexed, rgb) -> str:
+    """What a colour sequence's palette keeps of the source's colours, in words."""
+    if indexed.exact:
+        return f"colour: {indexed.colours} palette colours, exact"
+    mean, p95 = indexed_error(rgb, indexed)
+    return (f"colour: {indexed.colours} palette colours, quantised (CIEDE2000 mean {mean:.2f}, "
+            f"95th percentile {p95:.2f})")
 
 
 # A Dask task costs ~3 ms of scheduler round trip on the workers' own cores (measured: 100 tasks of a

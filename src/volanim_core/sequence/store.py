@@ -62,13 +62,15 @@ def chunk_shape(shape_zyx, edge: int = CHUNK_EDGE) -> tuple[int, int, int]:
 
 
 def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: dict, *, fps: float = 24.0,
-           geometry=None):
+           geometry=None, palette=None):
     """A new, empty sequence store (an existing one at ``path`` is replaced).
 
     ``origin_xyz``: the grid's voxel ``[0, 0, 0]`` in the frames' voxel indices; ``geometry``: where it
-    is in physical space (default: the identity shifted to ``origin_xyz``). OME-Zarr's ``scale`` and
-    ``translation`` are physical (millimetres), so napari and 3D Slicer overlay a frame on its scan;
-    OME-Zarr has no rotation, so a scan with tilted axes has its full geometry in volanim's attributes.
+    is in physical space (default: the identity shifted to ``origin_xyz``). ``palette``: a colour
+    sequence's ``(256, 3)`` colours, one per index its frames hold (:mod:`volanim_core.colour.indexed`).
+    OME-Zarr's ``scale`` and ``translation`` are physical (millimetres), so napari and 3D Slicer overlay a
+    frame on its scan; OME-Zarr has no rotation, so a scan with tilted axes has its full geometry in
+    volanim's attributes.
     """
     import zarr
 
@@ -95,6 +97,8 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     root = zarr.open_group(str(path), mode="w", zarr_format=3)
     root.attrs.update({"ome": ome, "volanim": {"origin_xyz": [ox, oy, oz], "mode": plan.get("mode"),
                                                "frames": plan.get("numbers"), "geometry": geometry.header_value()}})
+    if palette is not None:
+        root.attrs["volanim"] = {**root.attrs["volanim"], "palette": np.asarray(palette, np.uint8).tolist()}
     chunks = chunk_shape((z, y, x))
     # a shard holds whole chunks: round it up (past the array's edge), still exactly one per frame
     shard = tuple(-(-n // c) * c for n, c in zip((z, y, x), chunks))

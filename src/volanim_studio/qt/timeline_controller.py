@@ -20,7 +20,6 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QDialog, QFileDialog
 
 from volanim_core import io
-from volanim_core.io.volume_files import to_grey
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frame_files import write_frames
 from volanim_core.reconstruct.scan import scan_frames, scan_summary, worst_first
@@ -320,17 +319,20 @@ class TimelineController(Controller):
             return None
         mats, numbers = tl.matrices(frames), [tl.frame_number(f) for f in frames]
         camera, spacing, mode, source = self.camera(), tuple(self.scene.spacing), st.preview_mode, self.doc.volume
+        kernel = st.preview_kernel if mode == "sampled" else 1
+        if kernel > 1 and source is not None and source.ndim == 4:  # a colour movie's frames hold palette indices
+            kernel = 1
+            self.doc.message("The colour movie samples the nearest voxel (kernel 1): its frames hold palette "
+                             "indices, which cannot be averaged.")
         follow = st.follow_body if follow is None else follow
-        if source is not None and source.ndim == 4:  # sequences hold one value a voxel: a colour body's luminance
-            source = to_grey(source)
-            self.doc.message("The movie samples the colour volume's luminance (grey); the preview shows its colours.")
         fps = tl.frame_rate / step
         return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
-            conn, mats, numbers, out, mode=mode, source=source, camera=camera, spacing=spacing, style=style,
+            conn, mats, numbers, out, mode=mode, source=source, kernel=kernel, camera=camera, spacing=spacing,
+            style=style,
             size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, follow=follow, progress=progress,
             cancel=cancel),
             lambda r: self.doc.message(f"Rendered {r['frames']} frames to {r['out']} in {r['seconds']:.1f} s "
-                                       f"({r['workers']})."))
+                                       f"({r['workers']}){'; ' + r['colours'] if r['colours'] else ''}."))
 
     def render_movie_dialog(self) -> None:
         tl = self.doc.timeline

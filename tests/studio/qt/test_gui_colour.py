@@ -61,3 +61,35 @@ def test_the_threshold_is_chosen_on_the_luminance(colour_file):
     loaded = tasks.load_volume_file(str(colour_file))
     assert loaded["volume"].ndim == 4 and loaded["grey"].shape == samples.MANNEQUIN_SHAPE
     assert loaded["grey"].dtype == np.uint8 and loaded["grey"].max() > 100
+
+
+def test_the_colour_body_s_movie_is_in_colour(qtbot, window, colour_file, tmp_path):
+    """#61 item 7: the movie sampled the colour volume's luminance (grey) while the preview showed colours;
+    now the sequence holds palette indices and the movie draws the palette's colours."""
+    import imageio.v3 as iio
+
+    w = window
+    w.files.open_volume(colour_file, params={"lo": 1, "hi": None, "fill": False})
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert w.files.open_bones(ASSETS / "mannequin.bones")
+    assert w.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    w.timeline_panel.length.setValue(2)
+    w.timeline_panel.length.editingFinished.emit()
+    qtbot.keyClick(w, Qt.Key_S)  # a key at frame 0, and one with the arm raised at frame 1
+    w.doc.settings.current_frame = 1
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -60, 0))
+    w.timeline_panel.set_key.click()
+    w.doc.settings.preview_mode = "sampled"
+    w.doc.settings.preview_kernel = 3  # the preview averages colours; the movie's indices cannot be
+    assert w.timeline.render_movie(tmp_path / "pics", first=0, last=1, size=(160, 120), workers=1) is not None
+    assert "samples the nearest voxel (kernel 1)" in w.statusBar().currentMessage()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    message = w.statusBar().currentMessage()
+    assert "Rendered 2 frames" in message and "colour: 255 palette colours, quantised" in message
+    pngs = sorted((tmp_path / "pics").glob("*.png"))
+    assert len(pngs) == 2
+    for png in pngs:
+        pic = iio.imread(png)
+        body = np.abs(pic.astype(int) - (0x1E, 0x1F, 0x24)).max(axis=2) > 12  # not the studio's background
+        assert body.sum() > 500
+        assert (pic[..., 0].astype(int) - pic[..., 2] > 40)[body].mean() > 0.5  # warm skin; grey was 0
