@@ -68,6 +68,15 @@ def on_grid(volume: np.ndarray, geometry, target) -> np.ndarray:
     return resample(volume, geometry, target.spacing, order=0)[0]
 
 
+def series_choices(path) -> list[tuple[str, str]]:
+    """``[(uid, description)]`` of a DICOM folder's series (reads every file's header); [] for anything else."""
+    from volanim_core.io.dicom_files import is_dicom_folder, list_series
+
+    if not Path(path).is_dir() or not is_dicom_folder(Path(path)):
+        return []
+    return list_series(path)
+
+
 def load_volume_file(path: str, dims=None, series: str | None = None) -> dict:
     """Read any supported volume (fast; the heavy part is :func:`prepare_volume`). A colour volume
     stays in colour (``volume``); ``grey`` is what its threshold is chosen on."""

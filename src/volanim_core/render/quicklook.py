@@ -4,8 +4,8 @@ Used by ``volanim view`` (a pyvista window or a picture) and by the studio's
 *File → View volume or mesh…* (a window of its own); both draw through the
 same ``Renderer`` as ``volanim render``, so a quick look shows what a movie will.
 
-    file --read_look (reads; any thread)--> Look (settings, mesh or volume, description)
-         --draw_look (the GUI thread: VTK actors)--> Renderer
+    file --read_look (reads, and makes the surface: any thread)--> Look (settings, mesh or prepared frame,
+         description) --draw_look (the GUI thread: VTK actors only)--> Renderer
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import Renderer, RenderSettings, reset_clipping
+from .scene import PreparedFrame, Renderer, RenderSettings, prepare_frame, reset_clipping
 
 
 @dataclass
@@ -30,6 +30,7 @@ class Look:
     volume: np.ndarray | None = None
     origin: np.ndarray | None = None
     number: int = 0
+    frame: PreparedFrame | None = None  # the volume, ready to draw
 
 
 def read_look(path, *, style: str = "surface", preset: str | None = None, view: str = "three-quarter",
@@ -56,7 +57,9 @@ def read_look(path, *, style: str = "surface", preset: str | None = None, view: 
     what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {shown} colours"
     if ref.index >= 0:
         what = f"frame {ref.number}: {what}"
-    return Look(settings, what, volume=volume, origin=origin, number=ref.number)
+    # the surface (or the volume's point values) made here, off the GUI thread: only actors are left to draw
+    return Look(settings, what, volume=volume, origin=origin, number=ref.number,
+                frame=prepare_frame(settings, volume, origin))
 
 
 def draw_look(look: Look, *, plotter=None, off_screen: bool | None = True) -> Renderer:
@@ -69,7 +72,7 @@ def draw_look(look: Look, *, plotter=None, off_screen: bool | None = True) -> Re
         look.settings.camera.apply(renderer.plotter.renderer.GetActiveCamera())  # (a volume's draw() applies it)
         reset_clipping(renderer.plotter.renderer)
     else:
-        renderer.draw(look.volume, look.origin, look.number)
+        renderer.show(look.frame, look.number)
     return renderer
 
 

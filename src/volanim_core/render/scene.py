@@ -195,6 +195,43 @@ def prefer_egl_without_display() -> None:
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 
+@dataclass(frozen=True)
+class PreparedFrame:
+    """A frame ready to draw: the voxels as the settings colour them and, in the surface style, their surface."""
+    volume: np.ndarray
+    origin: np.ndarray
+    mesh: object = None  # the surface style's
+    data: np.ndarray | None = None  # the volume style's point values (x fastest; colour: RGBA)
+
+
+def prepare_frame(settings: RenderSettings, volume: np.ndarray, origin, table=None) -> PreparedFrame:
+    """The heavy part of drawing a frame, which needs no window (a reader thread may run it: the studio's
+    quick look of a large volume, #61): the cut, the colours' one value a voxel, the surface style's mesh.
+    ``table``: :func:`colour_table` of the settings, when the caller keeps it."""
+    from volanim_core.render.surfaces import label_surface
+
+    s = settings
+    if s.cut is not None:
+        volume = cut_away(volume, origin, *s.cut)
+    if volume.ndim == 4 and s.transfer is not None:
+        volume = to_grey(volume)  # a user's transfer function reads one value a voxel
+    if s.preset == "binary" and s.transfer is None and volume.ndim == 3:
+        volume = (volume > 0).astype(np.uint8)
+    if s.style != "surface":
+        if volume.ndim == 4:  # colour: RGB drawn as it is, black (the background) transparent
+            data = rgba_points(volume)
+        else:
+            data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
+            data = data.ravel(order="F")
+        return PreparedFrame(volume, np.asarray(origin), data=data)
+    part, at = crop(volume, origin)  # a sequence's shared grid is mostly empty
+    values = part if np.issubdtype(part.dtype, np.integer) else np.rint(part)
+    spacing = np.asarray(s.spacing, np.float64)  # world = voxel x spacing (the camera's units)
+    mesh = label_surface(values, np.asarray(at) * spacing, spacing,
+                         colour_table(s) if table is None else table)  # above the range: top colour
+    return PreparedFrame(volume, np.asarray(origin), mesh)
+
+
 class Renderer:
     """One off-screen plotter that draws frame after frame with one camera.
 
@@ -217,7 +254,7 @@ class Renderer:
         self._grid = None  # the volume style's image data, refilled per frame when its shape stays
         self._grid_key = None
         self._first = True
-        self._table = colour_table(settings)
+        self._table = colour_table(settings)  # every frame's surface colours
         self._bar = None
         if settings.title:
             self.plotter.add_text(settings.title, position="upper_left", font_size=12, name="title",
@@ -242,17 +279,15 @@ class Renderer:
 
     def draw(self, volume: np.ndarray, origin, number: int | None = None, camera: Camera | None = None) -> None:
         """Put a frame's actors in the scene (no rendering yet)."""
+        self.show(prepare_frame(self.settings, volume, origin, self._table), number, camera)
+
+    def show(self, frame: PreparedFrame, number: int | None = None, camera: Camera | None = None) -> None:
+        """Put a frame :func:`prepare_frame` made (any thread) in the scene: only VTK actors here."""
         s = self.settings
-        if s.cut is not None:
-            volume = cut_away(volume, origin, *s.cut)
-        if volume.ndim == 4 and s.transfer is not None:
-            volume = to_grey(volume)  # a user's transfer function reads one value a voxel
-        if s.preset == "binary" and s.transfer is None and volume.ndim == 3:
-            volume = (volume > 0).astype(np.uint8)
         if s.style == "surface":
-            self._draw_surface(*crop(volume, origin))  # a sequence's shared grid is mostly empty
+            self._draw_surface(frame.mesh)
         else:
-            self._draw_volume(volume, origin)
+            self._draw_volume(frame.volume, frame.origin, frame.data)
         if s.preset == "hotspot" and self._bar is None:
             self._add_colour_bar()
         if s.frame_numbers and number is not None:
@@ -264,27 +299,17 @@ class Renderer:
     def close(self) -> None:
         self.plotter.close()
 
-    def _draw_surface(self, volume, origin) -> None:
-        from volanim_core.render.surfaces import label_surface
-
-        values = volume if np.issubdtype(volume.dtype, np.integer) else np.rint(volume)
-        spacing = np.asarray(self.settings.spacing, np.float64)  # world = voxel x spacing (the camera's units)
-        mesh = label_surface(values, np.asarray(origin) * spacing, spacing, self._table)  # above the range: top colour
+    def _draw_surface(self, mesh) -> None:
         if mesh.n_points == 0:
             self.plotter.remove_actor("body", render=False)
             return
         self.plotter.add_mesh(mesh, scalars="rgb", rgb=True, name="body", reset_camera=False,
                               smooth_shading=False, show_scalar_bar=False, render=False)
 
-    def _draw_volume(self, volume, origin) -> None:
+    def _draw_volume(self, volume, origin, data) -> None:
         import pyvista as pv
 
         s = self.settings
-        if volume.ndim == 4:  # colour: RGB drawn as it is, black (the background) transparent
-            data = rgba_points(volume)
-        else:
-            data = volume.astype(np.float32) if volume.dtype.kind == "f" or volume.dtype.itemsize > 2 else volume
-            data = data.ravel(order="F")
         # the whole shared grid, refilled frame after frame: a new volume actor costs a VTK pipeline
         # set-up per frame, so cropping each frame to its body would be slower than drawing it
         key = (volume.shape, tuple(float(v) for v in np.asarray(origin) * s.spacing), data.dtype.str)

@@ -136,37 +136,83 @@ class FilesController(Controller):
             name, skeleton_path=skeleton_path, progress=progress, cancel=cancel), done)
 
     def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None,
-                    then: Callable[[], None] | None = None) -> Worker | None:
-        """Read a volume; ask for the threshold (unless ``params``); segment it in a worker;
-        ``then()`` runs right after it is applied. A DICOM folder of several series asks which."""
-        series = (params or {}).get("series") or self._choose_series(path)
-        if series is FAILED:
+                    then: Callable[[], None] | None = None, otherwise: Callable[[], None] | None = None,
+                    series: str | None = None) -> Worker | None:
+        """Read a volume and segment it, both in workers (#61: a large scan's read froze the window): a
+        DICOM folder of several series asks which; without ``params`` the threshold dialog asks between
+        the read and the segmentation. ``then()`` runs right after the result is applied; ``otherwise()``
+        when the read or the segmentation failed or was cancelled, or the user declined a dialog (the
+        error is shown). Returns the first job's worker (None while another job runs: said)."""
+        otherwise = otherwise or (lambda: None)
+        series = series or (params or {}).get("series")
+        name = Path(path).name
+        if self.jobs.busy:
+            self.doc.message(f"A job is running; open {name} when it ends.")
+            otherwise()
             return None
-        loaded = self.attempt("Open volume", lambda: tasks.load_volume_file(str(path), dims, series))
-        if loaded is FAILED:
-            return None
-        if params is None:
-            dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"],
-                                     segments=loaded["segments"])
-            if dialog.exec() != ThresholdDialog.Accepted:
-                return None
-            params = dialog.parameters()
-        params = dict(params)
-        params.pop("series", None)
-        spacing = tuple(float(v) for v in params.pop("spacing", None) or loaded["spacing"])
-        vol, grey = loaded["volume"], loaded["grey"]
-        geometry = loaded["geometry"].with_spacing(spacing)  # the voxel size the user confirmed
 
-        def done(r):
-            r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
-            r["segmentation"]["series"] = series  # and which series of a DICOM folder
-            self._apply_prepared(r, path=path, spacing=r["geometry"].spacing, dims=dims)
-            if then is not None:
-                then()
+        def task(progress, cancel):
+            if series is None:
+                choices = tasks.series_choices(path)  # [] unless a DICOM folder of several series
+                if len(choices) > 1:
+                    return {"choices": choices}
+            loaded = tasks.load_volume_file(str(path), dims, series)
+            if params is None:
+                return {"loaded": loaded}
+            return {"loaded": loaded, "prepared": tasks.prepare_volume(
+                loaded["volume"], skeleton_path=skeleton_path, progress=progress, cancel=cancel,
+                **self._segmentation(loaded, params))}
 
-        return self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
-            vol, skeleton_path=skeleton_path, grey=grey, geometry=geometry, progress=progress, cancel=cancel,
-            **params), done)
+        def read(r):
+            if "choices" in r:
+                chosen = self._ask_series(name, r["choices"])
+                if chosen is None:
+                    otherwise()
+                else:
+                    self.open_volume(path, dims=dims, params=params, skeleton_path=skeleton_path, then=then,
+                                     otherwise=otherwise, series=chosen)
+            elif "prepared" in r:
+                self._apply_volume(r["prepared"], path, dims, self._spacing(r["loaded"], params), series, then)
+            else:
+                self._ask_threshold(path, r["loaded"], dims, skeleton_path, series, then, otherwise)
+
+        worker = self.jobs.run(f"Opening {name}" if params else f"Reading {name}", task, read)
+        worker.failed.connect(lambda *_: otherwise())
+        worker.was_cancelled.connect(otherwise)
+        return worker
+
+    def _ask_threshold(self, path, loaded, dims, skeleton_path, series, then, otherwise) -> None:
+        """The threshold dialog over a volume just read, then its segmentation in a worker."""
+        dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"],
+                                 segments=loaded["segments"])
+        if dialog.exec() != ThresholdDialog.Accepted:
+            otherwise()
+            return
+        params = dialog.parameters()
+        worker = self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
+            loaded["volume"], skeleton_path=skeleton_path, progress=progress, cancel=cancel,
+            **self._segmentation(loaded, params)),
+            lambda r: self._apply_volume(r, path, dims, self._spacing(loaded, params), series, then))
+        worker.failed.connect(lambda *_: otherwise())
+        worker.was_cancelled.connect(otherwise)
+
+    @staticmethod
+    def _spacing(loaded: dict, params: dict) -> tuple:
+        """The voxel size the user confirmed (the dialog's, a project's), else the file's."""
+        return tuple(float(v) for v in params.get("spacing") or loaded["spacing"])
+
+    def _segmentation(self, loaded: dict, params: dict) -> dict:
+        """``prepare_volume``'s arguments from the segmentation ``params`` (the dialog's, or a project's)."""
+        args = {k: v for k, v in params.items() if k not in ("series", "spacing")}
+        geometry = loaded["geometry"].with_spacing(self._spacing(loaded, params))
+        return {**args, "grey": loaded["grey"], "geometry": geometry}
+
+    def _apply_volume(self, r: dict, path, dims, spacing, series, then) -> None:
+        r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
+        r["segmentation"]["series"] = series  # and which series of a DICOM folder
+        self._apply_prepared(r, path=path, spacing=r["geometry"].spacing, dims=dims)
+        if then is not None:
+            then()
 
     def open_volume_dialog(self) -> None:
         self.window.session.when_saved_or_discarded(self._ask_volume, "opening another volume")
@@ -187,21 +233,13 @@ class FilesController(Controller):
         if folder:
             self.open_volume(folder)
 
-    def _choose_series(self, path):
-        """None for anything but a DICOM folder of several series; else the UID the user picks (FAILED
-        when they cancel)."""
+    def _ask_series(self, name: str, choices) -> str | None:
+        """The UID of the series the user picks from ``choices`` ``[(uid, text)]``; None when they cancel."""
         from PySide6.QtWidgets import QInputDialog
 
-        from volanim_core.io.dicom_files import is_dicom_folder, list_series
-
-        if not Path(path).is_dir() or not is_dicom_folder(Path(path)):
-            return None
-        choices = list_series(path)
-        if len(choices) < 2:
-            return None
-        line, ok = QInputDialog.getItem(self.window, "Which series?", f"{Path(path).name} holds {len(choices)} "
+        line, ok = QInputDialog.getItem(self.window, "Which series?", f"{name} holds {len(choices)} "
                                         "DICOM series:", [text for _, text in choices], 0, False)
-        return next(uid for uid, text in choices if text == line) if ok else FAILED
+        return next(uid for uid, text in choices if text == line) if ok else None
 
     @staticmethod
     def _dicom_series_folder(path: str) -> str:
@@ -253,19 +291,14 @@ class FilesController(Controller):
             done(True)
             self.window.previews.show_body()  # opened in Pose mode: its body, not its bones alone
 
-        worker = None
+        # the rest is applied by the job's own completion handler, not by a second connection to
+        # `succeeded`: that would run as a separate event after the job reads as done ("not busy"),
+        # and anything acting in between (a key press, a test) would see a half-opened project
         if data.get("volume"):
-            worker = self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
-                                      skeleton_path=data.get("mskel"), then=rest)
-            if worker is None:
-                done(False)
-                return None
-        elif data.get("demo"):
+            return self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
+                                    skeleton_path=data.get("mskel"), then=rest, otherwise=lambda: done(False))
+        if data.get("demo"):
             worker = self.load_demo(data["demo"], skeleton_path=data.get("mskel"), then=rest)
-        if worker is not None:
-            # the rest is applied by the job's own completion handler, not by a second connection to
-            # `succeeded`: that would run as a separate event after the job reads as done ("not busy"),
-            # and anything acting in between (a key press, a test) would see a half-opened project
             worker.failed.connect(lambda *_: done(False))
             worker.was_cancelled.connect(lambda: done(False))
             return worker

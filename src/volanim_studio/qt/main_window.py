@@ -371,13 +371,6 @@ class MainWindow(QMainWindow):
 def main_window_for(args) -> MainWindow:
     """A window loaded as the command line asks (see ``app.main``)."""
     w = MainWindow()
-    worker = None
-    if args.project:
-        worker = w.files.open_project(args.project)
-    elif args.demo:
-        worker = w.files.load_demo(args.demo)
-    elif args.volume:
-        worker = w.files.open_volume(args.volume)
 
     def then(_=None):  # files that build on the loaded skeleton, after any background load
         if args.mskel:
@@ -389,8 +382,12 @@ def main_window_for(args) -> MainWindow:
         w.doc.undo.clear()  # what the command line named is where the session starts, not an edit to undo
         w.doc.undo.mark_clean()
 
-    if worker is not None:
-        worker.succeeded.connect(then)
+    if args.project:
+        w.files.open_project(args.project, lambda ok: ok and then())
+    elif args.demo:
+        w.files.load_demo(args.demo, then=then)
+    elif args.volume:
+        w.files.open_volume(args.volume, then=then)  # read, thresholded by the user, segmented: then the rest
     else:
         then()
     if not (args.project or args.demo or args.volume or args.mskel or args.connect or args.bones):

@@ -5,6 +5,7 @@
             progress(done, total) --Signal--> QProgressDialog
             Cancel button --> cancel() returns True --> Cancelled --> was_cancelled
             return value --succeeded(object)--> on_done on the GUI thread (dropped if cancelled by then)
+            on_done raises --> failed(message): said, and whoever waits on the job hears it failed
     JobRunner.shutdown()   (window close) cancel, show "Finishing…", wait as long as it takes
 
 Why ``shutdown`` never gives up: a QThread object destroyed while its thread
@@ -112,8 +113,26 @@ class JobRunner(QObject):
             finish()
             self._message(f"{label}: cancelled.")
 
-        worker.succeeded.connect(lambda result: cancelled() if worker.cancelled else (finish(), on_done(result)))
-        worker.failed.connect(lambda msg: (finish(), self._show_error(label, msg)))
+        def succeeded(result):
+            if worker.cancelled:
+                cancelled()
+                return
+            finish()
+            try:
+                on_done(result)
+            except USER_ERRORS as exc:  # applying the result can still find it bad: a failed job, said
+                worker.failed.emit(str(exc))  # whoever waits on the job (open_project's on_opened) hears of it
+            except Exception as exc:  # a bug: still tell the user and whoever waits, then let it be seen
+                worker.failed.emit(f"unexpected {type(exc).__name__}: {exc}")
+                raise
+
+        def failed(msg):
+            if self.worker is worker:  # not after its result was applied (a next job may be running)
+                finish()
+            self._show_error(label, msg)
+
+        worker.succeeded.connect(succeeded)
+        worker.failed.connect(failed)
         worker.was_cancelled.connect(cancelled)
         self.worker, self.dialog = worker, dialog
         worker.start()

@@ -52,3 +52,81 @@ def test_close_while_a_job_runs_waits_for_it_instead_of_aborting(qtbot):
     assert seen["cancel"] is True  # close asked the job to stop
     assert "result" not in seen  # and a result that came anyway is dropped: nothing applied after closing
     assert any("Finishing" in m for m in messages)  # and said what it was waiting for
+
+
+@pytest.mark.long("a 46 M-voxel volume opened and viewed: the reads and the surface stay off the GUI thread")
+def test_a_46m_voxel_volume_opens_and_is_viewed_while_the_event_loop_turns(qtbot, window, tmp_path, monkeypatch):
+    """#61 item 9: *Open volume* read the file, and the quick look made a large volume's surface, on the GUI
+    thread (the window froze). Each heavy call is watched where it runs: never on the GUI thread, and before
+    it returns the GUI's timer has ticked again -- the event loop turned while it worked (a call on the GUI
+    thread would wait for a tick forever; it is refused instead)."""
+    import threading
+    import time
+
+    import numpy as np
+    from PySide6.QtCore import QTimer
+
+    from volanim_core.render import surfaces
+    from volanim_studio import tasks
+
+    from ..conftest import viewer_opened
+
+    big = np.zeros((400, 400, 288), np.uint8)  # 46,080,000 voxels
+    big[120:280, 150:250, 40:250] = 180  # a slab of a body, and a limb off it
+    big[180:220, 180:220, 250:280] = 180
+    io.write_volume(tmp_path / "big.VOL", big)
+    ticks = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(time.perf_counter()))
+    timer.start(20)
+    calls = []
+
+    def watched(name, real):
+        def call(*args, **kwargs):
+            on_gui = threading.current_thread() is threading.main_thread()
+            calls.append((name, on_gui))
+            if on_gui:
+                raise AssertionError(f"{name} ran on the GUI thread")
+            before = len(ticks)
+            out = real(*args, **kwargs)
+            deadline = time.monotonic() + 120
+            while len(ticks) < before + 2 and time.monotonic() < deadline:  # the loop ticks while we wait
+                time.sleep(0.005)
+            assert len(ticks) >= before + 2, f"the GUI's timer stopped while {name} ran"
+            return out
+        return call
+
+    for name in ("load_volume_file", "prepare_volume"):
+        monkeypatch.setattr(tasks, name, watched(name, getattr(tasks, name)))
+    monkeypatch.setattr(surfaces, "label_surface", watched("label_surface", surfaces.label_surface))
+
+    window.files.open_volume(tmp_path / "big.VOL", params={"lo": 1, "hi": None, "fill": False})
+    assert window.busy and calls == []  # the open returned at once: nothing read yet on this thread
+    qtbot.waitUntil(lambda: not window.busy, timeout=4 * JOB_TIMEOUT_MS)
+    assert window.doc.shape == big.shape and len(window.doc.skeleton) > 0, window.last_error
+    viewer = viewer_opened(window, qtbot, window.files.view_file, tmp_path / "big.VOL")
+    timer.stop()
+    assert viewer is not None and "400x400x288 voxels" in viewer.what, window.last_error
+    assert [n for n, _ in calls] == ["load_volume_file", "prepare_volume", "label_surface"]
+    assert not any(on_gui for _, on_gui in calls)
+    gaps = np.diff(ticks)
+    print(f"timer: {len(ticks)} ticks, longest gap {gaps.max():.3f} s, 95th percentile {np.percentile(gaps, 95):.3f} s")
+    viewer.close()
+
+
+def test_a_result_that_cannot_be_applied_is_a_failed_job_said_and_heard(qtbot, window):
+    """Applying a job's result raised and the job was neither said to fail nor heard to: whoever waited on
+    it (open_project's on_opened) waited forever. Now it is a failed job: shown, and ``failed`` emitted."""
+    heard = []
+
+    def apply(result):
+        raise ValueError(f"{result} voxels do not fit the grid")
+
+    worker = window.jobs.run("Applying", lambda progress, cancel: 12, apply)
+    worker.failed.connect(heard.append)
+    qtbot.waitUntil(lambda: not window.busy and bool(heard), timeout=JOB_TIMEOUT_MS)
+    assert heard == ["12 voxels do not fit the grid"]
+    assert "12 voxels do not fit the grid" in window.last_error
+    window.files.load_demo("mannequin")  # the runner takes the next job
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    assert window.doc.demo_name == "mannequin"

@@ -57,8 +57,9 @@ def test_malformed_file_shows_error_dialog_and_keeps_document(qtbot, window, tmp
     assert window._error_box.isVisible()
     assert window.doc.bones == before
     (tmp_path / "short.VOL").write_bytes(b"10 10 10".ljust(100) + b"\0" * 10)
-    assert window.files.open_volume(tmp_path / "short.VOL", params={"lo": 1, "hi": None, "fill": False}) is None
-    assert "expected 1100" in window.last_error
+    window.files.open_volume(tmp_path / "short.VOL", params={"lo": 1, "hi": None, "fill": False})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)  # read in a worker (#61 item 9)
+    assert "expected 1100" in window.last_error and window.doc.bones == before
 
 
 def test_threshold_dialog_histogram_and_parameters(qtbot):
