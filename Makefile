@@ -16,6 +16,7 @@ $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e .
+	$(PY) -m volanim_core warmup  # every numba kernel compiled now, not on a user's first scan (#61)
 	touch $@
 
 $(VENV)/.installed-test: $(VENV)/.installed

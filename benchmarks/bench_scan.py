@@ -5,6 +5,7 @@
     each tree (this one; --old REV, checked out with `git worktree` into a temporary folder), in a process of
     its own with that tree's src first on the path:
         scan_frames(mannequin.0.50.connect with rigid / smooth joints, the frames) --> ms a frame
+        `volanim scan mannequin.0.50.connect` of all 1064 frames' .trans (written once by this tree) --> seconds
     printed as a table with each tree's ratio to the old one (the machine drifts: compare within a run)
 
 Run: .venv/bin/python benchmarks/bench_scan.py [--old REV] [--every 4]
@@ -18,11 +19,13 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
+WALK = REPO / "src" / "volanim_core" / "sample_data" / "walk.bvh"
 CHILD = r"""
 import json, sys, time
 import numpy as np
@@ -54,17 +57,24 @@ def walk_matrices(every: int) -> np.ndarray:
     from volanim_core.motion.retarget import Retarget
     from volanim_core.samples import mannequin_bones
 
-    r = Retarget.build(mannequin_bones(), read_bvh(REPO / "src" / "volanim_core" / "sample_data" / "walk.bvh"))
+    r = Retarget.build(mannequin_bones(), read_bvh(WALK))
     return r.matrices()[::every]
 
 
-def time_tree(root: Path, mats_path: Path) -> dict:
-    """Each tree scans with its own src and its own assets (a .connect as that tree wrote it)."""
+def time_tree(root: Path, mats_path: Path, trans: list[Path]) -> dict:
+    """Each tree scans with its own src and its own assets (a .connect as that tree wrote it): the library
+    call on the matrices, then the whole ``volanim scan`` command on every frame's .trans (start-up, reading
+    the files, the scan, the report: what a user waits for)."""
     env = dict(os.environ, PYTHONPATH=str(root / "src"))
     assets = root / "assets"
     out = subprocess.run([sys.executable, "-c", CHILD, str(mats_path), str(assets / "mannequin.0.50.connect"),
                           str(assets / "mannequin.bones")], env=env, capture_output=True, text=True, check=True)
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    rows = json.loads(out.stdout.strip().splitlines()[-1])
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "volanim_core", "scan", str(assets / "mannequin.0.50.connect"),
+                    *map(str, trans), "--top", "1"], env=env, capture_output=True, text=True)  # exit 1: frames broken
+    rows["command"] = time.perf_counter() - t0
+    return rows
 
 
 def main() -> None:
@@ -77,24 +87,29 @@ def main() -> None:
         tmp = Path(tmp)
         mats = walk_matrices(args.every)
         np.save(tmp / "walk.npy", mats)
+        subprocess.run([sys.executable, "-m", "volanim_core", "bvh2trans", str(WALK), "--bones",
+                        str(REPO / "assets" / "mannequin.bones"), "-o", str(tmp / "walk")], check=True,
+                       capture_output=True)
+        trans = sorted((tmp / "walk").glob("*.trans"))
         old = tmp / "old"
         subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(old), args.old], check=True,
                        capture_output=True)
         try:
-            rows = {f"old ({args.old})": time_tree(old, tmp / "walk.npy"),
-                    "this tree": time_tree(REPO, tmp / "walk.npy")}
+            rows = {f"old ({args.old})": time_tree(old, tmp / "walk.npy", trans),
+                    "this tree": time_tree(REPO, tmp / "walk.npy", trans)}
         finally:
             subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(old)], capture_output=True)
     base = next(iter(rows.values()))
     print(f"{len(mats)} frames of the walk (every {args.every}th), mannequin.0.50.connect, {os.cpu_count()} cores")
-    print("| tree | rigid: ms a frame | ratio | smooth: ms a frame | ratio | frames torn (rigid) |")
-    print("|---|---|---|---|---|---|")
+    print(f"| tree | rigid: ms a frame | ratio | smooth: ms a frame | ratio | frames torn (rigid) | "
+          f"`volanim scan` of all {len(trans)} .trans: s | ratio |")
+    print("|---|---|---|---|---|---|---|---|")
     for name, r in rows.items():
         smooth = r.get("smooth")
         print(f"| {name} | {r['rigid']['ms']:.1f} | {r['rigid']['ms'] / base['rigid']['ms']:.2f} | "
               + (f"{smooth['ms']:.1f} | " if smooth else "— | ")
               + (f"{smooth['ms'] / base['smooth']['ms']:.2f} | " if smooth and "smooth" in base else "— | ")
-              + f"{r['rigid']['broken']} |")
+              + f"{r['rigid']['broken']} | {r['command']:.1f} | {r['command'] / base['command']:.2f} |")
 
 
 if __name__ == "__main__":

@@ -3,12 +3,17 @@
     compile_kernels()
         skeletonize (euclid, 345) --> auto_connect (path) --> reconstruct
         (every mode x metric, sampled with kernel 1 and 3, and a colour source) --> palette
-        orderings --> breakage report (+ detached pieces) --> a crumble's heap
+        orderings --> breakage report (+ detached pieces; a clip's scan uses the same kernels)
+        --> a crumble's heap --> a proposed rig's balls
+
+Every kernel a user's command or the studio calls is in that list (a test holds it to that): a fresh
+install that skipped this compiles on first use instead -- the walk's first `volanim scan` took 22 s
+there against 8 s warm (#61 item 11), and three times as long on a busy machine.
 
 The kernels are ``@njit(cache=True)``: the machine code lands in the package's
 ``__pycache__`` and later processes load it in well under a second. A fresh
 install compiles them all in ~20 s the first time; doing it here, up front and
-with a message (``volanim warmup``, ``make demo``, the test session), keeps
+with a message (``volanim warmup``, run by ``make install``; ``make demo``; the test session), keeps
 that cost out of anything a user -- or a test with a timeout -- is waiting on.
 Types matter to numba, so the inputs use the dtypes real calls use (uint8
 labels and sources, uint16 hotspot counts, float64 geometry).
@@ -40,6 +45,7 @@ def compile_kernels(progress=None) -> float:
     from volanim_core.rig.attach import auto_connect
     from volanim_core.rig.bones import Bone, BoneSkeleton
     from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
+    from volanim_core.rig.curve_skeleton import balls
     from volanim_core.rig.pose import pose_matrices
     from volanim_core.sequence.effects import fall
     from volanim_core.skeleton.skeletonize import skeletonize
@@ -57,6 +63,7 @@ def compile_kernels(progress=None) -> float:
     for metric in metrics:
         skel = skeletonize(mask, metric=metric, min_thinness=-np.inf)
         bone_of, _ = auto_connect(skel.points, bones, mask, method="path")
+        auto_connect(skel.points, bones, mask, method="geodesic")  # the paths' many-pairs kernel
         conn = Connectivity(roots, skel.points, skel.dt, skel.thinness, np.maximum(bone_of, 0), metric).grouped()
         tskel = Tskel(conn.bones, matrices, conn.points, conn.dt, conn.thinness, conn.bone, metric)
         done += 1
@@ -70,11 +77,13 @@ def compile_kernels(progress=None) -> float:
     reconstruct(tskel, mode="sampled", source=rgb, kernel=3)  # a colour source: float32 linear light
     sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "path")  # all moves
     sort_palette(np.arange(12, dtype=np.uint8).repeat(3).reshape(-1, 3), "cluster-seeds")
+    sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "ramp")  # the default
     breakage_report(tskel, dict(bones.joints), dict(bones.joints))
     two = np.zeros((6, 6, 6), np.uint8)
     two[1, 1, 1] = two[4, 4, 4] = 1
     components(two)  # a report's detached pieces: where each is nearest the main body
     fall(np.pad(source, ((8, 8), (8, 8), (0, 8))), 1.0)  # a crumble's heap (room for it around the bar)
+    balls(skel)  # a proposed rig's body of balls (auto-rig)
     _report(progress, total, total)
     return time.perf_counter() - t0
 
