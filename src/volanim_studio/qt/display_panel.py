@@ -119,4 +119,9 @@ class DisplayPanel(QWidget):
             w.setValue(v)
             w.blockSignals(False)
         total = len(self.doc.skeleton) if self.doc.skeleton is not None else 0
-        self.count_label.setText(f"{self.doc.visible_count} of {total} points shown")
+        shown = self.doc.visible_count
+        text = f"{shown} of {total} points shown"
+        if shown > 1 and self.doc.skeleton.thinness[:shown].min() == self.doc.thinness_range[1]:
+            # the slider's far end shows the thinnest points (>= its value); several may tie there (#61)
+            text += f", tied for the thinnest ({self.doc.thinness_range[1]:.3f})"
+        self.count_label.setText(text)

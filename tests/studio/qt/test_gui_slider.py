@@ -13,7 +13,13 @@ def test_thinness_slider_shows_the_prefix(window):
         panel.thinness_slider.setValue(step)
         t = window.doc.thinness
         assert window.scene.shown_points == skel.count_at(t) == int((skel.thinness >= t).sum())
-    assert f"{window.scene.shown_points} of {len(skel)} points shown" == panel.count_label.text()
+        if step == 500:
+            assert f"{window.scene.shown_points} of {len(skel)} points shown" == panel.count_label.text()
+    # #61 item 12: at the far end two points stayed, unexplained. They are the knees, tied for the thinnest
+    # (>= the slider's value keeps both); the label says so rather than leave the user guessing
+    top = float(skel.thinness.max())
+    assert window.scene.shown_points == int((skel.thinness == top).sum()) == 2
+    assert panel.count_label.text() == f"2 of {len(skel)} points shown, tied for the thinnest ({top:.3f})"
 
 
 def test_a_held_slider_draws_fewer_points_and_a_coarser_hull(window, monkeypatch):
