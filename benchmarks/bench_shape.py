@@ -2,7 +2,8 @@
 
     mannequin (and mannequin-large with --large): the default pipeline's connectivity
         (skeletonize at thinness 0.5, connect to the nearest bone: what `volanim connect` gives)
-    for each joint and angle and method (rigid: today's default; smooth: --joints smooth, blend 1):
+    for each joint and angle and method (rigid: today's default; smooth: --joints smooth, blend 1; fitted:
+    rigid over `connect --method fitted`, rig/limb_tubes.py):
         bone-mode reconstruction --compare_shapes--> posed_sample (the capsules posed by the same matrices)
         Dice, the largest extra and missing blob (opened by one voxel) as % of the moved limb's voxels,
         surface distance p95 (voxels)
@@ -32,16 +33,18 @@ JOINTS = {
     "spine twist": ("SPINE", 60, lambda a, u: (0, 0, a)),
     "forearm twist": ("L_FOREARM", 90, lambda a, u: Rotation.from_rotvec(u * np.radians(a)).as_matrix()),
 }
-METHODS = ("rigid", "smooth")
+#: rigid and smooth joints over the default (nearest) connectivity; fitted: rigid joints over the fitted one
+METHODS = ("rigid", "smooth", "fitted")
 GOALS = {"dice": 0.995, "blob": 0.5, "p95": 1.5}
 
 
-def default_connectivity(sample):
-    """What a user's pipeline gives: skeletonize (thinness >= 0.5), then every point to its nearest bone."""
-    from volanim_core.rig.attach import connect_nearest
+def default_connectivity(sample, method: str = "nearest"):
+    """What a user's pipeline gives: skeletonize (thinness >= 0.5), then every point to its nearest bone
+    (``method``: another rule of `volanim connect`, e.g. fitted)."""
+    from volanim_core.rig.attach import connect
     from volanim_core.skeleton.skeletonize import skeletonize
 
-    return connect_nearest(skeletonize(sample.mask, min_thinness=0.5), sample.bones)
+    return connect(skeletonize(sample.mask, min_thinness=0.5), sample.bones, method=method)[0]
 
 
 def moved_limb_voxels(sample, bone: str) -> int:
@@ -67,6 +70,8 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
     from volanim_core.rig.skinning import Joints
 
     conn = default_connectivity(sample)
+    conns = {"rigid": conn, "smooth": conn.with_joints(Joints("smooth")),
+             "fitted": default_connectivity(sample, "fitted")}
     bones = sample.bones
     rest = RestParts.of(conn)
     rest_segments = [(b.proximal, b.distal) for b in conn.bones]
@@ -86,7 +91,7 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
             segments = {s.label: (at[s.proximal], at[s.distal]) for s in bones.bones}
             for method in METHODS:
                 t0 = time.perf_counter()
-                r = reconstruct(conn.with_joints(Joints(method)).posed(m), mode="bone")
+                r = reconstruct(conns[method].posed(m), mode="bone")
                 seconds = time.perf_counter() - t0
                 rep = compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin,
                                      joints=at, segments=segments)

@@ -1,6 +1,6 @@
 """Attaching skeleton points to bones (connectivity).
 
-Three rules, measured against the mannequin's ground-truth limb membership
+The rules, measured against the mannequin's ground-truth limb membership
 (``benchmarks/bench_connect.py``; README gives the error rates):
 
 * ``attach_nearest_bone`` -- the nearest segment. Ignores the shape: a point
@@ -16,6 +16,10 @@ Three rules, measured against the mannequin's ground-truth limb membership
   inside the mask), seeded by the points nearest to each bone; every point
   takes the bone whose seed it reaches by the shortest path.
 
+* ``auto_connect(method="fitted")`` -- nearest, then every point whose ball reaches past its bone's
+  own tube (fitted along the limb's middle) goes to the bone above: the armpit to the torso, not the
+  arm (:mod:`.limb_tubes`; #60).
+
 ``auto_connect`` never overwrites points already attached unless asked, and
 reports how many it left unattached and why -- it never fails silently.
 """
@@ -28,6 +32,7 @@ import numpy as np
 
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity
+from volanim_core.rig.limb_tubes import carry_up
 from volanim_core.rig.pose import root_bones
 from volanim_core.skeleton.points import Skeleton
 
@@ -131,7 +136,8 @@ def _geodesic_method(points, bones, mask, k=10):
 
 def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, method: str = "path",
                  current: np.ndarray | None = None, overwrite: bool = False,
-                 which: np.ndarray | None = None) -> tuple[np.ndarray, AutoConnectReport]:
+                 which: np.ndarray | None = None, radii: np.ndarray | None = None
+                 ) -> tuple[np.ndarray, AutoConnectReport]:
     """Attach points to bones, checking that the attachment runs inside the object.
 
     Parameters
@@ -139,11 +145,13 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     points : (N, 3) int ndarray, voxel coordinates
     bones : BoneSkeleton
     mask : (X, Y, Z) bool ndarray, the segmented object
-    method : {'path', 'path-or-nearest', 'geodesic', 'nearest'}
+    method : {'path', 'path-or-nearest', 'geodesic', 'nearest', 'fitted'}
     current : (N,) int ndarray, optional
         Existing attachments (-1 = none); kept unless ``overwrite``.
     which : (N,) bool ndarray, optional
         Only these points are considered (a cube or lasso selection).
+    radii : (N,) ndarray, the points' distance transform (needed by ``fitted``: the limbs' tubes are
+        measured on every point, whichever are attached)
 
     Returns
     -------
@@ -171,9 +179,13 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
             report.fallback = int(lost.sum())
     elif method == "geodesic":
         found = _geodesic_method(sub, bones, mask)
+    elif method == "fitted":
+        if radii is None or len(radii) != n:
+            raise ValueError("the 'fitted' method needs every point's radius (its distance transform)")
+        found = carry_up(points, radii, bones, attach_nearest_bone(points, bones))[todo]
     else:
-        raise ValueError(f"method must be 'path', 'path-or-nearest', 'geodesic' or 'nearest', got {method!r}")
-    if mask is not None and method != "nearest":
+        raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+    if mask is not None and method not in ("nearest", "fitted"):
         outside = ~mask[tuple(sub.T)]
         if outside.any():
             report.reasons["the point itself lies outside the segmented volume"] = int(outside.sum())
@@ -188,7 +200,8 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     return current, report
 
 
-METHODS = ("nearest", "path", "path-or-nearest", "geodesic")
+METHODS = ("nearest", "path", "path-or-nearest", "geodesic", "fitted")
+NEEDS_MASK = ("path", "path-or-nearest", "geodesic")
 
 
 def connect(skeleton: Skeleton, bones: BoneSkeleton, *, method: str = "nearest",
@@ -201,12 +214,12 @@ def connect(skeleton: Skeleton, bones: BoneSkeleton, *, method: str = "nearest",
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    if method != "nearest" and mask is None:
+    if method in NEEDS_MASK and mask is None:
         raise ValueError(f"the {method!r} method needs the segmented volume (a path must run inside it)")
     if mask is not None and len(skeleton) and (skeleton.points.max(axis=0) >= np.array(mask.shape)).any():
         raise ValueError(f"the segmented volume ({'x'.join(map(str, mask.shape))} voxels) does not hold the "
                          "skeleton's points: give the scan the skeleton was made from")
-    bone, report = auto_connect(skeleton.points, bones, mask, method=method)
+    bone, report = auto_connect(skeleton.points, bones, mask, method=method, radii=skeleton.dt)
     keep = bone != UNATTACHED
     conn = Connectivity(root_bones(bones), skeleton.points[keep], skeleton.dt[keep], skeleton.thinness[keep],
                         bone[keep], skeleton.metric, geometry=skeleton.geometry)

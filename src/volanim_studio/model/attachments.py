@@ -104,7 +104,7 @@ class Attachments:
         else:
             raise ValueError(f"scope must be 'all', 'unconnected' or 'selection', got {scope!r}")
         out, report = auto_connect(doc.skeleton.points, doc.bones, doc.mask, method=method, current=self.bone,
-                                   overwrite=overwrite, which=which)
+                                   overwrite=overwrite, which=which, radii=doc.skeleton.dt)
         idx = np.flatnonzero(which & (out != self.bone))
         self.assign_many(idx, out[idx], f"Auto-connect {len(idx)} points")
         return report
