@@ -111,7 +111,10 @@ def bench_playback(seconds: float = 6.0) -> None:
         time.sleep(0.005)
     w.files.open_bones(ROOT / "assets" / "mannequin.bones")
     w.files.open_connect(ROOT / "assets" / "mannequin.0.50.connect")
-    w.timeline.load_bvh(WALK)
+    w.timeline.load_bvh(WALK)  # read in the reader thread, then retargeted
+    while w.readers.busy:
+        app.processEvents()
+        time.sleep(0.005)
     rows = []
     for mode in ("bone", "binary"):
         w.doc.settings.preview_mode = mode

@@ -120,7 +120,10 @@ def main() -> None:
     grab(w, HERE / "studio-pose-fixed.png")
 
     # Timeline: the real walk clip on the mannequin, mid-stride, previewed in full
-    w.timeline.load_bvh(samples.walk_clip())
+    w.timeline.load_bvh(samples.walk_clip())  # read in the reader thread, then retargeted
+    while w.readers.busy:
+        app.processEvents()
+        time.sleep(0.005)
     w.doc.settings.current_frame = 330
     doc.settings.preview_mode = "sampled"
     w.scene.front_view()

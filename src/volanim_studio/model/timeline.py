@@ -186,15 +186,15 @@ class Timeline:
                             motion, used, r.up, r.forward))
         return r
 
-    def load_trans(self, paths) -> Clip:
+    def load_trans(self, paths, frames=None) -> Clip:
         """A folder (or list) of ``.trans`` frames of these bones as the clip; a load: the history starts
-        after it."""
-        return self.doc.loading(lambda: self._take_frames(paths))
+        after it. ``frames``: what :func:`read_frames` read of ``paths`` already (a reader thread)."""
+        return self.doc.loading(lambda: self._take_frames(paths, frames))
 
-    def _take_frames(self, paths) -> Clip:
+    def _take_frames(self, paths, frames=None) -> Clip:
         if not len(self.doc.bones):
             raise ValueError("build or open the bone skeleton first: the frames move its bones")
-        mats, files = read_frames(paths, self.doc.bones)
+        mats, files = read_frames(paths, self.doc.bones) if frames is None else frames
         numbers = [frame_number(p) for p in files]
         name = files[0].parent.name if len(files) > 1 else files[0].stem
         clip = Clip(name, mats, self.fps, str(files[0].parent if len(files) > 1 else files[0]),

@@ -184,6 +184,7 @@ def test_tskel_with_zero_points(tmp_path, small_connect):
     assert len(io.read_tskel(tmp_path / "z.tskel")) == 0
 
 
+IDENTITY = "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
 GOOD_TSKEL_HEAD = "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
 
 
@@ -211,6 +212,12 @@ GOOD_TSKEL_HEAD = "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"
         (io.read_connect, "Root: 0 0 0 :: 1 1 1\n1 2 3\n", 2, "expected 4 or 5 columns"),
         (io.read_connect, "Root: 0 0 0 :: 1 1 1\n1 2 3 1\nRoot: 1 1 1 :: 2 2 2\n1 2 3 1\n", 4, "listed twice"),
         (io.read_connect, "# metric: 456\nRoot: 0 0 0 :: 1 1 1\n", None, "unknown '# metric"),
+        # the second of two bones with the same joints, named at its own line (checked all pairs at once)
+        (io.read_connect, "Root: 0 0 0 :: 1 1 1\n1 2 3 1\nRoot: 5 5 5 :: 6 6 6\nRoot: 0 0 0 :: 1 1 1.0000001\n"
+         "4 4 4 1\n", 4, "bone (0 0 0)-(1 1 1) is listed twice (bone 0 has the same joints)"),
+        (io.read_trans, ("Root: 0 0 0 :: 1 1 1\n" + IDENTITY + "Root: 0 0 0 :: 1 1 2\n" + IDENTITY
+                         + "Root: 0 0 0 :: 1 1 2\n" + IDENTITY), 11,
+         "bone (0 0 0)-(1 1 2) is listed twice (bone 1 has the same joints)"),
         (io.read_trans, "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n", 1, "has 3 rows"),
         (io.read_trans, "Root: 0 0 0 :: 1 1 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\nRoot: 1 1 1 :: 2 2 2\n", 5, "has 3 rows"),
         (io.read_trans, "Root: 0 0 0 :: 1 1 1\n1 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", 2, "matrix row 1 of 4"),
