@@ -171,3 +171,21 @@ def test_cube_keys_change_the_size_setting_that_the_panel_shows(doc):
     mode.key("Plus")
     mode.key("Minus")
     assert doc.settings.cube_size == size + 2 and seen == [size + 2, size + 4, size + 2]
+
+
+def test_auto_connect_fitted_gives_the_shown_points_what_the_command_line_gives(doc):
+    """The studio's fitted auto-connect (#60) is the core's: the limbs' tubes measured on every point, the
+    shown ones attached, one undoable step."""
+    from volanim_core.rig.attach import attach_nearest_bone
+    from volanim_core.rig.limb_tubes import carry_up
+
+    skel = doc.skeleton
+    report = doc.attachments.auto(scope="all", overwrite=True, method="fitted")
+    n = doc.visible_count
+    want = carry_up(skel.points, skel.dt, doc.bones, attach_nearest_bone(skel.points, doc.bones))[:n]
+    assert report.attached == n and np.array_equal(doc.attachments.bone[:n], want)
+    arm, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")
+    nearest = attach_nearest_bone(skel.points[:n], doc.bones)
+    assert ((nearest == arm) & (want == spine)).any()  # the armpit: given to the torso
+    doc.undo.undo()
+    assert (doc.attachments.bone == -1).all()
