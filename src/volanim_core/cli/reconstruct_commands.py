@@ -196,7 +196,9 @@ def register(sub) -> None:
     p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
                     ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
                      "volanim connect mannequin.mskel mannequin.bones --method path --volume mannequin.VOL "
-                     "-o mannequin.path.connect"),
+                     "-o mannequin.path.connect",
+                     "volanim connect mannequin.mskel mannequin.bones --thinness 0.5 --method fitted "
+                     "-o mannequin.fitted.connect"),
                     _connect)
     p.add_argument("mskel", metavar="SKELETON", help="the skeleton: .mskel, or a .skel (one resolution)")
     p.add_argument("bones")
@@ -204,7 +206,8 @@ def register(sub) -> None:
     p.add_argument("--method", choices=METHODS, default="nearest",
                    help="nearest segment (default); path: the nearest bone reachable by a straight path inside "
                         "the object; path-or-nearest: path, else nearest; geodesic: along the skeleton inside "
-                        "the object (all but nearest need --volume)")
+                        "the object (these three need --volume); fitted: nearest, then flesh a limb's own tube "
+                        "cannot hold (the armpit, the groin) to the bone above")
     p.add_argument("--volume", help="the scan the skeleton was made from (segmented like skeletonize)")
     add_dims(p)
     p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
