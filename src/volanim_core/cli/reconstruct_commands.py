@@ -165,7 +165,9 @@ def _compare(args):
 
         if trans is None:
             raise ValueError("--sample needs --pose: the .trans the reconstruction was posed with")
-        made = posed_sample(args.sample, trans.matrices)
+        bar = TextProgress("posing the true shape")
+        made = posed_sample(args.sample, trans.matrices, progress=bar)
+        bar.close()
         truth, truth_geometry = made.volume, IDENTITY.shifted(made.origin)
         bones = bones or made.bones
     else:
@@ -178,8 +180,10 @@ def _compare(args):
         check_root_order(root_bones(bones), trans.bones)
         joints = posed_joints(bones, trans.matrices)
         segments = {b.label: (joints[b.proximal], joints[b.distal]) for b in bones.bones}
+    bar = TextProgress("comparing")
     report = compare_shapes(ours, truth, ours_origin=at[0], truth_origin=at[1], spacing=base.spacing,
-                            joints=joints, segments=segments, tissue=args.tissue)
+                            joints=joints, segments=segments, tissue=args.tissue, progress=bar)
+    bar.close()
     print(json.dumps(report.as_dict(), indent=2) if args.json else report.summary())
 
 

@@ -22,6 +22,10 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 from scipy import ndimage
 
+from volanim_core.progress import Reporter
+
+STEPS = 5  # grid and parts, the extra blob, the missing blob, the surface distance, the joints' regions
+
 OPENING = ndimage.generate_binary_structure(3, 1)  # a one-voxel ball: what a one-voxel rim does not survive
 PIECES = ndimage.generate_binary_structure(3, 3)  # 26-connected blobs
 
@@ -80,7 +84,7 @@ class ShapeReport:
 def compare_shapes(ours: np.ndarray, truth: np.ndarray, *, ours_origin=(0, 0, 0), truth_origin=(0, 0, 0),
                    spacing=(1.0, 1.0, 1.0), joints: dict[str, np.ndarray] | None = None,
                    segments: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
-                   tissue: bool = False) -> ShapeReport:
+                   tissue: bool = False, progress=None, cancel=None) -> ShapeReport:
     """Compare a posed volume with the true one (see the module docstring).
 
     Parameters
@@ -99,22 +103,33 @@ def compare_shapes(ours: np.ndarray, truth: np.ndarray, *, ours_origin=(0, 0, 0)
     tissue : bool
         Also the share of shared voxels whose value is the truth's (sampled reconstructions of a body
         whose values are tissues).
+    progress, cancel : optional
+        ``progress(done, total)`` after each of its steps (seconds each on a large body); ``cancel()``
+        returning True stops it (:class:`~volanim_core.errors.Cancelled`).
     """
+    report = Reporter(progress, cancel)
+    report(0, STEPS)
     a, t, lo = _on_one_grid(ours, truth, ours_origin, truth_origin)
     body_a, body_t = _body(a), _body(t)
     shared = body_a & body_t
     n_a, n_t, n_shared = int(body_a.sum()), int(body_t.sum()), int(shared.sum())
     dice = 2 * n_shared / (n_a + n_t) if n_a + n_t else 1.0
     parts = _parts(body_t, lo, segments) if segments else None
-    largest = [_largest_blob(d, lo, joints, segments, parts) for d in (body_a & ~body_t, body_t & ~body_a)]
+    report(1, STEPS)
+    largest = []
+    for k, diff in enumerate((body_a & ~body_t, body_t & ~body_a)):
+        largest.append(_largest_blob(diff, lo, joints, segments, parts))
+        report(2 + k, STEPS)
     mean, p95, mean_mm, p95_mm = _surface_distance(body_a, body_t, spacing)
+    report(4, STEPS)
     agree = None
     if tissue and n_shared:
         same = a[shared] == t[shared]
         agree = float((same.all(axis=-1) if a.ndim == 4 else same).mean())
+    regions = _regions(body_a, body_t, lo, joints) if joints else {}
+    report(STEPS, STEPS)
     return ShapeReport(dice, n_a, n_t, int((body_a & ~body_t).sum()), int((body_t & ~body_a).sum()),
-                       largest[0], largest[1], mean, p95, mean_mm, p95_mm, agree,
-                       _regions(body_a, body_t, lo, joints) if joints else {})
+                       largest[0], largest[1], mean, p95, mean_mm, p95_mm, agree, regions)
 
 
 def _body(v: np.ndarray) -> np.ndarray:

@@ -69,3 +69,23 @@ def test_tissue_agreement_counts_the_shared_voxels_with_the_truth_s_value():
     shared = int((truth > 0).sum())
     assert abs(r.tissue - (1 - 17 * 15 * 10 / shared)) < 1e-12 and r.dice == 1
     assert compare_shapes(ours, truth).tissue is None
+
+
+def test_progress_counts_every_step_and_cancel_stops_it():
+    """compare_shapes takes seconds on a large body: it reports each step and can be stopped (#60)."""
+    import pytest
+
+    from volanim_core.errors import Cancelled
+
+    body = _capsule_pair()
+    seen = []
+    compare_shapes(body, body, progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(0, 5), (1, 5), (2, 5), (3, 5), (4, 5), (5, 5)]
+    calls = []
+
+    def cancel():
+        calls.append(1)
+        return len(calls) > 2  # after the grid and the first blob
+
+    with pytest.raises(Cancelled):
+        compare_shapes(body, body, cancel=cancel)
