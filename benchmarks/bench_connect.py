@@ -110,9 +110,9 @@ def main() -> None:
     for th in (0.5, 0.25):
         sk = skeletonize(s.mask, min_thinness=th)
         truth = s.part[tuple(sk.points.T)] - 1
-        for method in ("nearest", "path", "geodesic"):
+        for method in ("nearest", "path", "geodesic", "fitted"):
             t0 = time.perf_counter()
-            out, report = auto_connect(sk.points, s.bones, s.mask, method=method)
+            out, report = auto_connect(sk.points, s.bones, s.mask, method=method, radii=sk.dt)
             el = time.perf_counter() - t0
             ok = out >= 0
             wrong_limb = int((limb[out[ok]] != limb[truth[ok]]).sum())
