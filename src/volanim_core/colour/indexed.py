@@ -8,8 +8,8 @@ Why: a sequence holds one value a voxel (its store, its verdicts, its render's t
 and a colour body's movie must still be in colour (#61). Indices are what the thesis's own pipeline
 sequenced (``MapImages`` + ``InvCMap``), and sampling them at the nearest voxel moves them exactly as
 it moves the colours: a volume with at most 255 colours besides black comes back voxel for voxel;
-one with more is quantised by weighted k-means in CIELAB (:func:`.palette.build_palette`), whose
-error :func:`quantisation_error` reports.
+one with more is quantised by weighted k-means in CIELAB (:func:`.palette.build_palette`), and
+``Indexed.error`` says by how much (:func:`.palette.quantisation_error`).
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ class Indexed:
     palette: np.ndarray  # (256, 3) uint8: any byte indexes it; row 0 is black
     colours: int  # palette rows in use besides row 0
     exact: bool  # every voxel's colour is its palette colour
+    error: tuple[float, float] = (0.0, 0.0)  # CIEDE2000 mean and 95th percentile over the body's voxels
 
     def colour(self, indices: np.ndarray) -> np.ndarray:
         """``[..., 3]`` uint8 colours of indices (a frame sampled from :attr:`indices`)."""
@@ -54,17 +55,11 @@ def index_colours(rgb: np.ndarray, *, progress: ProgressFn | None = None,
         return Indexed(np.zeros(rgb.shape[:3], np.uint8, order="F"), palette, 0, True)
     used = build_palette(colours, counts, COLOURS, cancel=cancel)
     palette[1:len(used) + 1] = used
+    exact = len(colours) <= COLOURS
+    # the error over the distinct colours already counted: no second pass over the voxels
+    error = (0.0, 0.0) if exact else quantisation_error(colours, counts, used)
     report(2, 3)
     index = NearestColour(used)(rgb) + np.uint8(1)  # per distinct colour once, then a table read a voxel
-    index[pack(rgb) == 0] = 0
+    index[(rgb == 0).all(axis=3)] = 0
     report(3, 3)
-    return Indexed(np.asfortranarray(index), palette, len(used), len(colours) <= COLOURS)
-
-
-def indexed_error(rgb: np.ndarray, indexed: Indexed) -> tuple[float, float]:
-    """Mean and 95th-percentile CIEDE2000 between the body's voxels and their palette colours (0, 0: exact)."""
-    colours, counts = unique_colours(np.asarray(rgb))
-    keep = pack(colours) != 0
-    if indexed.exact or not keep.any():
-        return 0.0, 0.0
-    return quantisation_error(colours[keep], counts[keep], indexed.palette[1:indexed.colours + 1])
+    return Indexed(np.asfortranarray(index), palette, len(used), exact, error)

@@ -32,21 +32,25 @@ import numpy as np
 
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity
-from volanim_core.rig.limb_tubes import carry_up
 from volanim_core.rig.pose import root_bones
 from volanim_core.skeleton.points import Skeleton
 
 UNATTACHED = -1
 
 
-def segment_distances(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """``(N, B)`` distances from points ``(N, 3)`` to segments ``(B, 2, 3)``."""
+def segment_positions(points: np.ndarray, segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(N, B)`` position of points ``(N, 3)`` along segments ``(B, 2, 3)`` (0 at the first end, 1 at the
+    second; not clipped) and their distance to each segment."""
     p = np.asarray(points, np.float64)[:, None, :]
     a, b = segments[None, :, 0, :], segments[None, :, 1, :]
     ab = b - a
-    denom = np.maximum((ab * ab).sum(-1), 1e-12)
-    t = np.clip(((p - a) * ab).sum(-1) / denom, 0.0, 1.0)
-    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
+    t = ((p - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-12)
+    return t, np.linalg.norm(p - (a + np.clip(t, 0.0, 1.0)[..., None] * ab), axis=-1)
+
+
+def segment_distances(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """``(N, B)`` distances from points ``(N, 3)`` to segments ``(B, 2, 3)``."""
+    return segment_positions(points, segments)[1]
 
 
 def attach_nearest_bone(points: np.ndarray, bones: BoneSkeleton) -> np.ndarray:
@@ -182,6 +186,8 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     elif method == "fitted":
         if radii is None or len(radii) != n:
             raise ValueError("the 'fitted' method needs every point's radius (its distance transform)")
+        from volanim_core.rig.limb_tubes import carry_up  # (it measures with this module's projections)
+
         found = carry_up(points, radii, bones, attach_nearest_bone(points, bones))[todo]
     else:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from volanim_core.rig.attach import segment_positions
 from volanim_core.rig.bones import BoneSkeleton
 
 #: voxels a ball may reach past its bone's tube and still be carried by it (the tube is a straight fit)
@@ -31,31 +32,30 @@ MIDDLE = (0.15, 0.85)  # the part of a bone whose points fit its tube: away from
 MIN_POINTS = 4
 
 
-def along(points: np.ndarray, segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(N, B)`` position along each segment (0 at the proximal joint, 1 at the distal; not clipped) and
-    distance to it."""
-    p = np.asarray(points, np.float64)[:, None, :]
-    a, b = segments[None, :, 0, :], segments[None, :, 1, :]
-    ab = b - a
-    t = ((p - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-12)
-    d = np.linalg.norm(p - (a + np.clip(t, 0.0, 1.0)[..., None] * ab), axis=-1)
+def on_own_bone(points: np.ndarray, segments: np.ndarray, bone: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each point's position along and distance to its own bone's segment (``bone`` >= 0): one segment a
+    point, so memory stays O(points) on a scan's million points (all bones at once would be O(points x bones))."""
+    t, d = (np.empty(len(bone)) for _ in range(2))
+    for k in np.unique(bone):
+        at = np.flatnonzero(bone == k)
+        tk, dk = segment_positions(points[at], segments[k:k + 1])
+        t[at], d[at] = tk[:, 0], dk[:, 0]
     return t, d
 
 
-def tube_profiles(points: np.ndarray, radii: np.ndarray, bones: BoneSkeleton, bone: np.ndarray,
-                  t: np.ndarray | None = None, d: np.ndarray | None = None) -> np.ndarray:
-    """``(B, 2)``: each bone's tube radius at its proximal and distal joint; NaN (no limit) for a bone with
-    fewer than ``MIN_POINTS`` points near the axis of its middle."""
-    if t is None or d is None:
-        t, d = along(points, bones.segments())
+def tube_profiles(points: np.ndarray, radii: np.ndarray, bones: BoneSkeleton, bone: np.ndarray) -> np.ndarray:
+    """``(B, 2)``: each bone's tube radius at its proximal and distal joint, from the points attached to it
+    (``bone``); NaN (no limit) for a bone with fewer than ``MIN_POINTS`` points near the axis of its middle."""
     radii = np.asarray(radii, np.float64)
     out = np.full((len(bones), 2), np.nan)
+    on = bone >= 0
+    t, d = on_own_bone(np.asarray(points)[on], bones.segments(), bone[on])
+    r = radii[on]
     for k in range(len(bones)):
-        tk, dk = t[:, k], d[:, k]
         # near the axis relative to the ball: the medial points of the limb's own middle
-        sel = (bone == k) & (tk > MIDDLE[0]) & (tk < MIDDLE[1]) & (dk <= 0.5 * radii + 1.0)
-        if sel.sum() >= MIN_POINTS and np.ptp(tk[sel]) > 0.1:
-            slope, at0 = np.polyfit(tk[sel], radii[sel] + dk[sel], 1)
+        sel = (bone[on] == k) & (t > MIDDLE[0]) & (t < MIDDLE[1]) & (d <= 0.5 * r + 1.0)
+        if sel.sum() >= MIN_POINTS and np.ptp(t[sel]) > 0.1:
+            slope, at0 = np.polyfit(t[sel], r[sel] + d[sel], 1)
             out[k] = (at0, at0 + slope)
     return out
 
@@ -67,19 +67,18 @@ def carry_up(points: np.ndarray, radii: np.ndarray, bones: BoneSkeleton, bone: n
     bone = np.asarray(bone).copy()
     if not len(bone):
         return bone
-    t, d = along(points, bones.segments())
-    tubes = tube_profiles(points, radii, bones, bone, t, d)
-    parent = np.array([next((k for k, o in enumerate(bones.bones) if o.distal == b.proximal), -1)
-                       for b in bones.bones])
-    radii = np.asarray(radii, np.float64)
-    rows = np.arange(len(bone))
-    todo = bone >= 0
+    points, radii = np.asarray(points), np.asarray(radii, np.float64)
+    segments = bones.segments()
+    tubes = tube_profiles(points, radii, bones, bone)
+    parent = np.array([-1 if k is None else k for k in bones.parents()])
+    todo = np.flatnonzero(bone >= 0)
     for _ in range(len(bones)):  # at most one step up per bone of the longest chain
-        k = np.where(todo, bone, 0)
-        tube = tubes[k, 0] + (tubes[k, 1] - tubes[k, 0]) * np.clip(t[rows, k], 0.0, 1.0)
-        over = todo & (parent[k] >= 0) & (d[rows, k] + radii > tube + tolerance)  # NaN tube: fits
+        k = bone[todo]
+        t, d = on_own_bone(points[todo], segments, k)
+        tube = tubes[k, 0] + (tubes[k, 1] - tubes[k, 0]) * np.clip(t, 0.0, 1.0)
+        over = (parent[k] >= 0) & (d + radii[todo] > tube + tolerance)  # NaN tube: fits
         if not over.any():
             break
-        bone[over] = parent[bone[over]]
-        todo = over
+        todo = todo[over]
+        bone[todo] = parent[bone[todo]]
     return bone

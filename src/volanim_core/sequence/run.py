@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.colour.indexed import index_colours, indexed_error
+from volanim_core.colour.indexed import index_colours
 from volanim_core.limits import available_bytes, human_bytes
 from volanim_core.parallel import executor
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
@@ -170,7 +170,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
             raise ValueError(f"a colour source is sequenced as palette indices, read at the nearest voxel "
                              f"(kernel 1): indices cannot be averaged, got kernel {kernel}")
         indexed = index_colours(source)
-        colours = describe_palette(indexed, source)
+        colours = describe_palette(indexed)
         source, palette = indexed.indices, indexed.palette
     elif source is not None and np.ndim(source) != 3:
         raise ValueError(f"a source is a grey [x, y, z] or colour [x, y, z, 3] volume, got shape {np.shape(source)}")
@@ -237,11 +237,11 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                           time.perf_counter() - t0, rest, label, colours)
 
 
-def describe_palette(indexed, rgb) -> str:
+def describe_palette(indexed) -> str:
     """What a colour sequence's palette keeps of the source's colours, in words."""
     if indexed.exact:
         return f"colour: {indexed.colours} palette colours, exact"
-    mean, p95 = indexed_error(rgb, indexed)
+    mean, p95 = indexed.error
     return (f"colour: {indexed.colours} palette colours, quantised (CIEDE2000 mean {mean:.2f}, "
             f"95th percentile {p95:.2f})")
 

@@ -43,3 +43,18 @@ class Controller:
         if done is not None:
             self.doc.message(done(result) if callable(done) else done)
         return result
+
+    def read_then(self, path, read: Callable, apply: Callable[[Any], Any]):
+        """``read(progress)`` in the window's reader thread (a progress dialog with Cancel; the document's
+        own job, if one runs, goes on), then ``apply(what was read)`` on the GUI thread (#61: no file is
+        read on the GUI thread). The reader's worker, or None while another file is still being read
+        (said in the status bar). A bad file is shown naming it; a read cannot stop half-way, so Cancel
+        (or closing the studio) lets it finish and applies nothing (the runner drops a cancelled result)."""
+        from pathlib import Path
+
+        name = Path(path).name
+        readers = self.window.readers
+        if readers.busy:
+            self.doc.message(f"Still reading a file: open {name} when it has been read.")
+            return None
+        return readers.run(f"Reading {name}", lambda progress, cancel: read(progress), apply)

@@ -83,18 +83,10 @@ class FilesController(Controller):
                                     f"Viewing slices of {Path(path).name}")
 
     def _read_then_view(self, path, title: str, read, make, doing: str) -> Worker | None:
-        """``read()`` in the window's reader thread (a progress dialog with Cancel; the document's own job,
-        if one runs, goes on), then the looking window ``make(what was read)`` shown on the GUI thread.
-        The worker, or None while another file is still being read for viewing (said in the status bar).
-        A bad file is shown under ``title`` naming it; a read cannot stop half-way, so Cancel (or closing
-        the studio) lets it finish and opens nothing (the runner drops a cancelled job's result)."""
-        name = Path(path).name
-        readers = self.window.readers
-        if readers.busy:
-            self.doc.message(f"Still reading a file to view: open {name} when that window has opened.")
-            return None
-        return readers.run(f"Reading {name}", lambda progress, cancel: read(),
-                           lambda result: self._viewer(title, lambda: make(result), doing))
+        """``read()`` in the reader thread (:meth:`read_then`), then the looking window ``make(what was read)``
+        shown on the GUI thread (a bad file shown under ``title``)."""
+        return self.read_then(path, lambda progress: read(),
+                              lambda result: self._viewer(title, lambda: make(result), doing))
 
     def _viewer(self, title: str, make, doing: str):
         """A looking window made by ``make()`` and shown, kept while visible; None (the error shown) on failure."""
@@ -159,9 +151,7 @@ class FilesController(Controller):
             loaded = tasks.load_volume_file(str(path), dims, series)
             if params is None:
                 return {"loaded": loaded}
-            return {"loaded": loaded, "prepared": tasks.prepare_volume(
-                loaded["volume"], skeleton_path=skeleton_path, progress=progress, cancel=cancel,
-                **self._segmentation(loaded, params))}
+            return {"loaded": loaded, "prepared": self._prepare(loaded, params, skeleton_path, progress, cancel)}
 
         def read(r):
             if "choices" in r:
@@ -176,10 +166,7 @@ class FilesController(Controller):
             else:
                 self._ask_threshold(path, r["loaded"], dims, skeleton_path, series, then, otherwise)
 
-        worker = self.jobs.run(f"Opening {name}" if params else f"Reading {name}", task, read)
-        worker.failed.connect(lambda *_: otherwise())
-        worker.was_cancelled.connect(otherwise)
-        return worker
+        return _or_else(self.jobs.run(f"Opening {name}" if params else f"Reading {name}", task, read), otherwise)
 
     def _ask_threshold(self, path, loaded, dims, skeleton_path, series, then, otherwise) -> None:
         """The threshold dialog over a volume just read, then its segmentation in a worker."""
@@ -189,23 +176,22 @@ class FilesController(Controller):
             otherwise()
             return
         params = dialog.parameters()
-        worker = self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: tasks.prepare_volume(
-            loaded["volume"], skeleton_path=skeleton_path, progress=progress, cancel=cancel,
-            **self._segmentation(loaded, params)),
-            lambda r: self._apply_volume(r, path, dims, self._spacing(loaded, params), series, then))
-        worker.failed.connect(lambda *_: otherwise())
-        worker.was_cancelled.connect(otherwise)
+        _or_else(self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: self._prepare(
+            loaded, params, skeleton_path, progress, cancel),
+            lambda r: self._apply_volume(r, path, dims, self._spacing(loaded, params), series, then)), otherwise)
 
     @staticmethod
     def _spacing(loaded: dict, params: dict) -> tuple:
         """The voxel size the user confirmed (the dialog's, a project's), else the file's."""
         return tuple(float(v) for v in params.get("spacing") or loaded["spacing"])
 
-    def _segmentation(self, loaded: dict, params: dict) -> dict:
-        """``prepare_volume``'s arguments from the segmentation ``params`` (the dialog's, or a project's)."""
+    def _prepare(self, loaded: dict, params: dict, skeleton_path, progress, cancel) -> dict:
+        """A volume just read, segmented by ``params`` (the dialog's, or a project's) and skeletonized
+        (in a worker): :func:`tasks.prepare_volume` on the voxel size the user confirmed."""
         args = {k: v for k, v in params.items() if k not in ("series", "spacing")}
-        geometry = loaded["geometry"].with_spacing(self._spacing(loaded, params))
-        return {**args, "grey": loaded["grey"], "geometry": geometry}
+        return tasks.prepare_volume(loaded["volume"], skeleton_path=skeleton_path, progress=progress, cancel=cancel,
+                                    grey=loaded["grey"],
+                                    geometry=loaded["geometry"].with_spacing(self._spacing(loaded, params)), **args)
 
     def _apply_volume(self, r: dict, path, dims, spacing, series, then) -> None:
         r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
@@ -298,10 +284,8 @@ class FilesController(Controller):
             return self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
                                     skeleton_path=data.get("mskel"), then=rest, otherwise=lambda: done(False))
         if data.get("demo"):
-            worker = self.load_demo(data["demo"], skeleton_path=data.get("mskel"), then=rest)
-            worker.failed.connect(lambda *_: done(False))
-            worker.was_cancelled.connect(lambda: done(False))
-            return worker
+            return _or_else(self.load_demo(data["demo"], skeleton_path=data.get("mskel"), then=rest),
+                            lambda: done(False))
         rest(reset=True)  # a project of bones alone: still a new document
         return None
 
@@ -382,3 +366,10 @@ class FilesController(Controller):
             self.doc.bone_edits.save_connections(path)
         else:
             self.scene.plotter.screenshot(path)
+
+
+def _or_else(worker: Worker, otherwise: Callable[[], None]) -> Worker:
+    """``worker`` with ``otherwise()`` called when it fails (the error is shown) or is cancelled."""
+    worker.failed.connect(lambda *_: otherwise())
+    worker.was_cancelled.connect(otherwise)
+    return worker

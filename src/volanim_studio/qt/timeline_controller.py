@@ -180,7 +180,7 @@ class TimelineController(Controller):
         confirm the mapping (``ask(dialog) -> bool``; None: the suggestions) and retarget it onto the bones.
         The reader's worker, or None while another file is being read (said)."""
         self.stop()
-        return self._read(path, lambda progress: read_bvh(path), lambda motion: self._retarget(path, motion, ask))
+        return self.read_then(path, lambda progress: read_bvh(path), lambda motion: self._retarget(path, motion, ask))
 
     def _retarget(self, path, motion, ask) -> bool:
         mapping, up, forward = None, "auto", "auto"
@@ -224,16 +224,7 @@ class TimelineController(Controller):
             if clip is not FAILED:
                 self.doc.message(f"Loaded {len(clip.matrices)} frames from {clip.path}. Space plays, arrows step.")
 
-        return self._read(folder, read, put)
-
-    def _read(self, path, read, apply) -> Worker | None:
-        """``read(progress)`` in the window's reader thread with progress and Cancel, then ``apply(result)``
-        here (a cancelled read applies nothing)."""
-        readers = self.window.readers
-        if readers.busy:
-            self.doc.message(f"Still reading a file: load {Path(path).name} when it has been read.")
-            return None
-        return readers.run(f"Reading {Path(path).name}", lambda progress, cancel: read(progress), apply)
+        return self.read_then(folder, read, put)
 
     def load_trans_dialog(self) -> None:
         folder = QFileDialog.getExistingDirectory(self.window, "Folder of .trans frames", self.folder())
@@ -351,9 +342,8 @@ class TimelineController(Controller):
         fps = tl.frame_rate / step
         return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
             conn, mats, numbers, out, mode=mode, source=source, kernel=kernel, camera=camera, spacing=spacing,
-            style=style,
-            size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, follow=follow, progress=progress,
-            cancel=cancel),
+            style=style, size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, follow=follow,
+            progress=progress, cancel=cancel),
             lambda r: self.doc.message(f"Rendered {r['frames']} frames to {r['out']} in {r['seconds']:.1f} s "
                                        f"({r['workers']}){'; ' + r['colours'] if r['colours'] else ''}."))
 

@@ -12,7 +12,7 @@ import pytest
 from paths import ASSETS, WALK
 from volanim_core import io, samples
 from volanim_core.cli import main
-from volanim_core.colour.indexed import index_colours, indexed_error
+from volanim_core.colour.indexed import index_colours
 from volanim_core.colour.space import delta_e
 from volanim_core.errors import FormatError
 from volanim_core.reconstruct.engine import reconstruct
@@ -55,7 +55,7 @@ def test_few_colours_are_indexed_exactly_and_many_within_a_just_noticeable_diffe
     assert not ix.exact and ix.colours == 255 and ix.indices.dtype == np.uint8
     body = rgb.any(axis=3)
     assert np.array_equal(ix.indices > 0, body)  # black (and only black) is the background's 0
-    mean, p95 = indexed_error(rgb, ix)
+    mean, p95 = ix.error
     assert mean < 1.5 and p95 < 3.0  # CIEDE2000; measured 0.82 and 1.62
     # every voxel's colour is checked here independently of the palette's own error sums
     errors = delta_e(rgb[body][::37], ix.colour(ix.indices)[body][::37])
@@ -64,7 +64,7 @@ def test_few_colours_are_indexed_exactly_and_many_within_a_just_noticeable_diffe
     few = ix.colour(ix.indices)  # now at most 255 colours besides black: indexed voxel for voxel
     again = index_colours(few)
     assert again.exact and np.array_equal(again.colour(again.indices), few)
-    assert indexed_error(few, again) == (0.0, 0.0)
+    assert again.error == (0.0, 0.0)
 
 
 def test_each_colour_frame_is_the_colour_preview_placed_in_the_shared_grid(tmp_path, conn, walk, rgb):
