@@ -85,3 +85,21 @@ def test_the_command_line_connects_fitted_without_the_scan(tmp_path, capsys):
                  "-o", str(tmp_path / "m.connect")]) == 0
     assert "(fitted)" in capsys.readouterr().out
     assert len(io.read_connect(tmp_path / "m.connect")) > 4000
+
+
+def test_a_hand_or_foot_stays_in_its_limb_on_the_larger_mannequin():
+    """mannequin-large: a ball at a limb's far end (a hand's, a foot's) spills past the straight tube of its
+    bone and was carried up bone by bone, to the spine (151 hand points a side) and the pelvis (53 foot
+    points). Carrying up is for the flesh next to the parent's joint (the armpit, the groin) only."""
+    from volanim_core.samples import mannequin_limb
+
+    s = samples.mannequin_large()
+    skel = skeletonize(s.mask, min_thinness=0.5)
+    conn = connect(skel, s.bones, method="fitted")[0]
+    names = [b.label for b in s.bones.bones]
+    truth = true_bone(s, conn.points)
+    ends = np.isin(truth, [names.index(n) for n in names if n.endswith(("HAND", "FOOT"))])
+    assert ends.sum() > 100
+    moved = [(names[t], names[b]) for t, b in zip(truth[ends], conn.bone[ends])
+             if mannequin_limb(names[t]) != mannequin_limb(names[b])]
+    assert moved == []

@@ -184,8 +184,23 @@ def test_auto_connect_fitted_gives_the_shown_points_what_the_command_line_gives(
     n = doc.visible_count
     want = carry_up(skel.points, skel.dt, doc.bones, attach_nearest_bone(skel.points, doc.bones))[:n]
     assert report.attached == n and np.array_equal(doc.attachments.bone[:n], want)
-    arm, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")
+    arm, torso = doc.bones.index("L_UPPERARM"), [doc.bones.index("SPINE"), doc.bones.index("L_CLAVICLE")]
     nearest = attach_nearest_bone(skel.points[:n], doc.bones)
-    assert ((nearest == arm) & (want == spine)).any()  # the armpit: given to the torso
+    assert ((nearest == arm) & np.isin(want, torso)).any()  # the armpit: given to the torso
     doc.undo.undo()
     assert (doc.attachments.bone == -1).all()
+
+
+def test_auto_connect_pieces_is_the_core_s_and_nearest_on_a_body_in_one_piece(doc):
+    """The studio's pieces auto-connect (#62) is the core's; the mannequin is one piece, so it is the nearest
+    bone for every point (a body in pieces: tests/core/rig/test_pieces.py)."""
+    from volanim_core.rig.attach import attach_nearest_bone
+    from volanim_core.rig.pieces import attach_by_piece
+
+    skel = doc.skeleton
+    report = doc.attachments.auto(scope="all", overwrite=True, method="pieces")
+    n = doc.visible_count
+    assert report.attached == n
+    got = doc.attachments.bone[:n]
+    assert np.array_equal(got, attach_by_piece(skel.points[:n], doc.bones, doc.mask))
+    assert np.array_equal(got, attach_nearest_bone(skel.points[:n], doc.bones))
