@@ -3,7 +3,8 @@
     rest owner voxels (RestParts.voxels, rigid joints: each voxel's bone)
       --> each bone's reach: 1.3 x the 75th percentile of its own rest voxels' distance to its segment, + 1
     posed bone volume: each voxel q, its owner b, the rest point it came from p = [q 1] M_b^-1
-      carried ....... p lay beyond b's reach but within another bone c's (the nearest such c)
+      carried ....... p lay beyond b's reach but within another bone c's (the nearest such c),
+                      and b moved it (|q - p| > MOVED: flesh left where it lay is not carried off)
       moved away .... c would have kept that flesh at [p 1] M_c, more than 1.5 voxels from q
       nobody's own .. no bone k's own rest flesh lands on q ([q 1] M_k^-1 is owned by k at rest)
     --> opened by one voxel (a one-voxel rim is not a lump), 26-connected pieces, largest first
@@ -114,6 +115,9 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
         sel = own == b
         rest[sel] = qf[sel] @ inverse[b, :3, :3] + inverse[b, 3, :3]
         beyond[sel] = segment_distance(rest[sel], *segments[b]) > reach[b]
+    # flesh its own bone left where it lay at rest was not carried anywhere: the body had flesh there
+    # (a groin point of the thigh's, held by the still pelvis while the thigh lifts, is not a lump)
+    beyond &= np.linalg.norm(rest - qf, axis=1) > MOVED
     cand = np.flatnonzero(beyond)
     if not len(cand):
         return []
