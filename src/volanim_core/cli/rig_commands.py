@@ -1,7 +1,7 @@
 """Auto-rig from the command line: ``volanim autorig`` (``volanim_core.autorig``).
 
     .mskel --autorig--> .bones (named by a template, or chains by position)
-           --connect (path method, inside the scan or the skeleton's own balls)--> .connect
+           --connect (pieces: each piece of the scan, or of the skeleton's own balls, to its bones)--> .connect
 """
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 from volanim_core.io import read_skeleton, skeleton_at, write_bones, write_connect
+from volanim_core.progress import TextProgress
 
 from ._common import add_command, add_dims, finite_float, parse_range, positive_int
 
@@ -21,15 +22,16 @@ def _autorig(args):
 
     skel = skeleton_at(read_skeleton(args.mskel), args.thinness, args.mskel)
     t0 = time.perf_counter()
-    proposal = autorig(skel, template=args.template, bones=args.bones)
+    proposal = autorig(skel, template=args.template, bones=args.bones, progress=TextProgress("proposing bones"))
     write_bones(args.output, proposal.bones)
     print(f"{proposal} in {time.perf_counter() - t0:.2f} s -> {args.output}")
     if args.connect:
         mask = _mask(args, skel)
-        conn, report = connect(skel, proposal.bones, method="path", mask=mask)
+        conn, report = connect(skel, proposal.bones, method=args.method, mask=mask,
+                               progress=TextProgress(f"attaching {len(skel)} points"))
         write_connect(args.connect, conn, thinness=args.thinness)
         counts = np.bincount(conn.bone, minlength=len(conn.bones))
-        print(f"{report} (path); fewest points on one bone: {counts.min()} -> {args.connect}")
+        print(f"{report} ({args.method}); fewest points on one bone: {counts.min()} -> {args.connect}")
 
 
 def _mask(args, skel):
@@ -45,6 +47,7 @@ def _mask(args, skel):
 
 
 def register(sub) -> None:
+    from volanim_core.rig.attach import METHODS
     from volanim_core.rig.autorig import TEMPLATES
 
     p = add_command(sub, "autorig", "Propose a bone skeleton from the volume's own skeleton -> .bones (and .connect).",
@@ -59,7 +62,10 @@ def register(sub) -> None:
     p.add_argument("--bones", type=positive_int, metavar="N",
                    help="with --template none: exactly N bones, split where the branches bend most")
     p.add_argument("-o", "--output", required=True, help="the proposed .bones")
-    p.add_argument("--connect", metavar="CONNECT", help="also attach every point (path method) -> this .connect")
+    p.add_argument("--connect", metavar="CONNECT", help="also attach every point -> this .connect")
+    p.add_argument("--method", choices=METHODS, default="pieces",
+                   help="how --connect attaches (default pieces: each piece of the body to the bones lying in it, "
+                        "else the nearest; `volanim connect --help` lists the others)")
     p.add_argument("--volume", help="with --connect: paths must run inside this scan (default: inside the "
                                     "skeleton's own balls)")
     add_dims(p)

@@ -20,6 +20,9 @@ The rules, measured against the mannequin's ground-truth limb membership
   own tube (fitted along the limb's middle) goes to the bone above: the armpit to the torso, not the
   arm (:mod:`.limb_tubes`; #60).
 
+* ``auto_connect(method="pieces")`` -- a body in separate pieces (limbs that are shells of their own):
+  each piece's points go to the nearest of the bones lying in that piece (:mod:`.pieces`; #62).
+
 ``auto_connect`` never overwrites points already attached unless asked, and
 reports how many it left unattached and why -- it never fails silently.
 """
@@ -30,12 +33,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volanim_core.progress import Reporter
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.pose import root_bones
 from volanim_core.skeleton.points import Skeleton
 
 UNATTACHED = -1
+PART = 131072  # points attached between two progress reports (nearest, path): a few tenths of a second
 
 
 def segment_positions(points: np.ndarray, segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -140,7 +145,7 @@ def _geodesic_method(points, bones, mask, k=10):
 
 def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, method: str = "path",
                  current: np.ndarray | None = None, overwrite: bool = False,
-                 which: np.ndarray | None = None, radii: np.ndarray | None = None
+                 which: np.ndarray | None = None, radii: np.ndarray | None = None, progress=None, cancel=None
                  ) -> tuple[np.ndarray, AutoConnectReport]:
     """Attach points to bones, checking that the attachment runs inside the object.
 
@@ -149,13 +154,17 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     points : (N, 3) int ndarray, voxel coordinates
     bones : BoneSkeleton
     mask : (X, Y, Z) bool ndarray, the segmented object
-    method : {'path', 'path-or-nearest', 'geodesic', 'nearest', 'fitted'}
+    method : {'path', 'path-or-nearest', 'geodesic', 'nearest', 'fitted', 'pieces'}
     current : (N,) int ndarray, optional
         Existing attachments (-1 = none); kept unless ``overwrite``.
     which : (N,) bool ndarray, optional
         Only these points are considered (a cube or lasso selection).
     radii : (N,) ndarray, the points' distance transform (needed by ``fitted``: the limbs' tubes are
         measured on every point, whichever are attached)
+    progress, cancel : optional
+        ``progress(done, total)`` in points, ``cancel()`` returning True stops it (:class:`Cancelled`);
+        the nearest and path methods go in parts of ``PART`` points, the others (which weigh every point
+        together) report their start and end
 
     Returns
     -------
@@ -173,16 +182,25 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     if not todo.any():
         return current, report
     sub = points[todo]
-    if method == "nearest":
-        found = attach_nearest_bone(sub, bones)
-    elif method in ("path", "path-or-nearest"):
-        found = _path_method(sub, bones, mask)
+    step = Reporter(progress, cancel)
+    step(0, len(sub))
+    if method in ("nearest", "path", "path-or-nearest"):  # each point on its own: in parts, with progress
+        found = np.empty(len(sub), np.int32)
+        for s in range(0, len(sub), PART):
+            part = sub[s:s + PART]
+            found[s:s + PART] = attach_nearest_bone(part, bones) if method == "nearest" else \
+                _path_method(part, bones, mask)
+            step(min(s + PART, len(sub)), len(sub))
         if method == "path-or-nearest":
             lost = found == UNATTACHED
             found[lost] = attach_nearest_bone(sub[lost], bones)
             report.fallback = int(lost.sum())
     elif method == "geodesic":
         found = _geodesic_method(sub, bones, mask)
+    elif method == "pieces":
+        from volanim_core.rig.pieces import attach_by_piece
+
+        found = attach_by_piece(sub, bones, mask)
     elif method == "fitted":
         if radii is None or len(radii) != n:
             raise ValueError("the 'fitted' method needs every point's radius (its distance transform)")
@@ -191,7 +209,8 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
         found = carry_up(points, radii, bones, attach_nearest_bone(points, bones))[todo]
     else:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
-    if mask is not None and method not in ("nearest", "fitted"):
+    step(len(sub), len(sub))
+    if mask is not None and method not in ("nearest", "fitted", "pieces"):
         outside = ~mask[tuple(sub.T)]
         if outside.any():
             report.reasons["the point itself lies outside the segmented volume"] = int(outside.sum())
@@ -206,12 +225,12 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     return current, report
 
 
-METHODS = ("nearest", "path", "path-or-nearest", "geodesic", "fitted")
-NEEDS_MASK = ("path", "path-or-nearest", "geodesic")
+METHODS = ("nearest", "path", "path-or-nearest", "geodesic", "fitted", "pieces")
+NEEDS_MASK = ("path", "path-or-nearest", "geodesic", "pieces")
 
 
 def connect(skeleton: Skeleton, bones: BoneSkeleton, *, method: str = "nearest",
-            mask: np.ndarray | None = None) -> tuple[Connectivity, AutoConnectReport]:
+            mask: np.ndarray | None = None, progress=None, cancel=None) -> tuple[Connectivity, AutoConnectReport]:
     """Attach a skeleton's points to bones by ``method`` (the studio's auto-connect, all points).
 
     ``mask`` (the segmented object on the skeleton's voxel grid) is needed by every method but
@@ -225,7 +244,8 @@ def connect(skeleton: Skeleton, bones: BoneSkeleton, *, method: str = "nearest",
     if mask is not None and len(skeleton) and (skeleton.points.max(axis=0) >= np.array(mask.shape)).any():
         raise ValueError(f"the segmented volume ({'x'.join(map(str, mask.shape))} voxels) does not hold the "
                          "skeleton's points: give the scan the skeleton was made from")
-    bone, report = auto_connect(skeleton.points, bones, mask, method=method, radii=skeleton.dt)
+    bone, report = auto_connect(skeleton.points, bones, mask, method=method, radii=skeleton.dt, progress=progress,
+                                cancel=cancel)
     keep = bone != UNATTACHED
     conn = Connectivity(root_bones(bones), skeleton.points[keep], skeleton.dt[keep], skeleton.thinness[keep],
                         bone[keep], skeleton.metric, geometry=skeleton.geometry)

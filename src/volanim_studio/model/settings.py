@@ -35,7 +35,7 @@ class Mode(StrEnum):
 COLOUR_BY = ("thinness", "dt", "bone")
 PREVIEW_MODES = ("bone", "binary", "mottled", "hotspot", "sampled")
 AUTO_SCOPES = ("unconnected", "all", "selection")
-AUTO_METHODS = ("path", "path-or-nearest", "nearest", "geodesic", "fitted")
+AUTO_METHODS = ("path", "path-or-nearest", "nearest", "geodesic", "fitted", "pieces")
 
 
 def one_of(*choices) -> Callable[[str, Any], Any]:
