@@ -49,7 +49,8 @@ def _connect(args):
         from .skeleton_commands import mask_like_skeleton
 
         mask = mask_like_skeleton(args, skel)
-    conn, report = connect(skel, read_bones(args.bones).on_grid(skel.geometry), method=args.method, mask=mask)
+    conn, report = connect(skel, read_bones(args.bones).on_grid(skel.geometry), method=args.method, mask=mask,
+                           progress=TextProgress(f"attaching {len(skel)} points"))
     write_connect(args.output, conn, thinness=args.thinness)
     counts = np.bincount(conn.bone, minlength=len(conn.bones))
     print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")

@@ -287,15 +287,20 @@ def left_axis(geometry) -> np.ndarray:
     return d[0] / np.asarray(geometry.spacing, float)
 
 
+STEPS = 4  # progress steps: the solid made, thinned, linked into a tree, the rig fitted
+
+
 def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str = "auto",
-            bones: int | None = None) -> Proposal:
+            bones: int | None = None, progress=None, cancel=None) -> Proposal:
     """A bone skeleton for ``skeleton`` (at ``thinness``; default: all its points).
 
     ``template``: ``humanoid`` and ``quadruped`` name joints and bones as those rigs do (the humanoid's
     are the mannequin's); ``none`` names chains by position; ``auto`` takes the template that fits.
     ``bones`` (template ``none`` only) asks for that many bones, split where branches bend most.
-    Raises :class:`NotRiggable` with where and why when the skeleton cannot be rigged.
+    Raises :class:`NotRiggable` with where and why when the skeleton cannot be rigged. ``progress(done,
+    total)`` after each of its ``STEPS`` stages; ``cancel()`` returning True stops it (:class:`Cancelled`).
     """
+    from volanim_core.progress import Reporter
     from volanim_core.rig import templates
 
     if template not in TEMPLATES:
@@ -303,7 +308,9 @@ def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str 
     if bones is not None and template not in ("none", "auto"):
         raise ValueError("--bones sets the number of bones without a template: use --template none")
     skel = skeleton.at(thinness) if thinness is not None else skeleton
-    curve = curve_tree(skel)
+    report, done = Reporter(progress, cancel), iter(range(1, STEPS))
+    report(0, STEPS)
+    curve = curve_tree(skel, step=lambda: report(next(done), STEPS))
     notes = []
     if curve.dropped:
         n = sum(c for c, _ in curve.dropped)
@@ -315,13 +322,18 @@ def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str 
         fit = templates.best_fit(tree)
         if fit is not None:
             result, name, why = fit
-            return Proposal(_on(result, skel), name, notes + [why])
+            return _done(Proposal(_on(result, skel), name, notes + [why]), report)
         notes.append("no template fits (humanoid: 5 limbs, legs away from the head; quadruped: 4 legs "
                      "across the spine): chains named by position")
     elif template in ("humanoid", "quadruped"):
         result = templates.fit(tree, template)
-        return Proposal(_on(result, skel), template, notes)
-    return Proposal(_on(chains(tree, skel.geometry, bones=bones), skel), "none", notes)
+        return _done(Proposal(_on(result, skel), template, notes), report)
+    return _done(Proposal(_on(chains(tree, skel.geometry, bones=bones), skel), "none", notes), report)
+
+
+def _done(proposal: Proposal, report) -> Proposal:
+    report(STEPS, STEPS)
+    return proposal
 
 
 def _on(bones: BoneSkeleton, skel: Skeleton) -> BoneSkeleton:

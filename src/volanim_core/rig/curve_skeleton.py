@@ -192,7 +192,7 @@ def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float, floor: f
             return
 
 
-def solid(skeleton: Skeleton, *, close: float = CLOSE) -> tuple[np.ndarray, np.ndarray, Body]:
+def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.ndarray, np.ndarray, Body]:
     """The medial points ``(points, radii)`` of the body the skeleton's balls make, remade solid.
 
     The balls are painted on a grid coarse enough to hold at most ``COARSE_VOXELS`` voxels, gaps
@@ -200,6 +200,7 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE) -> tuple[np.ndarray, np.n
     (scikit-image's ``skeletonize``, Lee's 3-D thinning) with its distance transform as radius: a
     porous segmentation (the frog's tissues, unlabelled seams between muscles) becomes one body
     whose thickness means something, and a flat part (a torso) a curve rather than a sheet.
+    ``step()``, if given, is called once the solid is made, before it is thinned (the two long stages).
     """
     import edt
     from scipy import ndimage
@@ -219,19 +220,24 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE) -> tuple[np.ndarray, np.n
     if close:
         grid = ndimage.binary_closing(grid, ndimage.generate_binary_structure(3, 1), iterations=steps)
     grid = ndimage.binary_fill_holes(grid)
+    if step is not None:
+        step()
     curve = thin(grid)
     dist = edt.edt(grid)
     idx = np.argwhere(curve)
     return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad)
 
 
-def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
-    """The curve skeleton of ``skeleton`` (all its points: pass ``skeleton.at(thinness)``)."""
+def curve_tree(skeleton: Skeleton, *, spur: float = SPUR, step=None) -> CurveTree:
+    """The curve skeleton of ``skeleton`` (all its points: pass ``skeleton.at(thinness)``); ``step()``, if
+    given, is called after each of its stages (the solid made, thinned, linked into a tree): three calls."""
     from scipy.sparse.csgraph import minimum_spanning_tree
 
     if len(skeleton) == 0:
         raise NotRiggable("the skeleton has no points at this thinness: lower --thinness")
-    p, r, body = solid(skeleton)
+    step = step or (lambda: None)
+    p, r, body = solid(skeleton, step=step)
+    step()
     if len(p) == 1:
         return CurveTree(p, r, np.zeros((0, 2), np.int64), body=body)
     graph = _bridge(_link(p, r), p, r)
@@ -244,6 +250,7 @@ def curve_tree(skeleton: Skeleton, *, spur: float = SPUR) -> CurveTree:
         adj[a].add(int(b))
         adj[b].add(int(a))
     _prune(adj, p, r, spur, FLOOR * r.max())
+    step()
     alive = np.array([len(a) > 0 for a in adj]) if len(p) > 1 else np.ones(1, bool)
     renum = np.cumsum(alive) - 1
     edges = np.array(sorted((renum[a], renum[b]) for a in range(len(adj)) for b in adj[a] if a < b),

@@ -18,11 +18,13 @@ class BoneProposal:
         self.doc = doc
         self.previewing: str | None = None  # the undo label of the proposal on screen, if any
 
-    def compute(self, template: str = "auto", bones: int | None = None) -> Proposal:
-        """The proposal for the skeleton at the slider's thinness (no document change: safe in a worker)."""
+    def compute(self, template: str = "auto", bones: int | None = None, progress=None, cancel=None) -> Proposal:
+        """The proposal for the skeleton at the slider's thinness (no document change: safe in a worker);
+        ``progress``/``cancel`` as autorig takes them (the runner's dialog)."""
         if self.doc.skeleton is None:
             raise ValueError("open a skeleton (.mskel) or a volume first: bones are proposed from its points")
-        return autorig(self.doc.skeleton.at(self.doc.thinness), template=template, bones=bones)
+        return autorig(self.doc.skeleton.at(self.doc.thinness), template=template, bones=bones, progress=progress,
+                       cancel=cancel)
 
     def preview(self, proposal: Proposal) -> None:
         """Show ``proposal`` as the document's bones (one undo step), replacing a previous preview."""

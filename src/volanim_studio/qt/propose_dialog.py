@@ -91,4 +91,5 @@ class ProposeController(Controller):
             self.doc.message(f"Proposed {result}")
             shown(result)
 
-        self.jobs.run("Proposing bones", lambda progress, cancel: proposal.compute(template), done)
+        self.jobs.run("Proposing bones", lambda progress, cancel: proposal.compute(template, progress=progress,
+                                                                             cancel=cancel), done)

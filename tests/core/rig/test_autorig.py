@@ -188,3 +188,30 @@ def test_the_frog_legs_are_separate_chains():
         for k in range(i + 1, 4):
             shared = lines[i] & lines[k]
             assert all(np.linalg.norm(bones.joints[j][:2] - centre[:2]) < 130 for j in shared), (tips[i], tips[k])
+
+
+def test_autorig_and_connect_report_progress_and_stop_when_cancelled():
+    """#62 item 6: autorig reports each of its stages and ends at total; cancel stops it at the next stage.
+    The connect step reports its points and stops the same way."""
+    from volanim_core.errors import Cancelled
+    from volanim_core.rig.autorig import STEPS
+
+    mask, *_ = star(4)
+    skel = skeletonize(mask)
+    seen = []
+    proposal = autorig(skel, template="none", progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(k, STEPS) for k in range(STEPS + 1)]
+    calls = []
+
+    def cancel_second():
+        calls.append(1)
+        return len(calls) >= 2
+
+    with pytest.raises(Cancelled):
+        autorig(skel, template="none", cancel=cancel_second)
+    assert len(calls) == 2  # stopped at the first stage boundary after the request, not at the end
+    seen = []
+    conn, _ = connect(skel, proposal.bones, method="nearest", progress=lambda d, t: seen.append((d, t)))
+    assert seen[0] == (0, len(skel)) and seen[-1] == (len(skel), len(skel))
+    with pytest.raises(Cancelled):
+        connect(skel, proposal.bones, method="pieces", mask=balls(skel), cancel=lambda: True)
