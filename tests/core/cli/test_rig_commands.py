@@ -114,6 +114,7 @@ def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
         for angle in (45, 90):
             trans = ant / f"{leaf}.{angle}.trans"
             assert main(["pose", str(ant / "auto.bones"), "--rotate", f"{leaf}=0,{angle},0", "-o", str(trans)]) == 0
+            capsys.readouterr()
             if main(["report", str(ant / "auto.connect"), str(trans), "--bones", str(ant / "auto.bones")]) != 0:
                 broken.append(f"{leaf} {angle}: {capsys.readouterr().out.splitlines()[0]}")
     assert broken == []
