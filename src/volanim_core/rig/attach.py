@@ -233,14 +233,15 @@ def connect(skeleton: Skeleton, bones: BoneSkeleton, *, method: str = "nearest",
             mask: np.ndarray | None = None, progress=None, cancel=None) -> tuple[Connectivity, AutoConnectReport]:
     """Attach a skeleton's points to bones by ``method`` (the studio's auto-connect, all points).
 
-    ``mask`` (the segmented object on the skeleton's voxel grid) is needed by every method but
-    ``nearest``: a path must run inside it. Unattached points are left out of the connectivity
+    ``mask`` (the segmented object on the skeleton's voxel grid) is needed by the methods in ``NEEDS_MASK``:
+    a path must run inside it, or its pieces are the body's. Unattached points are left out of the connectivity
     (a ``.connect`` lists attached points only) and counted in the report.
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
     if method in NEEDS_MASK and mask is None:
-        raise ValueError(f"the {method!r} method needs the segmented volume (a path must run inside it)")
+        why = "its pieces are the body's" if method == "pieces" else "a path must run inside it"
+        raise ValueError(f"the {method!r} method needs the segmented volume ({why})")
     if mask is not None and len(skeleton) and (skeleton.points.max(axis=0) >= np.array(mask.shape)).any():
         raise ValueError(f"the segmented volume ({'x'.join(map(str, mask.shape))} voxels) does not hold the "
                          "skeleton's points: give the scan the skeleton was made from")

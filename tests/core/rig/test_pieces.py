@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from volanim_core.rig.attach import attach_nearest_bone, auto_connect
 from volanim_core.rig.bones import Bone, BoneSkeleton
@@ -56,3 +57,12 @@ def test_auto_connect_pieces_attaches_every_point():
     assert report.attached == len(points) and report.unattached == 0
     leg = points[:, 0] >= 23
     assert (bone[leg] == 1).all() and (bone[~leg] == 0).all()
+
+
+def test_connect_by_pieces_without_the_volume_says_what_it_needs():
+    from volanim_core.rig.attach import connect
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    mask, bones = _body()
+    with pytest.raises(ValueError, match=r"'pieces' method needs the segmented volume \(its pieces are the body's\)"):
+        connect(skeletonize(mask), bones, method="pieces")
