@@ -41,6 +41,7 @@ def bender_frame(conn, matrices: np.ndarray, skin):
 def bender_skin(conn, volume: np.ndarray):
     """Bender's heat weights of ``conn``'s points; ``volume`` the rest sample (its bone tissue is the source)."""
     from scipy.sparse import coo_matrix, diags
+    from scipy.sparse.csgraph import connected_components, dijkstra
     from scipy.sparse.linalg import splu
 
     from volanim_core.rig.skinning import INFLUENCES, MIN_WEIGHT, Skin, links
@@ -50,14 +51,13 @@ def bender_skin(conn, volume: np.ndarray):
     at = np.clip(np.rint(points).astype(np.int64), 0, np.array(volume.shape) - 1)
     source = np.isin(volume[tuple(at.T)], BONE_TISSUE)
     i, j, d = links(points, conn.dt)
-    w = 1.0 / np.maximum(d, 1e-6)  # closer neighbours conduct more
-    a = coo_matrix((np.concatenate([w, w]), (np.concatenate([i, j]), np.concatenate([j, i]))), shape=(n, n)).tocsr()
+    graph = coo_matrix((d, (i, j)), shape=(n, n)).tocsr()  # the links' lengths
+    a = graph.copy()
+    a.data = 1.0 / np.maximum(a.data, 1e-6)  # conductances: closer neighbours conduct more
+    a = (a + a.T).tocsr()
     # a part with no bone tissue (the mannequin's torso, pelvis, clavicles, hands, feet, head: its bone rods are
     # in the limbs only) is its own source away from its joints: its points more than its thickness (thickest
     # sphere) along the links from any other part
-    from scipy.sparse.csgraph import dijkstra
-
-    graph = coo_matrix((d, (i, j)), shape=(n, n)).tocsr()
     for k in range(n_bones):
         mine = bone == k
         if mine.any() and not source[mine].any():
@@ -66,8 +66,6 @@ def bender_skin(conn, volume: np.ndarray):
             source |= mine & ~np.isfinite(far)
     laplacian = (diags(np.asarray(a.sum(1)).ravel()) - a).tocsr()
     # a linked group with no bone tissue has no source: its points keep their own bone (Bender leaves them at 0)
-    from scipy.sparse.csgraph import connected_components
-
     _, group = connected_components(a, directed=False)
     sourced = np.isin(group, np.unique(group[source]))
     free = np.flatnonzero(sourced & ~source)

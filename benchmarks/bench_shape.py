@@ -68,7 +68,7 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
     from volanim_core.reconstruct.breakage import RestParts
     from volanim_core.reconstruct.engine import reconstruct
     from volanim_core.reconstruct.lumps import bone_reach, find_lumps, limb_voxels
-    from volanim_core.reconstruct.shape import compare_shapes
+    from volanim_core.reconstruct.shape import compare_shapes, extra_flesh
     from volanim_core.rig.pose import pose_matrices, posed_joints
 
     conn = default_connectivity(sample)
@@ -98,7 +98,9 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
                                      joints=at, segments=segments)
                 lumps = find_lumps(r.volume, r.origin, m, rest_segments, reach, rest.rest_bone.volume,
                                    rest.rest_bone.origin, at, limbs) if method == "rigid" else []
-                real = [lump_is_real(lump, r, truth) for lump in lumps]
+                if lumps:  # once a frame, whatever the number of lumps
+                    extra, lo = extra_flesh(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin)
+                real = [lump_is_real(lump, extra, lo) for lump in lumps]
                 blobs = [b for b in (rep.largest_extra, rep.largest_missing) if b is not None]
                 worst = max(blobs, key=lambda b: b.voxels) if blobs else None
                 rows.append({"body": name, "joint": label, "angle": angle, "method": method, "dice": rep.dice,
@@ -124,16 +126,10 @@ def frames_of(sample, conn) -> dict:
             "lbs": lambda m: lbs_frame(conn, m), "bender": lambda m: bender_frame(conn, m, bender)}
 
 
-def lump_is_real(lump, ours, truth) -> bool:
+def lump_is_real(lump, extra: np.ndarray, lo: np.ndarray) -> bool:
     """Whether a flagged lump is flesh the true shape does not have: at least half its size of the extra
-    voxels (ours, not the truth's, opened by one voxel as the report's lumps are) lies in its box."""
-    from scipy import ndimage
-
-    from volanim_core.reconstruct.shape import OPENING, _on_one_grid
-
-    a, t, lo = _on_one_grid(ours.volume, truth.volume, ours.origin, truth.origin)
+    voxels (``extra, lo``: :func:`~volanim_core.reconstruct.shape.extra_flesh`) lies in its box."""
     box = tuple(slice(int(x), int(y) + 1) for x, y in zip(np.asarray(lump.lo) - lo, np.asarray(lump.hi) - lo))
-    extra = ndimage.binary_opening((a != 0) & (t == 0), OPENING)
     return int(extra[box].sum()) >= lump.voxels / 2
 
 

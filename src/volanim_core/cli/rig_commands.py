@@ -66,8 +66,8 @@ def register(sub) -> None:
     p.add_argument("--method", choices=METHODS, default="pieces",
                    help="how --connect attaches (default pieces: each piece of the body to the bones lying in it, "
                         "else the nearest; `volanim connect --help` lists the others)")
-    p.add_argument("--volume", help="with --connect: paths must run inside this scan (default: inside the "
-                                    "skeleton's own balls)")
+    p.add_argument("--volume", help="with --connect: the scan whose pieces (or, with --method path, whose inside) "
+                                    "the attachment follows (default: the skeleton's own balls)")
     add_dims(p)
     p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]", help="segment the scan as skeletonize did")
     p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background, as skeletonize did")

@@ -176,9 +176,21 @@ def _parts(body_t: np.ndarray, lo, segments) -> dict[str, int]:
     return {n: int(c) for n, c in zip(names, counts)}
 
 
+def extra_flesh(ours: np.ndarray, truth: np.ndarray, *, ours_origin=(0, 0, 0), truth_origin=(0, 0, 0)
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """``(extra, lo)``: the voxels ours has and the truth lacks, opened by one voxel as the blobs are, on the
+    grid holding both (its voxel [0, 0, 0] at ``lo`` in the frame's grid): what a flagged lump is checked
+    against (benchmarks/bench_shape.py)."""
+    a, t, lo = _on_one_grid(ours, truth, ours_origin, truth_origin)
+    return _opened(_body(a) & ~_body(t)), lo
+
+
+def _opened(diff: np.ndarray) -> np.ndarray:
+    return ndimage.binary_opening(diff, OPENING)
+
+
 def _largest_blob(diff: np.ndarray, lo, joints, segments, parts) -> Blob | None:
-    opened = ndimage.binary_opening(diff, OPENING)
-    labels, n = ndimage.label(opened, PIECES)
+    labels, n = ndimage.label(_opened(diff), PIECES)
     if n == 0:
         return None
     sizes = np.bincount(labels.ravel())[1:]
