@@ -46,16 +46,33 @@ class Body:
     lo: np.ndarray
     step: int
     pad: int
+    painted: np.ndarray | None = None  # the balls as painted, before gaps were closed (None: the grid)
+
+    def outline(self) -> Body:
+        """The body as its balls paint it, narrow gaps open: an armpit's apex, not its closing."""
+        return self if self.painted is None else Body(self.painted, self.lo, self.step, self.pad)
+
+    def inside(self, points: np.ndarray) -> np.ndarray:
+        """Whether each of ``points`` (skeleton voxel coordinates) lies in the body."""
+        idx = np.rint((np.atleast_2d(points) - self.lo) / self.step + self.pad).astype(int)
+        out = (idx >= 0).all(axis=1) & (idx < self.grid.shape).all(axis=1)
+        out[out] = self.grid[tuple(idx[out].T)]
+        return out
 
     def exit(self, start: np.ndarray, direction: np.ndarray) -> np.ndarray:
         d = direction / (np.linalg.norm(direction) or 1)
         t = np.arange(0, 4 * max(self.grid.shape) * self.step, 0.5 * self.step)
-        ray = start + t[:, None] * d
-        idx = np.rint((ray - self.lo) / self.step + self.pad).astype(int)
-        inside = (idx >= 0).all(axis=1) & (idx < self.grid.shape).all(axis=1)
-        inside[inside] = self.grid[tuple(idx[inside].T)]
-        out = np.flatnonzero(~inside)
-        return ray[out[0] - 1] if len(out) and out[0] > 0 else start
+        for k in range(0, len(t), 64):  # most rays leave within a few steps: walk them a piece at a time
+            ray = start + t[k: k + 65, None] * d
+            out = np.flatnonzero(~self.inside(ray))
+            if len(out):
+                return ray[out[0] - 1] if out[0] > 0 else (start if k == 0 else ray[0])
+        return start
+
+    def clear(self, a: np.ndarray, b: np.ndarray) -> bool:
+        """Whether the segment from ``a`` to ``b`` runs inside the body all the way."""
+        n = int(np.linalg.norm(b - a) / (0.5 * self.step)) + 2
+        return bool(self.inside(a + np.linspace(0, 1, n)[:, None] * (b - a)).all())
 
 
 class NotRiggable(ValueError):
@@ -217,6 +234,7 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     grid = np.zeros(shape, bool)
     centres = (skeleton.points - lo) / h + pad
     paint_balls(centres, np.maximum(skeleton.dt, 0.5) / h + 0.5, grid)
+    painted = grid
     if close:
         grid = ndimage.binary_closing(grid, ndimage.generate_binary_structure(3, 1), iterations=steps)
     grid = ndimage.binary_fill_holes(grid)
@@ -225,7 +243,7 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     curve = thin(grid)
     dist = edt.edt(grid)
     idx = np.argwhere(curve)
-    return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad)
+    return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad, painted)
 
 
 def curve_tree(skeleton: Skeleton, *, spur: float = SPUR, step=None) -> CurveTree:

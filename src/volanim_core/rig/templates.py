@@ -20,6 +20,7 @@ from itertools import combinations
 
 import numpy as np
 
+from volanim_core.rig import landmarks
 from volanim_core.rig.autorig import Tree, splits
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.curve_skeleton import NotRiggable
@@ -130,23 +131,43 @@ def _thinning(tree: Tree, path, lo: int, hi: int, default: int) -> int:
     return k_best
 
 
-def _limb(tree: Tree, start: int, end: int, fractions, last_bend: bool, thin_at: int | None = None):
-    """Joint positions along the limb from node ``start`` to end ``end``: first bend, interior joints at
-    ``fractions`` of the rest (or the last bend for the final one when ``last_bend``), the tip."""
+def _limb(tree: Tree, start: int, end: int, fractions, last_bend: bool, thin_at: int | None = None,
+          root: np.ndarray | None = None):
+    """Joint positions along the limb from node ``start`` to end ``end``: first bend (or ``root``, a
+    joint read off the body), interior joints at ``fractions`` of the rest (or the last bend for the
+    final one when ``last_bend``), the tip."""
     path = tree.path(start, end)
     n = len(path)
     first = _bend(tree, path, 0, max(2, int(0.45 * n)))
     s = tree.length(path)
     tip = tree.tip(end, inset=True)
     total = s[-1] + np.linalg.norm(tip - tree.p[end])
-    inner = [_at(tree, path, f, s[first], total) for f in fractions]
+    s0 = s[first]
+    if root is not None:  # the arc starts where the root lies along the limb, before or after the bend
+        down = tree.p[path[min(first + 3, n - 1)]] - tree.p[path[first]]
+        s0 -= (tree.p[path[first]] - root) @ (down / (np.linalg.norm(down) or 1))
+    inner = [_at(tree, path, f, s0, total) for f in fractions]
     if last_bend:
         inner[-1] = _bend(tree, path, max(first + 2, int(0.6 * n)), n - 1)
-        inner[:-1] = [_at(tree, path, f, s[first], s[inner[-1]]) for f in fractions[:-1]]
+        inner[:-1] = [_at(tree, path, f, s0, s[inner[-1]]) for f in fractions[:-1]]
     if thin_at is not None:
-        inner[thin_at] = _thinning(tree, path, _at(tree, path, 0.65, s[first], total),
-                                   _at(tree, path, 0.92, s[first], total), inner[thin_at])
-    return [_corner(tree.p[path], first)] + [tree.p[path[k]] for k in inner] + [tip]
+        inner[thin_at] = _thinning(tree, path, _at(tree, path, 0.65, s0, total),
+                                   _at(tree, path, 0.92, s0, total), inner[thin_at])
+    head = _corner(tree.p[path], first) if root is None else root
+    return [head] + [tree.p[path[k]] for k in inner] + [tip]
+
+
+def _section(tree: Tree, start: int, end: int, lo: float, hi: float) -> landmarks.Line | None:
+    """The straight line through the nodes between fractions ``lo`` and ``hi`` of the path's length
+    after its first bend (an upper arm, a thigh), pointing away from ``start``."""
+    path = tree.path(start, end)
+    s = tree.length(path)
+    s0 = s[_bend(tree, path, 0, max(2, int(0.45 * len(path))))]
+    pts = tree.p[path][(s >= s0 + lo * (s[-1] - s0)) & (s <= s0 + hi * (s[-1] - s0))]
+    if len(pts) < 3:
+        return None
+    centre, axis = _line(pts)
+    return centre, axis if axis @ (pts[-1] - pts[0]) >= 0 else -axis
 
 
 def _line(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -209,19 +230,48 @@ def _humanoid(tree: Tree, match) -> BoneSkeleton:
     narrowest = int(np.flatnonzero(r[: widest + 1] <= r[: widest + 1].min() + 0.5)[0])
     k_neck = _at(tree, neck_path, 0.5, 0.0, tree.length(neck_path)[narrowest])
     j = {"PELVIS": tree.p[m_legs], "NECK": tree.p[neck_path[k_neck]], "HEAD": tree.tip(head)}
-    for side, pick in (("L_", 0), ("R_", 1)):
-        hand = sorted(arms, key=lambda e: -(tree.p[e] @ n))[pick]
-        foot = sorted(legs, key=lambda e: -(tree.p[e] @ n))[pick]
+    hands = sorted(arms, key=lambda e: -(tree.p[e] @ n))
+    feet = sorted(legs, key=lambda e: -(tree.p[e] @ n))
+    up = (j["NECK"] - j["PELVIS"]) / (np.linalg.norm(j["NECK"] - j["PELVIS"]) or 1)
+    for side, hand, foot in zip(("L_", "R_"), hands, feet):
         arm = _limb(tree, m_arms, hand, (ELBOW, WRIST), last_bend=False, thin_at=1)
         leg = _limb(tree, m_legs, foot, (KNEE, 1.0), last_bend=True)
-        leg[0] = _at_level(tree, m_legs, foot, j["PELVIS"], j["NECK"] - j["PELVIS"])
+        leg[0] = _at_level(tree, m_legs, foot, j["PELVIS"], up)
         leg[1] = leg[0] + KNEE * (leg[2] - leg[0])  # between the moved hip and the ankle
         j.update(zip((side + k for k in ARM_JOINTS), arm))
         j.update(zip((side + k for k in LEG_JOINTS), leg))
+    if tree.curve.body is not None:
+        _from_body(tree, j, (m_arms, hands), (m_legs, feet), up, n)
     bones = [Bone("PELVIS", "NECK", "SPINE"), Bone("NECK", "HEAD", "HEAD"),
              *_limb_bones("NECK", ARM_JOINTS, ("CLAVICLE", "UPPERARM", "FOREARM", "HAND")),
              *_limb_bones("PELVIS", LEG_JOINTS, ("PELVIS", "THIGH", "SHIN", "FOOT"))]
     return BoneSkeleton(j, bones)
+
+
+def _from_body(tree: Tree, j: dict, arms, legs, up: np.ndarray, n: np.ndarray) -> None:
+    """Shoulders, hips and the pelvis moved, in place, to where the body's outline puts them
+    (:mod:`~volanim_core.rig.landmarks`); each stays the curve's guess where the body shows no landmark."""
+    body, spine = tree.curve.body.outline(), (j["PELVIS"], up)
+    armpits = []
+    for side, hand in zip(("L_", "R_"), arms[1]):
+        line = _section(tree, arms[0], hand, 0.08, 0.35)
+        found = line and landmarks.shoulder(body, line, spine, up, j[side + "ELBOW"] @ up, j["NECK"] @ up)
+        if found:
+            armpits.append(found[1])
+            arm = _limb(tree, arms[0], hand, (ELBOW, WRIST), last_bend=False, thin_at=1, root=found[0])
+            j.update(zip((side + k for k in ARM_JOINTS), arm))
+    thighs = [_section(tree, legs[0], foot, 0.1, 0.4) for foot in legs[1]]
+    if None in thighs:
+        return
+    top = np.mean(armpits) if armpits else tree.p[arms[0]] @ up
+    level = landmarks.hip_level(body, tuple(thighs), spine, n, up,
+                                max(j["L_KNEE"] @ up, j["R_KNEE"] @ up), top)
+    if level is None:
+        return
+    j["PELVIS"] = landmarks.at_level(spine, up, level)
+    for side, thigh in zip(("L_", "R_"), thighs):
+        j[side + "HIP"] = landmarks.at_level(thigh, up, level)
+        j[side + "KNEE"] = j[side + "HIP"] + KNEE * (j[side + "ANKLE"] - j[side + "HIP"])
 
 
 def _quadruped(tree: Tree, match) -> BoneSkeleton:

@@ -14,7 +14,6 @@ from volanim_core import samples
 from volanim_core.reconstruct.checks import report
 from volanim_core.rig.attach import connect
 from volanim_core.rig.autorig import autorig, splits
-from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.curve_skeleton import NotRiggable, balls
 from volanim_core.rig.pose import pose_matrices, root_bones
@@ -137,7 +136,7 @@ def test_the_mannequin_gets_its_own_bones_back():
     skel = skeletonize(s.mask)
     proposal = autorig(skel, template="auto")
     assert proposal.template == "humanoid"
-    assert _mean_error(proposal.bones, s.bones) < 5.0
+    assert _mean_error(proposal.bones, s.bones) < 3.0
     # every limb bent 60 degrees after auto-connect (path method, inside the skeleton's own balls): one piece
     conn, _ = connect(skel, proposal.bones, method="path", mask=balls(skel))
     for bone in ("HEAD", "L_UPPERARM", "R_FOREARM", "L_THIGH", "R_SHIN", "L_HAND", "R_FOOT"):
@@ -150,14 +149,12 @@ def test_mannequin_large_humanoid():
     s = samples.mannequin_large()
     proposal = autorig(skeletonize(s.mask))
     assert proposal.template == "humanoid"
-    # the same body on a grid 1.8 x 1.7 x 3.1 times finer: in the mannequin's own voxels the error is the
-    # small one's; in the large voxels, where the torso's top is stretched 3.1 times upwards and the
-    # thinned curve leaves it below the clavicles, it is twice the issue's 5 (see the issue's note)
-    scale = np.array(samples.LARGE_SHAPE, float) / samples.MANNEQUIN_SHAPE
-    body = _mean_error(BoneSkeleton({k: v / scale for k, v in proposal.bones.joints.items()}, proposal.bones.bones),
-                       BoneSkeleton({k: v / scale for k, v in s.bones.joints.items()}, s.bones.bones))
-    assert body < 5.0
-    assert _mean_error(proposal.bones, s.bones) < 10.5
+    # the same body on a grid 1.8 x 1.7 x 3.1 times finer, its torso stretched 3.1 times upwards in voxels:
+    # the thinned curve leaves the arms below the clavicles and forks below the hips (shoulders were 25-30
+    # voxels low, the mean 9.9); the armpits, the crotch and the hips' widest section are read off the body
+    assert _mean_error(proposal.bones, s.bones) < 5.0
+    for joint in ("L_SHOULDER", "R_SHOULDER", "L_HIP", "R_HIP"):
+        assert np.linalg.norm(proposal.bones.joints[joint] - s.bones.joints[joint]) < 5.0, joint
 
 
 def test_the_frog_legs_are_separate_chains():
