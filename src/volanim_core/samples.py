@@ -45,7 +45,10 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 #: ``mannequin-ct`` writes the mannequin as a CT scan arrives, a DICOM series (:func:`write_mannequin_ct`);
 #: ``ant`` copies the closed ant mesh pyvista's wheel ships (``ant.ply``), a model to voxelize, with joints
 #: placed on it as Slicer markups (``ant.mrk.json``) and a gait (``ant.keys``): :mod:`volanim_core.ant_sample`.
-FILE_SAMPLES = ("walk", "mannequin-ct", "ant")
+#: ``rabbit``, ``spot`` and ``bob`` copy closed meshes other projects ship (trimesh's test rabbit, MIT; Keenan
+#: Crane's Spot the cow and Bob, CC0, as geometry-central's test assets): creatures nobody templated.
+FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob")
+MESH_SAMPLES = ("rabbit", "spot", "bob")
 
 CT_SPACING, CT_ORIGIN = (0.7, 0.7, 2.5), (-56.0, -35.0, -1150.0)  # a CT's voxels (mm), somewhere in a scanner
 #: Hounsfield units a CT of the mannequin's tissues would read (air: -1000).
@@ -305,6 +308,12 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         written = [folder / "ant.ply"]
         atomic_write_bytes(written[0], Path(examples.antfile).read_bytes())
         return written + write_ant_rig(folder)  # its joints as Slicer markups, and a gait
+    if name in MESH_SAMPLES:
+        mesh = Path(__file__).resolve().parent / "sample_data" / f"{name}.ply"
+        written = [folder / f"{name}.ply", folder / f"{name}.ply.LICENSE"]
+        for src, dst in zip((mesh, mesh.with_name(f"{name}.ply.LICENSE")), written):
+            atomic_write_bytes(dst, src.read_bytes())
+        return written
     if name == "walk":
         clip = walk_clip()
         written = [folder / clip.name, folder / f"{clip.name}.LICENSE"]

@@ -28,7 +28,10 @@ from volanim_core.skeleton.points import Skeleton
 TEMPLATES = ("auto", "humanoid", "quadruped", "none")
 THICKNESS_WEIGHT = 2.0  # a radius change of 1 voxel counts as a bend of 2 voxels
 FORK_BALL = 1.5  # no joint within this x the fork's radius of a fork: the limb is leaving the fork's ball
-BEND = 0.6  # a branch is split where it strays more than this x its radius from its chord (at least 2 voxels)
+BEND = 0.6  # a branch is split where it strays more than this x its radius from its chord (at least 2 voxels) ...
+STRAIGHT = 0.08  # ... and, on a porous body, this x its length
+WIDER = 1.5  # a limb gets a joint where it leaves its fork's ball when the ball is this x its radius
+TIP_REACH = 3.0  # an end is extended to the surface only when that is within this x its radius
 
 
 @dataclass
@@ -111,6 +114,8 @@ class Tree:
         k = min(k, len(back) - 1)
         direction = self.p[end] - self.p[back[k]]
         surface = self.curve.surface(self.p[end], direction)
+        if np.linalg.norm(surface - self.p[end]) > TIP_REACH * self.r[end] + 2:
+            surface = self.p[end]  # a curled end points back along its limb: its ray runs inside, far
         if not inset:
             return surface
         reach = np.linalg.norm(surface - self.p[end])
@@ -137,18 +142,21 @@ def smooth(xyz: np.ndarray, width: int = 2) -> np.ndarray:
     return out
 
 
-def splits(xyz: np.ndarray, r: np.ndarray, *, count: int | None = None, skip: float = 0.0) -> list[int]:
+def splits(xyz: np.ndarray, r: np.ndarray, *, count: int | None = None, skip: float = 0.0,
+           straight: float = 0.0) -> list[int]:
     """Interior indices where a branch should bend: Douglas-Peucker on the smoothed curve (x, y, z, 2 r).
 
     With ``count``, up to that many splits (the largest deviations first); otherwise every split whose
-    deviation exceeds BEND x the branch's mean radius (at least 2 voxels). No
+    deviation exceeds BEND x the branch's mean radius (at least 2 voxels) and ``straight`` x its length
+    (on a porous body, whose surface is noise: a frog's hind leg, 700 voxels at radius 7, bends at its
+    folds, not at every wobble). No
     piece is made shorter than the branch's mean radius (a bone is longer than it is thick), and none
     within ``skip`` of the start: a limb thins where it leaves its fork's ball, which is not a joint.
     """
     curve = smooth(np.column_stack([xyz, THICKNESS_WEIGHT * np.asarray(r)]))
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xyz, axis=0), axis=1))])
     shortest = float(np.mean(r))
-    tol = max(2.0, BEND * float(np.mean(r)))
+    tol = max(2.0, BEND * float(np.mean(r)), straight * float(arc[-1]))
     chosen: list[int] = []
     first = min(int(np.searchsorted(arc, skip)), len(curve) - 1)  # the chord starts out of the fork's ball
     spans = [(first, len(curve) - 1)]
@@ -231,9 +239,13 @@ def chains(tree: Tree, geometry, *, bones: int | None = None) -> BoneSkeleton:
     if bones is not None and bones < len(branches):
         raise NotRiggable(f"--bones {bones} is fewer than the skeleton's {len(branches)} branches")
     # split points per branch, the largest deviations first when a count is asked for
-    cuts = {k: splits(tree.p[b], tree.r[b], skip=FORK_BALL * tree.r[b[0]]) for k, b in enumerate(branches)}
+    straight = STRAIGHT if tree.curve.body is not None and tree.curve.body.porous else 0.0
+    cuts = {k: splits(tree.p[b], tree.r[b], skip=FORK_BALL * tree.r[b[0]], straight=straight)
+            for k, b in enumerate(branches)}
     if bones is not None:
         cuts = _share(tree, branches, bones - len(branches))
+    else:
+        cuts = {k: _with_exit(tree, b, cuts[k]) for k, b in enumerate(branches)}
     joints: dict[str, np.ndarray] = {"ROOT": tree.p[root]}
     name_of = {root: "ROOT"}
     out: list[Bone] = []
@@ -259,6 +271,25 @@ def chains(tree: Tree, geometry, *, bones: int | None = None) -> BoneSkeleton:
     if not out:
         raise NotRiggable("the skeleton has no branches longer than it is thick: nothing to bend (a ball?)")
     return BoneSkeleton(joints, out)
+
+
+def _with_exit(tree: Tree, path: list[int], cuts: list[int]) -> list[int]:
+    """``cuts`` with one more where a limb (a branch that ends) leaves its fork's ball: the limb then
+    turns about the body's surface, as a shoulder does, not about a point deep in the trunk that would
+    swing the trunk's flesh with it. The ball must be ``WIDER`` than the limb (a T of one tube is its
+    own joint) and the limb must reach past it by its radius. Bend splits closer to that joint than
+    the limb's radius give way to it."""
+    if tree.degree(path[-1]) != 1 or tree.degree(path[0]) < 3:
+        return cuts
+    out = np.linalg.norm(tree.p[path] - tree.p[path[0]], axis=1) > tree.r[path[0]]
+    if not out.any():
+        return cuts
+    k = int(np.argmax(out))
+    arc = tree.length(path)
+    rest = float(np.mean(tree.r[path[k:]]))
+    if arc[k] < max(2.0, WIDER * rest) or arc[-1] - arc[k] < max(2.0, rest):
+        return cuts  # a fork no thicker than its limbs (a T of one tube) is a joint already
+    return sorted([k] + [c for c in cuts if abs(arc[c] - arc[k]) >= rest])
 
 
 def _share(tree: Tree, branches, extra: int) -> dict[int, list[int]]:
@@ -315,6 +346,7 @@ def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str 
     if curve.dropped:
         n = sum(c for c, _ in curve.dropped)
         notes.append(f"left out {len(curve.dropped)} small piece(s) apart from the body ({n} points)")
+    notes += _pruning_notes(curve)
     tree = Tree(curve, left_axis(skel.geometry))
     if len(tree.ends()) < 2:
         raise NotRiggable("the skeleton has no branches: nothing to bend (is the object a ball?)")
@@ -329,6 +361,21 @@ def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str 
         result = templates.fit(tree, template)
         return _done(Proposal(_on(result, skel), template, notes), report)
     return _done(Proposal(_on(chains(tree, skel.geometry, bones=bones), skel), "none", notes), report)
+
+
+def _pruning_notes(curve) -> list[str]:
+    """What the curve skeleton's pruning did that a user may miss: a porous body closed, and the
+    branches that stuck out of the body but were cut as noise (the longest, with where)."""
+    out = []
+    if curve.body is not None and curve.body.porous:
+        out.append("porous body (closing its seams grew it by over 5 %): its pores were closed, and its limbs "
+                   f"bend only where they stray {STRAIGHT:.0%} of their length from straight")
+    if curve.pruned:
+        length, tip = max(curve.pruned, key=lambda lt: lt[0])
+        where = ", ".join(f"{v:.0f}" for v in tip)
+        out.append(f"cut {len(curve.pruned)} short branch(es) as spurs, the longest {length:.0f} voxels to "
+                   f"({where}): if one is a limb, add its bones by hand")
+    return out
 
 
 def _done(proposal: Proposal, report) -> Proposal:

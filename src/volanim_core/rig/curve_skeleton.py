@@ -3,7 +3,8 @@
     Skeleton (points, dt at thinness T)
       --solid-->  the union of its balls painted on a coarse grid (at most COARSE_VOXELS),
                   gaps under CLOSE voxels closed, cavities filled: a porous segmentation
-                  (the frog's tissues) becomes one body whose thickness means something
+                  (the frog's tissues: closing grows it by over POROUS) has gaps up to PORE x its
+                  thickest radius closed too, and becomes one body whose thickness means something
       --thin-->   scikit-image's 3-D thinning: a curve, radius = the solid's distance
                   transform (a flat torso is a curve, not the medial sheet voxels give)
       --link-->   an edge where two curve balls overlap: the segment between their centres
@@ -14,8 +15,10 @@
                   and counted; a second large piece is refused (the object is not one body)
       --tree-->   the minimum spanning tree, an edge costing length / (sum of radii), so the
                   tree runs along thick routes
-      --prune-->  leaf branches shorter than SPUR x their fork's radius (or FLOOR x the largest
-                  radius) are surface noise, not limbs (Pinocchio's rule, Baran & Popovic 2007)
+      --prune-->  leaf branches that are not limbs: a tip sticking out of its fork's ball by less
+                  than PROTRUDE of its own radius (a bump), a thin one shorter than SPUR x its fork's
+                  radius (Pinocchio's rule, Baran & Popovic 2007), any shorter than LIMB of the body's
+                  longest path (its own scale): a stubby paw survives, a hair does not
       CurveTree (nodes, radii, edges, the solid body for rays to the surface)
 
 :mod:`volanim_core.rig.autorig` cuts the tree into chains and bones.
@@ -29,13 +32,17 @@ import numpy as np
 
 from volanim_core.skeleton.points import Skeleton
 
-SPUR = 3.0  # a leaf branch shorter than this x its fork's radius is pruned ...
-FLOOR = 2.0  # ... and so is one shorter than this x the body's largest radius
+SPUR = 3.0  # a thin leaf branch shorter than this x its fork's radius is pruned ...
+STUB = 0.25  # ... thin: its radius under this x its fork's
+PROTRUDE = 0.6  # a leaf branch whose tip sticks out of its fork's ball by less than this x its radius is a spur
+LIMB = 0.1  # ... and so does one shorter than this x the body's longest path (judged at the body's own scale)
 LARGE_PIECE = 0.2  # a second piece with this fraction of the largest one's volume is refused
 BRIDGE = 0.08  # a bridge may cross background this fraction of the body's length (at least 6 voxels)
 GAP = 3.0  # balls this many voxels apart still link (a coarse voxel's slack)
 COARSE_VOXELS = 8_000_000  # the solid body is remade on a grid of at most this many voxels
 CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues)
+POROUS = 0.05  # a body that closing grows by more than this fraction is porous (a dissected frog's tissues) ...
+PORE = 1.2  # ... and its gaps narrower than this x its thickest ball's radius are closed too
 
 
 @dataclass
@@ -47,6 +54,7 @@ class Body:
     step: int
     pad: int
     painted: np.ndarray | None = None  # the balls as painted, before gaps were closed (None: the grid)
+    porous: bool = False  # closing the seams grew the body by more than POROUS: a noisy surface
 
     def outline(self) -> Body:
         """The body as its balls paint it, narrow gaps open: an armpit's apex, not its closing."""
@@ -88,6 +96,7 @@ class CurveTree:
     edges: np.ndarray  # (M - 1, 2) int
     dropped: list[tuple[int, np.ndarray]] = field(default_factory=list)  # (points, centre) of pieces left out
     body: Body | None = None  # the solid body the tree was thinned from
+    pruned: list[tuple[float, np.ndarray]] = field(default_factory=list)  # (length, tip) of branches cut off
 
     def surface(self, start: np.ndarray, direction: np.ndarray) -> np.ndarray:
         """Where the ray from ``start`` along ``direction`` leaves the body (``start`` without a body)."""
@@ -181,11 +190,36 @@ def _largest_piece(graph, p, r):
     return label == main, dropped
 
 
-def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float, floor: float) -> None:
-    """Remove leaf branches shorter than ``factor`` x their fork's radius, in place, round by round.
-    A fork keeps at least two branches (its longest short ones), so a limb ending in a Y keeps one tip."""
+def _diameter(adj: list[set], p: np.ndarray) -> float:
+    """The length of the tree's longest path (two Dijkstra sweeps): the body's own scale."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    rows = np.array([a for a in range(len(adj)) for _ in adj[a]], np.int64)
+    cols = np.array([b for a in range(len(adj)) for b in adj[a]], np.int64)
+    if len(rows) == 0:
+        return 0.0
+    graph = coo_matrix((np.linalg.norm(p[rows] - p[cols], axis=1) + 1e-9, (rows, cols)), shape=(len(p),) * 2)
+    graph = graph.tocsr()
+    first = dijkstra(graph, indices=int(rows[0]))
+    far = int(np.argmax(np.where(np.isfinite(first), first, -1)))
+    second = dijkstra(graph, indices=far)
+    return float(np.max(second[np.isfinite(second)]))
+
+
+def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float,
+           floor: float = 0.0) -> list[tuple[float, np.ndarray]]:
+    """Remove leaf branches that are not limbs, in place, round by round; return the (length, tip) of
+    each removed branch that stuck out as a limb does (thin or short: what the proposal says it dropped).
+
+    A leaf branch is a limb when its tip sticks out of its fork's ball by ``PROTRUDE`` of its own
+    radius: a stubby paw does, a thinning's spur (a bump of the surface) does not. A thin branch (its
+    radius under ``STUB`` of its fork's) must also be ``factor`` x its fork's radius long (Pinocchio's
+    rule, Baran & Popovic 2007): a hair of noise is not a limb however far it reaches. A fork keeps at
+    least two branches (its longest short ones), so a limb ending in a Y keeps one tip."""
+    dropped = []
     while True:
-        at_fork: dict[int, list[tuple[float, list[int]]]] = {}
+        at_fork: dict[int, list[tuple[float, list[int], bool]]] = {}
         for leaf in [i for i in range(len(adj)) if len(adj[i]) == 1]:
             path, prev, cur, length = [leaf], leaf, next(iter(adj[leaf])), 0.0
             length += float(np.linalg.norm(p[cur] - p[prev]))
@@ -193,20 +227,27 @@ def _prune(adj: list[set], p: np.ndarray, r: np.ndarray, factor: float, floor: f
                 prev, cur = cur, next(k for k in adj[cur] if k != prev)
                 path.append(prev)
                 length += float(np.linalg.norm(p[cur] - p[prev]))
-            if len(adj[cur]) >= 3 and length < max(factor * r[cur], floor):
-                at_fork.setdefault(cur, []).append((length, path))
+            if len(adj[cur]) < 3:
+                continue
+            own = float(np.median(r[path]))
+            out = float(np.linalg.norm(p[leaf] - p[cur])) - r[cur]
+            stub = out < PROTRUDE * own
+            if stub or length < floor or (own < STUB * r[cur] and length < factor * r[cur]):
+                at_fork.setdefault(cur, []).append((length, path, not stub))
         removed = False
         for fork, branches in at_fork.items():
             branches.sort(key=lambda b: b[0])
             keep = max(0, 2 - (len(adj[fork]) - len(branches)))  # branches that must stay
-            for _, path in branches[: len(branches) - keep]:
+            for length, path, limb_like in branches[: len(branches) - keep]:
+                if limb_like:  # it stuck out like a limb: say so
+                    dropped.append((length, p[path[0]]))
                 for a in path:
                     for b in adj[a]:
                         adj[b].discard(a)
                     adj[a].clear()
                 removed = True
         if not removed:
-            return
+            return dropped
 
 
 def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.ndarray, np.ndarray, Body]:
@@ -234,16 +275,23 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     grid = np.zeros(shape, bool)
     centres = (skeleton.points - lo) / h + pad
     paint_balls(centres, np.maximum(skeleton.dt, 0.5) / h + 0.5, grid)
-    painted = grid
+    painted, porous = grid, False
+    cross = ndimage.generate_binary_structure(3, 1)
     if close:
-        grid = ndimage.binary_closing(grid, ndimage.generate_binary_structure(3, 1), iterations=steps)
+        grid = ndimage.binary_fill_holes(ndimage.binary_closing(painted, cross, iterations=steps))
+        porous = grid.sum() > (1 + POROUS) * painted.sum()
+        if porous:  # tissues with seams everywhere: close the pores too
+            pores = max(steps, int(round(PORE * skeleton.dt.max() / 2 / h)))
+            painted = np.pad(painted, pores - steps)  # room for the wider closing at the borders
+            grid = ndimage.binary_closing(painted, cross, iterations=pores)
+            pad += pores - steps
     grid = ndimage.binary_fill_holes(grid)
     if step is not None:
         step()
     curve = thin(grid)
     dist = edt.edt(grid)
     idx = np.argwhere(curve)
-    return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad, painted)
+    return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad, painted, porous)
 
 
 def curve_tree(skeleton: Skeleton, *, spur: float = SPUR, step=None) -> CurveTree:
@@ -267,13 +315,13 @@ def curve_tree(skeleton: Skeleton, *, spur: float = SPUR, step=None) -> CurveTre
     for a, b in zip(mst.row, mst.col):
         adj[a].add(int(b))
         adj[b].add(int(a))
-    _prune(adj, p, r, spur, FLOOR * r.max())
+    pruned = _prune(adj, p, r, spur, LIMB * _diameter(adj, p))
     step()
     alive = np.array([len(a) > 0 for a in adj]) if len(p) > 1 else np.ones(1, bool)
     renum = np.cumsum(alive) - 1
     edges = np.array(sorted((renum[a], renum[b]) for a in range(len(adj)) for b in adj[a] if a < b),
                      np.int64).reshape(-1, 2)
-    return CurveTree(p[alive], r[alive], edges, dropped, body)
+    return CurveTree(p[alive], r[alive], edges, dropped, body, pruned)
 
 
 def balls(skeleton: Skeleton) -> np.ndarray:
