@@ -1,7 +1,8 @@
 """Auto-rig on every body we have, each proposal posed leaf by leaf and judged (#62's proof table).
 
     body --skeletonize--> .mskel --autorig--> bones --connect (pieces, autorig --connect's default)-->
-    every leaf bone turned 45 and 90 degrees, rigid and smooth joints --report--> healthy or not
+    every leaf bone bent 45 and 90 degrees (about an axis across it), rigid and smooth joints
+      --report--> healthy or not
 
 Bodies: the mannequin and mannequin-large (hand-made rigs: the proposal's mean joint error), the frog,
 pyvista's ant, and three closed meshes other projects ship (voxelized at 160 voxels along the longest
@@ -43,6 +44,20 @@ def leaves(bones) -> list[str]:
     return [b.label for b in bones.bones if b.distal not in starts]
 
 
+def bend(bones, leaf: str, angle: float) -> np.ndarray:
+    """The rotation turning bone ``leaf`` by ``angle`` degrees towards the grid axis most across it (about
+    an axis across the bone: a real bend, never a twist about the bone's own length, which a fixed
+    ``0,45,0`` is for a bone along y)."""
+    from scipy.spatial.transform import Rotation
+
+    b = bones.bones[bones.index(leaf)]
+    along = bones.joints[b.distal] - bones.joints[b.proximal]
+    along = along / (np.linalg.norm(along) or 1)
+    towards = np.eye(3)[int(np.argmin(np.abs(along)))]
+    axis = np.cross(along, towards)
+    return Rotation.from_rotvec(np.radians(angle) * axis / np.linalg.norm(axis)).as_matrix()
+
+
 def leaf_poses(skel, bones, angles) -> dict:
     """{(joints, angle): (healthy, of, first broken verdict)} with the pieces connect."""
     from volanim_core.reconstruct.checks import report
@@ -59,7 +74,7 @@ def leaf_poses(skel, bones, angles) -> dict:
         for angle in angles:
             bad = []
             for leaf in leaves(bones):
-                m = pose_matrices(bones, {leaf: (0.0, float(angle), 0.0)})
+                m = pose_matrices(bones, {leaf: bend(bones, leaf, angle)})
                 rep = report(c, Trans(root_bones(bones), m), bones=bones)
                 if not rep.healthy:
                     bad.append(f"{leaf}: {rep.verdict.splitlines()[0][:60]}")
