@@ -115,6 +115,7 @@ screenshots: install-test system-deps
 	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py
 	$(PY) docs/make_colour_renders.py
 	$(PY) docs/make_shape_pictures.py
+	$(PY) docs/make_autorig_pictures.py
 
 clean:
 	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .coverage-data htmlcov

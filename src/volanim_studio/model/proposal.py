@@ -33,8 +33,16 @@ class BoneProposal:
         self.doc.bone_edits.set_bones(proposal.bones, label)
         self.previewing = label
 
-    def accept(self) -> None:
+    def accept(self) -> str:
+        """Keep the preview. Auto-connect then attaches by pieces, the method proposals are proven with
+        (each piece's points to its own bones; as nearest on a body in one piece): returns what to say."""
         self.previewing = None
+        settings = self.doc.settings
+        if settings.auto_method == "pieces":
+            return ""
+        was, settings.auto_method = settings.auto_method, "pieces"
+        return (f" Auto-connect (Ctrl+A) now attaches by pieces, as autorig --connect does (it was {was}; "
+                "the Connect tab changes it).")
 
     def discard(self) -> None:
         """Take the preview back, if it is still the last edit (later edits are the user's: kept)."""

@@ -60,8 +60,8 @@ class ProposeDialog(QDialog):
         self.adjustSize()  # the dialog grows with the text (it was clipped at its first size)
 
     def accept(self) -> None:
-        self.controller.doc.proposal.accept()
-        self.controller.doc.message(f"Kept the proposed bones: {self.controller.doc.undo.undo_label}.")
+        said = self.controller.doc.proposal.accept()
+        self.controller.doc.message(f"Kept the proposed bones: {self.controller.doc.undo.undo_label}.{said}")
         super().accept()
 
     def reject(self) -> None:

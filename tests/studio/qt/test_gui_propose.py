@@ -50,3 +50,45 @@ def test_discard_puts_the_bones_back(qtbot, window):
     assert window.doc.bones != hand_made
     qtbot.mouseClick(dialog.buttons.button(QDialogButtonBox.Discard), Qt.LeftButton)
     assert window.doc.bones == hand_made and not dialog.isVisible()
+
+
+@pytest.mark.long("the ant voxelized and skeletonized, then proposed, connected, posed and previewed in the studio")
+def test_propose_on_the_ant_accept_connect_and_pose_a_leg_healthy(qtbot, window, tmp_path):
+    """#62: a real model in pieces through the studio's widgets: Propose bones (auto), Accept, Auto-connect
+    (which accepting set to pieces), bend a leg's last bone 45 degrees in Pose mode: the preview's verdict
+    is healthy, in the status bar too."""
+    import numpy as np
+
+    from volanim_core.cli import main
+    from volanim_studio.model.modes import Mode
+
+    from ..conftest import JOB_TIMEOUT_MS
+    from .test_gui_pose import drag
+
+    assert main(["samples", "ant", "-o", str(tmp_path)]) == 0
+    assert main(["voxelize", str(tmp_path / "ant.ply"), str(tmp_path / "ant.nrrd"), "--size", "160"]) == 0
+    window.files.open_volume(tmp_path / "ant.nrrd", params={"lo": 1, "hi": None, "fill": False})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    doc = window.doc
+    assert doc.skeleton is not None and len(doc.bones) == 0
+    dialog = _propose(qtbot, window, "auto")
+    assert len(doc.bones) > 20 and "(none)" in dialog.summary.text()
+    assert doc.settings.auto_method == "path"  # the studio's default, until a proposal is accepted
+    qtbot.mouseClick(dialog.buttons.button(QDialogButtonBox.Ok), Qt.LeftButton)
+    assert doc.settings.auto_method == "pieces" and "attaches by pieces" in window.statusBar().currentMessage()
+    window.connect_panel.scope.setCurrentText("all")
+    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    assert (doc.attachments.bone[: doc.visible_count] >= 0).all()
+    # a leg: the leaf bone whose tip is farthest from the body's middle
+    starts = {b.proximal for b in doc.bones.bones}
+    middle = doc.skeleton.points.mean(axis=0)
+    leaf = max((i for i, b in enumerate(doc.bones.bones) if b.distal not in starts),
+               key=lambda i: np.linalg.norm(doc.bones.joints[doc.bones.bones[i].distal] - middle))
+    qtbot.keyClick(window, Qt.Key_P)
+    assert window.mode == Mode.POSE
+    doc.select_bones([leaf])
+    drag(qtbot, window, 1, range(0, 46, 5))
+    qtbot.waitUntil(lambda: not window.busy and doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    assert not doc.pose.is_rest
+    assert doc.preview.report.healthy, doc.preview.report.verdict
+    assert "healthy" in window.verdict_label.text()
