@@ -21,7 +21,9 @@ The rules, measured against the mannequin's ground-truth limb membership
   arm (:mod:`.limb_tubes`; #60).
 
 * ``auto_connect(method="pieces")`` -- a body in separate pieces (limbs that are shells of their own):
-  each piece's points go to the nearest of the bones lying in that piece (:mod:`.pieces`; #62).
+  each piece's points go to the nearest of the bones lying in that piece (:mod:`.pieces`; #62), then
+  each bone's flesh is made one piece: a ball touching only other bones' balls goes to the bone it
+  touches most (:mod:`.islands`), so no pose of either floats it off as a speck.
 
 ``auto_connect`` never overwrites points already attached unless asked, and
 reports how many it left unattached and why -- it never fails silently.
@@ -201,6 +203,10 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
         from volanim_core.rig.pieces import attach_by_piece
 
         found = attach_by_piece(sub, bones, mask)
+        if radii is not None and len(radii) == n:
+            from volanim_core.rig.islands import one_piece_each
+
+            found = one_piece_each(sub, radii[todo], found)
     elif method == "fitted":
         if radii is None or len(radii) != n:
             raise ValueError("the 'fitted' method needs every point's radius (its distance transform)")
