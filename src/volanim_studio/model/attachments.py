@@ -89,6 +89,15 @@ class Attachments:
     # ------------------------------------------------------- auto and mirror
     def auto(self, *, scope: str = "unconnected", overwrite: bool = False, selection=None, method: str = "path"):
         """Auto-connect shown points: scope 'all', 'unconnected' or 'selection'. Returns the report."""
+        task, apply = self.auto_job(scope=scope, overwrite=overwrite, selection=selection, method=method)
+        return apply(task())
+
+    def auto_job(self, *, scope: str = "unconnected", overwrite: bool = False, selection=None,
+                 method: str = "path"):
+        """Auto-connect as ``(task, apply)`` for a worker: ``task(progress, cancel)`` measures on the
+        document's arrays as they are now and changes nothing (safe off the GUI thread: the pieces
+        method takes seconds on a frog); ``apply(result)`` assigns its attachments as one undo step and
+        returns the report. Bad arguments raise ValueError here, before any work."""
         doc = self.doc
         if doc.mask is None:
             raise ValueError("auto-connect needs the segmented volume: open the volume (or project) first")
@@ -103,11 +112,21 @@ class Attachments:
             overwrite = overwrite if scope == "all" else False
         else:
             raise ValueError(f"scope must be 'all', 'unconnected' or 'selection', got {scope!r}")
-        out, report = auto_connect(doc.skeleton.points, doc.bones, doc.mask, method=method, current=self.bone,
-                                   overwrite=overwrite, which=which, radii=doc.skeleton.dt)
-        idx = np.flatnonzero(which & (out != self.bone))
-        self.assign_many(idx, out[idx], f"Auto-connect {len(idx)} points")
-        return report
+        points, dt, bones, mask, current = doc.skeleton.points, doc.skeleton.dt, doc.bones, doc.mask, self.bone.copy()
+
+        def task(progress=None, cancel=None):
+            return auto_connect(points, bones, mask, method=method, current=current, overwrite=overwrite,
+                                which=which, radii=dt, progress=progress, cancel=cancel)
+
+        def apply(result):
+            out, report = result
+            if doc.skeleton is None or doc.skeleton.points is not points or doc.bones is not bones:
+                raise ValueError("the skeleton or the bones changed while auto-connect ran: run it again")
+            idx = np.flatnonzero(which & (out != self.bone))
+            self.assign_many(idx, out[idx], f"Auto-connect {len(idx)} points")
+            return report
+
+        return task, apply
 
     def mirror(self, bones=None) -> tuple[int, int]:
         """Copy the attachments of sided bones to their twins across the symmetry plane.

@@ -18,13 +18,22 @@ class ConnectController(Controller):
         action("Mirror connectivity of selected bones", self.mirror_connectivity, menu=menu)
 
     def auto_connect(self) -> None:
+        """Measure in a worker with progress and Cancel (the pieces method takes seconds on a big scan),
+        then assign on the GUI thread as one undo step."""
         st = self.doc.settings
+        if self.jobs.busy:
+            self.show_error("Auto-connect", "another job is running; try again when it has finished")
+            return
         try:
-            report = self.doc.attachments.auto(scope=st.auto_scope, overwrite=st.auto_overwrite,
-                                               selection=self.doc.point_selection, method=st.auto_method)
+            task, apply = self.doc.attachments.auto_job(scope=st.auto_scope, overwrite=st.auto_overwrite,
+                                                        selection=self.doc.point_selection, method=st.auto_method)
         except ValueError as exc:
             self.show_error("Auto-connect", str(exc))
             return
+        self.jobs.run("Auto-connect", task, lambda result: self._connected(apply(result)))
+
+    def _connected(self, report) -> None:
+        st = self.doc.settings
         st.colour_by = "bone"  # what was connected to what is the thing to look at now
         self.doc.message(f"Auto-connect: {report}.")
         if not report.unattached:

@@ -204,3 +204,22 @@ def test_auto_connect_pieces_is_the_core_s_and_nearest_on_a_body_in_one_piece(do
     got = doc.attachments.bone[:n]
     assert np.array_equal(got, attach_by_piece(skel.points[:n], doc.bones, doc.mask))
     assert np.array_equal(got, attach_nearest_bone(skel.points[:n], doc.bones))
+
+
+def test_auto_connect_measures_apart_from_the_document_and_refuses_a_result_for_other_bones(doc):
+    """The studio runs the measuring in a worker (auto_job's task) and assigns on the GUI thread (its apply):
+    the task changes nothing, and a result measured for bones since replaced is refused, not applied."""
+    doc.bones = samples.mannequin_bones()
+    task, apply = doc.attachments.auto_job(scope="all")
+    label = doc.undo.undo_label
+    result = task()
+    assert (doc.attachments.bone == -1).all() and doc.undo.undo_label == label  # measured, nothing assigned
+    report = apply(result)
+    assert report.attached == doc.visible_count and doc.undo.undo_label.startswith("Auto-connect")
+    task, apply = doc.attachments.auto_job(scope="all", method="nearest")
+    result = task()
+    doc.bones = samples.mannequin_bones()  # the bones replaced while it measured
+    before = doc.attachments.bone.copy()
+    with pytest.raises(ValueError, match="changed while auto-connect ran"):
+        apply(result)
+    assert np.array_equal(doc.attachments.bone, before)

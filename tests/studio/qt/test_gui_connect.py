@@ -108,9 +108,12 @@ def test_lasso_depth_modes(qtbot, depth_scene, mode):
 def test_auto_connect_and_mirror_in_the_gui(qtbot, window):
     assert window.files.open_bones(ASSETS / "mannequin.bones")
     window.connect_panel.scope.setCurrentText("all")
-    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    window.connecting.auto_connect()  # what the button and Ctrl+A call (no events processed until the wait)
+    assert window.busy  # measured in a worker, with progress and Cancel
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     doc = window.doc
     assert (doc.attachments.bone[: doc.visible_count] >= 0).all()
+    assert doc.undo.undo_label.startswith("Auto-connect")  # one undo step
     left, right = doc.bones.index("L_FOREARM"), doc.bones.index("R_FOREARM")
     n_left = int((doc.attachments.bone == left).sum())
     doc.attachments.assign(np.flatnonzero(doc.attachments.bone == right), -1)
@@ -257,12 +260,14 @@ def test_auto_connect_colours_by_bone_and_offers_path_or_nearest_when_path_leave
     window.connect_panel.scope.setCurrentText("all")
     assert window.doc.settings.colour_by == "thinness"
     qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert window.doc.settings.colour_by == "bone" and window.display_panel.colour_by.currentText() == "bone"
     box = window._error_box
     assert box.isVisible() and "path-or-nearest" in box.text()
     shown = window.doc.visible_count
     assert (window.doc.attachments.bone[:shown] >= 0).sum() < shown / 2
     box.button(QMessageBox.Yes).click()  # "Use path-or-nearest"
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert window.doc.settings.auto_method == "path-or-nearest"
     assert (window.doc.attachments.bone[:shown] >= 0).all()
 

@@ -78,6 +78,7 @@ def test_propose_on_the_ant_accept_connect_and_pose_a_leg_healthy(qtbot, window,
     assert doc.settings.auto_method == "pieces" and "attaches by pieces" in window.statusBar().currentMessage()
     window.connect_panel.scope.setCurrentText("all")
     qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert (doc.attachments.bone[: doc.visible_count] >= 0).all()
     # a leg: the leaf bone whose tip is farthest from the body's middle
     starts = {b.proximal for b in doc.bones.bones}
