@@ -29,6 +29,16 @@ def test_an_island_goes_to_the_bone_it_touches_and_the_main_piece_stays():
     assert out[-1] == 0 and (out[:20] == bone[:20]).all()
 
 
+def test_islands_are_the_painted_voxels_own_not_a_guess_from_distances():
+    # a radius-1 ball paints its centre voxel only; 12 voxels from a radius-10 ball of its bone (which
+    # paints up to x = 9) it is apart from it, however near the two radii and a slack put it -- and it
+    # shares its voxel with the other bone's ball: a pose of either would float it off, so it goes there
+    points = np.array([[0.0, 0, 0], [12.0, 0, 0], [14.0, 0, 0]])
+    radius = np.array([10.0, 1.0, 2.5])
+    out = one_piece_each(points, radius, np.array([0, 0, 1]))
+    assert out.tolist() == [0, 1, 1]
+
+
 def test_an_island_touching_no_other_bone_stays_and_the_input_is_not_changed():
     points = np.array([[0.0, 0, 0], [2.0, 0, 0], [50.0, 0, 0]])
     bone = np.array([0, 0, 0])
