@@ -44,27 +44,13 @@ def leaves(bones) -> list[str]:
     return [b.label for b in bones.bones if b.distal not in starts]
 
 
-def bend(bones, leaf: str, angle: float) -> np.ndarray:
-    """The rotation turning bone ``leaf`` by ``angle`` degrees towards the grid axis most across it (about
-    an axis across the bone: a real bend, never a twist about the bone's own length, which a fixed
-    ``0,45,0`` is for a bone along y)."""
-    from scipy.spatial.transform import Rotation
-
-    b = bones.bones[bones.index(leaf)]
-    along = bones.joints[b.distal] - bones.joints[b.proximal]
-    along = along / (np.linalg.norm(along) or 1)
-    towards = np.eye(3)[int(np.argmin(np.abs(along)))]
-    axis = np.cross(along, towards)
-    return Rotation.from_rotvec(np.radians(angle) * axis / np.linalg.norm(axis)).as_matrix()
-
-
 def leaf_poses(skel, bones, angles) -> dict:
     """{(joints, angle): (healthy, of, first broken verdict)} with the pieces connect."""
     from volanim_core.reconstruct.checks import report
     from volanim_core.rig.attach import connect
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.curve_skeleton import balls
-    from volanim_core.rig.pose import pose_matrices, root_bones
+    from volanim_core.rig.pose import bend_across, pose_matrices, root_bones
     from volanim_core.rig.skinning import Joints
 
     conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
@@ -74,7 +60,7 @@ def leaf_poses(skel, bones, angles) -> dict:
         for angle in angles:
             bad = []
             for leaf in leaves(bones):
-                m = pose_matrices(bones, {leaf: bend(bones, leaf, angle)})
+                m = pose_matrices(bones, {leaf: bend_across(bones, leaf, angle)})
                 rep = report(c, Trans(root_bones(bones), m), bones=bones)
                 if not rep.healthy:
                     bad.append(f"{leaf}: {rep.verdict.splitlines()[0][:60]}")

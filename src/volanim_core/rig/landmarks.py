@@ -13,9 +13,10 @@ voxels low). The body's outline has landmarks that do not move with the curve:
                  two thirds up from the axilla to the acromion)
     both thighs' lines
       --march up from the knees' level-->   the CROTCH: the highest level with background between them
-      --widest torso above it-->            HIPS at the level where the body is widest across, within
-                                            WAIST of the way from the crotch to the armpits (the greater
-                                            trochanters, the landmark anthropometry places hips by)
+      --largest torso section above it-->   HIPS at the level where the torso's cross-section (seen
+                                            from the spine: a hanging arm across background is not in
+                                            it) is largest, within WAIST of the way from the crotch to
+                                            the armpits (the greater trochanters' level)
 
 Every measure is a ratio along one line or a comparison at one level, so a body stretched along its
 spine (anisotropic voxels) keeps its landmarks. Each function returns None when the body does not

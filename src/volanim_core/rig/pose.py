@@ -69,6 +69,16 @@ def euler(degrees) -> np.ndarray:
     return Rotation.from_euler("xyz", np.asarray(degrees, np.float64), degrees=True).as_matrix()
 
 
+def bend_across(bones: BoneSkeleton, label: str, degrees: float) -> np.ndarray:
+    """The 3x3 rotation bending bone ``label`` by ``degrees`` towards the grid axis most across it, about
+    an axis across the bone: a real bend whichever way the bone lies (a fixed ``0,45,0`` only twists a
+    bone that lies along y). For :func:`pose_matrices`."""
+    b = bones.bones[bones.index(label)]
+    along = bones.joints[b.distal] - bones.joints[b.proximal]
+    axis = np.cross(along, np.eye(3)[int(np.argmin(np.abs(along)))])
+    return Rotation.from_rotvec(np.radians(degrees) * axis / (np.linalg.norm(axis) or 1)).as_matrix()
+
+
 def parents_first(parents: list[int | None]) -> list[int]:
     """Bone indices with every parent before its children (the forest may list them in any order)."""
     done: list[int] = []

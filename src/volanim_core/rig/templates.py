@@ -199,11 +199,11 @@ def _at_level(tree: Tree, start: int, end: int, level: np.ndarray, up: np.ndarra
     pts = tree.p[path][(s >= 0.2 * s[-1]) & (s <= 0.5 * s[-1])]
     if len(pts) < 2:
         return tree.p[path[len(path) // 4]]
-    centre, axis = _line(pts)
+    line = _line(pts)
     up = up / np.linalg.norm(up)
-    if abs(axis @ up) < 0.3:  # a limb across the spine never reaches that level
+    if abs(line[1] @ up) < landmarks.STEEP:  # a limb across the spine never reaches that level
         return tree.p[path[len(path) // 4]]
-    return centre + ((level - centre) @ up) / (axis @ up) * axis
+    return landmarks.at_level(line, up, level @ up)
 
 
 def _limb_bones(parent: str, joints, names) -> list[Bone]:
