@@ -16,7 +16,8 @@ import numpy as np
 
 from volanim_core.reconstruct.engine import posed_centres
 from volanim_core.rig.connectivity import Tskel
-from volanim_core.rig.skinning import deepest_sphere, posed_radii
+from volanim_core.rig.skinning import posed_radii
+from volanim_core.rig.thin_spheres import deepest_sphere
 
 
 def touching_pairs(tskel: Tskel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -4,11 +4,12 @@
       --links: points whose spheres hold each other's centres (never across a gap)
       --per bone k that meets another: its reach along the body (Dijkstra over the links from its
         points): g_k = 1 for one blend width h_k (blend x its thickest sphere, or blend mm), fading to 0
-        at 2 h_k
+        at 2 h_k; only points of bones at most HOPS joints from k (bone_hops)
       --per reached point: w_k = g_k * exp(-(d_k / tau_k)^2 / 2), d_k its distance to bone k's segment,
         tau_k = h_k / SHARPNESS, the own bone with g = 1; normalised
       --heat diffusion over the links, DIFFUSION steps, of the blended points only
-      --specks (linked groups of one-voxel spheres): the weights of the sphere each lies deepest in
+      --one-voxel spheres (rig/thin_spheres.py): a speck group, and a surface point inside a thicker
+        sphere of its bone, move as the thicker sphere they lie deepest in
       --_with_sheets: the blended points on a medial sheet, and their links' rest lengths
       --> Skin: the blended points, their bones (own first) and weights (summing to 1)
     Skin + a frame's matrices --dual_quaternion.blended_matrices--> one matrix per blended point
@@ -48,6 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volanim_core.memo import Recent, content_key
+from volanim_core.rig.thin_spheres import SPECK, with_thin_spheres
 
 INFLUENCES = 4  # bones per point at most: its own and three neighbours' (a fork's bone near two children)
 LINK = np.sqrt(3.0)  # points this close (26-neighbours) are always linked, whatever their radii
@@ -56,8 +58,10 @@ DEFAULT_BLEND = 1.0
 PLATEAU = 2.0  # a bone reaches fully (PLATEAU - 1) blend widths along the body from its points, then fades out
 SHARPNESS = 1.25  # tau = h / SHARPNESS: how fast a bone's weight falls with distance from its segment
 MIN_WEIGHT = 0.005  # smaller weights are dropped (and the rest renormalised): far points move exactly rigidly
+# A bone blends only with bones at most this many joints away (bone_hops): the torso and an upper arm are 2
+# (across the clavicle); an ear's tip curled back onto the ear is 4 from it and only touches it there.
+HOPS = 2
 DIFFUSION = 8  # smoothing steps over the links (heat diffusion, as Bender does over voxels)
-SPECK = 2.0  # spheres thinner than this are one voxel: linked groups of only those are specks of the surface
 # A point is on a medial sheet when its links spread over a plane: the middle eigenvalue of the scatter
 # of their directions (trace 1) is 0 along a curve and 0.5 on a flat sheet. On mannequin-large (measured
 # with a prototype) 0.1 and 0.2 thin the same (hip 120: 2.7 % above rest), 0.3 too little (3.1 %).
@@ -160,10 +164,11 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
 
     Each bone ``k`` that meets another (their points are linked, :func:`links`) reaches along the body
     (Dijkstra over the links from its points) fully for one blend width ``h_k`` and fades out over the
-    next (``g_k``: 1 .. 0). A reached point weighs every bone that reaches it, its own with ``g = 1``,
-    by ``g_k * exp(-(d_k / tau_k)^2 / 2)``: ``d_k`` its distance to the bone's segment, ``tau_k = h_k /
-    SHARPNESS`` (so a thick bone's points are not taken by a thin neighbour's segment); normalised, smoothed
-    by heat diffusion (:func:`_diffused`), weights under ``MIN_WEIGHT`` dropped."""
+    next (``g_k``: 1 .. 0), over the points of bones at most ``HOPS`` joints from it. A reached point
+    weighs every bone that reaches it, its own with ``g = 1``, by ``g_k * exp(-(d_k / tau_k)^2 / 2)``:
+    ``d_k`` its distance to the bone's segment, ``tau_k = h_k / SHARPNESS`` (so a thick bone's points
+    are not taken by a thin neighbour's segment); normalised, smoothed by heat diffusion (:func:`_diffused`),
+    weights under ``MIN_WEIGHT`` dropped."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
@@ -178,12 +183,13 @@ def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) 
     h = np.full(len(bones), joints.blend / spacing) if joints.mm else joints.blend * thickness
     graph = coo_matrix((d, (i, j)), shape=(n, n)).tocsr()
     reached = []  # per bone: the points of other bones it reaches, and how far (g)
+    near = bone_hops(bones) <= HOPS
     for k in np.unique(np.concatenate([bone[i][cross], bone[j][cross]])):
         geo = dijkstra(graph, directed=False, indices=np.flatnonzero(bone == k), min_only=True, limit=PLATEAU * h[k])
-        p = np.flatnonzero(np.isfinite(geo) & (bone != k))
+        p = np.flatnonzero(np.isfinite(geo) & (bone != k) & near[k][bone])
         g = 1.0 - _smoothstep((geo[p] - (PLATEAU - 1) * h[k]) / h[k])
         reached.append((p[g > 0], np.full(int((g > 0).sum()), k), g[g > 0]))
-    skin = _with_specks(_weights(reached, points, bone, bones, h / SHARPNESS, graph), points, dt, bone, graph)
+    skin = with_thin_spheres(_weights(reached, points, bone, bones, h / SHARPNESS, graph), points, dt, bone, graph)
     return _with_sheets(skin, points, dt, (i, j, d))
 
 
@@ -236,65 +242,6 @@ def posed_radii(tskel, centres: np.ndarray) -> np.ndarray:
     return out
 
 
-def _with_specks(skin: Skin, points, dt, bone, graph) -> Skin:
-    """Each speck moves with the body beside it: a speck is a group of linked points whose spheres are
-    all one voxel (``dt < SPECK``), the skeleton's noise at the surface. No link reaches it, so no bone's
-    reach does, and left rigid on its own bone it would stay put while the blended flesh around it
-    moves: a lone voxel torn off at every bent joint. It takes the weights of the sphere outside any
-    speck that it lies deepest in (its own bone first, with weight 0 when that point has none on it)."""
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
-
-    if not len(skin):
-        return skin
-    _, part = connected_components(graph, directed=False)
-    big = np.zeros(part.max() + 1, bool)
-    np.logical_or.at(big, part, dt >= SPECK)
-    speck = np.flatnonzero(~big[part])
-    body = np.flatnonzero(big[part])
-    if not len(speck) or not len(body):
-        return skin
-    row = np.full(len(points), -1, np.int64)
-    row[skin.index] = np.arange(len(skin))
-    # only a speck that may lie deepest in a blended sphere can change: one within the largest radius
-    # of a blended centre beyond its nearest body centre (the frog has 26 k speck points, few near joints)
-    nearest, _ = cKDTree(points[body]).query(points[speck])
-    blended, _ = cKDTree(points[skin.index]).query(points[speck], distance_upper_bound=nearest.max() + dt.max())
-    speck = speck[blended <= nearest + dt.max()]
-    if not len(speck):
-        return skin
-    near = body[deepest_sphere(points[body], dt[body], points[speck])]
-    speck, near = speck[row[near] >= 0], near[row[near] >= 0]  # beside a blended point
-    influence, weight = skin.influence[row[near]].copy(), skin.weight[row[near]].copy()
-    # own bone first: where it is among the influences, or in the last place with weight 0
-    own = bone[speck]
-    has = influence == own[:, None]
-    at = np.where(has.any(1), has.argmax(1), INFLUENCES - 1)
-    r = np.arange(len(speck))
-    weight[r, at] *= has.any(1)
-    influence[r, at] = own
-    col = np.arange(INFLUENCES)[None, :]
-    order = np.where(col == 0, at[:, None], col - (col <= at[:, None]))  # at, then the others in order
-    influence, weight = np.take_along_axis(influence, order, 1), np.take_along_axis(weight, order, 1)
-    weight /= weight.sum(1, keepdims=True)
-    keep = np.setdiff1d(np.arange(len(skin)), row[speck[row[speck] >= 0]])  # a speck's own weights give way
-    index = np.concatenate([skin.index[keep], speck])
-    order = np.argsort(index, kind="stable")
-    return Skin(index[order], np.concatenate([skin.influence[keep], influence])[order],
-                np.concatenate([skin.weight[keep], weight])[order])
-
-
-def deepest_sphere(centres: np.ndarray, radii: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """For each of ``points``, the sphere it lies deepest in, or nearest outside, by power distance
-    ``|p - c|^2 - r^2``: the nearest neighbour of ``(p, 0)`` among the lifted centres
-    ``(c, sqrt(R^2 - r^2))`` (``R`` the largest radius), one KD-tree query for all."""
-    from scipy.spatial import cKDTree
-
-    lift = np.sqrt(np.maximum(radii.max() ** 2 - radii ** 2, 0.0))
-    tree = cKDTree(np.column_stack([centres, lift]))
-    return tree.query(np.column_stack([points, np.zeros(len(points))]))[1]
-
-
 def links(points: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Linked point pairs ``(i, j, distance)``: among each point's nearest, those whose sphere holds
     the other's centre (or 26-neighbours). Two limbs that merely touch are never linked: their
@@ -312,6 +259,19 @@ def links(points: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     i, j, d = i[ok], j[ok], d[ok]
     ok = d <= np.maximum(np.maximum(dt[i], dt[j]), LINK)
     return i[ok], j[ok], d[ok]
+
+
+def bone_hops(bones) -> np.ndarray:
+    """(B, B) how many joints apart two bones are: 0 itself, 1 sharing a joint (a parent and its child,
+    two siblings), 2 their neighbours' (the torso and an upper arm, across the clavicle); bones with no
+    chain of shared joints between them a large number."""
+    from scipy.sparse.csgraph import shortest_path
+
+    ends = np.array([[b.proximal, b.distal] for b in bones], np.float64).reshape(len(bones), 2, 3)
+    meet = (np.abs(ends[:, None, :, None] - ends[None, :, None, :]).max(-1) < 1e-6).any(axis=(2, 3))
+    np.fill_diagonal(meet, False)
+    hops = shortest_path(meet.astype(float), unweighted=True, directed=False)
+    return np.where(np.isfinite(hops), hops, len(bones) + 1)
 
 
 def segment_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -96,12 +96,15 @@ def _leaves(bones) -> list[str]:
     return [b.label for b in bones.bones if b.distal not in starts]
 
 
-@pytest.mark.long("18 poses of a real model through the commands a user runs, each reconstructed and judged")
+@pytest.mark.long("18 poses of a real model through the commands a user runs, each judged with both joints")
 def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
     """#62: the ant's proposal connected by autorig itself, each leaf bone turned 45 and 90 degrees: `volanim
     report` exits 0 for every one. Its legs are separate shells; the path method (the old default) left a
     tenth of the points unattached and gave a shell's first points to the bone of the shell next to it, and
-    6 of the 9 leaf poses tore a piece off. Now each piece's points go to the bones lying in that piece."""
+    6 of the 9 leaf poses tore a piece off. Now each piece's points go to the bones lying in that piece.
+    With smooth joints the abdomen's tip bent 90 degrees tore a one-voxel speck off the waist: it took the
+    weights of a thorax sphere it lay deepest in by power distance but did not touch; now the sphere whose
+    surface is nearest."""
     assert main(["autorig", str(ant / "ant.mskel"), "-o", str(ant / "auto.bones"),
                  "--connect", str(ant / "auto.connect")]) == 0
     said = capsys.readouterr().out
@@ -115,7 +118,9 @@ def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
             trans = ant / f"{leaf}.{angle}.trans"
             assert main(["pose", str(ant / "auto.bones"), "--rotate", f"{leaf}=0,{angle},0", "-o", str(trans)]) == 0
             capsys.readouterr()
-            if main(["report", str(ant / "auto.connect"), str(trans), "--bones", str(ant / "auto.bones")]) != 0:
-                broken.append(f"{leaf} {angle}: {capsys.readouterr().out.splitlines()[0]}")
+            for joints in ("rigid", "smooth"):
+                if main(["report", str(ant / "auto.connect"), str(trans), "--bones", str(ant / "auto.bones"),
+                         "--joints", joints]) != 0:
+                    broken.append(f"{leaf} {angle} {joints}: {capsys.readouterr().out.splitlines()[0]}")
     assert broken == []
     assert "(pieces)" in said
