@@ -41,17 +41,18 @@ def deepest_sphere(centres: np.ndarray, radii: np.ndarray, points: np.ndarray) -
 def holder(centres: np.ndarray, radii: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each of ``points``, the sphere whose surface is furthest inside it or, outside all, nearest:
     least ``|p - c| - r`` among its ``NEAREST`` nearest centres and the one it lies deepest in by power
-    distance (:func:`deepest_sphere`, which finds a big sphere's centre however far). With its ``gap``
-    (negative inside). The sphere a point keeps in touch with best when it moves as that sphere."""
+    distance (:func:`deepest_sphere`, which finds a big sphere's centre however far); of equal gaps, the
+    first sphere. With its ``gap`` (negative inside). The sphere a point keeps in touch with best when
+    it moves as that sphere."""
     from scipy.spatial import cKDTree
 
     k = min(NEAREST, len(centres))
     _, nn = cKDTree(centres).query(points, k=k)
     cand = np.column_stack([nn.reshape(len(points), k), deepest_sphere(centres, radii, points)])
     gap = np.linalg.norm(points[:, None, :] - centres[cand], axis=2) - radii[cand]
-    best = gap.argmin(1)
-    r = np.arange(len(points))
-    return cand[r, best], gap[r, best]
+    least = gap.min(1)
+    best = np.where(gap <= least[:, None] + 1e-12, cand, len(centres)).min(1)  # ties: the first sphere
+    return best, least
 
 
 def with_thin_spheres(skin, points, dt, bone, graph):

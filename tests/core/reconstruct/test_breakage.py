@@ -199,6 +199,22 @@ def test_misplaced_points_are_part_of_the_limbs_flesh():
     assert sorted(idx.tolist()) == list(range(153, 165)) and set(along.tolist()) == {1}
 
 
+def test_points_far_from_every_bone_lie_along_none():
+    """The frog's foot webbing lies 51-57 voxels from every segment of its leg, 1 voxel nearer the upper
+    arm's than the foot's: nearer by more than its radius, and touching a stray arm point, it was read as a
+    21-point stump of the foot along the arm whenever the foot bent. Nearer by 5 % is along neither bone;
+    a point 10 times nearer the arm's segment than its own still is a stump."""
+    bones = [BoneSegment([0, 0, 0], [0, 40, 0], "FOOT"), BoneSegment([20, 0, 0], [60, 0, 0], "ARM")]
+    web = [42.0, 40, 0]  # 42 from the foot's segment, 40 from the arm's
+    stray = [42.0, 38, 0]  # an arm point beside it (nearer the arm's segment): the web touches the arm's flesh
+    stump = [40.0, 4, 0]  # a foot point 4 from the arm's segment, 40 from the foot's
+    arm = [40.0, 0, 0]
+    points = np.array([web, stray, stump, arm])
+    conn = Connectivity(bones, points, np.array([1.0, 1.0, 1.0, 3.0]), None, np.array([0, 1, 0, 1]))
+    idx, along = misplaced_points(conn)
+    assert idx.tolist() == [2] and along.tolist() == [1]
+
+
 def thinned_pair(*middle):
     """Two spheres of different bones, overlapping at rest, on a medial sheet (smooth joints; the skin made
     by hand): LOWER moves 3 voxels away, the link between them stretches 2x, both thin to THIN_FLOOR and
