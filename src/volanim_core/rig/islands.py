@@ -4,8 +4,9 @@
       --each bone's balls painted alone, as the reconstruction paints them, 26-connected parts-->
                                           its islands (exact at rest: what a pose moves as one piece)
       --k nearest of each size, balls touching on the voxel grid-->  links between bones
-      every island but the bone's largest --> the bone its balls touch most (a few rounds, until none
-                                              moves)
+      every island but the bone's largest --> of the bones its balls touch, most first, the first whose
+                                              largest island its voxels touch: it joins that flesh
+                                              (a few rounds, until none moves)
 
 Why: a bone moves its balls as one rigid piece, so flesh of its that touches the rest of its flesh only
 through another bone's balls is cut loose by any pose of either. Spot the cow's front leg bent 45 degrees
@@ -52,12 +53,19 @@ def bone_islands(points: np.ndarray, radius: np.ndarray, bone: np.ndarray) -> tu
     """``(count, island)``: each point's island, the 26-connected part of its bone's painted balls (a voxel
     is painted when its centre is nearer a ball's centre than the radius, as the reconstruction paints)
     that holds its centre; numbered 0..count-1 across all bones."""
+    count, island, _ = _painted_islands(points, radius, bone)
+    return count, island
+
+
+def _painted_islands(points, radius, bone):
+    """:func:`bone_islands`, and per island number ``(bone, lo, label grid, label)``: where its voxels are
+    (``grid == label``, the grid's voxel 0 at ``lo``; None for a ball too thin to paint its centre)."""
     from scipy import ndimage
 
     from volanim_core.rig._curve_kernels import paint_balls
 
     island = np.zeros(len(bone), np.int64)
-    count = 0
+    where = []
     cube = ndimage.generate_binary_structure(3, 3)
     for b in np.unique(bone):
         idx = np.flatnonzero(bone == b)
@@ -69,15 +77,43 @@ def bone_islands(points: np.ndarray, radius: np.ndarray, bone: np.ndarray) -> tu
         label, k = ndimage.label(grid, cube)
         at = label[tuple(np.rint(c - lo).astype(np.int64).T)]
         at = np.where(at > 0, at, k + 1 + np.arange(len(idx)))  # a ball too thin to paint its centre: alone
-        _, at = np.unique(at, return_inverse=True)
-        island[idx] = count + at
-        count += int(at.max()) + 1
-    return count, island
+        labels, at = np.unique(at, return_inverse=True)
+        island[idx] = len(where) + at
+        where += [(int(b), lo.astype(np.int64), label, int(v) if v <= k else None) for v in labels]
+    return len(where), island, where
+
+
+def _touching(where, x: int, main: dict) -> set[int]:
+    """The bones whose largest island (``main``: bone -> island number) island ``x``'s voxels touch
+    (26-neighbours or shared voxels): where it joins that bone's flesh when given to it."""
+    b, lo, grid, v = where[x]
+    if v is None:
+        return set()
+    vox = np.argwhere(grid == v) + lo
+    near = (vox[:, None, :] + _CUBE[None]).reshape(-1, 3)
+    out = set()
+    for other, m in main.items():
+        ob, olo, ogrid, ov = where[m]
+        if other == b or ov is None:
+            continue
+        q = near - olo
+        q = q[((q >= 0) & (q < ogrid.shape)).all(1)]
+        if len(q) and (ogrid[tuple(q.T)] == ov).any():
+            out.add(other)
+    return out
+
+
+_CUBE = np.argwhere(np.ones((3, 3, 3), bool)) - 1
 
 
 def one_piece_each(points: np.ndarray, radius: np.ndarray, bone: np.ndarray) -> np.ndarray:
     """``bone`` (each point's, >= 0) with every bone's islands but its largest (by ball volume) given to
-    the bone whose balls they touch most; an island touching no other bone stays. ``(N,)``, a new array."""
+    the bone it touches most (by :func:`links`) among those whose largest island its painted voxels touch,
+    so it joins that bone's flesh; an island touching none stays. ``(N,)``, a new array.
+
+    Why the painted voxels decide: an island touching a bone's balls within the slack but not its voxels
+    stays an island of that bone too, and went back the next round (the frog: 5931 points between two
+    bones every round, so the four rounds left them all where they began)."""
     bone = np.asarray(bone, np.int64).copy()
     n = len(bone)
     if n < 2:
@@ -88,22 +124,28 @@ def one_piece_each(points: np.ndarray, radius: np.ndarray, bone: np.ndarray) -> 
     nb = int(bone.max()) + 1
     for _ in range(ROUNDS):
         same = bone[i] == bone[j]
-        count, island = bone_islands(points, r, bone)
+        count, island, where = _painted_islands(points, r, bone)
         size = np.bincount(island, weights=weight, minlength=count)
         owner = np.zeros(count, np.int64)
         owner[island] = bone
         order = np.lexsort((-size, owner))  # per bone, its largest island first
+        first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]]
+        main = {int(owner[x]): int(x) for x in first}
         stray = np.ones(count, bool)
-        stray[order[np.r_[True, owner[order][1:] != owner[order][:-1]]]] = False
+        stray[first] = False
         across = ~same & stray[island[i]]
         if not across.any():
             break
         keys, hits = np.unique(island[i[across]] * nb + bone[j[across]], return_counts=True)
         isl, other = keys // nb, keys % nb
-        order = np.lexsort((-hits, isl))  # per stray island, the bone it touches most first
-        pick = np.r_[True, isl[order][1:] != isl[order][:-1]]
+        order = np.lexsort((-hits, isl))  # per stray island, the bones it touches, most first
         target = np.full(count, -1)
-        target[isl[order][pick]] = other[order][pick]
+        for x in np.unique(isl):
+            joins = _touching(where, int(x), main)
+            for o in other[order][isl[order] == x]:
+                if int(o) in joins:
+                    target[x] = o
+                    break
         moved = target[island]
         if not (moved >= 0).any():
             break

@@ -75,3 +75,21 @@ def test_every_leaf_of_spot_bends_without_tearing_a_speck(tmp_path):
             if not rep.healthy:
                 broken.append(f"{b.label} {angle}: {rep.verdict.splitlines()[0]}")
     assert broken == []
+
+
+def test_an_island_goes_where_its_voxels_join_a_bone_and_does_not_swing_back():
+    """A stray ball of bone 0 lies between two chains, of bone 0 and of bone 1, each 3 voxels off: near
+    enough for the slack, not for their voxels to touch. It touches most the chain of bone 1, so it went
+    there, was a stray of bone 1 the next round and came back, round after round: the frog's 5931 points
+    swung between two bones and the four rounds left them where they began. Given to the bone whose
+    flesh its voxels join (bone 2's ball beside it), it stays."""
+    main0 = [[float(x), -3.0, 0] for x in range(0, 56)]  # bone 0's flesh: a chain passing the stray at y = -3
+    chain1 = [[float(x), 3.0, 0] for x in range(40, 61)]  # bone 1's: a chain at y = +3
+    stray = [[50.0, 0, 0]]  # bone 0, radius 2: its voxels reach y = +-1, a voxel short of either chain
+    beside = [[53.5, 0, 0]]  # bone 2, radius 2: its voxels and the stray's are neighbours
+    points = np.array(main0 + chain1 + stray + beside)
+    radius = np.r_[np.full(len(main0) + len(chain1), 1.0), 2.0, 2.0]
+    bone = np.r_[np.zeros(len(main0), int), np.ones(len(chain1), int), 0, 2]
+    out = one_piece_each(points, radius, bone)
+    assert out[len(main0) + len(chain1)] == 2
+    assert (out[:len(main0) + len(chain1)] == bone[:len(main0) + len(chain1)]).all() and out[-1] == 2
