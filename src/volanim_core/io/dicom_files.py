@@ -292,9 +292,21 @@ def _read_multiframe(path: Path):
                                 f"mm after frame {int(order[where])}, median {np.median(steps):.4g} mm)")
     dz = float(np.median(steps)) if len(steps) else float(ds.get("SliceThickness", 1.0) or 1.0)
     vol = np.asfortranarray(pixels[order].transpose(2, 1, 0))
-    slope = float(ds.get("RescaleSlope", 1) or 1) * float(ds.get("DoseGridScaling", 1) or 1)
-    intercept = float(ds.get("RescaleIntercept", 0) or 0)
-    vol = rescale(vol, [slope] * frames, [intercept] * frames)
+    # enhanced CT/MR keep the rescale in a functional group: a frame's own, else the shared one (pydicom-data's
+    # eCT_Supplemental.dcm: intercept -1024 there and nowhere else), else the classic top-level attributes
+    def frame_value(g, attr, default):
+        v = item(g, "PixelValueTransformationSequence", attr)
+        if v is None:
+            v = item(shared, "PixelValueTransformationSequence", attr)
+        if v is None:
+            v = ds.get(attr)
+        return float(v) if v not in (None, "") else default
+
+    groups = list(per_frame) if per_frame and len(per_frame) == frames else [None] * frames
+    scale = float(ds.get("DoseGridScaling", 1) or 1)
+    slopes = [frame_value(groups[k], "RescaleSlope", 1.0) * scale for k in order]
+    intercepts = [frame_value(groups[k], "RescaleIntercept", 0.0) for k in order]
+    vol = rescale(vol, slopes, intercepts)
     direction = np.column_stack([row, col, normal])
     return vol, Geometry((dx, dy, dz), tuple(positions[order[0]]), tuple(direction.reshape(-1)))
 

@@ -289,6 +289,47 @@ def test_multiframe_rt_dose_frames_are_placed_by_their_offsets():
     assert np.isclose(scan.geometry.spacing[2], offsets[1] - offsets[0])
 
 
+def test_enhanced_ct_is_in_hounsfield_units_as_simpleitk_reads_it():
+    """pydicom-data's enhanced (multi-frame) CT keeps its rescale (intercept -1024) in the shared functional
+    groups and nowhere else: it read 0 .. 1196, every value 1024 too high. SimpleITK gives -1024 .. 172."""
+    from pydicom.data import get_testdata_file
+
+    path = get_testdata_file("eCT_Supplemental.dcm")
+    scan = io.read_scan(path)
+    image = sitk.ReadImage(str(path))
+    assert scan.data.min() == -1024 and scan.data.max() == 172
+    # ITK stacks the frames up z with a left-handed direction; we along the frame normal (row x column, here
+    # -z): the same voxel at the same physical point, each grid's index of it found through its own geometry
+    theirs = sitk.GetArrayFromImage(image).T
+    idx = np.argwhere(np.ones(scan.data.shape, bool))[::97]
+    points = scan.geometry.to_physical(idx)
+    at = np.array([image.TransformPhysicalPointToIndex([float(v) for v in p]) for p in points])
+    np.testing.assert_array_equal(scan.data[tuple(idx.T)], theirs[tuple(at.T)])
+
+
+def test_enhanced_ct_with_a_rescale_per_frame(tmp_path):
+    """Per-frame functional groups may carry each frame's own rescale: each frame is rescaled by its own,
+    the others by the shared one (the frames as pydicom decodes them, times the slope, plus the intercept)."""
+    from pydicom.data import get_testdata_file
+    from pydicom.dataset import Dataset
+    from pydicom.sequence import Sequence
+
+    ds = pydicom.dcmread(get_testdata_file("eCT_Supplemental.dcm"))
+    own = Dataset()
+    own.RescaleIntercept, own.RescaleSlope, own.RescaleType = "-1000", "2", "US"
+    ds.PerFrameFunctionalGroupsSequence[1].PixelValueTransformationSequence = Sequence([own])
+    ds.save_as(tmp_path / "per_frame.dcm")
+    scan = io.read_scan(tmp_path / "per_frame.dcm")
+    raw = ds.pixel_array.astype(np.float64)
+    iop = np.asarray(ds.SharedFunctionalGroupsSequence[0].PlaneOrientationSequence[0].ImageOrientationPatient, float)
+    normal = np.cross(iop[:3], iop[3:])
+    along = [np.asarray(g.PlanePositionSequence[0].ImagePositionPatient, float) @ normal
+             for g in ds.PerFrameFunctionalGroupsSequence]
+    want = {0: raw[0] - 1024, 1: raw[1] * 2 - 1000}
+    for z, k in enumerate(np.argsort(along, kind="stable")):  # frames in order along the normal
+        np.testing.assert_array_equal(scan.data[:, :, z], want[int(k)].T)
+
+
 # --- TIFF stacks ------------------------------------------------------------------------------
 
 def test_multipage_tiff_with_imagej_spacing(tmp_path):
