@@ -71,6 +71,10 @@ def _lists(path: Path) -> list[list[tuple[str, str, np.ndarray]]]:
             raise FormatError(path, f"markup {m}: coordinateUnits {markup.get('coordinateUnits')!r} (expected mm)")
         rows = []
         for k, cp in enumerate(markup.get("controlPoints") or []):
+            if isinstance(cp, dict) and cp.get("positionStatus", "defined") != "defined":
+                # a point Slicer was asked to place and never got ("undefined", its position written ""),
+                # or is being placed ("preview"): not a joint yet, whatever its position says
+                continue
             pos = cp.get("position") if isinstance(cp, dict) else None
             label = cp.get("label") if isinstance(cp, dict) else None
             ok = isinstance(pos, list) and len(pos) == 3 and all(
@@ -78,8 +82,6 @@ def _lists(path: Path) -> list[list[tuple[str, str, np.ndarray]]]:
             if not ok or not isinstance(label, str) or not label.strip() or len(label.split()) != 1:
                 raise FormatError(path, f"markup {m}, control point {k}: expected a one-word \"label\" and a "
                                   "\"position\" of three finite numbers")
-            if cp.get("positionStatus", "defined") != "defined":
-                continue  # a point Slicer was asked to place and never got
             p = np.asarray(pos, np.float64) * ((-1, -1, 1) if system == "RAS" else 1)
             rows.append((label, str(cp.get("description") or ""), p))
         out.append(rows)

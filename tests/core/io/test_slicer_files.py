@@ -79,6 +79,31 @@ def test_markups_as_slicer_writes_them_become_chains(tmp_path):
         read_markups(tmp_path / "bad.mrk.json", g)
 
 
+def test_an_unplaced_point_as_slicer_saves_it_is_skipped(tmp_path):
+    """Slicer saves a control point it was asked to place and never got with ``"position": ""`` and
+    ``"positionStatus": "undefined"`` (a user's file, as posted; the fields in Slicer's order): the file
+    was refused whole ("a position of three finite numbers"). The point is no joint yet: skipped."""
+    unplaced = {"id": "3", "label": "editing", "description": "", "associatedNodeID": "", "position": "",
+                "orientation": [-1.0, -0.0, -0.0, -0.0, -1.0, -0.0, 0.0, 0.0, 1.0], "selected": True,
+                "locked": False, "visibility": True, "positionStatus": "undefined"}
+    placed = [{"id": str(k + 1), "label": label, "description": "", "associatedNodeID": "", "position": p,
+               "orientation": [-1.0, -0.0, -0.0, -0.0, -1.0, -0.0, 0.0, 0.0, 1.0], "selected": True,
+               "locked": False, "visibility": True, "positionStatus": "defined"}
+              for k, (label, p) in enumerate([("HIP", [0.0, 0.0, 0.0]), ("KNEE", [0.0, 0.0, -40.0])])]
+    doc = {"@schema": "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/"
+                      "Schema/markups-schema-v1.0.3.json#",
+           "markups": [{"type": "Fiducial", "coordinateSystem": "LPS", "coordinateUnits": "mm",
+                        "controlPoints": placed + [unplaced]}]}
+    (tmp_path / "leg.mrk.json").write_text(json.dumps(doc, indent=4))
+    bones = read_markups(tmp_path / "leg.mrk.json", Geometry((1.0, 1.0, 1.0), (-10.0, -10.0, -50.0)))
+    assert [(b.proximal, b.distal) for b in bones.bones] == [("HIP", "KNEE")]
+    assert "editing" not in bones.joints
+    unplaced["positionStatus"] = "defined"  # a defined point without a position is still refused, by name
+    (tmp_path / "bad.mrk.json").write_text(json.dumps(doc))
+    with pytest.raises(FormatError, match="bad.mrk.json.*control point 2"):
+        read_markups(tmp_path / "bad.mrk.json", Geometry((1.0, 1.0, 1.0), (-10.0, -10.0, -50.0)))
+
+
 def test_markups_command_needs_the_scan_and_writes_nothing_without(scan, tmp_path):
     assert main(["markups", str(scan / "mannequin.bones"), "--like", str(scan / "ct.nrrd"),
                  "-o", str(tmp_path / "m.mrk.json")]) == 0
