@@ -170,6 +170,7 @@ def write_tiff_stack(path: str | Path, vol: np.ndarray, geometry) -> None:
 
     from ._atomic import atomic_open
 
+    vol = _imagej_voxels(path, vol)
     zyx = np.ascontiguousarray(np.moveaxis(vol, (0, 1, 2), (2, 1, 0)))  # colour keeps its channels last
     sx, sy, sz = (float(v) for v in geometry.spacing)
     buffer = io.BytesIO()  # tifffile wants a named file; the atomic temporary has none
@@ -177,6 +178,34 @@ def write_tiff_stack(path: str | Path, vol: np.ndarray, geometry) -> None:
                      metadata={"spacing": sz, "unit": "mm", "axes": "ZYXS" if zyx.ndim == 4 else "ZYX"})
     with atomic_open(path, "wb") as fh:
         fh.write(buffer.getvalue())
+
+
+IMAGEJ_TYPES = (np.uint8, np.uint16, np.int16, np.float32)  # what an ImageJ TIFF stack holds
+
+
+def _imagej_voxels(path, vol: np.ndarray) -> np.ndarray:
+    """``vol`` in a type an ImageJ TIFF holds, exactly: itself, or the first of uint8, uint16, int16 that
+    holds every value (a CT read as int32), or float32 when every value is one. Otherwise ValueError
+    saying which types TIFF takes here and what to write instead (tifffile said only "the ImageJ format
+    does not support data type 'i'")."""
+    if vol.dtype.type in IMAGEJ_TYPES:
+        return vol
+    if vol.dtype.kind in "biu":
+        lo, hi = (int(vol.min()), int(vol.max())) if vol.size else (0, 0)
+        for t in IMAGEJ_TYPES[:3]:
+            if np.iinfo(t).min <= lo and hi <= np.iinfo(t).max:
+                return vol.astype(t)
+        span = f"span {lo} .. {hi}"
+    elif vol.dtype.kind == "f":
+        as32 = vol.astype(np.float32)
+        if np.array_equal(as32, vol, equal_nan=True):
+            return as32
+        span = "are not all float32 numbers"
+    else:
+        span = "are not numbers"
+    raise ValueError(f"cannot write {path}: a TIFF stack (ImageJ, which Fiji reads with its spacing) holds uint8, "
+                     f"uint16, int16 or float32 voxels, and these {vol.dtype} voxels {span}; write .nrrd, .nii.gz "
+                     "or .mha instead, which keep them as they are")
 
 
 def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:

@@ -342,6 +342,33 @@ def test_multipage_tiff_with_imagej_spacing(tmp_path):
     assert np.array_equal(scan.data, zyx.T) and np.allclose(scan.geometry.spacing, (0.4, 0.4, 1.2))
 
 
+def test_an_int32_ct_converts_to_tiff_as_int16_and_one_that_does_not_fit_is_refused_plainly(tmp_path, capsys):
+    """`volanim convert CT.nrrd ct.tif` on int32 Hounsfield units printed tifffile's "the ImageJ format does
+    not support data type 'i'". Values that fit a type ImageJ holds are written in it exactly (tifffile reads
+    them back); values that fit none are refused, naming the types and what to write instead."""
+    import nrrd
+    import tifffile
+
+    from volanim_core.cli import main
+
+    hu = np.random.default_rng(9).integers(-1024, 3072, (6, 5, 4)).astype(np.int32)
+    nrrd.write(str(tmp_path / "ct.nrrd"), hu, {"space": "left-posterior-superior",
+                                                 "space directions": np.diag([0.5, 0.5, 2.0]),
+                                                 "space origin": np.zeros(3)})
+    assert main(["convert", str(tmp_path / "ct.nrrd"), str(tmp_path / "ct.tif")]) == 0
+    with tifffile.TiffFile(tmp_path / "ct.tif") as tif:
+        back = tif.asarray()
+        assert back.dtype == np.int16 and tif.imagej_metadata["spacing"] == 2.0
+    np.testing.assert_array_equal(back, hu.T)
+    nrrd.write(str(tmp_path / "big.nrrd"), hu * 100, {"space": "left-posterior-superior",
+                                                        "space directions": np.eye(3), "space origin": np.zeros(3)})
+    capsys.readouterr()
+    assert main(["convert", str(tmp_path / "big.nrrd"), str(tmp_path / "big.tif")]) == 2
+    said = capsys.readouterr().err
+    assert "uint8, uint16, int16 or float32" in said and "int32" in said and ".nrrd" in said
+    assert not (tmp_path / "big.tif").exists()
+
+
 # --- NaN and infinity -------------------------------------------------------------------------
 
 def test_nan_voxels_are_background_not_a_black_volume(tmp_path, capsys):
