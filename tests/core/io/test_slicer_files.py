@@ -133,6 +133,30 @@ def test_transform_files_move_the_joints_where_ours_go(scan, tmp_path, fmt):
             assert np.allclose(tx.GetInverse().TransformPoint(tuple(rest)), posed, atol=1e-6)
 
 
+@pytest.mark.parametrize("writer", ["pynrrd", "SimpleITK"])
+def test_a_scan_at_the_origin_in_1_mm_voxels_takes_a_displacement_field(tmp_path, writer):
+    """#63: a scan written at origin 0 in 1 mm voxels (the identity grid) gives a .mskel and .connect with no
+    `# geometry:` line; `displacement --like` the same scan was reported to refuse ("records no voxel grid").
+    The identity grid is that scan's grid: the field is written on it (pynrrd's and SimpleITK's files)."""
+    import nrrd
+
+    v = np.zeros((40, 30, 60), np.uint8)
+    v[10:30, 8:22, 5:55] = 1
+    if writer == "pynrrd":
+        nrrd.write(str(tmp_path / "s.nrrd"), v, {"space": "left-posterior-superior", "space directions": np.eye(3),
+                                                 "space origin": np.zeros(3)})
+    else:
+        sitk.WriteImage(sitk.GetImageFromArray(v.transpose(2, 1, 0).copy()), str(tmp_path / "s.nrrd"))
+    f = {k: str(tmp_path / f"s.{k}") for k in ("nrrd", "mskel", "bones", "connect", "trans")}
+    assert main(["skeletonize", f["nrrd"], "-o", f["mskel"]]) == 0
+    assert "# geometry:" not in (tmp_path / "s.mskel").read_text()[:200]
+    assert main(["autorig", f["mskel"], "-o", f["bones"], "--connect", f["connect"]]) == 0
+    assert main(["pose", f["bones"], "-o", f["trans"]]) == 0
+    assert main(["displacement", f["connect"], f["trans"], "--like", f["nrrd"], "-o", str(tmp_path / "d.nrrd")]) == 0
+    field = sitk.ReadImage(str(tmp_path / "d.nrrd"))
+    assert field.GetSize() == (40, 30, 60) and field.GetOrigin() == (0.0, 0.0, 0.0)
+
+
 @pytest.mark.long("3D Slicer's own resampling of our displacement field gives our sampled pose")
 def test_displacement_field_resamples_the_scan_into_our_sampled_pose(scan, tmp_path):
     frame = scan / "wave" / "mannequin.0012.trans"
