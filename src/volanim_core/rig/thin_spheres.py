@@ -3,9 +3,10 @@
     Skin of every reached point (rig/skinning.py), the links' graph
       --specks: each group of linked points whose spheres are all one voxel (dt < SPECK), linked to
         nothing thicker, so no bone reaches it: the whole group takes the weights of the one thicker
-        sphere the group lies deepest in
-      --surface: each one-voxel point linked to the body that overlaps a thicker sphere of its own bone:
-        the weights of the thicker sphere of its bone it lies deepest in
+        sphere that holds it best (holder: the least |p - c| - r over its points)
+      --surface: each linked group of one-voxel points of one bone, in a body, that all overlap one
+        thicker sphere of that bone (the one holding the group best): that sphere's weights; a group
+        spreading beyond one sphere is a thin sheet and keeps its own
       --> the same Skin, those rows replaced (own bone first, with weight 0 where the host has none)
 
 Why. A one-voxel sphere is the skeleton's noise at a scan's surface: it carries no shape of its own,
