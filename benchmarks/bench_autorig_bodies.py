@@ -40,8 +40,7 @@ def body_mask(name: str, folder: Path):
 
 
 def leaves(bones) -> list[str]:
-    starts = {b.proximal for b in bones.bones}
-    return [b.label for b in bones.bones if b.distal not in starts]
+    return [bones.bones[i].label for i in bones.leaves()]
 
 
 def leaf_poses(skel, bones, angles) -> dict:

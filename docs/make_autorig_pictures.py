@@ -60,8 +60,7 @@ def row(name: str, view: str) -> np.ndarray:
     skel = skeletonize(mask)
     bones = autorig(skel).bones
     conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
-    starts = {b.proximal for b in bones.bones}
-    leaves = [b.label for b in bones.bones if b.distal not in starts]
+    leaves = [bones.bones[i].label for i in bones.leaves()]
     rest = pose_matrices(bones, {})
     lo0 = np.asarray(skel.points.min(axis=0), float) - skel.dt.max()
     hi0 = np.asarray(skel.points.max(axis=0), float) + skel.dt.max()

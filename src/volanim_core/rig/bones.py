@@ -105,6 +105,11 @@ class BoneSkeleton:
         distal_of = {b.distal: j for j, b in enumerate(self.bones)}
         return [distal_of.get(b.proximal) for b in self.bones]
 
+    def leaves(self) -> list[int]:
+        """Indices of the bones no bone starts from (a chain's last: a hand, a foot, a tail's tip)."""
+        starts = {b.proximal for b in self.bones}
+        return [i for i, b in enumerate(self.bones) if b.distal not in starts]
+
     def index(self, label: str) -> int:
         for i, b in enumerate(self.bones):
             if label in (b.name, b.label):

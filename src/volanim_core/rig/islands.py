@@ -53,19 +53,23 @@ def bone_islands(points: np.ndarray, radius: np.ndarray, bone: np.ndarray) -> tu
     """``(count, island)``: each point's island, the 26-connected part of its bone's painted balls (a voxel
     is painted when its centre is nearer a ball's centre than the radius, as the reconstruction paints)
     that holds its centre; numbered 0..count-1 across all bones."""
-    count, island, _ = _painted_islands(points, radius, bone)
+    count, island, *_ = _painted_islands(points, radius, bone, np.ones(len(bone)))
     return count, island
 
 
-def _painted_islands(points, radius, bone):
-    """:func:`bone_islands`, and per island number ``(bone, lo, label grid, label)``: where its voxels are
-    (``grid == label``, the grid's voxel 0 at ``lo``; None for a ball too thin to paint its centre)."""
+def _painted_islands(points, radius, bone, weight):
+    """:func:`bone_islands`, and what :func:`one_piece_each` asks of them, one bone's grid at a time:
+    ``main`` (bone -> its largest island by ``weight``, the first on a tie), ``voxels`` (every other
+    island -> its voxels, None for a ball too thin to paint its centre) and ``surface`` (bone -> the
+    :func:`_keys` of its largest island's voxels that touch a voxel outside it: all an island beside it
+    can touch)."""
     from scipy import ndimage
 
     from volanim_core.rig._curve_kernels import paint_balls
 
     island = np.zeros(len(bone), np.int64)
-    where = []
+    count = 0
+    main, voxels, surface = {}, {}, {}
     cube = ndimage.generate_binary_structure(3, 3)
     for b in np.unique(bone):
         idx = np.flatnonzero(bone == b)
@@ -78,29 +82,38 @@ def _painted_islands(points, radius, bone):
         at = label[tuple(np.rint(c - lo).astype(np.int64).T)]
         at = np.where(at > 0, at, k + 1 + np.arange(len(idx)))  # a ball too thin to paint its centre: alone
         labels, at = np.unique(at, return_inverse=True)
-        island[idx] = len(where) + at
-        where += [(int(b), lo.astype(np.int64), label, int(v) if v <= k else None) for v in labels]
-    return len(where), island, where
+        island[idx] = count + at
+        largest = int(np.argmax(np.bincount(at, weights=weight[idx])))
+        main[int(b)] = count + largest
+        boxes = ndimage.find_objects(label)
+        for local, v in enumerate(labels):
+            if local == largest:
+                if v <= k:
+                    box = boxes[v - 1]
+                    inside = label[box] == v
+                    edge = inside & ~ndimage.binary_erosion(inside, cube, border_value=0)
+                    surface[int(b)] = np.sort(_keys(np.argwhere(edge) + lo.astype(np.int64) + [t.start for t in box]))
+            else:
+                box = boxes[v - 1] if v <= k else None
+                voxels[count + local] = None if box is None else \
+                    np.argwhere(label[box] == v) + lo.astype(np.int64) + [t.start for t in box]
+        count += len(labels)
+    return count, island, main, voxels, surface
 
 
-def _touching(where, x: int, main: dict) -> set[int]:
-    """The bones whose largest island (``main``: bone -> island number) island ``x``'s voxels touch
-    (26-neighbours or shared voxels): where it joins that bone's flesh when given to it."""
-    b, lo, grid, v = where[x]
-    if v is None:
+def _keys(vox: np.ndarray) -> np.ndarray:
+    """One int64 per voxel (coordinates within +-2^20 of the origin)."""
+    v = np.asarray(vox, np.int64) + (1 << 20)
+    return (v[:, 0] << 42) | (v[:, 1] << 21) | v[:, 2]
+
+
+def _touching(vox: np.ndarray | None, own: int, surface: dict) -> set[int]:
+    """The bones other than ``own`` whose largest island the voxels ``vox`` touch (26-neighbours or shared
+    voxels): where an island joins that bone's flesh when given to it."""
+    if vox is None:
         return set()
-    vox = np.argwhere(grid == v) + lo
-    near = (vox[:, None, :] + _CUBE[None]).reshape(-1, 3)
-    out = set()
-    for other, m in main.items():
-        ob, olo, ogrid, ov = where[m]
-        if other == b or ov is None:
-            continue
-        q = near - olo
-        q = q[((q >= 0) & (q < ogrid.shape)).all(1)]
-        if len(q) and (ogrid[tuple(q.T)] == ov).any():
-            out.add(other)
-    return out
+    near = np.unique(_keys((vox[:, None, :] + _CUBE[None]).reshape(-1, 3)))
+    return {b for b, keys in surface.items() if b != own and np.isin(near, keys, assume_unique=True).any()}
 
 
 _CUBE = np.argwhere(np.ones((3, 3, 3), bool)) - 1
@@ -123,31 +136,30 @@ def one_piece_each(points: np.ndarray, radius: np.ndarray, bone: np.ndarray) -> 
     weight = r**3
     nb = int(bone.max()) + 1
     for _ in range(ROUNDS):
-        same = bone[i] == bone[j]
-        count, island, where = _painted_islands(points, r, bone)
-        size = np.bincount(island, weights=weight, minlength=count)
-        owner = np.zeros(count, np.int64)
-        owner[island] = bone
-        order = np.lexsort((-size, owner))  # per bone, its largest island first
-        first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]]
-        main = {int(owner[x]): int(x) for x in first}
+        count, island, main, voxels, surface = _painted_islands(points, r, bone, weight)
         stray = np.ones(count, bool)
-        stray[first] = False
-        across = ~same & stray[island[i]]
+        stray[list(main.values())] = False
+        across = (bone[i] != bone[j]) & stray[island[i]]
         if not across.any():
             break
         keys, hits = np.unique(island[i[across]] * nb + bone[j[across]], return_counts=True)
         isl, other = keys // nb, keys % nb
         order = np.lexsort((-hits, isl))  # per stray island, the bones it touches, most first
+        isl, other = isl[order], other[order]
+        owner = np.zeros(count, np.int64)
+        owner[island] = bone
         target = np.full(count, -1)
-        for x in np.unique(isl):
-            joins = _touching(where, int(x), main)
-            for o in other[order][isl[order] == x]:
-                if int(o) in joins:
-                    target[x] = o
-                    break
+        for x, start, stop in _runs(isl):
+            joins = _touching(voxels[x], int(owner[x]), surface)
+            target[x] = next((int(o) for o in other[start:stop] if int(o) in joins), -1)
         moved = target[island]
         if not (moved >= 0).any():
             break
         bone[moved >= 0] = moved[moved >= 0]
     return bone
+
+
+def _runs(sorted_values: np.ndarray):
+    """``(value, start, stop)`` of each run of equal values in a sorted array."""
+    cut = np.flatnonzero(np.r_[True, sorted_values[1:] != sorted_values[:-1], True])
+    return [(int(sorted_values[a]), int(a), int(b)) for a, b in zip(cut[:-1], cut[1:])]

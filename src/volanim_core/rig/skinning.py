@@ -8,8 +8,8 @@
       --per reached point: w_k = g_k * exp(-(d_k / tau_k)^2 / 2), d_k its distance to bone k's segment,
         tau_k = h_k / SHARPNESS, the own bone with g = 1; normalised
       --heat diffusion over the links, DIFFUSION steps, of the blended points only
-      --one-voxel spheres (rig/thin_spheres.py): a speck group, and a surface point inside a thicker
-        sphere of its bone, move as the thicker sphere they lie deepest in
+      --one-voxel spheres (rig/thin_spheres.py): a speck group, and a group of one-voxel points lying on
+        one thicker sphere of their bone, move as the thicker sphere that holds them best
       --_with_sheets: the blended points on a medial sheet, and their links' rest lengths
       --> Skin: the blended points, their bones (own first) and weights (summing to 1)
     Skin + a frame's matrices --dual_quaternion.blended_matrices--> one matrix per blended point

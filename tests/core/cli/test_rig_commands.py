@@ -92,8 +92,7 @@ def ant(tmp_path_factory):
 
 
 def _leaves(bones) -> list[str]:
-    starts = {b.proximal for b in bones.bones}
-    return [b.label for b in bones.bones if b.distal not in starts]
+    return [bones.bones[i].label for i in bones.leaves()]
 
 
 @pytest.mark.long("18 poses of a real model through the commands a user runs, each judged with both joints")

@@ -50,31 +50,18 @@ def test_every_leaf_of_spot_bends_without_tearing_a_speck(tmp_path):
     """Spot's front leg bent 45 degrees tore off an 8-voxel speck: one ball of radius 1 at the knee, given
     to the shin by its distance to the bone, touching 43 balls of the thigh and trunk and none of the
     shin's. With each bone's flesh in one piece, every leaf bends healthy with rigid joints."""
+    from leaf_bends import leaf_bends
     from volanim_core import samples
     from volanim_core.io.mesh_files import read_mesh, voxelize
-    from volanim_core.reconstruct.checks import report
-    from volanim_core.rig.attach import connect
     from volanim_core.rig.autorig import autorig
-    from volanim_core.rig.connectivity import Trans
-    from volanim_core.rig.curve_skeleton import balls
-    from volanim_core.rig.pose import bend_across, pose_matrices, root_bones
     from volanim_core.skeleton.skeletonize import skeletonize
 
     samples.write_sample("spot", tmp_path)
     vol, _ = voxelize(read_mesh(tmp_path / "spot.ply"), size=160)
     skel = skeletonize(vol > 0)
     bones = autorig(skel).bones
-    conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
-    starts = {b.proximal for b in bones.bones}
-    broken, leaves = [], [b for b in bones.bones if b.distal not in starts]
-    assert len(leaves) >= 6  # four legs, the horns or the tail at least
-    for b in leaves:
-        for angle in (45, 90):
-            turn = bend_across(bones, b.label, angle)
-            rep = report(conn, Trans(root_bones(bones), pose_matrices(bones, {b.label: turn})), bones=bones)
-            if not rep.healthy:
-                broken.append(f"{b.label} {angle}: {rep.verdict.splitlines()[0]}")
-    assert broken == []
+    assert len(bones.leaves()) >= 6  # four legs, the horns or the tail at least
+    assert leaf_bends(skel, bones) == []
 
 
 def test_an_island_goes_where_its_voxels_join_a_bone_and_does_not_swing_back():

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from leaf_bends import leaf_bends
 from volanim_core import samples
 from volanim_core.reconstruct.breakage import components
 from volanim_core.reconstruct.checks import report
@@ -23,19 +24,6 @@ from volanim_core.skeleton.skeletonize import skeletonize
 SMOOTH = Joints("smooth")
 
 
-def _leaf_bends(skel, bones, angle) -> list[str]:
-    """Each leaf bone of the proposal bent ``angle`` degrees with smooth joints: the poses not healthy."""
-    conn = connect(skel, bones, method="pieces", mask=balls(skel))[0].with_joints(SMOOTH)
-    starts = {b.proximal for b in bones.bones}
-    broken = []
-    for b in (b for b in bones.bones if b.distal not in starts):
-        trans = Trans(root_bones(bones), pose_matrices(bones, {b.label: bend_across(bones, b.label, angle)}))
-        rep = report(conn, trans, bones=bones)
-        if not rep.healthy:
-            broken.append(f"{b.label}: {rep.verdict.splitlines()[0]}")
-    return broken
-
-
 @pytest.mark.long("the 46 M-voxel sample skeletonized, proposed, connected and each leaf bent")
 def test_mannequin_large_bends_every_leaf_90_degrees_with_smooth_joints():
     """A one-voxel sphere at the ankle's surface, its centre just inside a shin sphere of radius 10, was
@@ -44,7 +32,7 @@ def test_mannequin_large_bends_every_leaf_90_degrees_with_smooth_joints():
     the bend tore it off."""
     s = samples.mannequin_large()
     skel = skeletonize(s.mask)
-    assert _leaf_bends(skel, autorig(skel).bones, 90) == []
+    assert leaf_bends(skel, autorig(skel).bones, (90,), "smooth") == []
 
 
 @pytest.mark.long("the frog skeletonized, proposed, connected and one leg bent")
@@ -118,4 +106,4 @@ def test_every_leaf_of_the_rabbit_bends_90_degrees_with_smooth_joints(tmp_path):
     samples.write_sample("rabbit", tmp_path)
     vol, _ = voxelize(read_mesh(tmp_path / "rabbit.ply"), size=160)
     skel = skeletonize(vol > 0)
-    assert _leaf_bends(skel, autorig(skel).bones, 90) == []
+    assert leaf_bends(skel, autorig(skel).bones, (90,), "smooth") == []

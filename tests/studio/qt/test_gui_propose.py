@@ -81,9 +81,8 @@ def test_propose_on_the_ant_accept_connect_and_pose_a_leg_healthy(qtbot, window,
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert (doc.attachments.bone[: doc.visible_count] >= 0).all()
     # a leg: the leaf bone whose tip is farthest from the body's middle
-    starts = {b.proximal for b in doc.bones.bones}
     middle = doc.skeleton.points.mean(axis=0)
-    leaf = max((i for i, b in enumerate(doc.bones.bones) if b.distal not in starts),
+    leaf = max(doc.bones.leaves(),
                key=lambda i: np.linalg.norm(doc.bones.joints[doc.bones.bones[i].distal] - middle))
     qtbot.keyClick(window, Qt.Key_P)
     assert window.mode == Mode.POSE
