@@ -39,7 +39,7 @@ def _keys(args):
     from volanim_core.motion.keyframes import keys
     from volanim_core.motion.keys_files import read_keys
 
-    bones = read_bones(args.bones)
+    bones = read_bones(args.bones).on_cubes()
     k = read_keys(args.keys, bones)
     key_fps = k.fps or 24.0
     ease = args.ease if args.ease is not None else bool(k.ease)

@@ -45,7 +45,7 @@ def axis_or_auto(text: str) -> str:
 
 
 def _bvh2trans(args):
-    bones = read_bones(args.bones)
+    bones = read_bones(args.bones).on_cubes()
     motion = read_bvh(args.clip)
     mapping = None
     if args.map:
@@ -97,7 +97,7 @@ def _bones_and_frames(args):
     """``args.bones`` and the matrices of ``args.trans`` (files or a folder), in frame-number order."""
     from volanim_core.motion.frame_files import read_frames
 
-    bones = read_bones(args.bones)
+    bones = read_bones(args.bones).on_cubes()
     bar = TextProgress("reading frames")
     out = read_frames(args.trans, bones, progress=bar)
     bar.close()
@@ -130,7 +130,7 @@ def _trans2positions(args):
 def _positions2trans(args):
     from volanim_core.motion.positions import solve
 
-    bones = read_bones(args.bones)
+    bones = read_bones(args.bones).on_cubes()
     names = list(bones.joints)
     numbers, positions, what = _joint_positions(args, bones, names)
     have = [n for j, n in enumerate(names) if not np.isnan(positions[:, j]).all()]

@@ -69,7 +69,7 @@ def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
 
 
 def _pose(args):
-    bones = read_bones(args.bones)
+    bones = read_bones(args.bones).on_cubes()
     rotations = {}
     for name, angles in args.rotate or []:
         try:
@@ -78,7 +78,7 @@ def _pose(args):
             raise ValueError(f"{args.bones}: no bone named {name!r}; bones are "
                              + ", ".join(b.label for b in bones.bones)) from None
         rotations[name] = angles
-    trans = Trans(root_bones(bones), pose_matrices(bones, rotations))
+    trans = Trans(root_bones(bones), pose_matrices(bones, rotations), bones.geometry)
     write_trans(args.output, trans)
     print(f"posed {len(rotations)} of {len(bones)} bones (children follow) -> {args.output}")
 
@@ -178,6 +178,7 @@ def _compare(args):
     at = [_offset(g, base, f) for g, f in ((ours_geometry, args.ours), (truth_geometry, args.truth or args.sample))]
     joints = segments = None
     if bones is not None and trans is not None:
+        trans = trans.on_grid(bones.geometry)
         check_root_order(root_bones(bones), trans.bones)
         joints = posed_joints(bones, trans.matrices)
         segments = {b.label: (joints[b.proximal], joints[b.distal]) for b in bones.bones}

@@ -155,9 +155,9 @@ def read_connect(path: str | Path) -> Connectivity:
 
 
 def read_trans(path: str | Path) -> Trans:
-    """Read a ``.trans`` file: per bone a ``Root:`` line and 4 matrix rows."""
-    _, bones, mats, _, _ = _read_rooted(path, matrices=True, points=False)
-    return Trans(bones, mats)
+    """Read a ``.trans`` file: per bone a ``Root:`` line and 4 matrix rows (and the grid they are on)."""
+    rec, bones, mats, _, _ = _read_rooted(path, matrices=True, points=False)
+    return Trans(bones, mats, parse_geometry(rec))
 
 
 def read_tskel(path: str | Path) -> Tskel:
@@ -219,8 +219,8 @@ def write_connect(path: str | Path, conn: Connectivity, *, thinness: float | Non
 
 
 def write_trans(path: str | Path, trans: Trans) -> None:
-    """Write a ``.trans`` file atomically."""
-    lines = ["# volanim trans 1"]
+    """Write a ``.trans`` file atomically (a ``# geometry:`` line when it is on a grid other than identity)."""
+    lines = ["# volanim trans 1", *_geometry_header(trans.geometry)]
     for root, m in zip(trans.bones, trans.matrices):
         lines.append(_format_root(root))
         lines.extend(_format_matrix(m))

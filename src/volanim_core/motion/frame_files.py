@@ -43,7 +43,7 @@ def write_frames(folder, stem: str, bones: BoneSkeleton, matrices: np.ndarray, f
     written = []
     for n, (frame, m) in enumerate(zip(frames, matrices)):
         report(n, len(frames))
-        trans = Trans(roots, np.asarray(m))
+        trans = Trans(roots, np.asarray(m), bones.geometry)
         written.append(frame_path(out, stem, frame))
         io.write_trans(written[-1], trans)
         if connect is not None:
@@ -78,7 +78,7 @@ def read_frames(paths, bones: BoneSkeleton, progress=None) -> tuple[np.ndarray, 
     report = Reporter(progress)
     for i, p in enumerate(paths):
         report(i, len(paths))
-        trans = io.read_trans(p)
+        trans = io.read_trans(p).on_grid(bones.geometry)
         try:
             check_root_order(roots, trans.bones, p.name)
         except ValueError as exc:

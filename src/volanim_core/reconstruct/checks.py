@@ -106,6 +106,7 @@ def scan(conn: Connectivity, frames: list[Trans], *, bones: BoneSkeleton | None 
     """
     if not frames:
         raise ValueError("no frame to scan")
+    frames = [t.on_grid(conn.geometry) for t in frames]
     for n, t in enumerate(frames):
         check_root_order(conn.bones, t.bones, f"frame {n if numbers is None else numbers[n]}")
     matrices = np.stack([t.matrices for t in frames])

@@ -83,6 +83,14 @@ class BoneSkeleton:
         where = geometry.to_index(self.geometry.to_physical(np.array([self.joints[n] for n in names])))
         return BoneSkeleton(dict(zip(names, np.round(where, 6))), self.bones, geometry)
 
+    def on_cubes(self) -> BoneSkeleton:
+        """These bones on cubes of their grid's smallest spacing (the grid ``skeletonize`` makes of the
+        scan), where they are in the body. Rotations are taken in voxels, and on a grid of 1 x 1 x 2.5 mm
+        voxels a rotation in voxels is a shear in the body: every frame is posed on cubes."""
+        if self.geometry.is_isotropic:
+            return self
+        return self.on_grid(self.geometry.with_spacing((min(self.geometry.spacing),) * 3))
+
     def segment(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         b = self.bones[i]
         return self.joints[b.proximal], self.joints[b.distal]

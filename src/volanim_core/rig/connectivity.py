@@ -150,10 +150,12 @@ def _check_matrices(matrices, nbones):
 
 @dataclass(eq=False)
 class Trans:
-    """Contents of a ``.trans`` file: one 4x4 matrix per bone, root order."""
+    """Contents of a ``.trans`` file: one 4x4 matrix per bone, root order, in the voxels of ``geometry``
+    (its ``# geometry:`` line; none: the grid of whatever file it is paired with, as the seed's were)."""
 
     bones: list[BoneSegment]
     matrices: np.ndarray
+    geometry: Geometry = IDENTITY
 
     def __post_init__(self):
         self.matrices = _check_matrices(self.matrices, len(self.bones))
@@ -163,7 +165,28 @@ class Trans:
             isinstance(other, Trans)
             and self.bones == other.bones
             and np.array_equal(self.matrices, other.matrices)
+            and self.geometry == other.geometry
         )
+
+    def on_grid(self, geometry: Geometry) -> Trans:
+        """This frame in the voxels of ``geometry`` (a ``.connect``'s grid), through physical space.
+
+        A frame posed on one grid and a rig skeletonized on another (a scan of 1 x 1 x 2.5 mm voxels
+        and the 1 mm cubes skeletonize resampled it to) are one frame: the roots go where they are in
+        the body, each matrix is conjugated by the map between the grids (``A M A^-1``, row vectors).
+        Between cube grids that is a similarity, so a rotation stays a rotation. Either side recording
+        no grid: taken as on the other, as :meth:`BoneSkeleton.on_grid` does.
+        """
+        if self.geometry.is_identity or geometry.is_identity or self.geometry == geometry:
+            return self if geometry.is_identity or geometry == self.geometry else \
+                Trans(self.bones, self.matrices, geometry)
+        a = geometry.index_map(self.geometry)  # [i j k 1] @ a: our voxels -> theirs, then M, then back
+
+        def here(p):
+            return np.round(geometry.to_index(self.geometry.to_physical(p[None]))[0], 6)
+
+        bones = [BoneSegment(here(b.proximal), here(b.distal), b.name) for b in self.bones]
+        return Trans(bones, a[None] @ self.matrices @ np.linalg.inv(a)[None], geometry)
 
 
 class Tskel(Connectivity):

@@ -71,7 +71,7 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
     for p, n in sorted(zip(paths, numbers), key=lambda pn: pn[1]):
         suffix = p.suffix.lower()
         if suffix == ".trans":
-            trans = io.read_trans(p)
+            trans = io.read_trans(p).on_grid(conn.geometry)
             mats, bones_of = trans.matrices, trans.bones
         elif suffix == ".tskel":
             t = io.read_tskel(p)

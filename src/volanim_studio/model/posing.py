@@ -187,12 +187,12 @@ class PoseState:
     def load_trans(self, path) -> None:
         """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order); a load,
         not an edit: the history starts after it."""
-        trans = io.read_trans(path)
+        trans = io.read_trans(path).on_grid(self.doc.bones.geometry)  # a frame posed on another grid too
         check_root_order(root_bones(self.doc.bones), trans.bones, ".trans")
         self.doc.loading(lambda: self._write(*self._from_matrices(trans.matrices)))
 
     def save_trans(self, path) -> None:
-        io.write_trans(path, Trans(root_bones(self.doc.bones), self.matrices()))
+        io.write_trans(path, Trans(root_bones(self.doc.bones), self.matrices(), self.doc.bones.geometry))
 
     def tskel(self, thinness: float | None = None) -> Tskel:
         """The posed frame of the attached points with thinness >= ``thinness`` (default: the slider)."""
