@@ -12,7 +12,7 @@ from volanim_core.errors import FormatError
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
 from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.frame_files import write_frames
-from volanim_core.motion.plausible import check_clip
+from volanim_core.motion.plausible import check_clip, refuse_failed
 from volanim_core.motion.retarget import Retarget, check_mapping_file, format_mapping, read_mapping
 from volanim_core.progress import TextProgress
 from volanim_core.rig.tskel_tools import connect_to_tskel
@@ -58,6 +58,7 @@ def _bvh2trans(args):
                          f"selects no frame of {motion.frames}")
     used = {retarget.bones.bones[b].label: motion.names[k] for b, k in retarget.mapping.items()}
     report = retarget.report
+    print(f"# the clip's figure: {report['kind'].kind}: {report['kind'].reason}")
     print(f"# naming scheme: {report['scheme']}; each line says what placed it (name, shape or both)")
     print(format_mapping(used, bones, report["how"]), end="")
     for note in report["notes"]:
@@ -69,12 +70,8 @@ def _bvh2trans(args):
     checks, sampled = check_clip(retarget)
     for c in checks:
         print(f"# {c.line(sampled)}")
-    failed = [c for c in checks if not c.ok]
-    if failed and not args.no_check:
-        raise ValueError(f"{args.clip}: the retargeted clip does not look like a person standing: "
-                         + "; ".join(f"{c.name} in only {100 * c.held:.0f}% of frames (suspect {c.suspect})"
-                                     for c in failed)
-                         + ". Nothing was written; give --up/--forward/--map, or --no-check to write it anyway")
+    if not args.no_check:
+        refuse_failed(args.clip, checks)
     conn = read_connect(args.connect) if args.connect else None
     mats = retarget.matrices(args.frames)
     write_frames(args.output, Path(args.clip).stem, bones, mats, frames, connect=conn,

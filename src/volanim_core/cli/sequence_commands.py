@@ -45,7 +45,7 @@ def _sequence(args):
     conn = joints_of(args, read_connect(args.connect))
     bones = read_bones(args.bones) if args.bones else None
     frames = frames_from_files(conn, args.frames, bones=bones, mapping=read_mapping(args.map) if args.map else None,
-                               frames=args.range, up=args.up, forward=args.forward)
+                               frames=args.range, up=args.up, forward=args.forward, check=not args.no_check)
     if not args.crumble and (args.acceleration or args.heap != "keep"):
         raise ValueError("--acceleration and --heap shape a crumble: give --crumble N")
     if args.melt and args.teleport:
@@ -167,3 +167,5 @@ def register(sub) -> None:
                    help="BVH: which frames")
     p.add_argument("--up", default="auto", help="BVH: the clip's up axis (default detected)")
     p.add_argument("--forward", default="auto", help="BVH: the way the clip faces (default detected)")
+    p.add_argument("--no-check", action="store_true",
+                   help="BVH: run a clip that fails bvh2trans's checks (another kind of figure, lying down) anyway")

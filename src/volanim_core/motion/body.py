@@ -24,6 +24,7 @@ from .bvh import Motion
 from .presets import part_key
 
 SAMPLES = 64  # frames looked at: enough to see a stride, cheap on a 7000-frame clip
+TWINS = 0.15  # two branches are twins when their reaches differ by less than this share
 
 
 @dataclass
@@ -67,6 +68,29 @@ def reach(motion: Motion) -> np.ndarray:
             ends.append(float(np.linalg.norm(motion.end_sites[j])))
         out[j] = max(ends, default=0.0)
     return out
+
+
+def subtree(kids, j):
+    """``j`` and every joint below it."""
+    stack = [j]
+    while stack:
+        k = stack.pop()
+        yield k
+        stack.extend(kids[k])
+
+
+def twins(motion: Motion, kids, far: np.ndarray, branches: list[int]) -> tuple[int, int] | None:
+    """The longest pair of mirror-twin branches: the same number of joints, reaches within TWINS."""
+    def size(j):
+        return sum(1 for _ in subtree(kids, j))
+
+    def length(j):
+        return far[j] + float(np.linalg.norm(motion.offsets[j]))
+
+    pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1:]
+             if size(a) == size(b) and abs(length(a) - length(b)) <= TWINS * max(length(a), length(b), 1e-9)
+             and min(length(a), length(b)) > 0]
+    return max(pairs, key=lambda p: length(p[0]) + length(p[1]), default=None)
 
 
 def longest_path(motion: Motion, start: int, far: np.ndarray, kids) -> list[int]:
@@ -117,11 +141,13 @@ def read_body(motion: Motion, s: Sampled) -> Body:
     branches = kids[root]
     if len(branches) < 2:
         return Body({}, ["the hierarchy does not fork at the hips"])
-    count = {b: _subtree_size(kids, b) for b in branches}
+    count = {b: sum(1 for _ in subtree(kids, b)) for b in branches}
     upper = max(branches, key=lambda b: (count[b], far[b]))
     others = sorted((b for b in branches if b != upper), key=lambda b: -(far[b] + np.linalg.norm(motion.offsets[b])))
     longest = far[others[0]] + np.linalg.norm(motion.offsets[others[0]])
-    legs = [b for b in others[:2] if far[b] + np.linalg.norm(motion.offsets[b]) >= 0.5 * longest]
+    pair = twins(motion, kids, far, others)  # not a tail longer than the legs (a tailed biped, 3ds Max's)
+    legs = list(pair) if pair else \
+        [b for b in others[:2] if far[b] + np.linalg.norm(motion.offsets[b]) >= 0.5 * longest]
     fork = upper
     while len(kids[fork]) == 1:
         fork = kids[fork][0]
@@ -160,14 +186,6 @@ def read_body(motion: Motion, s: Sampled) -> Body:
         for side, limb in sided:
             parts.update({part_key(side, p): j for p, j in limb.items()})
     return Body(parts, notes)
-
-
-def _subtree_size(kids, j: int) -> int:
-    size, stack = 0, [j]
-    while stack:
-        size += 1
-        stack.extend(kids[stack.pop()])
-    return size
 
 
 def _up(s: Sampled, tops: list[int], bottoms: list[int]) -> np.ndarray | None:

@@ -262,7 +262,9 @@ def _hierarchy(path, text: str):
                 raise FormatError(path, "a JOINT inside an End Site", line)
             if len(names) >= MAX_JOINTS:
                 raise FormatError(path, f"more than {MAX_JOINTS} joints", line)
-            _, name = take("a joint name")
+            name_line, name = take("a joint name")
+            while i < len(toks) and toks[i][0] == name_line and toks[i][1] != "{":  # "Bip01 L Thigh": a name
+                name += " " + take("a joint name")[1]  # with spaces, as 3ds Max writes and Blender reads it
             if name in names:
                 raise FormatError(path, f"joint {name!r} is defined twice", line)
             brace = take("'{'")

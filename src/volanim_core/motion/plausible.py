@@ -1,5 +1,6 @@
 """Is a retargeted clip a person? Checks on our posed joints at sampled frames, before anything is written.
 
+    the clip's kind (motion/kind.py) and our rig's -> the same kind, or the clip is refused whatever else holds
     Retarget.matrices(sampled frames) -> our joints posed (z up) -> per check: the share of frames it holds
         head above pelvis        the spine's top over its bottom: not on its back, not upside down
         feet near the floor      the lowest joint within half a leg of our rest floor (scale, up)
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .kind import rig_kind
 from .presets import part_of
 
 MOST = 0.8  # a check must hold in this share of the sampled frames (a jump leaves the floor, a bow dips the head)
@@ -27,6 +29,7 @@ class Check:
     name: str
     held: float  # share of the sampled frames in which it held
     suspect: str  # what to look at when it fails
+    whole: bool = False  # said of the clip as a whole (its figure's kind), not frame by frame
 
     @property
     def ok(self) -> bool:
@@ -34,7 +37,15 @@ class Check:
 
     def line(self, frames: int) -> str:
         state = "ok" if self.ok else f"FAILS: suspect {self.suspect}"
+        if self.whole:
+            return f"{self.name}: {'yes' if self.ok else 'no'}, over {frames} sampled frames ({state})"
         return f"{self.name}: {100 * self.held:.0f}% of {frames} sampled frames ({state})"
+
+    def failure(self) -> str:
+        """What failed, for a refusal."""
+        if self.whole:
+            return f"{self.name}: no ({self.suspect})"
+        return f"{self.name} in only {100 * self.held:.0f}% of frames (suspect {self.suspect})"
 
 
 def _posed(bones, mats: np.ndarray, joint: str) -> np.ndarray:
@@ -48,6 +59,11 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
     frames = np.unique(np.linspace(0, motion.frames - 1, min(samples, motion.frames)).round().astype(int))
     mats = retarget.matrices(frames)
     checks = []
+    clip, ours = retarget.report.get("kind"), rig_kind(bones)
+    if clip is not None and ours is not None:  # first: a quadruped's steps pass a person's checks
+        checks.append(Check(f"the clip's figure is a {ours}, as the rig", float(clip.kind == ours),
+                            f"it is {'a ' if clip.kind != 'other' else ''}{clip.kind}: {clip.reason}; "
+                            "a clip drives a rig of its own kind", whole=True))
     by_part = {part_of(b.label): k for k, b in enumerate(bones.bones)}
     spine = by_part.get((None, "SPINE"))
     if spine is not None:
@@ -77,6 +93,16 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
             checks.append(Check(f"{side} {name} bends less than {FOLD_DEGREES:.0f} degrees", held,
                                 f"the mapping of {label} ({motion.names[retarget.mapping[b]]})"))
     return checks, len(frames)
+
+
+def refuse_failed(path, checks: list[Check]) -> None:
+    """Raise ValueError naming the clip and every failed check (``bvh2trans``, ``sequence``): nothing is
+    written from a clip that does not look like the rig's figure standing."""
+    failed = [c for c in checks if not c.ok]
+    if failed:
+        raise ValueError(f"{path}: the retargeted clip does not look like the rig's figure standing: "
+                         + "; ".join(c.failure() for c in failed)
+                         + ". Nothing was written; give --up/--forward/--map, or --no-check to write it anyway")
 
 
 def _direction(bones, mats, b: int) -> np.ndarray:

@@ -61,14 +61,21 @@ PRESETS = (
         "SPINE": ("spine_01",), "NECK": ("neck_01",), "HEAD": ("head",), "CLAVICLE": ("clavicle{S}",),
         "UPPERARM": ("upperarm{S}",), "FOREARM": ("lowerarm{S}",), "HAND": ("hand{S}",), "THIGH": ("thigh{S}",),
         "SHIN": ("calf{S}",), "FOOT": ("foot{S}",), "TOE": ("ball{S}",)}),
+    # 3ds Max's biped, "Bip01 L UpperArm" or "Bip01_L_UpperArm" (Bip001, Bip02: see plain)
+    Preset("3ds Max biped (Bip01)", ("L_", "R_"), {
+        "SPINE": ("Spine", "Spine1"), "NECK": ("Neck",), "HEAD": ("Head",), "CLAVICLE": ("{S}Clavicle",),
+        "UPPERARM": ("{S}UpperArm",), "FOREARM": ("{S}Forearm",), "HAND": ("{S}Hand",), "THIGH": ("{S}Thigh",),
+        "SHIN": ("{S}Calf",), "FOOT": ("{S}Foot",), "TOE": ("{S}Toe0", "{S}Toe")}),
     Preset("volanim L_/R_", ("L_", "R_"), {
         **{p: ("{S}" + p,) for p in SIDED}, "SPINE": ("SPINE",), "NECK": ("NECK",), "HEAD": ("HEAD",)}),
 )
 
 
 def plain(name: str) -> str:
-    """``mixamorig:LeftArm`` -> ``leftarm``: the name without a namespace, lower case."""
-    return re.sub(r"^.*[:|]", "", name).lower()
+    """``mixamorig:LeftArm`` -> ``leftarm``: the name without a namespace, lower case; a 3ds Max biped's
+    ``Bip01 L UpperArm`` (``Bip001_L_UpperArm``) -> ``l_upperarm``: no biped prefix, spaces as ``_``."""
+    name = re.sub(r"^.*[:|]", "", name).lower()
+    return re.sub(r"^bip0*\d+[ _]+", "", name).replace(" ", "_")
 
 
 def part_of(label: str) -> tuple[str | None, str]:

@@ -47,6 +47,7 @@ from .body import (
     upright,
 )
 from .bvh import Motion
+from .kind import clip_kind
 from .presets import best_preset, part_key, part_of
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -344,7 +345,7 @@ class Retarget:
             scale = our_height / clip_height if clip_height > 1e-9 and our_height > 0 else 1.0
             scale_how, units = "hip height at rest", "unknown"
         report = {"scheme": found.scheme, "how": found.how, "notes": found.notes, "axes": axes_how,
-                  "scale": scale_how, "reference": reference, "units": units}
+                  "scale": scale_how, "reference": reference, "units": units, "kind": clip_kind(motion, s)}
         return cls(bones, motion, index, axes, float(scale), align, up, forward, reference, report)
 
     def matrices(self, frames=slice(None)) -> np.ndarray:

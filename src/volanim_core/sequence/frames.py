@@ -53,7 +53,7 @@ class FrameSpec:
 
 
 def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, frames=slice(None),
-                      up: str = "auto", forward: str = "auto") -> list[FrameSpec]:
+                      up: str = "auto", forward: str = "auto", check: bool = True) -> list[FrameSpec]:
     """FrameSpecs from ``.trans``/``.tskel`` files or one ``.bvh`` (needs ``bones``: a BoneSkeleton)."""
     from volanim_core import io
 
@@ -63,7 +63,7 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
     if any(p.suffix.lower() == ".bvh" for p in paths):
         if len(paths) != 1:
             raise ValueError("give one .bvh clip, or .trans/.tskel files, not both")
-        return _from_bvh(conn, paths[0], bones, mapping, frames, up, forward)
+        return _from_bvh(conn, paths[0], bones, mapping, frames, up, forward, check)
     numbers = [frame_number(p) for p in paths]
     if None in numbers or len(set(numbers)) != len(numbers):
         numbers = list(range(len(paths)))  # names without (distinct) numbers: their order on the command line
@@ -90,7 +90,7 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
     return out
 
 
-def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward) -> list[FrameSpec]:
+def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward, check) -> list[FrameSpec]:
     from volanim_core.motion.bvh import read_bvh
     from volanim_core.motion.retarget import Retarget, check_mapping_file
     from volanim_core.rig.pose import root_bones
@@ -102,7 +102,12 @@ def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward) -> list[Fra
     motion = read_bvh(path)
     if mapping is not None:
         check_mapping_file(path, mapping, bones, motion)
-    mats = Retarget.build(bones, motion, mapping, up=up, forward=forward).matrices(frames)
+    retarget = Retarget.build(bones, motion, mapping, up=up, forward=forward)
+    if check:  # as bvh2trans: a quadruped's clip or one lying down is refused before any frame is made
+        from volanim_core.motion.plausible import check_clip, refuse_failed
+
+        refuse_failed(path, check_clip(retarget)[0])
+    mats = retarget.matrices(frames)
     numbers = list(range(motion.frames))[frames]
     if not numbers:
         raise ValueError(f"{path.name}: the frame range selects none of its {motion.frames} frames")

@@ -1,0 +1,157 @@
+"""#63 item 5: a clip is read as a biped, a quadruped or other, and drives only a rig of its own kind.
+
+The report: a 3ds Max biped-named elephant (``Bip01_L_Thigh``, ``BN_Tail_01``) was mapped onto the
+mannequin (HEAD <- a calf, R_THIGH <- the tail) with every plausibility check passing. No real
+quadruped clip with a licence we can use is on hand, so the elephant here is written as such clips
+are: 3ds Max's biped hierarchy (the thighs off the spine's first joint, the clavicles off the neck,
+the front legs named as arms), a tail, Y up, trotting. The bipeds are the real clips of
+tests/real_clips.py and ../shared's walk.bvh, also renamed into 3ds Max's biped scheme.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from tests.paths import WALK
+
+from real_clips import CLIPS, clip
+from volanim_core.cli import main
+from volanim_core.motion.body import sample
+from volanim_core.motion.bvh import read_bvh
+from volanim_core.motion.kind import clip_kind
+from volanim_core.motion.plausible import check_clip
+from volanim_core.motion.retarget import Retarget
+from volanim_core.samples import mannequin_bones
+
+# joint, parent, offset (cm, Y up, facing +z): an elephant as 3ds Max's biped rigs one
+ELEPHANT = [
+    ("Bip01", None, (0, 160, 0)), ("Bip01_Pelvis", "Bip01", (0, 0, 0)), ("Bip01_Spine", "Bip01_Pelvis", (0, 0, 5)),
+    *[(f"Bip01_{s}_{n}", p, o) for s, x in (("L", 30), ("R", -30)) for n, p, o in (
+        ("Thigh", "Bip01_Spine", (x, -15, -10)), ("Calf", f"Bip01_{s}_Thigh", (0, -55, 0)),
+        ("HorseLink", f"Bip01_{s}_Calf", (0, -45, 0)), ("Foot", f"Bip01_{s}_HorseLink", (0, -35, 0)))],
+    ("BN_Tail_01", "Bip01_Spine", (0, 0, -40)), ("BN_Tail_02", "BN_Tail_01", (0, -20, -40)),
+    ("BN_Tail_03", "BN_Tail_02", (0, -30, -30)),
+    ("Bip01_Spine1", "Bip01_Spine", (0, 5, 60)), ("Bip01_Spine2", "Bip01_Spine1", (0, 5, 60)),
+    ("Bip01_Neck", "Bip01_Spine2", (0, 10, 30)),
+    *[(f"Bip01_{s}_{n}", p, o) for s, x in (("L", 30), ("R", -30)) for n, p, o in (
+        ("Clavicle", "Bip01_Neck", (x / 2, -10, 0)), ("UpperArm", f"Bip01_{s}_Clavicle", (x / 2, -20, 0)),
+        ("Forearm", f"Bip01_{s}_UpperArm", (0, -60, 0)), ("Hand", f"Bip01_{s}_Forearm", (0, -55, 0)))],
+    ("Bip01_Head", "Bip01_Neck", (0, 20, 40)),
+]
+
+
+def elephant_bvh(path, frames: int = 48, side: bool = False) -> None:
+    """The elephant trotting (diagonal legs together); ``side``: the whole clip lying on its side."""
+    kids = {}
+    for name, parent, _ in ELEPHANT:
+        kids.setdefault(parent, []).append(name)
+    offsets = {name: o for name, _, o in ELEPHANT}
+    order: list[str] = []
+    lines = ["HIERARCHY"]
+
+    def write(name, depth):
+        pad = "  " * depth
+        lines.append(f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {name}")
+        lines.append(f"{pad}{{")
+        lines.append(f"{pad}  OFFSET {' '.join(f'{v:g}' for v in offsets[name])}")
+        chans = "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation" if depth == 0 \
+            else "3 Zrotation Xrotation Yrotation"
+        lines.append(f"{pad}  CHANNELS {chans}")
+        order.append(name)
+        for k in kids.get(name, []):
+            write(k, depth + 1)
+        if name not in kids:
+            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0 -10 0", f"{pad}  }}"])
+        lines.append(f"{pad}}}")
+
+    write("Bip01", 0)
+    lines += ["MOTION", f"Frames: {frames}", "Frame Time: 0.0333333"]
+    swing = {"Bip01_L_Thigh": 1, "Bip01_R_UpperArm": 1, "Bip01_R_Thigh": -1, "Bip01_L_UpperArm": -1}
+    for f in range(frames):
+        phase = np.sin(2 * np.pi * f / 24)
+        row = []
+        for name in order:
+            if name == "Bip01":
+                row += [0, 160, 3.0 * f, 90 if side else 0, 0, 0]
+            else:
+                row += [0, 25 * phase * swing.get(name, 0) + (10 * abs(phase) if "Calf" in name else 0), 0]
+        lines.append(" ".join(f"{v:.4f}" for v in row))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_the_elephant_is_a_quadruped_upright_or_on_its_side(tmp_path):
+    for side in (False, True):
+        elephant_bvh(tmp_path / "e.bvh", side=side)
+        m = read_bvh(tmp_path / "e.bvh")
+        kind = clip_kind(m, sample(m))
+        assert kind.kind == "quadruped", kind
+
+
+@pytest.mark.parametrize("name", ["walk", *sorted(CLIPS)])
+def test_real_human_clips_are_bipeds(name):
+    m = read_bvh(WALK if name == "walk" else clip(name))
+    kind = clip_kind(m, sample(m))
+    assert kind.kind == "biped", kind
+
+
+def test_a_quadruped_clip_is_refused_for_the_mannequin_saying_why(tmp_path, capsys):
+    """Before: mapped HEAD <- a calf, R_THIGH <- the tail, every check passing, frames written."""
+    elephant_bvh(tmp_path / "elephant.bvh")
+    bones = tmp_path / "m.bones"
+    from volanim_core.io import write_bones
+
+    write_bones(bones, mannequin_bones())
+    assert main(["bvh2trans", str(tmp_path / "elephant.bvh"), "--bones", str(bones), "-o", str(tmp_path / "f")]) == 2
+    out = capsys.readouterr()
+    assert "# the clip's figure: quadruped: both pairs of limbs reach across the spine" in out.out
+    assert "the clip's figure is a biped, as the rig: no (it is a quadruped: both pairs" in out.err
+    assert not (tmp_path / "f").exists()
+    r = Retarget.build(mannequin_bones(), read_bvh(tmp_path / "elephant.bvh"))
+    got = {r.bones.bones[b].label: r.motion.names[k] for b, k in r.mapping.items()}
+    assert "Tail" not in got.get("R_THIGH", "") and "Tail" not in got.get("L_THIGH", "")  # twins, not the tail
+    assert main(["bvh2trans", str(tmp_path / "elephant.bvh"), "--bones", str(bones), "--no-check",
+                 "-o", str(tmp_path / "f")]) == 0  # the user's call, said
+
+
+BIP01 = {"Hips": "Pelvis", "Spine": "Spine", "Head": "Head", "Shoulder": "Clavicle", "Arm": "UpperArm",
+         "ForeArm": "Forearm", "Hand": "Hand", "HandThumb1": "Finger0", "Hand_End": "Finger1", "UpLeg": "Thigh",
+         "Leg": "Calf", "Foot": "Foot", "ToeBase": "Toe0"}
+
+
+def _bip01(name: str, prefix: str, sep: str) -> str:
+    for side, s in (("Left", "L"), ("Right", "R")):
+        if name.startswith(side):
+            return sep.join((prefix, s, BIP01[name[len(side):]]))
+    return sep.join((prefix, BIP01[name]))
+
+
+@pytest.mark.parametrize("prefix, sep", [("Bip01", " "), ("Bip001", "_")])
+def test_the_real_walk_in_3ds_max_biped_names_maps_as_it_did(tmp_path, prefix, sep):
+    """walk.bvh with every joint renamed as 3ds Max names it ("Bip01 L Thigh", names with spaces as
+    Max writes and Blender reads them; "Bip001_L_Thigh") maps bone for bone as under its own names."""
+    text = WALK.read_text()
+    for old in sorted({t.split()[1] for t in text.splitlines() if t.split()[:1] in (["ROOT"], ["JOINT"])},
+                      key=len, reverse=True):
+        text = text.replace(f"T {old}\n", f"T {_bip01(old, prefix, sep)}\n")
+    (tmp_path / "bip.bvh").write_text(text)
+    bones = mannequin_bones()
+    theirs = Retarget.build(bones, read_bvh(tmp_path / "bip.bvh"))
+    ours = Retarget.build(bones, read_bvh(WALK))
+    assert theirs.report["scheme"] == "3ds Max biped (Bip01)"
+    named = {b: _bip01(ours.motion.names[k], prefix, sep) for b, k in ours.mapping.items()}
+    assert {b: theirs.motion.names[k] for b, k in theirs.mapping.items()} == named
+    assert all(how != "shape" for how in theirs.report["how"].values()), theirs.report["how"]
+    checks, n = check_clip(theirs)
+    assert all(c.ok for c in checks), [c.line(n) for c in checks]
+    assert np.allclose(theirs.matrices(slice(0, 40, 10)), ours.matrices(slice(0, 40, 10)))
+
+
+def test_sequence_refuses_the_quadruped_clip_too(tmp_path, capsys):
+    """`volanim sequence` ran a .bvh with no check at all: the elephant would have been rendered as a person."""
+    from tests.paths import ASSETS
+
+    elephant_bvh(tmp_path / "elephant.bvh")
+    argv = ["sequence", str(ASSETS / "mannequin.0.50.connect"), str(tmp_path / "elephant.bvh"), "--bones",
+            str(ASSETS / "mannequin.bones"), "--frames", "0:4:2", "-o", str(tmp_path / "e.zarr")]
+    assert main(argv) == 2
+    assert "it is a quadruped" in capsys.readouterr().err and not (tmp_path / "e.zarr").exists()
