@@ -65,6 +65,12 @@ def _sequence(args):
                        threads_per_worker=args.threads_per_worker, on_frame=FrameProgress())
     print(file=sys.stderr)
     print(format_report(rep))
+    from volanim_core.sequence.store import ome_scale
+
+    if not ome_scale(conn.geometry)[1]:
+        print(f"note: the scan's axes are swapped or tilted ({conn.geometry.describe()}): OME-Zarr's scale and "
+              "translation cannot say so, and a viewer that reads only them shows the frames beside the scan; "
+              "the store's volanim attributes hold the full geometry")
     if rep.colours:
         print(rep.colours)
     print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "

@@ -156,8 +156,9 @@ def _read_store(path: Path) -> Store:
     except (KeyError, IndexError, TypeError):
         raise FormatError(group_file, "\"attributes\" lack the OME-Zarr \"ome\" multiscales scale "
                                       "(datasets[0].coordinateTransformations[0].scale)") from None
-    _need(group_file, isinstance(scale, list) and len(scale) == 4 and all(_number(v) and v > 0 for v in scale),
-          f"the OME scale must be 4 positive numbers (t, z, y, x), got {scale!r}")
+    # a spatial scale may be negative: an axis that runs against its physical one (store.ome_scale)
+    _need(group_file, isinstance(scale, list) and len(scale) == 4 and all(_number(v) and v != 0 for v in scale)
+          and scale[0] > 0, f"the OME scale must be 4 numbers (t, z, y, x), time positive, none zero, got {scale!r}")
 
     array_file = path / "0" / "zarr.json"
     array = load_json(array_file, what="zarr array")

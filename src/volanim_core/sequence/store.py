@@ -68,9 +68,9 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     ``origin_xyz``: the grid's voxel ``[0, 0, 0]`` in the frames' voxel indices; ``geometry``: where it
     is in physical space (default: the identity shifted to ``origin_xyz``). ``palette``: a colour
     sequence's ``(256, 3)`` colours, one per index its frames hold (:mod:`volanim_core.colour.indexed`).
-    OME-Zarr's ``scale`` and ``translation`` are physical (millimetres), so napari and 3D Slicer overlay a
-    frame on its scan; OME-Zarr has no rotation, so a scan with tilted axes has its full geometry in
-    volanim's attributes.
+    OME-Zarr's ``scale`` and ``translation`` are physical (millimetres, :func:`ome_scale`), so napari
+    overlays a frame on its scan, reversed axes included; OME-Zarr has no rotation, so a scan with
+    swapped or tilted axes has its full geometry in volanim's attributes only.
     """
     import zarr
 
@@ -83,7 +83,7 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     ox, oy, oz = (float(v) for v in origin_xyz)
     if geometry is None:
         geometry = Geometry(origin=(ox, oy, oz))
-    sx, sy, sz = geometry.spacing
+    (sx, sy, sz), _ = ome_scale(geometry)
     px, py, pz = geometry.origin
     ome = {"version": "0.5", "multiscales": [{
         "name": path.stem,
@@ -106,6 +106,22 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
                       fill_value=0, dimension_names=("t", "z", "y", "x"), config=WRITE_CONFIG)
     atomic_write_text(path / PLAN_FILE, json.dumps(plan, indent=1))
     (path / FRAMES_FILE).write_bytes(b"")
+
+
+def ome_scale(geometry) -> tuple[tuple[float, float, float], bool]:
+    """OME-Zarr's per-axis ``scale`` (x, y, z) for a grid, and whether scale and translation place it exactly.
+
+    OME-Zarr (0.5) has scale and translation, no rotation: an axis that runs against its physical axis
+    (a scan stored RAS, read into LPS with x and y reversed) is a negative scale, which napari and
+    neuroglancer draw flipped, so the frame lies on the scan; the translation stays voxel ``[0, 0, 0]``'s
+    centre. Axes swapped or tilted (a sagittal acquisition, an oblique one) no scale can say: the
+    spacing is written and ``False`` returned (the full geometry is in volanim's attributes).
+    """
+    d = geometry.matrix
+    signs = np.sign(np.diag(d))
+    exact = bool(np.allclose(d, np.diag(signs), atol=1e-6) and np.all(signs != 0))
+    spacing = np.asarray(geometry.spacing, np.float64)
+    return tuple(float(v) for v in (spacing * signs if exact else spacing)), exact
 
 
 def read_plan(path: str | Path) -> dict | None:

@@ -246,3 +246,15 @@ def test_a_scheduler_that_cannot_be_reached_is_named_and_announced(tmp_path, cap
     error = err.strip().splitlines()[-1]
     assert error.startswith(f"volanim sequence: error: cannot reach the Dask scheduler at {address}"), error
     assert CONNECT.name not in error
+
+
+@pytest.mark.parametrize("direction, scale, exact", [
+    ((1, 0, 0, 0, 1, 0, 0, 0, 1), (0.5, 0.5, 2.0), True),
+    ((-1, 0, 0, 0, -1, 0, 0, 0, 1), (-0.5, -0.5, 2.0), True),  # a scan stored RAS, read into LPS
+    ((0, 0, 1, 1, 0, 0, 0, 1, 0), (0.5, 0.5, 2.0), False),  # a sagittal acquisition: axes swapped
+    ((0.8, -0.6, 0, 0.6, 0.8, 0, 0, 0, 1), (0.5, 0.5, 2.0), False),  # tilted
+])
+def test_ome_scale_says_a_reversed_axis_and_owns_up_to_what_it_cannot(direction, scale, exact):
+    from volanim_core.geometry import Geometry
+
+    assert store.ome_scale(Geometry((0.5, 0.5, 2.0), (1, 2, 3), direction)) == (scale, exact)
