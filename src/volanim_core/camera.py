@@ -22,6 +22,11 @@ class Camera:
     view_angle: float = 30.0  # degrees, perspective
     parallel_scale: float | None = None  # set: a parallel projection, half the picture's height in voxels
 
+    def __post_init__(self):  # a camera at NaN is no camera (the rest: check(), naming a file's line)
+        if not all(np.all(np.isfinite(np.asarray(v, np.float64)))
+                   for v in (self.position, self.focal_point, self.view_up, self.view_angle)):
+            raise ValueError("camera: every number must be finite")
+
     def check(self, where: str = "camera") -> None:
         """Refuse a camera that cannot make a picture (ValueError naming the fault)."""
         pos, focal, up = (np.asarray(v, np.float64) for v in (self.position, self.focal_point, self.view_up))

@@ -25,6 +25,8 @@ class TransferFunction:
             raise ValueError(f"a transfer function needs one RGBA per value, got {len(v)} values, {len(c)} colours")
         if len(v) > MAX_POINTS:
             raise ValueError(f"a transfer function has at most {MAX_POINTS} points, got {len(v)}")
+        if not np.all(np.isfinite(v)):
+            raise ValueError("transfer function values must be finite numbers")
         if np.any(np.diff(v) <= 0):
             raise ValueError("transfer function values must be strictly ascending")
         if np.any((c < 0) | (c > 1)) or not np.all(np.isfinite(c)):

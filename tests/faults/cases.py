@@ -30,6 +30,7 @@ class Case:
     expect: str = "refuse"
     check: str | None = None
     sparse: dict[str, int] = field(default_factory=dict)  # name -> size of a sparse file to create
+    links: dict[str, str] = field(default_factory=dict)  # name -> what the symbolic link points at
 
     def write(self, folder: Path) -> None:
         for rel, data in self.files.items():
@@ -38,6 +39,8 @@ class Case:
         for rel, size in self.sparse.items():
             with open(folder / rel, "wb") as fh:
                 fh.truncate(size)
+        for rel, target in self.links.items():
+            (folder / rel).symlink_to(target)
 
 
 def vol_header(x, y, z) -> bytes:

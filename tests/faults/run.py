@@ -123,7 +123,8 @@ def _run_cli(case, folder: Path) -> tuple[str, str]:
         return ("clean", "exit 0") if out.returncode == 0 else ("silent", f"refused: {err.strip()[:160]}")
     if out.returncode == 0:
         return "silent", f"exit 0: {out.stdout.strip()[-160:]}"
-    files = [part for name in (*case.files, *case.sparse) for part in (Path(name).name, Path(name).parts[0])]
+    files = [part for name in (*case.files, *case.sparse, *case.links)
+             for part in (Path(name).name, Path(name).parts[0])]
     named = any(f in err for f in files) or "error: argument" in err
     return ("clean" if named else "silent"), err.strip()[:160]
 

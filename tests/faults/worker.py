@@ -14,6 +14,8 @@ import resource
 import sys
 from pathlib import Path
 
+import numpy as np
+
 MEMORY_CAP = 6 << 30  # address space; VTK and numpy need ~1-2 GB of it just to load
 
 
@@ -25,11 +27,43 @@ def read_sequence(path):
     return [s.read_frame(i) for i in sorted(s.done)]
 
 
+def api_call(path):
+    """The call the file names, given what the files' readers refuse (round3_cases.API)."""
+    from volanim_core.camera import Camera
+    from volanim_core.colour.palette import build_palette
+    from volanim_core.motion.frame_files import write_frames
+    from volanim_core.rig.bones import Bone, BoneSkeleton
+    from volanim_core.rig.connectivity import BoneSegment, Trans
+    from volanim_core.samples import mannequin_bones
+    from volanim_core.transfer_function import TransferFunction
+
+    name = Path(path).read_text()
+    nan = float("nan")
+    calls = {
+        "write_frames with a NaN matrix": lambda: write_frames(
+            Path(path).parent / "out", "f", mannequin_bones(), np.full((1, 18, 4, 4), nan), [0]),
+        "a TransferFunction with a NaN value": lambda: TransferFunction([0, nan, 2], np.zeros((3, 4))),
+        "a Camera at NaN": lambda: Camera((nan, 0, 0), (0, 0, 0)),
+        "build_palette with a negative count": lambda: build_palette(np.zeros((2, 3), np.uint8) + [[0], [9]],
+                                                                     [5, -3], 2),
+        "a BoneSkeleton with a joint at infinity": lambda: BoneSkeleton(
+            {"a": (0, 0, 0), "b": (0, 0, float("inf"))}, [Bone("a", "b")]),
+        "a Trans of a NaN matrix": lambda: Trans([BoneSegment((0, 0, 0), (0, 0, 1), "a")], np.full((1, 4, 4), nan)),
+    }
+    try:
+        return calls[name]()
+    except ValueError as exc:  # the library's refusal: the case's file names the call
+        raise OSError(f"{path}: {exc}") from None
+
+
 def readers() -> dict:
     from volanim_core import io
+    from volanim_core.geometry import IDENTITY
     from volanim_core.io.mesh_files import read_mesh
     from volanim_core.io.palette_files import read_alpha_map, read_palette
+    from volanim_core.io.slicer_files import read_markups
     from volanim_core.motion.bvh import read_bvh
+    from volanim_core.motion.markers import read_c3d
     from volanim_studio.model import Document
     from volanim_studio.model.project import apply_project, read_project
 
@@ -38,7 +72,8 @@ def readers() -> dict:
             "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh,
             "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function,
             "read_mesh": read_mesh, "read_palette": read_palette, "read_alpha_map": read_alpha_map,
-            "read_sequence": read_sequence,
+            "read_sequence": read_sequence, "read_markups": lambda p: read_markups(p, IDENTITY),
+            "read_c3d": read_c3d, "api": api_call,
             "open_project": lambda p: apply_project(Document(), read_project(p), p, reset=True)}
 
 
@@ -54,6 +89,10 @@ CHECKS = {
     "warns_dev_zero": lambda r: any("/dev/zero" in w and "not a regular file" in w for w in r),
     "one_cell": lambda r: r.n_cells == 1 and r.n_points >= 3,
     "two_cells": lambda r: r.n_cells == 2 and r.n_points == 4,
+    "one_bone": lambda r: len(r.bones) == 1 and set(r.joints) == {"A", "B"},
+    "c3d_first_marker_missing": lambda r: np.isnan(r[1][0, 0]).all() and np.isfinite(r[1][0, 1]).all(),
+    "c3d_qualisys": lambda r: len(r[0]) == 55 and r[1].shape == (340, 55, 3) and r[2] == 200.0,
+    "shape_8_6_4": lambda r: tuple(r.shape) == (8, 6, 4) and int(r.max()) == 300,
     "two_frames": lambda r: len(r) == 2 and r[0].shape == (6, 5, 4) and int(r[1].max()) == 2,
 }
 

@@ -59,9 +59,12 @@ def build_palette(colours: np.ndarray, counts: np.ndarray, n: int = 255, *, meth
         raise ValueError(f"palette method must be one of {', '.join(METHODS)}, got {method!r}")
     if not 1 <= n <= 256:
         raise ValueError(f"a palette has 1..256 colours, got {n}")
-    colours, counts = np.asarray(colours, np.uint8).reshape(-1, 3), np.asarray(counts, np.float64)
+    colours, counts = np.asarray(colours, np.uint8).reshape(-1, 3), np.asarray(counts, np.float64).reshape(-1)
     if len(colours) == 0:
         raise ValueError("no voxels to build a palette from")
+    if len(counts) != len(colours) or not np.all(np.isfinite(counts)) or np.any(counts < 0) or counts.sum() <= 0:
+        raise ValueError(f"counts must be one finite number >= 0 per colour ({len(colours)}), not all 0; got "
+                         f"{len(counts)} counts from {counts.min() if len(counts) else 'none'}")
     if len(colours) <= n:
         return colours
     if method == "median-cut":

@@ -27,7 +27,10 @@ def pending_name(name: str, suffix: str = ".tmp") -> str:
     return f".{name}.{os.getpid()}-{secrets.token_hex(4)}{suffix}"  # matches _OURS
 
 
-def _pid_alive(pid: int) -> bool:
+def _pid_alive(pid: int, since: float | None = None) -> bool:
+    """Whether process ``pid`` lives and, given ``since`` (a temporary's mtime), is the one that wrote it:
+    pids are reused (a container's run through the same few thousand), and a process that started after
+    the file was last written cannot be its writer (Linux: its start time from /proc)."""
     if pid == os.getpid():
         return True
     try:
@@ -36,7 +39,20 @@ def _pid_alive(pid: int) -> bool:
         return False
     except (PermissionError, OverflowError):
         return True
-    return True
+    started = _start_time(pid)
+    return since is None or started is None or started <= since + 1.0
+
+
+def _start_time(pid: int) -> float | None:
+    """When process ``pid`` started (seconds since the epoch), or None where /proc does not say."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        ticks = int(fields[19])  # field 22 of stat: starttime, clock ticks after boot
+        boot = next(float(line.split()[1]) for line in Path("/proc/stat").read_text().splitlines()
+                    if line.startswith("btime "))
+        return boot + ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, StopIteration):
+        return None
 
 
 _OURS = re.compile(r"^\..+\.(\d+)-[0-9a-f]{8}\.tmp(?:\.[A-Za-z0-9]+)?$")  # pending_name's shape
@@ -61,7 +77,7 @@ def clean_stale(folder: Path, name: str | None = None, suffix: str = ".tmp") -> 
         try:
             ours = _OURS.match(entry.name)
             if ours:
-                stale = not _pid_alive(int(ours.group(1)))
+                stale = not _pid_alive(int(ours.group(1)), entry.stat(follow_symlinks=False).st_mtime)
             elif legacy is not None and legacy.match(entry.name):
                 stale = time.time() - entry.stat().st_mtime > LEGACY_STALE_SECONDS
             else:

@@ -85,3 +85,13 @@ def parse_json(path, text: str | bytes):
 def load_json(path, limit: int = MAX_JSON_BYTES, what: str = "JSON file"):
     """:func:`parse_json` of a regular file of at most ``limit`` bytes."""
     return parse_json(path, regular_file_bytes(path, limit, what))
+
+
+def resolved(path) -> Path:
+    """``Path(path).resolve()``, a symbolic-link loop refused as FormatError naming the path (Python raises
+    RuntimeError "Symlink loop", which reached users of ``render`` and ``view`` as a traceback)."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError) as exc:
+        raise FormatError(path, f"its path cannot be resolved ({exc}): a symbolic link that leads back to "
+                                "itself?") from None

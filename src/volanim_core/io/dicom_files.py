@@ -167,13 +167,19 @@ def _pixels(f: Path, ds) -> np.ndarray:
     """One frame's pixels ``[rows, columns]``. Uncompressed little-endian grey slices, what most series
     are, are viewed straight from their bytes (pydicom's general decoder spent half of a CT series'
     read deciding that); everything else goes through pydicom."""
+    if "PixelData" not in ds:
+        raise FormatError(f, "has no PixelData: a slice of the series without its image")
     syntax = str(getattr(getattr(ds, "file_meta", None), "TransferSyntaxUID", ""))
     alloc, stored = int(ds.get("BitsAllocated", 0)), int(ds.get("BitsStored", 0) or 0)
     if syntax in _PLAIN_SYNTAXES and int(ds.get("SamplesPerPixel", 1)) == 1 and alloc in (8, 16, 32) \
             and 0 < stored <= alloc and int(ds.get("NumberOfFrames", 1) or 1) == 1:
         rows, cols = int(ds.Rows), int(ds.Columns)
         data = ds.PixelData
-        if len(data) >= rows * cols * alloc // 8:
+        need = rows * cols * alloc // 8
+        if len(data) not in (need, need + 1):  # DICOM pads an odd length with one byte
+            raise FormatError(f, f"its PixelData holds {len(data):,} bytes where {cols} x {rows} pixels of "
+                                 f"BitsAllocated {alloc} need {need:,}: the header does not describe the pixels")
+        if len(data) >= need:
             signed = int(ds.get("PixelRepresentation", 0)) == 1
             img = np.frombuffer(data, f"<{'i' if signed else 'u'}{alloc // 8}", count=rows * cols).reshape(rows, cols)
             if stored < alloc:  # the bits above BitsStored are not the pixel's: sign-extend or clear them
@@ -186,6 +192,19 @@ def _pixels(f: Path, ds) -> np.ndarray:
         syntax = getattr(getattr(ds, "file_meta", None), "TransferSyntaxUID", None)
         name = getattr(syntax, "name", syntax)
         raise FormatError(f, f"its pixel data cannot be decoded ({name}): {exc}") from None
+
+
+def _finite(f: Path, ds, attr: str, default: float) -> float:
+    """A rescale value of a slice: absent is ``default``; NaN, infinite or not a number is refused (a slope of
+    NaN made an all-NaN volume)."""
+    raw = ds.get(attr, None)
+    try:
+        value = default if raw is None or raw == "" else float(raw)
+    except (TypeError, ValueError):
+        raise FormatError(f, f"{attr} {raw!r} is not a number") from None
+    if not np.isfinite(value) or abs(value) > 1e30:
+        raise FormatError(f, f"{attr} {raw!r} is not a finite number")
+    return value
 
 
 def _read_slices(folder: Path, headers):
@@ -227,8 +246,8 @@ def _read_slices(folder: Path, headers):
         if first is None:
             first = np.empty((cols, rows, len(headers)), img.dtype, order="F")
         first[:, :, z] = img.T
-        slopes.append(float(ds.get("RescaleSlope", 1) or 1))
-        intercepts.append(float(ds.get("RescaleIntercept", 0) or 0))
+        slopes.append(_finite(f, ds, "RescaleSlope", 1.0))
+        intercepts.append(_finite(f, ds, "RescaleIntercept", 0.0))
     dx, dy = _pixel_spacing(f0, ds0.get("PixelSpacing") or ds0.get("ImagerPixelSpacing"))
     origin = np.asarray(headers[order[0]][1].ImagePositionPatient, np.float64)
     direction = np.column_stack([row, col, normal])
@@ -306,6 +325,8 @@ def _read_multiframe(path: Path):
     scale = float(ds.get("DoseGridScaling", 1) or 1)
     slopes = [frame_value(groups[k], "RescaleSlope", 1.0) * scale for k in order]
     intercepts = [frame_value(groups[k], "RescaleIntercept", 0.0) for k in order]
+    if not np.all(np.isfinite(slopes + intercepts)) or max(map(abs, slopes + intercepts)) > 1e30:
+        raise FormatError(path, "its rescale slope, intercept or DoseGridScaling is not a finite number")
     vol = rescale(vol, slopes, intercepts)
     direction = np.column_stack([row, col, normal])
     return vol, Geometry((dx, dy, dz), tuple(positions[order[0]]), tuple(direction.reshape(-1)))

@@ -22,6 +22,8 @@ from volanim_core.errors import FormatError
 
 MAX_CORNERS = 1024  # corners of one polygon (VTK triangulates it: a 900 000-corner face hung)
 MAX_HEADER = 1 << 16
+MAX_LINE = 1 << 20  # an OBJ line: a face of MAX_CORNERS corners is some 20 KB
+MAX_VERTEX = 1e9  # a coordinate past it is no model's (and overflows the voxel grid's size)
 _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
               "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
               "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
@@ -179,13 +181,31 @@ def _checked_uniform(path, faces, n_vertices: int, end: int) -> int:
 _OBJ_INDEX = re.compile(r"[+-]?\d+")
 
 
+def _lines(path: Path, chunk: int = 1 << 20):
+    """The file's lines (latin-1), read a megabyte at a time: memory follows the mesh, not the file's size
+    (a sparse 3 GB OBJ peaked at 6 GB read whole); a line longer than MAX_LINE is refused."""
+    rest = b""
+    number = 0
+    with open(path, "rb") as fh:
+        while block := fh.read(chunk):
+            parts = (rest + block).split(b"\n")
+            rest = parts.pop()
+            for part in parts:
+                number += 1
+                yield part.decode("latin-1").rstrip("\r")
+            if len(rest) > MAX_LINE:
+                raise FormatError(path, f"line {number + 1} runs past {MAX_LINE:,} bytes: not an OBJ's line",
+                                  number + 1)
+    if rest:
+        yield rest.decode("latin-1").rstrip("\r")
+
+
 def read_obj(path: Path):
     """A Wavefront OBJ's vertices and polygon faces as a pyvista PolyData, every index checked."""
     import pyvista as pv
 
-    text = path.read_bytes().decode("latin-1")
     vertices, cells = [], []
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(_lines(path), start=1):
         words = line.split()
         if not words:
             continue
@@ -194,8 +214,9 @@ def read_obj(path: Path):
                 xyz = [float(w) for w in words[1:4]]
             except ValueError:
                 raise FormatError(path, f"a vertex needs 3 numbers: {line[:80]!r}", number) from None
-            if len(xyz) != 3 or not np.isfinite(xyz).all():
-                raise FormatError(path, f"a vertex needs 3 finite numbers: {line[:80]!r}", number)
+            if len(xyz) != 3 or not np.isfinite(xyz).all() or max(map(abs, xyz)) > MAX_VERTEX:
+                raise FormatError(path, f"a vertex needs 3 finite numbers within {MAX_VERTEX:g}: {line[:80]!r}",
+                                  number)
             vertices.append(xyz)
         elif words[0] == "f":
             corners = words[1:]

@@ -33,6 +33,7 @@ SCHEMA = ("https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadab
 POINT_LISTS = ("fiducial", "curve", "opencurve", "line")  # markup types whose control points can be a chain
 _BONE = re.compile(r"^volanim bone (\d+) from (\S+)(?: named (\S+))?$")
 SAME_JOINT_MM = 1e-3  # one label at two places further apart than this is an error, not one joint
+MAX_MM = 1e6  # a kilometre: past it a "position" is no body's (1e308 became a joint at infinity in voxels)
 
 
 def write_markups(path: str | Path, bones: BoneSkeleton, geometry: Geometry | None = None) -> None:
@@ -69,8 +70,11 @@ def _lists(path: Path) -> list[list[tuple[str, str, np.ndarray]]]:
             raise FormatError(path, f"markup {m}: coordinateSystem {system!r} (expected LPS or RAS)")
         if str(markup.get("coordinateUnits", "mm")).lower() != "mm":
             raise FormatError(path, f"markup {m}: coordinateUnits {markup.get('coordinateUnits')!r} (expected mm)")
+        points = markup.get("controlPoints") or []
+        if not isinstance(points, list):
+            raise FormatError(path, f"markup {m}: \"controlPoints\" must be a list, got {type(points).__name__}")
         rows = []
-        for k, cp in enumerate(markup.get("controlPoints") or []):
+        for k, cp in enumerate(points):
             if isinstance(cp, dict) and cp.get("positionStatus", "defined") != "defined":
                 # a point Slicer was asked to place and never got ("undefined", its position written ""),
                 # or is being placed ("preview"): not a joint yet, whatever its position says
@@ -78,10 +82,10 @@ def _lists(path: Path) -> list[list[tuple[str, str, np.ndarray]]]:
             pos = cp.get("position") if isinstance(cp, dict) else None
             label = cp.get("label") if isinstance(cp, dict) else None
             ok = isinstance(pos, list) and len(pos) == 3 and all(
-                isinstance(v, int | float) and not isinstance(v, bool) for v in pos) and np.isfinite(pos).all()
+                isinstance(v, int | float) and not isinstance(v, bool) and abs(v) <= MAX_MM for v in pos)
             if not ok or not isinstance(label, str) or not label.strip() or len(label.split()) != 1:
                 raise FormatError(path, f"markup {m}, control point {k}: expected a one-word \"label\" and a "
-                                  "\"position\" of three finite numbers")
+                                  f"\"position\" of three numbers within {MAX_MM:g} mm of the origin")
             p = np.asarray(pos, np.float64) * ((-1, -1, 1) if system == "RAS" else 1)
             rows.append((label, str(cp.get("description") or ""), p))
         out.append(rows)

@@ -24,6 +24,8 @@ from scipy.spatial.transform import Rotation, Slerp
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.pose import pose_frames
 
+MAX_FRAMES = 10_000  # a keyed animation writes a .trans per frame: 100 000 took minutes of files
+
 BoneKey = tuple[str, str]  # (proximal joint, distal joint)
 
 
@@ -114,6 +116,6 @@ def keys(keys: dict[int, KeyPose], bones: BoneSkeleton, *, length: int | None = 
     if length is None:  # n frames span (n - 1) / fps seconds: the same span at the output's rate
         last = max(keys) if key_length is None else key_length - 1
         length = int(np.floor(last * fps / key_fps + 1e-9)) + 1
-    if not 1 <= length <= 100_000:
-        raise ValueError(f"length must be 1 to 100000 frames, got {length}")
+    if not 1 <= length <= MAX_FRAMES:
+        raise ValueError(f"length must be 1 to {MAX_FRAMES} frames (7 minutes at 24 fps, a file each), got {length}")
     return interpolate(bones, keys, np.arange(length) * (key_fps / fps), ease=ease)

@@ -22,7 +22,7 @@ import numpy as np
 
 from volanim_core.io._atomic import atomic_write_text
 from volanim_core.io._text import fmt_float, parse_float, parse_int, read_records
-from volanim_core.motion.keyframes import KeyPose
+from volanim_core.motion.keyframes import MAX_FRAMES, KeyPose
 from volanim_core.rig.bones import BoneSkeleton
 
 MAX_FRAME = 10_000_000
@@ -54,9 +54,9 @@ def read_keys(path: str | Path, bones: BoneSkeleton) -> Keys:
                 if out.fps < 1:
                     raise rec.error(line, f"fps must be 1 to 1000, got {toks[1]}")
             elif word == "length":
-                out.length = parse_int(rec, line, toks[1], "length", 100_000)
+                out.length = parse_int(rec, line, toks[1], "length", MAX_FRAMES)
                 if out.length < 1:
-                    raise rec.error(line, f"length must be 1 to 100000 frames, got {toks[1]}")
+                    raise rec.error(line, f"length must be 1 to {MAX_FRAMES} frames, got {toks[1]}")
             else:
                 if toks[1].lower() not in ("on", "off"):
                     raise rec.error(line, f"expected 'ease on' or 'ease off', got {toks[1]!r}")

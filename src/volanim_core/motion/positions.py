@@ -28,6 +28,8 @@ import numpy as np
 
 from volanim_core.rig.bones import BoneSkeleton
 
+MAX_FRAME_NUMBER = 10_000_000  # frame numbers name files (NAME.0012.trans); 10^23 is no frame
+MAX_POSITION = 1e9  # in the file's units: a kilometre in millimetres a thousand times over; 1e308 is no joint
 MIN_SIN = 0.2  # a third marker nearer the bone's line than this (as a fraction of its distance) gives no twist
 
 
@@ -55,8 +57,11 @@ def read_positions(path: str | Path, names: list[str], scale: float = 1.0) -> tu
         except ValueError:
             raise FormatError(path, f"expected a whole frame number and three numbers, got {line.strip()!r}",
                               line_no) from None
-        if not np.all(np.isfinite(xyz)):
-            raise FormatError(path, "a position must be finite", line_no)
+        if not 0 <= frame <= MAX_FRAME_NUMBER:
+            raise FormatError(path, f"frame {fields[0]}: frame numbers are 0 to {MAX_FRAME_NUMBER:,}", line_no)
+        if not all(np.isfinite(v) and abs(v) <= MAX_POSITION for v in xyz):
+            raise FormatError(path, f"a position must be finite and within {MAX_POSITION:g} of the origin, got "
+                              f"{', '.join(fields[2:])}", line_no)
         if fields[1] in index:
             rows.setdefault(frame, {})[index[fields[1]]] = xyz
     if not rows:
@@ -66,6 +71,10 @@ def read_positions(path: str | Path, names: list[str], scale: float = 1.0) -> tu
     for f, frame in enumerate(frames):
         for j, xyz in rows[frame].items():
             out[f, j] = xyz
+        present = out[f][~np.isnan(out[f]).any(axis=1)]
+        if len(present) >= 2 and np.ptp(present, axis=0).max() == 0:
+            raise FormatError(path, f"frame {frame}: every joint is at one place {present[0].tolist()}; no pose "
+                              "can be read from it")
     return frames, out * scale
 
 

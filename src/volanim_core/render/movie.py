@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.io._files import resolved
 from volanim_core.parallel import executor
 
 from .camera import Camera, union_box
@@ -116,7 +117,7 @@ def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
         if dtype.itemsize > 1 or dtype.kind == "f":
             vmax = float(np.max(seq.read_frame(indices[len(indices) // 2])))  # a middle frame's brightest voxel
     scale = seq.seconds_per_frame
-    refs = [FrameRef(str(path.resolve()), i, int(numbers[i])) for i in indices]
+    refs = [FrameRef(str(resolved(path)), i, int(numbers[i])) for i in indices]
     boxes = None
     if all("box" in done[i] for i in indices):  # stores written before boxes were recorded: the grid
         boxes = [None if done[i]["box"] is None else (tuple(done[i]["box"][0]), tuple(done[i]["box"][1]))
@@ -155,8 +156,8 @@ def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
         if vol.size:
             vmax = max(vmax, float(vol.max()))
         st = p.stat()
-        fingerprint.append([str(p.resolve()), st.st_size, st.st_mtime_ns])
-    refs = [FrameRef(str(p.resolve()), -1, int(n)) for n, p in pairs]
+        fingerprint.append([str(resolved(p)), st.st_size, st.st_mtime_ns])
+    refs = [FrameRef(str(resolved(p)), -1, int(n)) for n, p in pairs]
     lo, hi = union_box(boxes, np.min(los, 0).tolist(), np.max(his, 0).tolist())
     mode = modes.pop() if len(modes) == 1 else None  # the files' recorded mode, when they agree
     return RenderInputs(refs, lo, hi, mode, vmax, None, fingerprint, boxes, spacing)

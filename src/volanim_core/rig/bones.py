@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
+from volanim_core.limits import MAX_COORD
 
 
 @dataclass(frozen=True)
@@ -37,6 +38,10 @@ class BoneSkeleton:
 
     def __post_init__(self):
         self.joints = {k: np.asarray(v, dtype=np.float64).reshape(3) for k, v in self.joints.items()}
+        for name, p in self.joints.items():  # as read_bones refuses them: a joint at NaN or 1e308 is no joint
+            if not (np.isfinite(p).all() and np.abs(p).max() <= MAX_COORD):
+                raise ValueError(f"joint {name!r} is at {p.tolist()}: coordinates must be finite numbers "
+                                 f"within {MAX_COORD:,} voxels")
         self.bones = list(self.bones)
         self.validate()
 

@@ -141,10 +141,14 @@ class Connectivity:
         return self.take(np.argsort(self.bone, kind="stable"))
 
 
-def _check_matrices(matrices, nbones):
+def _check_matrices(matrices, bones):
     m = np.ascontiguousarray(matrices, dtype=np.float64).reshape(-1, 4, 4)
-    if len(m) != nbones:
-        raise ValueError(f"{len(m)} matrices for {nbones} bones")
+    if len(m) != len(bones):
+        raise ValueError(f"{len(m)} matrices for {len(bones)} bones")
+    bad = ~np.isfinite(m).all(axis=(1, 2))
+    if bad.any():  # as the files' readers refuse them: a NaN frame reconstructs to nothing
+        b = int(np.argmax(bad))
+        raise ValueError(f"bone {b} ({bones[b].label}): its matrix holds NaN or infinite numbers")
     return m
 
 
@@ -158,7 +162,7 @@ class Trans:
     geometry: Geometry = IDENTITY
 
     def __post_init__(self):
-        self.matrices = _check_matrices(self.matrices, len(self.bones))
+        self.matrices = _check_matrices(self.matrices, self.bones)
 
     def __eq__(self, other) -> bool:
         return (
@@ -199,7 +203,7 @@ class Tskel(Connectivity):
     def __init__(self, bones, matrices, points, dt, thinness, bone, metric: str = "euclid",
                  geometry: Geometry = IDENTITY, *, joints: Joints = RIGID, skin: Skin | None = None):
         super().__init__(bones, points, dt, thinness, bone, metric, None, geometry, joints)
-        self.matrices = _check_matrices(matrices, len(self.bones))
+        self.matrices = _check_matrices(matrices, self.bones)
         self._skin = skin
 
     def with_joints(self, joints: Joints) -> Tskel:

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.io._files import load_json, parse_json, regular_file_bytes
+from volanim_core.io._files import load_json, parse_json, regular_file_bytes, resolved
 from volanim_core.limits import MAX_AXIS, checked_grid
 from volanim_core.modes import MODES
 
@@ -105,7 +105,7 @@ _CACHE: dict = {}  # path -> (the metadata files' sizes and times, Store): a mov
 def read_store(path) -> Store:
     """Check a sequence store's metadata (see the module docstring); FormatError naming the file and key.
     Checked once while its files are unchanged."""
-    path = Path(path).resolve()
+    path = resolved(path)
     stamp = []
     for name in (PLAN_FILE, "zarr.json", "0/zarr.json", FRAMES_FILE):
         try:

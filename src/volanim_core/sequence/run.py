@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.colour.indexed import index_colours
+from volanim_core.io._files import resolved
 from volanim_core.limits import available_bytes, human_bytes
 from volanim_core.parallel import executor
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
@@ -208,7 +209,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
     if every_frame_as:
         Path(every_frame_as).parent.mkdir(parents=True, exist_ok=True)
     todo = [i for i in range(len(frames)) if i not in done]
-    payload = Payload(conn, mode, kernel, bounds, str(out.resolve()), source, source_geometry, every_frame_as,
+    payload = Payload(conn, mode, kernel, bounds, str(resolved(out)), source, source_geometry, every_frame_as,
                       threads_per_worker)
     records = dict(done)
     total = len(frames)
