@@ -9,6 +9,7 @@ import io as stdio
 import json
 import struct
 import tempfile
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -125,7 +126,8 @@ def _dicom_series(mutate=None) -> dict[str, bytes]:
 
     vol = np.zeros((8, 6, 4), np.int16)
     vol[2:6, 1:5, 1:3] = 300
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # pydicom warns of the very values the cases write (RescaleSlope "NaN")
         paths = write_dicom_series(tmp, vol, Geometry((0.5, 0.5, 1.0)))
         out = {}
         for k, p in enumerate(sorted(paths)):
@@ -177,6 +179,12 @@ def mesh_cases() -> list[Case]:
             case("a sparse 3 GB OBJ", {}, "voxelize {d}/m.obj {d}/o.nrrd", {"m.obj": 3 << 30})]
 
 
+def autorig_cases() -> list[Case]:
+    far = "# volanim mskel 1\n# metric: euclid\n10 10 10 8 1\n1073741000 10 10 8 1\n"
+    return [Case("autorig: two balls 2^30 voxels apart", "cli:autorig", {"m.mskel": far.encode()},
+                 "autorig {d}/m.mskel -o {d}/m.bones")]
+
+
 def loop_cases() -> list[Case]:
     return [Case(f"{cmd}: a .zarr that is a symlink loop", f"cli:{cmd}", {}, arg, links={"a.zarr": "b", "b": "a.zarr"})
             for cmd, arg in (("render", "render {d}/a.zarr -o {d}/m.mp4"),
@@ -194,4 +202,4 @@ def api_cases() -> list[Case]:
 
 def round3_cases() -> list[Case]:
     return markups_cases() + keys_cases() + positions_cases() + c3d_cases() + dicom_cases() + mesh_cases() + \
-        loop_cases() + api_cases()
+        autorig_cases() + loop_cases() + api_cases()

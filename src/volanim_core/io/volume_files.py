@@ -217,6 +217,18 @@ def _without_alpha(img: np.ndarray, path: Path) -> np.ndarray:
     return img[..., 0] if img.shape[-1] == 2 else img[..., :3]
 
 
+def _keyed_transparency(path: Path) -> bool:
+    """Whether the image keys transparency in its palette or by a colour (PNG's tRNS, GIF's), not in an alpha
+    channel of its own."""
+    try:
+        from PIL import Image
+
+        with Image.open(path) as im:
+            return "transparency" in im.info and im.mode in ("P", "L", "RGB", "I", "I;16")
+    except Exception:  # noqa: BLE001 - not an image PIL opens: the reader below says why
+        return False
+
+
 def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.ndarray:
     """One slice image as ``[x, y]``, or ``[x, y, 3]`` with ``colour`` (grey images then repeat in
     R, G, B). ``colour=None`` keeps the image as it is: ``[x, y, 3]`` for a colour image, else ``[x, y]``.
@@ -226,7 +238,11 @@ def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.nd
     import imageio.v3 as iio  # not skimage.io.imread: it moves the axes of a grey+alpha image 3 or 4 rows high
 
     try:
-        img = np.asarray(iio.imread(path))
+        # a palette (or grey, RGB) image with a tRNS chunk: its transparency is read as alpha, which PIL's
+        # plain conversion drops (a mask's transparent background came in as opaque colour)
+        img = np.asarray(iio.imread(path, mode="RGBA") if _keyed_transparency(path) else iio.imread(path))
+    except FormatError:
+        raise
     except Exception as exc:  # imageio/PIL raise many types
         raise FormatError(path, f"cannot read image: {exc}") from exc
     if img.ndim == 3 and img.shape[2] in (2, 4):  # grey+alpha or RGBA

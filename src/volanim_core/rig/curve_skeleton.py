@@ -39,6 +39,7 @@ LIMB = 0.1  # ... and so does one shorter than this x the body's longest path (j
 LARGE_PIECE = 0.2  # a second piece with this fraction of the largest one's volume is refused
 BRIDGE = 0.08  # a bridge may cross background this fraction of the body's length (at least 6 voxels)
 GAP = 3.0  # balls this many voxels apart still link (a coarse voxel's slack)
+SPREAD = 4  # a coarse voxel may be this many times the thickest ball's radius, no more
 COARSE_VOXELS = 8_000_000  # the solid body is remade on a grid of at most this many voxels
 CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues)
 POROUS = 0.05  # a body that closing grows by more than this fraction is porous (a dissected frog's tissues) ...
@@ -269,6 +270,11 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     lo = np.floor(skeleton.points.min(axis=0) - skeleton.dt.max() - 1)
     hi = skeleton.points.max(axis=0) + skeleton.dt.max() + 1
     h = max(1, int(np.ceil((np.prod(hi - lo) / COARSE_VOXELS) ** (1 / 3))))
+    if h > SPREAD * max(float(skeleton.dt.max()), 1.0):  # two balls 2^30 voxels apart thinned for minutes
+        raise NotRiggable(f"the skeleton's points span {' x '.join(f'{v:.0f}' for v in hi - lo)} voxels while its "
+                          f"thickest ball's radius is {skeleton.dt.max():.3g} voxels: on a grid coarse enough to hold "
+                          f"that span its body would vanish; parts this far apart are not one body (crop the "
+                          "scan to the creature)")
     steps = max(1, int(round(close / 2 / h)))  # a closing by k steps bridges gaps of about 2 k
     pad = steps + 1
     shape = tuple(int(v) for v in np.ceil((hi - lo) / h) + 1 + 2 * pad)

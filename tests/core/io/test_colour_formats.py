@@ -104,3 +104,22 @@ def test_a_grey_and_alpha_slice_4_rows_high_reads_as_grey_when_opaque(tmp_path):
     for z in range(2):
         Image.fromarray(np.stack([grey, np.full_like(grey, 255)], axis=2), "LA").save(tmp_path / f"s{z}.png")
     assert np.array_equal(io.read_volume(tmp_path), np.stack([grey.T, grey.T], axis=2))
+
+
+def test_a_palette_png_with_a_transparent_index_is_not_read_as_opaque(tmp_path):
+    """#64: PIL converts a palette PNG to RGB without its tRNS chunk: a mask's transparent background came in
+    as white. Transparency keyed in the palette is now alpha: refused where a pixel uses it, as RGBA is."""
+    from PIL import Image
+
+    from volanim_core.io.volume_files import read_slice
+
+    a = np.zeros((4, 5), np.uint8)
+    a[1:3, 1:4] = 1
+    im = Image.fromarray(a, mode="P")
+    im.putpalette([255, 255, 255, 200, 50, 50] + [0] * 762)
+    im.save(tmp_path / "keyed.png", transparency=0)  # index 0, the white background, transparent
+    im.save(tmp_path / "unused.png", transparency=7)  # a transparent index no pixel uses
+    with pytest.raises(FormatError, match=r"keyed\.png: 14 of 20 pixels are transparent"):
+        read_slice(tmp_path / "keyed.png")
+    opaque = read_slice(tmp_path / "unused.png")
+    assert opaque.shape == (5, 4) and opaque[0, 0] == 255 and opaque[2, 1] < 255
