@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import sys
 from pathlib import Path
 
@@ -86,10 +87,28 @@ def describe(exc: BaseException, args) -> str:
         return text
     if isinstance(exc, OSError) and exc.filename:
         return f"{exc.filename}: {exc.strerror or text}"
+    if isinstance(exc, OSError) and exc.errno == errno.ENOSPC:  # the output did not fit, not the input's fault
+        outputs = [str(v) for k, v in vars(args).items() if k in OUTPUT_ARGS and isinstance(v, str | Path)]
+        if outputs:
+            return f"{', '.join(outputs)}: {text} ({_free(outputs[0])})"
     inputs = _input_files(args)
     if inputs and not any(Path(f).name in text for f in inputs):
         return f"{', '.join(inputs)}: {text}"
     return text
+
+
+def _free(path: str) -> str:
+    """How much room is left where ``path`` was being written, for a disk-full message."""
+    import os
+
+    from volanim_core.limits import human_bytes
+
+    folder = Path(path).parent if not Path(path).is_dir() else Path(path)
+    try:
+        room = os.statvfs(folder if str(folder) else ".")
+    except OSError:
+        return "the free room could not be read"
+    return f"{human_bytes(room.f_bavail * room.f_frsize)} free there"
 
 
 def _quiet_stdout() -> None:

@@ -13,6 +13,7 @@ temporaries in the same folder whose process is gone (``clean_stale``).
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import re
 import secrets
@@ -126,9 +127,14 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs):
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
+        written = tmp.stat().st_size if tmp.exists() else 0
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.errno == errno.ENOSPC and exc.filename is None:
+            # said of the file being written (the CLI named the input it was reading before)
+            raise OSError(errno.ENOSPC, f"no space left on the device: {written:,} bytes of it were written "
+                                        "when the disk filled; it needs more room than that", str(path)) from exc
         raise
 
 

@@ -39,17 +39,37 @@ def write_frames(folder, stem: str, bones: BoneSkeleton, matrices: np.ndarray, f
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
     roots = root_bones(bones)
+    trans = [Trans(roots, np.asarray(m), bones.geometry) for m in matrices]  # every frame checked before any file
     report = Reporter(progress, cancel)
+    marker = incomplete_marker(out, stem)
+    marker.write_text(f"{len(frames)} frames of {stem} were being written; this file goes when the last is\n")
     written = []
-    for n, (frame, m) in enumerate(zip(frames, matrices)):
+    for n, (frame, t) in enumerate(zip(frames, trans)):
         report(n, len(frames))
-        trans = Trans(roots, np.asarray(m), bones.geometry)
         written.append(frame_path(out, stem, frame))
-        io.write_trans(written[-1], trans)
+        io.write_trans(written[-1], t)
         if connect is not None:
-            io.write_tskel(frame_path(out, stem, frame, ".tskel"), connect_to_tskel(connect, trans))
+            io.write_tskel(frame_path(out, stem, frame, ".tskel"), connect_to_tskel(connect, t))
+    marker.unlink()  # the frames are whole: a run killed, cancelled or out of room leaves the marker behind
     report(len(frames), len(frames))
     return written
+
+
+def incomplete_marker(folder: str | Path, stem: str) -> Path:
+    """``folder/STEM.incomplete``: there while ``write_frames`` writes a clip's frames, gone once all are."""
+    return Path(folder) / f"{stem}.incomplete"
+
+
+def check_complete(paths) -> None:
+    """Refuse frames of a clip whose writing did not finish (a marker beside them, :func:`write_frames`)."""
+    from volanim_core.errors import FormatError
+
+    for p in paths:
+        m = re.match(r"(.+?)\.?\d+$", Path(p).stem)
+        marker = incomplete_marker(Path(p).parent, m.group(1) if m else Path(p).stem)
+        if marker.is_file():
+            raise FormatError(p, f"{marker.name} lies beside it: the run writing these frames stopped before the "
+                                 "last (killed, cancelled or out of room); run it again to write them all")
 
 
 def frame_number(path: str | Path) -> int | None:
@@ -73,6 +93,7 @@ def read_frames(paths, bones: BoneSkeleton, progress=None) -> tuple[np.ndarray, 
         if not paths:
             raise FileNotFoundError(f"{folder}: no .trans files in this folder")
     paths.sort(key=lambda p: (frame_number(p) is None, frame_number(p) or 0, p.name))
+    check_complete(paths)
     roots = root_bones(bones)
     mats = np.empty((len(paths), len(bones), 4, 4))
     report = Reporter(progress)

@@ -12,6 +12,7 @@ ones (``volanim-render.json`` holds the settings' key; other settings start over
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import os
@@ -429,6 +430,8 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
             ticks = np.round(np.arange(len(frames) + 1) * 100.0 / fps)
             iio.imwrite(tmp, frames, extension=".gif", duration=list(np.diff(ticks) * 10.0), loop=0)
         os.replace(tmp, out)
-    except BaseException:
+    except BaseException as exc:
         tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.errno == errno.ENOSPC and exc.filename is None:
+            raise OSError(errno.ENOSPC, "no space left on the device for the movie", str(out)) from exc
         raise

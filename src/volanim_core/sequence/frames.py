@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.motion.frame_files import frame_number
+from volanim_core.motion.frame_files import check_complete, frame_number
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.tskel_tools import check_root_order
 
@@ -64,6 +64,7 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
         if len(paths) != 1:
             raise ValueError("give one .bvh clip, or .trans/.tskel files, not both")
         return _from_bvh(conn, paths[0], bones, mapping, frames, up, forward, check)
+    check_complete(paths)
     numbers = [frame_number(p) for p in paths]
     if None in numbers or len(set(numbers)) != len(numbers):
         numbers = list(range(len(paths)))  # names without (distinct) numbers: their order on the command line

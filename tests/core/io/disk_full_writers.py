@@ -27,6 +27,10 @@ def writers(spare: Path):
     from volanim_core.render.movie import encode, write_png
     from volanim_core.rig.bones import Bone, BoneSkeleton
     from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
+    from volanim_core.io.slicer_files import write_markups, write_transform
+    from volanim_core.motion.bvh_export import write_bvh
+    from volanim_core.motion.keyframes import KeyPose
+    from volanim_core.motion.keys_files import Keys, write_keys
     from volanim_core.skeleton.points import Skeleton
 
     rng = np.random.default_rng(0)
@@ -38,6 +42,11 @@ def writers(spare: Path):
     skel = Skeleton(pts, rng.random(len(pts)) + 1, rng.random(len(pts))).sorted()
     bones = BoneSkeleton({f"J{i}": (i, i, i) for i in range(3)}, [Bone("J0", "J1"), Bone("J1", "J2")])
     roots = [BoneSegment(*bones.segment(i), "") for i in range(2)]
+    # a chain of 800 joints: markups, keys and a BVH larger than the room left
+    many_joints = BoneSkeleton({f"J{i}": (0, 0, 10 * i) for i in range(801)},
+                               [Bone(f"J{i}", f"J{i + 1}", f"B{i}") for i in range(800)])
+    many_keys = {k: KeyPose({(f"J{i}", f"J{i + 1}"): np.array([0.0, k, 0.0]) for i in range(800)}) for k in range(3)}
+    clip_matrices = np.tile(np.eye(4), (40, 800, 1, 1))
     conn = Connectivity(roots, skel.points, skel.dt, skel.thinness, np.arange(len(skel)) % 2).grouped()
     picture = rng.integers(0, 255, (600, 800, 3), dtype=np.uint8)
     pngs = []
@@ -54,7 +63,7 @@ def writers(spare: Path):
         doc.save_project(path)
 
     out = {f"volume {s}": (f"v{s}", lambda p: io.write_volume(p, vol, geo))
-           for s in (".vti", ".nrrd", ".mha", ".nii", ".nii.gz", ".VOL")}
+           for s in (".vti", ".nrrd", ".mha", ".nii", ".nii.gz", ".VOL", ".tif")}
     out.update({f"mesh {s}": (f"m{s}", lambda p: write_mesh(p, verts, faces))
                 for s in (".ply", ".vtp", ".stl", ".obj")})
     out.update({
@@ -65,8 +74,26 @@ def writers(spare: Path):
         "picture .png": ("o.png", lambda p: write_png(p, picture)),
         "movie .gif": ("o.gif", lambda p: encode(pngs * 4, p, 12.0)),
         "project .volanim": ("p.volanim", project),
+        # the writers added since #38 (#64)
+        "markups .mrk.json": ("b.mrk.json", lambda p: write_markups(p, many_joints, geo)),
+        "keys .keys": ("k.keys", lambda p: write_keys(p, Keys(many_keys), many_joints)),
+        "transform .tfm": ("t.tfm", lambda p: _big_text_file(p, lambda q: write_transform(q, np.eye(4)))),
+        "transform .h5": ("t.h5", lambda p: _big_text_file(p, lambda q: write_transform(q, np.eye(4)))),
+        "BVH export .bvh": ("w.bvh", lambda p: write_bvh(p, many_joints, clip_matrices, 30.0)),
     })
     return out
+
+
+def _big_text_file(path, write):
+    """A transform file is a few hundred bytes: write it into a disk with no room at all."""
+    ballast = path.parent / "ballast-all"
+    room = os.statvfs(path.parent)
+    with open(ballast, "wb") as fh:
+        fh.write(b"\0" * (room.f_bavail * room.f_frsize))
+    try:
+        write(path)
+    finally:
+        ballast.unlink()
 
 
 def fill(full: Path, leave: int) -> Path:
@@ -120,7 +147,7 @@ def main(full: Path, spare: Path) -> None:
         target = full / rel
         target.write_bytes(OLD)
         ballast = fill(full, 24 * 1024)  # more than the old file, less than any new one
-        result = {"writer": name}
+        result = {"writer": name, "target": rel}
         try:
             write(target)
             result["raised"] = None

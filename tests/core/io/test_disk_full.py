@@ -34,11 +34,13 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
     table = "\n".join(f"{r['writer']:<24} raised: {bool(r['raised'])!s:<6} old intact: {r['old_intact']!s:<6} "
                       f"litter: {r['litter']}" for r in rows)
     print("\n" + table)
-    assert len(rows) == 16, out.stderr[-2000:]
+    assert len(rows) == 22, out.stderr[-2000:]
     for r in rows:
         assert r["raised"] and not r.get("traceback"), r
         assert r["old_intact"], r
         assert r["litter"] == [], r
+    unnamed = [(r["writer"], r["raised"]) for r in rows if r["target"] not in r["raised"]]
+    assert not unnamed, unnamed  # the message names the file that did not fit (#64)
     # a store is resumable: it stops with the error, what it recorded verifies, the rerun finishes it
     assert seq["raised"] and 0 <= seq["recorded"] < seq["frames"], seq
     assert seq["recorded_verify"] and seq["skipped_on_resume"] == seq["recorded"], seq

@@ -56,3 +56,32 @@ def test_cancel_stops_between_frames(tmp_path):
         write_frames(tmp_path, "wave", bones, mats, range(4), progress=lambda d, t: seen.append(d),
                      cancel=lambda: len(seen) >= 2)
     assert len(list(tmp_path.glob("*.trans"))) == 2
+
+
+def test_frames_a_run_did_not_finish_are_refused_until_it_is_run_again(tmp_path):
+    """#64: a bvh2trans/keys/positions2trans run killed, cancelled or out of room left some frames and no way to
+    tell; the marker write_frames keeps beside them until the last is written tells every reader."""
+    bones, mats = clip()
+    seen = []
+    with pytest.raises(Cancelled):
+        write_frames(tmp_path, "wave", bones, mats, range(4), progress=lambda d, t: seen.append(d),
+                     cancel=lambda: len(seen) >= 2)
+    assert (tmp_path / "wave.incomplete").is_file()
+    with pytest.raises(FormatError, match=r"wave\.incomplete lies beside it"):
+        read_frames(tmp_path, bones)
+    from volanim_core.sequence.frames import frames_from_files
+
+    conn = Connectivity(root_bones(bones), np.array([[2.0, 0, 8]]), np.array([1.0]), np.array([1.0]), np.array([1]))
+    with pytest.raises(FormatError, match="stopped before the last"):
+        frames_from_files(conn, sorted(tmp_path.glob("*.trans")))
+    write_frames(tmp_path, "wave", bones, mats, range(4))  # run again: whole, the marker gone
+    assert not (tmp_path / "wave.incomplete").exists() and len(read_frames(tmp_path, bones)[0]) == 4
+
+
+def test_a_nan_frame_is_refused_before_any_file_is_written(tmp_path):
+    bones, mats = clip()
+    mats = mats.copy()
+    mats[2, 1, 0, 0] = np.nan
+    with pytest.raises(ValueError, match="NaN or infinite"):
+        write_frames(tmp_path / "out", "wave", bones, mats, range(4))
+    assert not list((tmp_path / "out").glob("*"))
