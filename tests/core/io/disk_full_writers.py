@@ -24,13 +24,13 @@ def writers(spare: Path):
     from volanim_core import io
     from volanim_core.geometry import Geometry
     from volanim_core.io.mesh_files import write_mesh
-    from volanim_core.render.movie import encode, write_png
-    from volanim_core.rig.bones import Bone, BoneSkeleton
-    from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
     from volanim_core.io.slicer_files import write_markups, write_transform
     from volanim_core.motion.bvh_export import write_bvh
     from volanim_core.motion.keyframes import KeyPose
     from volanim_core.motion.keys_files import Keys, write_keys
+    from volanim_core.render.movie import encode, write_png
+    from volanim_core.rig.bones import Bone, BoneSkeleton
+    from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
     from volanim_core.skeleton.points import Skeleton
 
     rng = np.random.default_rng(0)
