@@ -86,6 +86,11 @@ def clean_stale(folder: Path, name: str | None = None, suffix: str = ".tmp") -> 
             if stale and entry.is_file(follow_symlinks=False):
                 os.unlink(entry.path)
                 removed += 1
+            elif stale and ours and entry.is_dir(follow_symlinks=False):  # a store made beside its target
+                import shutil
+
+                shutil.rmtree(entry.path, ignore_errors=True)
+                removed += 1
         except (OSError, ValueError):
             continue
     return removed

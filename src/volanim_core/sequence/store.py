@@ -72,12 +72,19 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     overlays a frame on its scan, reversed axes included; OME-Zarr has no rotation, so a scan with
     swapped or tilted axes has its full geometry in volanim's attributes only.
     """
+    import shutil
+
     import zarr
 
     from volanim_core.geometry import Geometry
-    from volanim_core.io._atomic import atomic_write_text
+    from volanim_core.io._atomic import atomic_write_text, clean_stale, pending_name
 
-    path = Path(path)
+    final = Path(path)
+    # made whole beside the target, then renamed: a run killed while creating its store leaves no half-made
+    # folder that the rerun must refuse as "not a volanim sequence" (#64), only a temporary the next sweeps
+    final.parent.mkdir(parents=True, exist_ok=True)
+    clean_stale(final.parent, final.name)
+    path = final.parent / pending_name(final.name)
     dtype = np.dtype(dtype)
     z, y, x = (int(v) for v in shape_zyx)
     ox, oy, oz = (float(v) for v in origin_xyz)
@@ -86,7 +93,7 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     (sx, sy, sz), _ = ome_scale(geometry)
     px, py, pz = geometry.origin
     ome = {"version": "0.5", "multiscales": [{
-        "name": path.stem,
+        "name": final.stem,
         "axes": [{"name": "t", "type": "time", "unit": "second"}, {"name": "z", "type": "space", "unit": "millimeter"},
                  {"name": "y", "type": "space", "unit": "millimeter"},
                  {"name": "x", "type": "space", "unit": "millimeter"}],
@@ -106,6 +113,9 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
                       fill_value=0, dimension_names=("t", "z", "y", "x"), config=WRITE_CONFIG)
     atomic_write_text(path / PLAN_FILE, json.dumps(plan, indent=1))
     (path / FRAMES_FILE).write_bytes(b"")
+    if final.exists():  # a store of another plan the caller chose to replace (never anything else)
+        shutil.rmtree(final) if final.is_dir() else final.unlink()
+    os.replace(path, final)
 
 
 def ome_scale(geometry) -> tuple[tuple[float, float, float], bool]:

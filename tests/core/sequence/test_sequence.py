@@ -8,6 +8,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -134,6 +135,21 @@ def test_a_run_that_cannot_fit_says_how_large_its_largest_frame_is(tmp_path, con
     assert not (tmp_path / "s.zarr").exists()
 
 
+def test_a_run_killed_while_making_its_store_is_run_again_by_the_same_command(tmp_path, conn, walk):
+    """#64: killed 2.35 s in, before the store's plan was written, the rerun refused with "walk.zarr exists
+    and is not a volanim sequence". The store is now made beside its target and renamed whole: what such a
+    kill leaves is a temporary of a dead process, which the rerun sweeps."""
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()
+    half = tmp_path / f".walk.zarr.{dead}-0123abcd.tmp"
+    (half / "0").mkdir(parents=True)
+    (half / "zarr.json").write_text('{"zarr_format": 3, "node_type": "group"}')
+    out = tmp_path / "walk.zarr"
+    rep = run_sequence(conn, walk[:2], out, mode="bone")
+    assert rep.skipped == 0 and len(store.finished(out)) == 2
+    assert not half.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["walk.zarr"]
+
+
 # spec: docs/formats.md#zarr
 @pytest.mark.long("kill -9 of a real sequence run, then the same command: nothing finished is lost or redone")
 def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
@@ -258,3 +274,34 @@ def test_ome_scale_says_a_reversed_axis_and_owns_up_to_what_it_cannot(direction,
     from volanim_core.geometry import Geometry
 
     assert store.ome_scale(Geometry((0.5, 0.5, 2.0), (1, 2, 3), direction)) == (scale, exact)
+
+
+def test_the_workers_of_a_killed_run_end_with_it(tmp_path):
+    """#64: killing `volanim sequence` (-9) left its two pool workers running for over 30 s in 4 of 10 kills.
+    Each worker now dies with the process that started it."""
+    clip = frames_from_files(io.read_connect(CONNECT), [WALK], bones=mannequin_bones(), frames=slice(0, 480, 10))
+    frames = tmp_path / "frames"
+    write_frames(frames, "walk", mannequin_bones(), np.array([f.matrices for f in clip]), [f.number for f in clip])
+    out = tmp_path / "walk.zarr"
+    cmd = [sys.executable, "-m", "volanim_core.cli", "sequence", str(CONNECT), *map(str, sorted(frames.glob("*.trans"))),
+           "--mode", "bone", "--workers", "2", "-o", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 300
+    while not store.finished(out) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    children = [int(p) for p in subprocess.run(["pgrep", "-P", str(proc.pid)], capture_output=True,
+                                               text=True).stdout.split()]
+    workers = [p for p in children if "spawn_main" in Path(f"/proc/{p}/cmdline").read_bytes().decode(errors="replace")]
+    assert len(workers) == 2 and proc.poll() is None, (children, proc.poll())
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    while any(Path(f"/proc/{p}").exists() and "Z" not in _state(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [p for p in workers if Path(f"/proc/{p}").exists() and "Z" not in _state(p)]
+
+
+def _state(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return "Z"
