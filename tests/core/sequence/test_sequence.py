@@ -283,8 +283,9 @@ def test_the_workers_of_a_killed_run_end_with_it(tmp_path):
     frames = tmp_path / "frames"
     write_frames(frames, "walk", mannequin_bones(), np.array([f.matrices for f in clip]), [f.number for f in clip])
     out = tmp_path / "walk.zarr"
-    cmd = [sys.executable, "-m", "volanim_core.cli", "sequence", str(CONNECT), *map(str, sorted(frames.glob("*.trans"))),
-           "--mode", "bone", "--workers", "2", "-o", str(out)]
+    trans = [str(p) for p in sorted(frames.glob("*.trans"))]
+    cmd = [sys.executable, "-m", "volanim_core.cli", "sequence", str(CONNECT), *trans, "--mode", "bone", "--workers",
+           "2", "-o", str(out)]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 300
     while not store.finished(out) and proc.poll() is None and time.monotonic() < deadline:
