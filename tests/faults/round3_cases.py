@@ -156,7 +156,8 @@ def dicom_cases() -> list[Case]:
     return [case("a slice without PixelData", drop_pixels), case("BitsAllocated 8 on 16-bit pixels", bits_8),
             case("RescaleSlope NaN", slope_nan), case("the series as written", None, "accept", "shape_8_6_4"),
             *[Case(f"dicom: {cmd} of a series with a slice without PixelData", f"cli:{cmd}",
-                   _dicom_series(drop_pixels), arg) for cmd, arg in (("info", "info {d}/ct"), ("skeletonize", "skeletonize {d}/ct -o {d}/s.mskel"))]]
+                   _dicom_series(drop_pixels), arg)
+              for cmd, arg in (("info", "info {d}/ct"), ("skeletonize", "skeletonize {d}/ct -o {d}/s.mskel"))]]
 
 
 def mesh_cases() -> list[Case]:
