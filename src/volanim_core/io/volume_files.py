@@ -241,8 +241,6 @@ def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.nd
         # a palette (or grey, RGB) image with a tRNS chunk: its transparency is read as alpha, which PIL's
         # plain conversion drops (a mask's transparent background came in as opaque colour)
         img = np.asarray(iio.imread(path, mode="RGBA") if _keyed_transparency(path) else iio.imread(path))
-    except FormatError:
-        raise
     except Exception as exc:  # imageio/PIL raise many types
         raise FormatError(path, f"cannot read image: {exc}") from exc
     if img.ndim == 3 and img.shape[2] in (2, 4):  # grey+alpha or RGBA
