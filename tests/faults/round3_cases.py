@@ -80,7 +80,8 @@ def positions_cases() -> list[Case]:
     return [case("a position of 1e20", rows(value="1e20")), case("a position of 1e308", rows(value="1e308")),
             case("a frame number of 10^23", rows(frame="100000000000000000000000")),
             case("every joint at one place", rows(value="0", same=True)),
-            case("a negative frame", rows(frame="-5"))]
+            case("a negative frame", rows(frame="-5")),
+            case("one joint only", "frame,joint,x,y,z\n0,PELVIS,0,0,100\n1,PELVIS,0,5,100\n")]
 
 
 def _c3d(mutate) -> bytes:
@@ -196,7 +197,8 @@ def loop_cases() -> list[Case]:
 
 # the library's constructors, given what the files' readers refuse: the file names the call
 API = ("write_frames with a NaN matrix", "a TransferFunction with a NaN value", "a Camera at NaN",
-       "build_palette with a negative count", "a BoneSkeleton with a joint at infinity", "a Trans of a NaN matrix")
+       "build_palette with a negative count", "a BoneSkeleton with a joint at infinity", "a Trans of a NaN matrix",
+       "a 2-channel volume drawn")
 
 
 def api_cases() -> list[Case]:

@@ -32,6 +32,7 @@ def api_call(path):
     from volanim_core.camera import Camera
     from volanim_core.colour.palette import build_palette
     from volanim_core.motion.frame_files import write_frames
+    from volanim_core.render.scene import RenderSettings, prepare_frame
     from volanim_core.rig.bones import Bone, BoneSkeleton
     from volanim_core.rig.connectivity import BoneSegment, Trans
     from volanim_core.samples import mannequin_bones
@@ -49,6 +50,8 @@ def api_call(path):
         "a BoneSkeleton with a joint at infinity": lambda: BoneSkeleton(
             {"a": (0, 0, 0), "b": (0, 0, float("inf"))}, [Bone("a", "b")]),
         "a Trans of a NaN matrix": lambda: Trans([BoneSegment((0, 0, 0), (0, 0, 1), "a")], np.full((1, 4, 4), nan)),
+        "a 2-channel volume drawn": lambda: prepare_frame(RenderSettings(camera=Camera((0, -9, 0), (0, 0, 0))),
+                                                          np.zeros((4, 4, 4, 2), np.uint8), (0, 0, 0)),
     }
     try:
         return calls[name]()

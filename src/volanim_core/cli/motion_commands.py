@@ -134,6 +134,9 @@ def _positions2trans(args):
     missing = [n for n in names if n not in have]
     print(f"{len(numbers)} frames, {len(have)} of {len(names)} joints in {args.positions}{what}"
           + (f"; no data for {', '.join(missing)} (their bones follow their parents)" if missing else ""))
+    if not any(b.proximal in have and b.distal in have for b in bones.bones):  # one marker: nothing turns
+        raise FormatError(args.positions, f"no bone has both of its joints in the data ({', '.join(have) or 'none'} "
+                                          "found): no bone can be turned; give --map, or data with more joints")
     bar = TextProgress("solving bones")
     mats = solve(bones, positions, names, progress=bar)
     bar.close()

@@ -210,17 +210,44 @@ def _imagej_voxels(path, vol: np.ndarray) -> np.ndarray:
 
 def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
     """One 2-D image a z slice (rows y, columns x), named by ``pattern % z`` (``slices/frog%04d.png``); the
-    folder reads back as a volume. Returns the paths."""
+    folder reads back as a volume. Returns the paths.
+
+    Whole or not at all (#64): the slices are made in a hidden folder beside them, then moved into place,
+    and slices of an older, longer stack of the same name are removed, so the folder is never half one
+    stack and half another (a full disk stops the making; the old stack stays as it was)."""
+    import errno
+    import os
+    import shutil
+
     import imageio.v3 as iio
 
-    from ._atomic import atomic_open
+    from ._atomic import clean_stale, fsync_folder, pending_name
 
-    out = []
-    for z in range(vol.shape[2]):
-        path = Path(pattern % z)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_open(path, "wb") as fh:
-            fh.write(iio.imwrite("<bytes>", np.ascontiguousarray(np.swapaxes(vol[:, :, z], 0, 1)),
-                                 extension=path.suffix))
-        out.append(path)
+    out = [Path(pattern % z) for z in range(vol.shape[2])]
+    folder = out[0].parent
+    folder.mkdir(parents=True, exist_ok=True)
+    clean_stale(folder, "stack")
+    stage = folder / pending_name("stack")
+    stage.mkdir()
+    try:
+        for z, path in enumerate(out):
+            data = iio.imwrite("<bytes>", np.ascontiguousarray(np.swapaxes(vol[:, :, z], 0, 1)), extension=path.suffix)
+            with open(stage / path.name, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        for path in out:
+            os.replace(stage / path.name, path)
+        k = len(out)
+        while Path(pattern % k).is_file():  # an older stack's slices past the new one's end
+            Path(pattern % k).unlink()
+            k += 1
+        fsync_folder(folder)
+    except OSError as exc:
+        if exc.errno == errno.ENOSPC and exc.filename is None:
+            raise OSError(errno.ENOSPC, "no space left on the device for the slices; the folder's old slices are "
+                                        "as they were", pattern) from exc
+        raise
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
     return out

@@ -211,6 +211,8 @@ def prepare_frame(settings: RenderSettings, volume: np.ndarray, origin, table=No
     from volanim_core.render.surfaces import label_surface
 
     s = settings
+    if not (volume.ndim == 3 or (volume.ndim == 4 and volume.shape[3] == 3)):  # as the volume readers refuse it
+        raise ValueError(f"a volume to draw is [x, y, z] or RGB [x, y, z, 3], got shape {volume.shape}")
     if s.cut is not None:
         volume = cut_away(volume, origin, *s.cut)
     if volume.ndim == 4 and s.transfer is not None:

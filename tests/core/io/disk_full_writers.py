@@ -80,6 +80,7 @@ def writers(spare: Path):
         "transform .tfm": ("t.tfm", lambda p: _big_text_file(p, lambda q: write_transform(q, np.eye(4)))),
         "transform .h5": ("t.h5", lambda p: _big_text_file(p, lambda q: write_transform(q, np.eye(4)))),
         "BVH export .bvh": ("w.bvh", lambda p: write_bvh(p, many_joints, clip_matrices, 30.0)),
+        "slice stack .png": ("st%04d.png", lambda p: io.write_volume(p, vol)),
     })
     return out
 
@@ -145,7 +146,9 @@ def sequence_store(full: Path, spare: Path) -> dict:
 def main(full: Path, spare: Path) -> None:
     for name, (rel, write) in writers(spare).items():
         target = full / rel
-        target.write_bytes(OLD)
+        old = [full / (rel % k) for k in range(3)] if "%" in rel else [target]  # a stack: three old slices
+        for f in old:
+            f.write_bytes(OLD)
         ballast = fill(full, 24 * 1024)  # more than the old file, less than any new one
         result = {"writer": name, "target": rel}
         try:
@@ -156,9 +159,9 @@ def main(full: Path, spare: Path) -> None:
             result["traceback"] = "Traceback" if not isinstance(exc, OSError | ValueError) else ""
             if result["traceback"]:
                 result["traceback"] = traceback.format_exc()[-600:]
-        result["old_intact"] = target.is_file() and target.read_bytes() == OLD
+        result["old_intact"] = all(f.is_file() and f.read_bytes() == OLD for f in old)
         ballast.unlink()
-        result["litter"] = sorted(str(p.relative_to(full)) for p in full.rglob("*") if p.is_file() and p != target)
+        result["litter"] = sorted(str(p.relative_to(full)) for p in full.rglob("*") if p.is_file() and p not in old)
         for p in sorted(full.rglob("*"), reverse=True):  # the next writer starts on an empty disk
             p.unlink() if p.is_file() else p.rmdir()
         print(json.dumps(result), flush=True)

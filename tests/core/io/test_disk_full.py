@@ -34,7 +34,7 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
     table = "\n".join(f"{r['writer']:<24} raised: {bool(r['raised'])!s:<6} old intact: {r['old_intact']!s:<6} "
                       f"litter: {r['litter']}" for r in rows)
     print("\n" + table)
-    assert len(rows) == 22, out.stderr[-2000:]
+    assert len(rows) == 23, out.stderr[-2000:]
     for r in rows:
         assert r["raised"] and not r.get("traceback"), r
         assert r["old_intact"], r

@@ -33,3 +33,15 @@ def test_a_slice_stack_is_one_image_a_slice_and_reads_back_as_the_volume(tmp_pat
     for z, f in enumerate(files):
         assert np.array_equal(iio.imread(f), v[:, :, z].T)  # rows y, columns x
     assert np.array_equal(io.read_volume(tmp_path / "slices"), v)
+
+
+def test_a_shorter_stack_over_a_longer_one_leaves_only_itself(tmp_path):
+    """#64: slices were written one by one over the old ones: a 4-slice stack written where a 10-slice one was
+    left slices 4..9 of the old, and the folder read back as a 10-slice volume of two stacks."""
+    rng = np.random.default_rng(7)
+    old, new = (rng.integers(0, 256, (6, 5, n), dtype=np.uint8) for n in (10, 4))
+    io.write_volume(tmp_path / "s" / "frog%04d.png", old)
+    io.write_volume(tmp_path / "s" / "frog%04d.png", new)
+    assert sorted(p.name for p in (tmp_path / "s").iterdir()) == [f"frog{k:04d}.png" for k in range(4)]
+    theirs = np.stack([iio.imread(tmp_path / "s" / f"frog{k:04d}.png") for k in range(4)], axis=2).swapaxes(0, 1)
+    assert np.array_equal(theirs, new) and np.array_equal(io.read_volume(tmp_path / "s"), new)
