@@ -77,13 +77,13 @@ class BoneSkeleton:
     def on_grid(self, geometry: Geometry) -> BoneSkeleton:
         """These bones in the voxels of ``geometry`` (a skeleton's grid), through physical space.
 
-        Where either side records no geometry (files from before it was recorded), the joints are
-        taken to be on that grid already, as they always were; bones drawn on another grid (another
-        voxel size, a scan placed elsewhere, 3D Slicer's) land where they were drawn in the body.
+        Bones that record no geometry (files from before it was recorded) are taken to be on that grid
+        already, as they always were; bones drawn on another grid (another voxel size, a scan placed
+        elsewhere, 3D Slicer's) land where they were drawn in the body, onto the identity grid too (a scan
+        at origin 0 in 1 mm voxels records no line, and is a grid all the same: #63).
         """
-        if self.geometry.is_identity or geometry.is_identity or self.geometry == geometry:
-            known = geometry if not geometry.is_identity else self.geometry
-            return self if known == self.geometry else BoneSkeleton(self.joints, self.bones, known)
+        if self.geometry.is_identity or self.geometry == geometry:
+            return self if geometry == self.geometry else BoneSkeleton(self.joints, self.bones, geometry)
         names = list(self.joints)
         where = geometry.to_index(self.geometry.to_physical(np.array([self.joints[n] for n in names])))
         return BoneSkeleton(dict(zip(names, np.round(where, 6))), self.bones, geometry)

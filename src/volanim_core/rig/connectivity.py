@@ -178,12 +178,12 @@ class Trans:
         A frame posed on one grid and a rig skeletonized on another (a scan of 1 x 1 x 2.5 mm voxels
         and the 1 mm cubes skeletonize resampled it to) are one frame: the roots go where they are in
         the body, each matrix is conjugated by the map between the grids (``A M A^-1``, row vectors).
-        Between cube grids that is a similarity, so a rotation stays a rotation. Either side recording
-        no grid: taken as on the other, as :meth:`BoneSkeleton.on_grid` does.
+        Between cube grids that is a similarity, so a rotation stays a rotation. A frame recording no
+        grid is taken as on the other, as :meth:`BoneSkeleton.on_grid` does; the identity grid (no line)
+        is a grid like any other to a frame that records one.
         """
-        if self.geometry.is_identity or geometry.is_identity or self.geometry == geometry:
-            return self if geometry.is_identity or geometry == self.geometry else \
-                Trans(self.bones, self.matrices, geometry)
+        if self.geometry.is_identity or self.geometry == geometry:
+            return self if geometry == self.geometry else Trans(self.bones, self.matrices, geometry)
         a = geometry.index_map(self.geometry)  # [i j k 1] @ a: our voxels -> theirs, then M, then back
 
         def here(p):

@@ -100,3 +100,44 @@ def test_a_frame_is_the_same_motion_on_any_grid():
     assert np.allclose(r @ r.T, np.eye(3))  # between cube grids a rotation stays a rotation
     old = Trans([BoneSegment(np.zeros(3), np.ones(3), "ab")], np.eye(4)[None])  # a seed's file: no grid
     assert old.on_grid(fine).bones == old.bones and old.on_grid(fine).geometry == fine
+
+
+def _dice(args) -> float:
+    import contextlib
+    import io as text
+    import json
+
+    out = text.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main([str(a) for a in args]) == 0
+    return json.loads(out.getvalue()[out.getvalue().index("{"):])["dice"]
+
+
+def test_the_posed_body_of_a_scan_at_origin_0_is_the_true_posed_shape(tmp_path):
+    """The mannequin scanned at 1 x 1 x 2.5 mm with its origin at 0 (the resampled cubes are then the identity
+    grid, which records no line), its joints placed in millimetres, the arm raised 60 degrees: the posed body
+    is the mannequin's true posed shape as nearly as its rest body is its true rest shape. The review found
+    the identity grid taken for "no grid": bones stayed in the scan's 2.5 mm slices on the 1 mm cubes and
+    the raised body scored Dice 0.951 against the truth, its rest 0.987."""
+    from volanim_core.volume import resample
+
+    d = tmp_path
+    write_sample("mannequin", d)
+    aniso, geometry = resample(io.read_volume(d / "mannequin.VOL"), Geometry(), (1.0, 1.0, 2.5), order=1,
+                               threshold_at=0.5)
+    io.write_volume(d / "ct.nrrd", aniso.astype(np.uint8) * 255, geometry)
+    write_markups(d / "m.mrk.json", io.read_bones(d / "mannequin.bones"), Geometry())
+    for argv in (["markups", d / "m.mrk.json", "--like", d / "ct.nrrd", "-o", d / "ct.bones"],
+                 ["skeletonize", d / "ct.nrrd", "-o", d / "ct.mskel"],
+                 ["connect", d / "ct.mskel", d / "ct.bones", "--thinness", "0.5", "-o", d / "ct.connect"],
+                 ["pose", d / "ct.bones", "--rotate", "L_UPPERARM=0,60,0", "-o", d / "p.trans"],
+                 ["pose", d / "mannequin.bones", "--rotate", "L_UPPERARM=0,60,0", "-o", d / "truth.trans"],
+                 ["pose", d / "mannequin.bones", "-o", d / "rest.trans"],
+                 ["connect2tskel", d / "ct.connect", d / "p.trans", "-o", d / "p.tskel"],
+                 ["connect2identitytskel", d / "ct.connect", "-o", d / "rest.tskel"]):
+        assert main([str(a) for a in argv]) == 0, argv[0]
+    for frame in ("p", "rest"):
+        assert main(["reconstruct", str(d / f"{frame}.tskel"), "--mode", "binary", "-o", str(d / f"{frame}.vti")]) == 0
+    posed = _dice(["compare", d / "p.vti", "--sample", "mannequin", "--pose", d / "truth.trans", "--json"])
+    rest = _dice(["compare", d / "rest.vti", "--sample", "mannequin", "--pose", d / "rest.trans", "--json"])
+    assert rest > 0.98 and posed >= rest - 0.005, (posed, rest)
