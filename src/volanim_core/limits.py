@@ -21,6 +21,7 @@ from volanim_core.errors import FormatError
 DEFAULT_MAX_VOXELS = 2**33  # 8 G voxels: far above any scan we know of, far below exabytes
 MAX_AXIS = 2**31 - 1  # kernels index with 32-bit ints per axis
 MAX_COORD = 2**30  # voxel coordinates and radii (int32 with room to spare); text readers refuse larger
+MAX_MEASURE = 1e9  # a coordinate in a file's own units (mm, a mesh's): past it, no measurement of a body
 
 
 def max_voxels() -> int:

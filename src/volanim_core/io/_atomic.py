@@ -17,10 +17,19 @@ import errno
 import os
 import re
 import secrets
+import shutil
 import time
 from pathlib import Path
 
 LEGACY_STALE_SECONDS = 600  # temporaries without a pid (older versions) are stale after this
+
+
+def out_of_room(exc: BaseException, path, what: str) -> OSError | None:
+    """The full disk ``exc`` (ENOSPC, no file named) said of ``path``, the file being written: the CLI names
+    an OSError's file, and named the *input* it was reading when none was given. None for anything else."""
+    if isinstance(exc, OSError) and exc.errno == errno.ENOSPC and exc.filename is None:
+        return OSError(errno.ENOSPC, f"no space left on the device for {what}", str(path))
+    return None
 
 
 def pending_name(name: str, suffix: str = ".tmp") -> str:
@@ -87,8 +96,6 @@ def clean_stale(folder: Path, name: str | None = None, suffix: str = ".tmp") -> 
                 os.unlink(entry.path)
                 removed += 1
             elif stale and ours and entry.is_dir(follow_symlinks=False):  # a store made beside its target
-                import shutil
-
                 shutil.rmtree(entry.path, ignore_errors=True)
                 removed += 1
         except (OSError, ValueError):
@@ -136,10 +143,9 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs):
         written = tmp.stat().st_size if tmp.exists() else 0
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
-        if isinstance(exc, OSError) and exc.errno == errno.ENOSPC and exc.filename is None:
-            # said of the file being written (the CLI named the input it was reading before)
-            raise OSError(errno.ENOSPC, f"no space left on the device: {written:,} bytes of it were written "
-                                        "when the disk filled; it needs more room than that", str(path)) from exc
+        full = out_of_room(exc, path, f"it ({written:,} bytes were written when the disk filled; it needs more)")
+        if full is not None:
+            raise full from exc
         raise
 
 

@@ -215,13 +215,12 @@ def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
     Whole or not at all (#64): the slices are made in a hidden folder beside them, then moved into place,
     and slices of an older, longer stack of the same name are removed, so the folder is never half one
     stack and half another (a full disk stops the making; the old stack stays as it was)."""
-    import errno
     import os
     import shutil
 
     import imageio.v3 as iio
 
-    from ._atomic import clean_stale, fsync_folder, pending_name
+    from ._atomic import clean_stale, fsync_folder, out_of_room, pending_name
 
     out = [Path(pattern % z) for z in range(vol.shape[2])]
     folder = out[0].parent
@@ -244,9 +243,9 @@ def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
             k += 1
         fsync_folder(folder)
     except OSError as exc:
-        if exc.errno == errno.ENOSPC and exc.filename is None:
-            raise OSError(errno.ENOSPC, "no space left on the device for the slices; the folder's old slices are "
-                                        "as they were", pattern) from exc
+        full = out_of_room(exc, pattern, "the slices (the folder's old slices are as they were)")
+        if full is not None:
+            raise full from exc
         raise
     finally:
         shutil.rmtree(stage, ignore_errors=True)

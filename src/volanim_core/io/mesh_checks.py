@@ -19,11 +19,11 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
+from volanim_core.limits import MAX_MEASURE
 
 MAX_CORNERS = 1024  # corners of one polygon (VTK triangulates it: a 900 000-corner face hung)
 MAX_HEADER = 1 << 16
 MAX_LINE = 1 << 20  # an OBJ line: a face of MAX_CORNERS corners is some 20 KB
-MAX_VERTEX = 1e9  # a coordinate past it is no model's (and overflows the voxel grid's size)
 _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
               "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
               "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
@@ -214,8 +214,8 @@ def read_obj(path: Path):
                 xyz = [float(w) for w in words[1:4]]
             except ValueError:
                 raise FormatError(path, f"a vertex needs 3 numbers: {line[:80]!r}", number) from None
-            if len(xyz) != 3 or not np.isfinite(xyz).all() or max(map(abs, xyz)) > MAX_VERTEX:
-                raise FormatError(path, f"a vertex needs 3 finite numbers within {MAX_VERTEX:g}: {line[:80]!r}",
+            if len(xyz) != 3 or not np.isfinite(xyz).all() or max(map(abs, xyz)) > MAX_MEASURE:
+                raise FormatError(path, f"a vertex needs 3 finite numbers within {MAX_MEASURE:g}: {line[:80]!r}",
                                   number)
             vertices.append(xyz)
         elif words[0] == "f":

@@ -55,14 +55,14 @@ def read_mesh(path):
         raise FormatError(path, f"VTK could not read it as a mesh: {exc}") from exc
     if not isinstance(mesh, pv.PolyData) or mesh.n_points == 0 or mesh.n_cells == 0:
         raise FormatError(path, "holds no mesh (no points or no faces)")
-    from .mesh_checks import MAX_VERTEX
+    from volanim_core.limits import MAX_MEASURE
 
     points = np.asarray(mesh.points)
-    bad = ~(np.isfinite(points) & (np.abs(points) <= MAX_VERTEX)).all(axis=1)
+    bad = ~(np.isfinite(points) & (np.abs(points) <= MAX_MEASURE)).all(axis=1)
     if bad.any():  # an infinite vertex overflowed the voxel grid; a NaN one voxelized to nothing
         k = int(np.argmax(bad))
         raise FormatError(path, f"vertex {k} is at {points[k].tolist()}: vertices must be finite numbers within "
-                                f"{MAX_VERTEX:g}")
+                                f"{MAX_MEASURE:g}")
     return mesh
 
 

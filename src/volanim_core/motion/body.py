@@ -70,25 +70,23 @@ def reach(motion: Motion) -> np.ndarray:
     return out
 
 
-def subtree(kids, j):
-    """``j`` and every joint below it."""
-    stack = [j]
-    while stack:
-        k = stack.pop()
-        yield k
-        stack.extend(kids[k])
+def sizes(motion: Motion) -> np.ndarray:
+    """Per joint: how many joints its branch holds, itself included."""
+    out = np.ones(len(motion.names), np.int64)
+    for j in reversed(range(len(motion.names))):  # parents come first in file order
+        if motion.parents[j] >= 0:
+            out[motion.parents[j]] += out[j]
+    return out
 
 
-def twins(motion: Motion, kids, far: np.ndarray, branches: list[int]) -> tuple[int, int] | None:
-    """The longest pair of mirror-twin branches: the same number of joints, reaches within TWINS."""
-    def size(j):
-        return sum(1 for _ in subtree(kids, j))
-
+def twins(motion: Motion, size: np.ndarray, far: np.ndarray, branches: list[int]) -> tuple[int, int] | None:
+    """The longest pair of mirror-twin branches: the same number of joints (``size``, :func:`sizes`),
+    reaches (``far``, :func:`reach`) within TWINS."""
     def length(j):
         return far[j] + float(np.linalg.norm(motion.offsets[j]))
 
     pairs = [(a, b) for i, a in enumerate(branches) for b in branches[i + 1:]
-             if size(a) == size(b) and abs(length(a) - length(b)) <= TWINS * max(length(a), length(b), 1e-9)
+             if size[a] == size[b] and abs(length(a) - length(b)) <= TWINS * max(length(a), length(b), 1e-9)
              and min(length(a), length(b)) > 0]
     return max(pairs, key=lambda p: length(p[0]) + length(p[1]), default=None)
 
@@ -141,11 +139,11 @@ def read_body(motion: Motion, s: Sampled) -> Body:
     branches = kids[root]
     if len(branches) < 2:
         return Body({}, ["the hierarchy does not fork at the hips"])
-    count = {b: sum(1 for _ in subtree(kids, b)) for b in branches}
+    count = sizes(motion)
     upper = max(branches, key=lambda b: (count[b], far[b]))
     others = sorted((b for b in branches if b != upper), key=lambda b: -(far[b] + np.linalg.norm(motion.offsets[b])))
     longest = far[others[0]] + np.linalg.norm(motion.offsets[others[0]])
-    pair = twins(motion, kids, far, others)  # not a tail longer than the legs (a tailed biped, 3ds Max's)
+    pair = twins(motion, count, far, others)  # not a tail longer than the legs (a tailed biped, 3ds Max's)
     legs = list(pair) if pair else \
         [b for b in others[:2] if far[b] + np.linalg.norm(motion.offsets[b]) >= 0.5 * longest]
     fork = upper

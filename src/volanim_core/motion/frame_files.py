@@ -65,8 +65,7 @@ def check_complete(paths) -> None:
     from volanim_core.errors import FormatError
 
     for p in paths:
-        m = re.match(r"(.+?)\.?\d+$", Path(p).stem)
-        marker = incomplete_marker(Path(p).parent, m.group(1) if m else Path(p).stem)
+        marker = incomplete_marker(Path(p).parent, _named(p)[0])
         if marker.is_file():
             raise FormatError(p, f"{marker.name} lies beside it: the run writing these frames stopped before the "
                                  "last (killed, cancelled or out of room); run it again to write them all")
@@ -74,8 +73,13 @@ def check_complete(paths) -> None:
 
 def frame_number(path: str | Path) -> int | None:
     """The frame number in ``NAME.0012.trans`` (or ``NAME0012.trans``, ``12.trans``); None without one."""
-    m = re.search(r"(\d+)$", Path(path).stem)
-    return int(m.group(1)) if m else None
+    return _named(path)[1]
+
+
+def _named(path) -> tuple[str, int | None]:
+    """``NAME.0012.trans`` -> ("NAME", 12); a name without a number -> (its stem, None)."""
+    m = re.match(r"^(.*?)\.?(\d+)$", Path(path).stem)
+    return (m.group(1), int(m.group(2))) if m else (Path(path).stem, None)
 
 
 def read_frames(paths, bones: BoneSkeleton, progress=None) -> tuple[np.ndarray, list[Path]]:

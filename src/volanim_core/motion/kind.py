@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .body import Sampled, children, longest_path, reach, twins
+from .body import Sampled, children, longest_path, reach, sizes, twins
 from .bvh import Motion
 from .presets import part_of
 
@@ -45,8 +45,8 @@ def _angles(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def clip_kind(motion: Motion, s: Sampled) -> Kind:
     """The kind of the clip's figure, and the reason in words (printed by ``bvh2trans``)."""
-    kids, far = children(motion), reach(motion)
-    pairs = [p for j in range(len(motion.names)) for p in _pairs(motion, kids, far, kids[j])]
+    kids, far, size = children(motion), reach(motion), sizes(motion)
+    pairs = [p for j in range(len(motion.names)) for p in _pairs(motion, size, far, kids[j])]
     if len(pairs) < 2:
         return Kind("other", f"{'one pair' if pairs else 'no pair'} of twin limbs, not two")
     pairs = sorted(pairs, key=lambda p: -(far[p[0]] + far[p[1]]))[:2]  # not a hand's fingers
@@ -68,10 +68,10 @@ def clip_kind(motion: Motion, s: Sampled) -> Kind:
     return Kind("other", f"neither a biped's legs nor a quadruped's ({said})")
 
 
-def _pairs(motion: Motion, kids, far, siblings: list[int]) -> list[tuple[int, int]]:
+def _pairs(motion: Motion, size, far, siblings: list[int]) -> list[tuple[int, int]]:
     """Twin pairs among one joint's children, longest first (a root may carry both legs and arms)."""
     out, left = [], list(siblings)
-    while (pair := twins(motion, kids, far, left)) is not None:
+    while (pair := twins(motion, size, far, left)) is not None:
         out.append(pair)
         left = [c for c in left if c not in pair]
     return out

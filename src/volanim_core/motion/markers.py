@@ -21,9 +21,10 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.limits import MAX_MEASURE
 from volanim_core.rig.bones import BoneSkeleton
 
-MAX_MARKER = 1e9  # in the file's units (mm): past it a coordinate is no measurement
+from .c3d_layout import C3dLayout
 
 
 def read_c3d(path: str | Path) -> tuple[list[str], np.ndarray, float, str]:
@@ -36,7 +37,7 @@ def read_c3d(path: str | Path) -> tuple[list[str], np.ndarray, float, str]:
     if not Path(path).is_file():  # ezc3d's own message says neither which file nor why
         raise FormatError(path, "no such file" if not Path(path).exists() else "is not a regular file; expected "
                           "a C3D file")
-    held = _c3d_frames_held(path)  # ezc3d allocates what the header claims (32767 points), then reads
+    layout = C3dLayout.read(path)  # checked before ezc3d allocates what the header claims
     try:
         c3d = ezc3d.c3d(str(path))
     except (OSError, RuntimeError, ValueError) as e:
@@ -46,10 +47,10 @@ def read_c3d(path: str | Path) -> tuple[list[str], np.ndarray, float, str]:
     xyz = np.asarray(c3d["data"]["points"], float)[:3]  # (4, M, F): x, y, z, 1
     if xyz.shape[1] != len(labels) or xyz.shape[2] == 0:
         raise FormatError(path, f"{xyz.shape[1]} markers and {len(labels)} labels in {xyz.shape[2]} frames")
-    claimed = _point_frames(path)  # as written: ezc3d rewrites POINT:FRAMES to what a truncated file still holds
-    if xyz.shape[2] > held or (claimed is not None and claimed > xyz.shape[2] and not _ends_on_a_frame(path)):
+    claimed = layout.point_frames
+    if xyz.shape[2] > layout.held or (claimed is not None and claimed > xyz.shape[2] and not layout.ends_on_a_frame):
         raise FormatError(path, f"{xyz.shape[2]} frames read, where its POINT:FRAMES says {claimed} and its bytes "
-                                f"hold {held} and part of another: cut short in the middle of a frame")
+                                f"hold {layout.held} and part of another: cut short in the middle of a frame")
     if claimed is not None and claimed > xyz.shape[2]:  # cut at a frame's end, as ezc3d's own Optotrak.c3d is
         import warnings
 
@@ -58,92 +59,10 @@ def read_c3d(path: str | Path) -> tuple[list[str], np.ndarray, float, str]:
     unit = str(point["UNITS"]["value"][0]).strip() if "UNITS" in point and len(point["UNITS"]["value"]) else ""
     xyz = np.transpose(xyz, (2, 1, 0))
     # a coordinate no camera measured (inf, NaN, 1e30) is a missing marker in that frame, as an invalid one is
-    xyz[~(np.isfinite(xyz) & (np.abs(xyz) <= MAX_MARKER)).all(axis=2)] = np.nan
+    xyz[~(np.isfinite(xyz) & (np.abs(xyz) <= MAX_MEASURE)).all(axis=2)] = np.nan
     if np.isnan(xyz).all():
         raise FormatError(path, f"no marker has a position in any of its {len(xyz)} frames")
     return labels, xyz, float(point["RATE"]["value"][0]), unit
-
-
-def _s8(byte: int) -> int:
-    return byte - 256 if byte > 127 else byte
-
-
-def _point_frames(path) -> int | None:
-    """The POINT:FRAMES parameter as the file writes it (C3D's parameter section: records of a signed name
-    length, a group or parameter id, the name, an offset to the next record, then a parameter's type,
-    dimensions and data), or None where it cannot be found."""
-    with open(path, "rb") as fh:
-        block = fh.read(1)
-        fh.seek(max(block[0] - 1, 0) * 512 if block else 0)
-        section = fh.read(4)
-        if len(section) < 4:
-            return None
-        data = fh.read(max(section[2], 1) * 512 - 4)
-    order = ">" if section[3] == 86 else "<"
-    groups, params, at = {}, {}, 0
-    while at + 4 <= len(data):
-        size, ident = abs(_s8(data[at])), _s8(data[at + 1])
-        if size == 0:
-            break
-        name = data[at + 2:at + 2 + size].decode("latin-1").upper()
-        step = int(np.frombuffer(data[at + 2 + size:at + 4 + size], order + "i2")[0]) if at + 4 + size <= len(data) \
-            else 0
-        if ident < 0:
-            groups[-ident] = name
-        else:
-            body = at + 4 + size
-            kind, dims = _s8(data[body]), data[body + 1] if body + 1 < len(data) else 0
-            first = body + 2 + dims
-            if kind in (2, 4) and first + abs(kind) <= len(data):
-                params[(ident, name)] = float(np.frombuffer(data[first:first + 4], order + "f4")[0]) if kind == 4 \
-                    else int(np.frombuffer(data[first:first + 2], order + "u2")[0])
-        if step <= 0:
-            break
-        at += 2 + size + step
-    point = next((g for g, n in groups.items() if n == "POINT"), None)
-    value = params.get((point, "FRAMES"))
-    return int(value) if value is not None and np.isfinite(value) else None
-
-
-def _ends_on_a_frame(path) -> bool:
-    """Whether the data ends with a whole frame (then at most zeros, padding to the 512-byte block)."""
-    with open(path, "rb") as fh:
-        head = fh.read(512)
-        fh.seek(max(head[0] - 1, 0) * 512)
-        big = fh.read(4)[3:4] == b"\x56"
-        words = np.frombuffer(head[:24], ">u2" if big else "<u2")
-        size = 4 if float(np.frombuffer(head[12:16], ">f4" if big else "<f4")[0]) < 0 else 2
-        frame = (int(words[1]) * 4 + int(words[2])) * size
-        start = max(int(words[8]) - 1, 0) * 512
-        total = Path(path).stat().st_size
-        tail = (total - start) % frame if frame else 0
-        fh.seek(total - tail)
-        return tail < 512 and not fh.read(tail).strip(b"\0")
-
-
-def _c3d_frames_held(path) -> int:
-    """How many frames of points (and analog samples) the file's bytes after its data start can hold, as its
-    header counts them; a file that cannot hold one is refused (a header claiming 32767 points of a
-    file of a few kilobytes). The header's frame range is not trusted: real files (Optotrak's) get it
-    wrong and readers go by the POINT:FRAMES parameter."""
-    from volanim_core.errors import FormatError
-
-    with open(path, "rb") as fh:
-        head = fh.read(512)
-        if len(head) < 512 or head[1] != 0x50:
-            raise FormatError(path, "not a C3D file (its first block is not a C3D header)")
-        fh.seek(max(head[0] - 1, 0) * 512)
-        params = fh.read(4)
-    big = len(params) == 4 and params[3] == 86  # processor type 86: MIPS, big-endian; 84/85: little
-    words = np.frombuffer(head[:24], ">u2" if big else "<u2")
-    points, analog, start = int(words[1]), int(words[2]), int(words[8])
-    size = 4 if float(np.frombuffer(head[12:16], ">f4" if big else "<f4")[0]) < 0 else 2  # < 0: float data
-    frame_bytes = (points * 4 + analog) * size
-    held = (Path(path).stat().st_size - max(start - 1, 0) * 512) // max(frame_bytes, 1)
-    if held < 1:
-        raise FormatError(path, f"its header claims {points} points and {analog} analog samples a frame "
-                                f"({frame_bytes:,} bytes from block {start}); the file holds no whole frame of them")
-    return int(held)
 
 
 def read_marker_map(path: str | Path) -> dict[str, list[str]]:

@@ -26,10 +26,10 @@ from pathlib import Path
 
 import numpy as np
 
+from volanim_core.limits import MAX_MEASURE
 from volanim_core.rig.bones import BoneSkeleton
 
 MAX_FRAME_NUMBER = 10_000_000  # frame numbers name files (NAME.0012.trans); 10^23 is no frame
-MAX_POSITION = 1e9  # in the file's units: a kilometre in millimetres a thousand times over; 1e308 is no joint
 MIN_SIN = 0.2  # a third marker nearer the bone's line than this (as a fraction of its distance) gives no twist
 
 
@@ -59,8 +59,8 @@ def read_positions(path: str | Path, names: list[str], scale: float = 1.0) -> tu
                               line_no) from None
         if not 0 <= frame <= MAX_FRAME_NUMBER:
             raise FormatError(path, f"frame {fields[0]}: frame numbers are 0 to {MAX_FRAME_NUMBER:,}", line_no)
-        if not all(np.isfinite(v) and abs(v) <= MAX_POSITION for v in xyz):
-            raise FormatError(path, f"a position must be finite and within {MAX_POSITION:g} of the origin, got "
+        if not all(np.isfinite(v) and abs(v) <= MAX_MEASURE for v in xyz):
+            raise FormatError(path, f"a position must be finite and within {MAX_MEASURE:g} of the origin, got "
                               f"{', '.join(fields[2:])}", line_no)
         if fields[1] in index:
             rows.setdefault(frame, {})[index[fields[1]]] = xyz

@@ -12,7 +12,6 @@ ones (``volanim-render.json`` holds the settings' key; other settings start over
 
 from __future__ import annotations
 
-import errno
 import hashlib
 import json
 import os
@@ -411,7 +410,7 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
     import imageio.v2 as iio2
     import imageio.v3 as iio
 
-    from volanim_core.io._atomic import clean_stale, pending_name
+    from volanim_core.io._atomic import clean_stale, out_of_room, pending_name
 
     out.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(out.parent, out.name)
@@ -432,6 +431,7 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
         os.replace(tmp, out)
     except BaseException as exc:
         tmp.unlink(missing_ok=True)
-        if isinstance(exc, OSError) and exc.errno == errno.ENOSPC and exc.filename is None:
-            raise OSError(errno.ENOSPC, "no space left on the device for the movie", str(out)) from exc
+        full = out_of_room(exc, out, "the movie")
+        if full is not None:
+            raise full from exc
         raise
