@@ -116,7 +116,35 @@ def c3d_cases() -> list[Case]:
         case("a marker at +inf reads as missing", _c3d(marker(float("inf"))), "accept", "c3d_first_marker_missing"),
         case("a marker at 1e30 reads as missing", _c3d(marker(1e30)), "accept", "c3d_first_marker_missing"),
         case("the real file", whole, "accept", "c3d_qualisys"),
-    ]
+    ] + c3d_label_cases()
+
+
+def _written_c3d(labels: list[str], frames: int = 5) -> bytes:
+    """A small C3D written by ezc3d: ``labels`` moving apart, 10 units a step, 100 Hz."""
+    import ezc3d
+
+    c = ezc3d.c3d()
+    c["parameters"]["POINT"]["RATE"]["value"] = [100]
+    c["parameters"]["POINT"]["LABELS"]["value"] = labels
+    points = np.ones((4, len(labels), frames))
+    points[:3] = np.arange(3 * len(labels) * frames).reshape(3, len(labels), frames) * 10.0
+    c["data"]["points"] = points
+    with tempfile.TemporaryDirectory() as tmp:
+        c.write(f"{tmp}/m.c3d")
+        return Path(f"{tmp}/m.c3d").read_bytes()
+
+
+def c3d_label_cases() -> list[Case]:
+    """Labels through ``positions2trans``: none of them a joint, or too few to pose a bone, is refused."""
+    def case(name, labels, expect="refuse"):
+        return Case(f"c3d: {name}", "cli:positions2trans",
+                    {"m.c3d": _written_c3d(labels), "m.bones": MANNEQUIN_BONES.read_bytes()},
+                    "positions2trans {d}/m.c3d --bones {d}/m.bones -o {d}/out", expect)
+
+    return [case("labels none of which names a joint", ["FOO", "BAR", "BAZ"]),
+            case("one marker", ["PELVIS"]),
+            case("an accented and an empty label", ["PEL\xe9VIS", ""]),
+            case("two markers: one bone posed, the rest follow", ["PELVIS", "NECK"], "accept")]
 
 
 def _dicom_series(mutate=None) -> dict[str, bytes]:

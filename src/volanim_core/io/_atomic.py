@@ -32,6 +32,23 @@ def out_of_room(exc: BaseException, path, what: str) -> OSError | None:
     return None
 
 
+class naming_the_output:  # noqa: N801 - used as a context manager, named as one
+    """``with naming_the_output(path, what):`` re-raises a full disk met inside as :func:`out_of_room` of
+    ``path``. Reusable: one object may guard several blocks writing the same output."""
+
+    def __init__(self, path, what: str):
+        self.path, self.what = path, what
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        full = out_of_room(exc, self.path, self.what) if exc is not None else None
+        if full is not None:
+            raise full from exc
+        return False
+
+
 def pending_name(name: str, suffix: str = ".tmp") -> str:
     """A hidden temporary name for ``name`` in the same folder, owned by this process."""
     return f".{name}.{os.getpid()}-{secrets.token_hex(4)}{suffix}"  # matches _OURS

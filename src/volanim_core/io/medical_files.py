@@ -220,7 +220,7 @@ def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
 
     import imageio.v3 as iio
 
-    from ._atomic import clean_stale, fsync_folder, out_of_room, pending_name
+    from ._atomic import clean_stale, fsync_folder, naming_the_output, pending_name
 
     out = [Path(pattern % z) for z in range(vol.shape[2])]
     folder = out[0].parent
@@ -229,24 +229,21 @@ def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
     stage = folder / pending_name("stack")
     stage.mkdir()
     try:
-        for z, path in enumerate(out):
-            data = iio.imwrite("<bytes>", np.ascontiguousarray(np.swapaxes(vol[:, :, z], 0, 1)), extension=path.suffix)
-            with open(stage / path.name, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-        for path in out:
-            os.replace(stage / path.name, path)
-        k = len(out)
-        while Path(pattern % k).is_file():  # an older stack's slices past the new one's end
-            Path(pattern % k).unlink()
-            k += 1
-        fsync_folder(folder)
-    except OSError as exc:
-        full = out_of_room(exc, pattern, "the slices (the folder's old slices are as they were)")
-        if full is not None:
-            raise full from exc
-        raise
+        with naming_the_output(pattern, "the slices (the folder's old slices are as they were)"):
+            for z, path in enumerate(out):
+                picture = np.ascontiguousarray(np.swapaxes(vol[:, :, z], 0, 1))
+                data = iio.imwrite("<bytes>", picture, extension=path.suffix)
+                with open(stage / path.name, "wb") as fh:
+                    fh.write(data)
+                    fh.flush()
+                    os.fsync(fh.fileno())
+            for path in out:
+                os.replace(stage / path.name, path)
+            k = len(out)
+            while Path(pattern % k).is_file():  # an older stack's slices past the new one's end
+                Path(pattern % k).unlink()
+                k += 1
+            fsync_folder(folder)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
     return out

@@ -95,7 +95,8 @@ def default_map(labels: list[str], joints: list[str]) -> dict[str, list[str]]:
 
 def listed(labels: list[str], most: int = 60) -> str:
     """``"54 markers: Marker_1, ..."`` for an error message, at most ``most`` names."""
-    return f"{len(labels)} markers: {', '.join(labels[:most])}{' ...' if len(labels) > most else ''}"
+    names = [label or "(no label)" for label in labels[:most]]
+    return f"{len(labels)} markers: {', '.join(names)}{' ...' if len(labels) > most else ''}"
 
 
 def joints_from_markers(labels: list[str], markers: np.ndarray, mapping: dict[str, list[str]],

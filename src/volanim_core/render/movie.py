@@ -410,28 +410,26 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
     import imageio.v2 as iio2
     import imageio.v3 as iio
 
-    from volanim_core.io._atomic import clean_stale, out_of_room, pending_name
+    from volanim_core.io._atomic import clean_stale, naming_the_output, pending_name
 
     out.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(out.parent, out.name)
     tmp = out.parent / (pending_name(out.name) + out.suffix)  # the encoder picks the format by extension
-    try:
-        if out.suffix.lower() == ".mp4":
-            with iio2.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264", quality=8, macro_block_size=16,
-                                 pixelformat="yuv420p", ffmpeg_log_level="error") as writer:
-                for p in pngs:
-                    writer.append_data(iio.imread(p))
-        else:
-            frames = [iio.imread(p) for p in pngs]
-            # GIF delays are whole centiseconds: spread the rounding so the clip keeps its length
-            # (24 fps as 4 cs each would play 4 % slow). Identical neighbours are merged by Pillow, their
-            # delays added: the frame count may drop, the timing does not.
-            ticks = np.round(np.arange(len(frames) + 1) * 100.0 / fps)
-            iio.imwrite(tmp, frames, extension=".gif", duration=list(np.diff(ticks) * 10.0), loop=0)
-        os.replace(tmp, out)
-    except BaseException as exc:
-        tmp.unlink(missing_ok=True)
-        full = out_of_room(exc, out, "the movie")
-        if full is not None:
-            raise full from exc
-        raise
+    with naming_the_output(out, "the movie"):
+        try:
+            if out.suffix.lower() == ".mp4":
+                with iio2.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264", quality=8, macro_block_size=16,
+                                     pixelformat="yuv420p", ffmpeg_log_level="error") as writer:
+                    for p in pngs:
+                        writer.append_data(iio.imread(p))
+            else:
+                frames = [iio.imread(p) for p in pngs]
+                # GIF delays are whole centiseconds: spread the rounding so the clip keeps its length
+                # (24 fps as 4 cs each would play 4 % slow). Identical neighbours are merged by Pillow, their
+                # delays added: the frame count may drop, the timing does not.
+                ticks = np.round(np.arange(len(frames) + 1) * 100.0 / fps)
+                iio.imwrite(tmp, frames, extension=".gif", duration=list(np.diff(ticks) * 10.0), loop=0)
+            os.replace(tmp, out)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise

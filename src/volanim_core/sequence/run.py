@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.colour.indexed import index_colours
+from volanim_core.io._atomic import naming_the_output
 from volanim_core.io._files import resolved
 from volanim_core.limits import available_bytes, human_bytes
 from volanim_core.parallel import executor
@@ -191,6 +192,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
         key = hashlib.blake2b((key + palette.tobytes().hex()).encode(), digest_size=16).hexdigest()
     plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
             "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
+    # a full disk names the store: it stopped there, and its finished frames stay for the next run
+    full_disk = naming_the_output(out, "the sequence store (its finished frames are kept: run again with room)")
     old = store.read_plan(out) if out.exists() else None
     if out.exists() and old is None and (out.is_file() or any(out.iterdir())):
         # never replaced, even with --force: it may be anything the user keeps there
@@ -203,8 +206,9 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
             raise ValueError(f"{out} holds another sequence (different frames, connectivity, mode or source); "
                              "pass --force to replace it, or choose another -o")
         rest = plan["rest_filled"] = _rest_filled(conn)  # once per store: a resumed run does not redo it
-        store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps,
-                     geometry=conn.geometry.shifted(bounds.lo), palette=palette)
+        with full_disk:
+            store.create(out, bounds.shape[::-1], len(frames), dtype, bounds.lo, plan, fps=fps,
+                         geometry=conn.geometry.shifted(bounds.lo), palette=palette)
         done = {}
     if every_frame_as:
         Path(every_frame_as).parent.mkdir(parents=True, exist_ok=True)
@@ -214,8 +218,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
     records = dict(done)
     total = len(frames)
     task_seconds = DASK_TASK_SECONDS if scheduler is not None else 0.0
-    with executor(reconstruct_frames, payload, install, workers=n_workers, scheduler=scheduler) as (submit, label,
-                                                                                                 in_flight):
+    with full_disk, executor(reconstruct_frames, payload, install, workers=n_workers,
+                             scheduler=scheduler) as (submit, label, in_flight):
         pending: set[Future] = set()
         queue = list(todo)
         seconds: list[float] = []  # finished frames' own seconds: how many make a task

@@ -143,6 +143,47 @@ def sequence_store(full: Path, spare: Path) -> dict:
     return result
 
 
+def frame_folder(full: Path, spare: Path) -> dict:
+    """A clip's frames (``bvh2trans``, ``keys``, ``positions2trans`` write them with ``write_frames``) on a
+    disk with room for some: the run raises naming the frame that did not fit, the folder is marked
+    incomplete and refused by every reader, and the same run after room is made completes it."""
+    sys.path.insert(0, str(Path(__file__).parents[2]))
+    from paths import WALK
+    from volanim_core.errors import FormatError
+    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.motion.frame_files import incomplete_marker, read_frames, write_frames
+    from volanim_core.motion.retarget import Retarget
+    from volanim_core.samples import mannequin_bones
+
+    bones = mannequin_bones()
+    mats = Retarget.build(bones, read_bvh(WALK)).matrices(slice(0, 200))
+    write_frames(spare / "roomy", "walk", bones, mats, range(len(mats)))
+    size = sum(f.stat().st_size for f in (spare / "roomy").iterdir())
+    ballast = fill(full, size // 3)
+    result = {"writer": "frame folder .trans", "frames": len(mats)}
+    try:
+        write_frames(full / "out", "walk", bones, mats, range(len(mats)))
+        result["raised"] = None
+    except OSError as exc:
+        result["raised"] = f"{type(exc).__name__}: {exc}"[:300]
+    result["written"] = len(list((full / "out").glob("*.trans")))
+    result["marked"] = incomplete_marker(full / "out", "walk").is_file()
+    try:
+        read_frames(full / "out", bones)
+        result["read_refused"] = None
+    except FormatError as exc:
+        result["read_refused"] = str(exc)[:300]
+    ballast.unlink()
+    write_frames(full / "out", "walk", bones, mats, range(len(mats)))
+    result["marked_after_rerun"] = incomplete_marker(full / "out", "walk").is_file()
+    result["rerun_equal"] = bool(np.array_equal(read_frames(full / "out", bones)[0],
+                                                read_frames(spare / "roomy", bones)[0]))
+    for f in (full / "out").iterdir():
+        f.unlink()
+    (full / "out").rmdir()
+    return result
+
+
 def main(full: Path, spare: Path) -> None:
     for name, (rel, write) in writers(spare).items():
         target = full / rel
@@ -165,6 +206,7 @@ def main(full: Path, spare: Path) -> None:
         for p in sorted(full.rglob("*"), reverse=True):  # the next writer starts on an empty disk
             p.unlink() if p.is_file() else p.rmdir()
         print(json.dumps(result), flush=True)
+    print(json.dumps(frame_folder(full, spare)), flush=True)
     print(json.dumps(sequence_store(full, spare)), flush=True)
 
 

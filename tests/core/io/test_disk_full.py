@@ -30,6 +30,8 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
     rows = [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
     assert rows and rows[-1]["writer"] == "sequence .zarr", out.stderr[-2000:]
     seq = rows.pop()
+    frames = rows.pop()
+    print(f"\nframe folder: {frames}")
     print(f"\nsequence .zarr: {seq}")
     table = "\n".join(f"{r['writer']:<24} raised: {bool(r['raised'])!s:<6} old intact: {r['old_intact']!s:<6} "
                       f"litter: {r['litter']}" for r in rows)
@@ -41,7 +43,12 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
         assert r["litter"] == [], r
     unnamed = [(r["writer"], r["raised"]) for r in rows if r["target"] not in r["raised"]]
     assert not unnamed, unnamed  # the message names the file that did not fit (#64)
+    # a clip's frames: the run stops naming a frame, the folder is marked and refused, the rerun completes it
+    assert frames["writer"] == "frame folder .trans" and ".trans" in (frames["raised"] or ""), frames
+    assert 0 < frames["written"] < frames["frames"] and frames["marked"], frames
+    assert "walk.incomplete" in (frames["read_refused"] or ""), frames
+    assert not frames["marked_after_rerun"] and frames["rerun_equal"], frames
     # a store is resumable: it stops with the error, what it recorded verifies, the rerun finishes it
-    assert seq["raised"] and 0 <= seq["recorded"] < seq["frames"], seq
+    assert seq["raised"] and "s.zarr" in seq["raised"] and 0 <= seq["recorded"] < seq["frames"], seq
     assert seq["recorded_verify"] and seq["skipped_on_resume"] == seq["recorded"], seq
     assert seq["resumed_equal"], seq
