@@ -54,7 +54,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
 
     # spawn, not fork: zarr's I/O thread, numba's threads and an OpenGL context do not survive a fork
     with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=_start_worker,
-                             initargs=(install, payload)) as pool:
+                             initargs=(install, payload, os.getpid())) as pool:
         try:
             label = f"{workers} local worker{'s' if workers > 1 else ''}"
             yield (lambda *args: pool.submit(task, None, *args)), label, 2 * workers
@@ -98,9 +98,11 @@ def keep_freed_memory() -> None:
     libc.mallopt(m_trim_threshold, 64 << 20)
 
 
-def end_with_parent() -> None:
+def end_with_parent(parent: int | None = None) -> None:
     """Ask Linux to kill this process when the one that started it dies (prctl PR_SET_PDEATHSIG): a
-    ``sequence`` killed with -9 left its pool's workers computing frames for half a minute (#64)."""
+    ``sequence`` killed with -9 left its pool's workers computing frames for half a minute (#64).
+    ``parent``: its pid. A parent killed while this process was still starting (its imports take
+    seconds) never signals it, so it ends here instead of taking a queued frame."""
     import ctypes
     import signal
 
@@ -109,11 +111,13 @@ def end_with_parent() -> None:
         libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1: PR_SET_PDEATHSIG
     except (OSError, AttributeError):  # not Linux: the pool's own shutdown is all there is
         return
+    if parent is not None and os.getppid() != parent:
+        os._exit(1)
 
 
-def _start_worker(install, payload) -> None:
+def _start_worker(install, payload, parent: int | None = None) -> None:
     """A local pool worker's initializer."""
-    end_with_parent()
+    end_with_parent(parent)
     keep_freed_memory()
     install(payload)
 

@@ -46,3 +46,16 @@ def test_a_dask_worker_reuses_freed_memory():
         with executor(faults_of_reused_arrays, None, nothing, scheduler=client) as (submit, _, _n):
             faults = [submit(ROUNDS).result() for _ in range(2)]
     assert max(faults) < 10 * ROUNDS, faults
+
+
+def test_a_worker_whose_parent_died_while_it_started_ends_at_once():
+    """#64: a parent killed while its pool's workers were still importing never sends them the death signal
+    (it is asked for only once they start): one took a queued frame and outlived it by 3.6 s. A worker
+    that finds another parent than the one that started it now ends in its initializer."""
+    import subprocess
+    import sys
+
+    script = ("import os; from volanim_core.parallel import end_with_parent; "
+              "end_with_parent(os.getppid()); print('kept'); end_with_parent(os.getppid() + 1); print('not ended')")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert out.stdout.split() == ["kept"] and out.returncode == 1, (out.stdout, out.stderr)

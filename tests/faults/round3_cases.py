@@ -119,32 +119,42 @@ def c3d_cases() -> list[Case]:
     ] + c3d_label_cases()
 
 
-def _written_c3d(labels: list[str], frames: int = 5) -> bytes:
-    """A small C3D written by ezc3d: ``labels`` moving apart, 10 units a step, 100 Hz."""
-    import ezc3d
-
+_WRITE_C3D = """
+import json, sys
+import ezc3d, numpy as np
+for k, labels in enumerate(json.loads(sys.argv[2])):
     c = ezc3d.c3d()
     c["parameters"]["POINT"]["RATE"]["value"] = [100]
     c["parameters"]["POINT"]["LABELS"]["value"] = labels
-    points = np.ones((4, len(labels), frames))
-    points[:3] = np.arange(3 * len(labels) * frames).reshape(3, len(labels), frames) * 10.0
+    points = np.ones((4, len(labels), 5))
+    points[:3] = np.arange(3 * len(labels) * 5).reshape(3, len(labels), 5) * 10.0
     c["data"]["points"] = points
+    c.write(f"{sys.argv[1]}/{k}.c3d")
+"""
+
+
+def _written_c3ds(label_lists: list[list[str]]) -> list[bytes]:
+    """Small C3D files written by ezc3d: each list's markers moving apart, 10 units a step, 5 frames at
+    100 Hz. In a process of its own: once SimpleITK is imported (another test module does), ezc3d's
+    writer fails -- the two SWIG modules share one type table -- while its reader is unaffected."""
+    import subprocess
+    import sys
+
     with tempfile.TemporaryDirectory() as tmp:
-        c.write(f"{tmp}/m.c3d")
-        return Path(f"{tmp}/m.c3d").read_bytes()
+        subprocess.run([sys.executable, "-c", _WRITE_C3D, tmp, json.dumps(label_lists)], check=True)
+        return [Path(f"{tmp}/{k}.c3d").read_bytes() for k in range(len(label_lists))]
 
 
 def c3d_label_cases() -> list[Case]:
     """Labels through ``positions2trans``: none of them a joint, or too few to pose a bone, is refused."""
-    def case(name, labels, expect="refuse"):
-        return Case(f"c3d: {name}", "cli:positions2trans",
-                    {"m.c3d": _written_c3d(labels), "m.bones": MANNEQUIN_BONES.read_bytes()},
-                    "positions2trans {d}/m.c3d --bones {d}/m.bones -o {d}/out", expect)
-
-    return [case("labels none of which names a joint", ["FOO", "BAR", "BAZ"]),
-            case("one marker", ["PELVIS"]),
-            case("an accented and an empty label", ["PEL\xe9VIS", ""]),
-            case("two markers: one bone posed, the rest follow", ["PELVIS", "NECK"], "accept")]
+    cases = [("labels none of which names a joint", ["FOO", "BAR", "BAZ"], "refuse"),
+             ("one marker", ["PELVIS"], "refuse"),
+             ("an accented and an empty label", ["PEL\xe9VIS", ""], "refuse"),
+             ("two markers: one bone posed, the rest follow", ["PELVIS", "NECK"], "accept")]
+    files = _written_c3ds([labels for _, labels, _ in cases])
+    return [Case(f"c3d: {name}", "cli:positions2trans", {"m.c3d": data, "m.bones": MANNEQUIN_BONES.read_bytes()},
+                 "positions2trans {d}/m.c3d --bones {d}/m.bones -o {d}/out", expect)
+            for (name, _, expect), data in zip(cases, files)]
 
 
 def _dicom_series(mutate=None) -> dict[str, bytes]:
