@@ -28,18 +28,27 @@ from _harness import child, measure, table  # noqa: E402
 
 
 @cache
+def load_connectivity(dataset: str):
+    """The dataset's default skeleton (thinness >= 0.5) attached to its bones by nearest bone, and the bones."""
+    from volanim_core import samples
+    from volanim_core.rig.attach import connect_nearest
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.load(dataset)
+    return connect_nearest(skeletonize(s.mask), s.bones), s.bones
+
+
+@cache
 def load(dataset: str):
     from volanim_core import samples
     from volanim_core.reconstruct.engine import grid_bounds
     from volanim_core.reconstruct.neighbours import sphere_neighbours
-    from volanim_core.rig.attach import connect_nearest
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.pose import pose_matrices, root_bones
     from volanim_core.rig.tskel_tools import connect_to_tskel, identity_tskel
-    from volanim_core.skeleton.skeletonize import skeletonize
 
     s = samples.load(dataset)
-    conn = connect_nearest(skeletonize(s.mask), s.bones)
+    conn, _ = load_connectivity(dataset)
     bone = "LEGS" if dataset == "frog" else "L_UPPERARM"
     posed = connect_to_tskel(conn, Trans(root_bones(s.bones), pose_matrices(s.bones, {bone: (0, -45, 45)})))
     ident = identity_tskel(conn)

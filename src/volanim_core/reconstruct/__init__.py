@@ -2,6 +2,7 @@
 
     plan.py ............ a frame checked and made ready: FramePlan (grid, centres, values, cut, slice lists)
     engine.py .......... reconstruct(): runs the plan, five modes, two metrics
+    live.py ............ LiveFrame: frame after frame on one grid, redoing only the slices moved spheres reach
     _plan_kernels.py ... the plan's numba kernels; _kernels.py the fill and sample kernels (tested
                          against tests/naive.py); _clip_kernels.py what falls outside the grid
     sampling.py ........ sampled mode, grey or colour; neighbours.py the overdraw cut's neighbour lists
@@ -11,5 +12,6 @@
 """
 
 from volanim_core.reconstruct.engine import MODES, Reconstruction, grid_bounds, reconstruct
+from volanim_core.reconstruct.live import LiveFrame
 
-__all__ = ["MODES", "Reconstruction", "grid_bounds", "reconstruct"]
+__all__ = ["MODES", "LiveFrame", "Reconstruction", "grid_bounds", "reconstruct"]

@@ -37,11 +37,20 @@ strictly smaller float32 distance, visiting spheres in file order -- so each
 voxel ends with the smallest ``(distance, file index)`` whichever thread
 filled which slice.
 
-Overdraw cut (Euclid, all modes but hotspot): if ``r_j >= r_i`` and ``q`` is
-closer to ``c_j`` than to ``c_i``, then ``j`` covers ``q`` (|q - c_j| <
-|q - c_i| < r_i <= r_j) and beats ``i`` there. So sphere i visits only its
-side of the bisector plane of each such neighbour -- a half-space that clips
-each x-run in O(1). A margin (2^-20 r_i^2 + 1e-6 in squared distance) keeps
+Overdraw cut (Euclid, all modes but hotspot): sphere i skips the voxels q of
+its ball that a neighbour j provably covers and wins, found by one plane:
+* ``r_j >= r_i``, q closer to c_j than to c_i (past their bisector plane):
+  |q - c_j| < |q - c_i| < r_i <= r_j, so j covers q and beats i there;
+* ``r_j < r_i``, q past their *power* plane (|q - c_j|^2 - r_j^2 <
+  |q - c_i|^2 - r_i^2 < 0): j covers q, and is closer than i by at least
+  r_i^2 - r_j^2 > 0. Without this plane a big sphere visited every voxel the
+  small spheres near the body's surface win -- the bulk of mannequin-large's
+  overdraw (#65): on its posed frame 214 of the 352 visits per voxel an
+  uncut fill makes.
+Both are one half-space ``|q - c_i|^2 - |q - c_j|^2 <= max(0, r_i^2 - r_j^2)``
+that clips each x-run in O(1). The owner of q is never cut at q (a cut needs a
+sphere that covers q and beats it), so it visits q and wins whatever else was
+skipped. A margin (2^-20 r_i^2 + 1e-6 in squared distance) keeps
 the cut clear of float32 ties, so every voxel's owner is provably the same as
 without the cut; the oracle tests check it. Planes are written in the sphere's
 own frame (small numbers: rounding far below the margin wherever the grid

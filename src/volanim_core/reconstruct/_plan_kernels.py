@@ -2,8 +2,8 @@
 
     spheres_fit       every sphere within a coordinate limit (the frame's checks)
     sphere_box        the box around all spheres (the output grid)
-    build_halfspaces  the overdraw cut: each big sphere's bisector planes against its larger
-                      neighbours, in the sphere's own frame, with the float margin
+    build_halfspaces  the overdraw cut: each big sphere's planes against its neighbours (bisector
+                      against larger, power plane against smaller), in its own frame, with the margin
     slice_lists       bucket spheres by the output z-slices they overlap, keeping file order
                       inside each slice (that order is the tie-break)
 """
@@ -42,13 +42,15 @@ def sphere_box(centres, extents):
 
 @njit(cache=True)
 def build_halfspaces(centres, r2s, neighbours, min_r2):
-    """Bisector half-spaces of each sphere against its larger neighbours, with the float margin,
-    in the sphere's own frame ``u = q - c_i``: ``a.u + w <= 0`` keeps ``q``, where
-    ``a = 2 (c_j - c_i)`` and ``w = -|c_j - c_i|^2 - margin``, so ``a.u + w`` is
-    ``|q - c_i|^2 - |q - c_j|^2 - margin`` computed from small numbers (its rounding stays far
-    below the margin wherever the grid lies). Column 4 is ``|(a_x, a_y)|``, how fast the value
-    changes within a slice. Sphere i's planes are rows ``start[i]:start[i + 1]``; spheres with
-    ``r2 < min_r2`` get none: for small spheres clipping each row costs more than it saves."""
+    """Each big sphere's cut planes against its neighbours, with the float margin, in the sphere's own
+    frame ``u = q - c_i``: ``a.u + w <= 0`` keeps ``q``, where ``a = 2 (c_j - c_i)`` and
+    ``w = -|c_j - c_i|^2 - max(0, r_i^2 - r_j^2) - margin``, so ``a.u + w`` is
+    ``|q - c_i|^2 - |q - c_j|^2 - max(0, r_i^2 - r_j^2) - margin`` computed from small numbers (its
+    rounding stays far below the margin wherever the grid lies). Against a larger neighbour that is
+    the bisector plane, against a smaller one their power plane (_kernels.py says why each is exact).
+    Column 4 is ``|(a_x, a_y)|``, how fast the value changes within a slice. Sphere i's planes are
+    rows ``start[i]:start[i + 1]``; spheres with ``r2 < min_r2`` get none: for small spheres
+    clipping each row costs more than it saves."""
     n, k = neighbours.shape
     start = np.zeros(n + 1, np.int64)
     for i in range(n):
@@ -71,10 +73,12 @@ def build_halfspaces(centres, r2s, neighbours, min_r2):
             d0 = centres[j, 0] - centres[i, 0]
             d1 = centres[j, 1] - centres[i, 1]
             d2 = centres[j, 2] - centres[i, 2]
+            # the radii's difference is exact: float32 squares (integers below 2^24, or a sheet's thinned ones)
+            shift = max(0.0, np.float64(r2s[i]) - np.float64(r2s[j]))
             planes[row, 0] = 2.0 * d0
             planes[row, 1] = 2.0 * d1
             planes[row, 2] = 2.0 * d2
-            planes[row, 3] = -(d0 * d0 + d1 * d1 + d2 * d2) - margin
+            planes[row, 3] = -(d0 * d0 + d1 * d1 + d2 * d2) - shift - margin
             planes[row, 4] = 2.0 * np.sqrt(d0 * d0 + d1 * d1)
             row += 1
     return start, planes

@@ -1,4 +1,4 @@
-"""Same-bone neighbour lists: which larger spheres may clip each sphere (the overdraw cut).
+"""Same-bone neighbour lists: which spheres may clip each sphere (the overdraw cut).
 
     connectivity --sphere_neighbours (cKDTree per bone)--> (N, k) indices, -1 padded
     reconstruct() --cached_neighbours--> the lists of the last few connectivities, remembered
@@ -18,38 +18,38 @@ from volanim_core.memo import Recent, content_key
 from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.rig.connectivity import Connectivity
 
-HALFSPACES = 8  # larger neighbours per sphere whose bisector planes clip it
+HALFSPACES = 8  # nearest same-bone neighbours per sphere whose planes clip it (bisector or power plane)
 # Below it, clipping rows costs more than the short runs it saves: with the voxel loop vectorised,
 # the frog gains from no radius and mannequin-large gains nothing below 10 (bench_reconstruct.py).
 CUT_MIN_RADIUS = 10.0
 
 
 def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: float = CUT_MIN_RADIUS) -> np.ndarray:
-    """For each sphere of radius >= ``min_radius``, up to ``k`` nearby spheres of the same bone with
-    radius >= its own.
+    """For each sphere of radius >= ``min_radius``, its ``k`` nearest spheres of the same bone (any radius:
+    a larger one cuts it at their bisector, a smaller one at their power plane).
 
     ``(N, k)`` int32, -1 where there are fewer. Same-bone neighbours keep their
     distances under any pose (a bone moves rigidly), so this depends only on
     the connectivity: :func:`reconstruct` remembers it (:func:`cached_neighbours`).
 
     Only spheres of at least ``min_radius`` get lists: the kernel clips no smaller
-    sphere (its rows are too short to gain), and their larger neighbours are large
-    too, so the trees hold only those. On the frog (137 k spheres, mean radius 1.9)
-    that is about 1 % of them.
+    sphere (its rows are too short to gain).
     """
     from scipy.spatial import cKDTree
 
     n = len(tskel)
     out = np.full((n, k), -1, np.int32)
-    r2, big = _big_spheres(tskel, min_radius)
-    for b in np.unique(tskel.bone[big]):
-        idx = big[tskel.bone[big] == b]
-        if len(idx) < 2:
+    _, big = _big_spheres(tskel, min_radius)
+    bones = np.asarray(tskel.bone)
+    for b in np.unique(bones[big]):
+        every = np.flatnonzero(bones == b)  # the tree: every sphere of the bone, small ones too
+        idx = big[bones[big] == b]
+        if len(every) < 2:
             continue
-        q = min(len(idx), 4 * k + 1)
-        _, nn = cKDTree(tskel.points[idx]).query(tskel.points[idx], k=q, workers=-1)
-        nn = idx[nn]  # global indices, nearest first (self included)
-        ok = (r2[nn] >= r2[idx][:, None]) & (nn != idx[:, None])
+        q = min(len(every), k + 1)
+        _, nn = cKDTree(tskel.points[every]).query(tskel.points[idx], k=q, workers=-1)
+        nn = every[nn.reshape(len(idx), q)]  # global indices, nearest first (self among them)
+        ok = nn != idx[:, None]
         rank = np.cumsum(ok, axis=1) - 1
         keep = ok & (rank < k)
         rows, cols = np.nonzero(keep)
@@ -73,16 +73,16 @@ def cached_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: floa
     """:func:`sphere_neighbours`, remembered for the last few connectivities (read-only result).
 
     A caller who reconstructs frame after frame without passing lists gets them made
-    once: the key is a hash of exactly what they depend on -- the spheres of at least
-    ``min_radius`` (their indices, centres, radii and bones) and the point count -- a
-    few thousand values on the frog, so looking up costs ~1 ms against ~25 ms to make them.
+    once: the key is a hash of exactly what they depend on -- which spheres are at least
+    ``min_radius``, every centre and bone, and the point count.
     A pose is not part of it (same-bone distances survive any pose), so every frame of a
     clip, the studio's live and full previews and the rest frame share one set.
     ``r2``: the spheres' :func:`radius_squared`, when the caller has them.
     """
     r2, big = _big_spheres(tskel, min_radius, r2)
-    key = content_key(np.array([len(tskel), k], np.int64), big, np.asarray(tskel.points[big], np.float64), r2[big],
-                      np.asarray(tskel.bone)[big].astype(np.int64))
+    # every sphere's centre and bone (any may be a big one's neighbour); the radii only say which are big
+    key = content_key(np.array([len(tskel), k], np.int64), big, np.asarray(tskel.points, np.float64),
+                      np.asarray(tskel.bone).astype(np.int64))
 
     def make() -> np.ndarray:
         lists = sphere_neighbours(tskel, k, min_radius)

@@ -3,6 +3,11 @@
 A reduced preview reconstructs on a ``factor``-times coarser grid: the bone
 matrices are followed by a 1/factor scale and radii shrink alike, so the
 voxel count (the cost) drops by factor^3 while the shape stays.
+
+Live previews (a drag, the timeline playing) come from :class:`LivePreviews`: one
+:class:`~volanim_core.reconstruct.live.LiveFrame` on a grid with room around the body, so each
+pose redoes only the slices the moved spheres reach (#65); what it hands out is cropped to the
+frame's own grid, the very preview :func:`make_preview` makes.
 """
 
 from __future__ import annotations
@@ -12,9 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.reconstruct.breakage import BreakageReport, RestParts, breakage_report
-from volanim_core.reconstruct.engine import Reconstruction, reconstruct
+from volanim_core.reconstruct.engine import Reconstruction, grid_bounds, reconstruct
+from volanim_core.reconstruct.live import LiveFrame
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.tskel_tools import coarse_tskel
+from volanim_core.volume import Bounds
 
 
 @dataclass
@@ -59,3 +66,42 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
                                      cancel=cancel)
         out.rest_parts = rest_parts
     return out
+
+
+class LivePreviews:
+    """The live previews of one studio: frame after frame on a :class:`LiveFrame` whose grid holds the
+    first frame with ``margin`` of its size to spare each side. A frame outside that grid, another mode
+    or factor start a new one (every slice once); other attachments are found by the LiveFrame itself."""
+
+    def __init__(self, margin: float = 0.15):
+        self.margin = margin
+        self._live: LiveFrame | None = None
+        self._key = None
+
+    def make(self, tskel: Tskel, *, mode: str = "bone", factor: int = 2, padding: int = 2) -> Preview:
+        """The preview :func:`make_preview` makes of ``tskel`` (same voxels, same grid), redoing only what moved."""
+        if not len(tskel):
+            raise ValueError("no attached points to reconstruct: connect points to bones first")
+        coarse = coarse_tskel(tskel, factor)
+        own = grid_bounds(coarse, max(1, padding // factor))
+        if self._live is None or self._key != (mode, factor) or not _inside(own, self._live.bounds):
+            self._live, self._key = LiveFrame(_grown(own, self.margin), mode=mode), (mode, factor)
+        r = self._live.update(coarse, copy=False)
+        lo = np.subtract(own.lo, r.origin)
+        box = tuple(slice(a, a + n) for a, n in zip(lo, own.shape))
+        cropped = Reconstruction(r.volume[box].copy(), own.lo, r.stats, r.geometry.shifted(lo))
+        return Preview(cropped, factor, mode)
+
+    @property
+    def redone(self) -> int:
+        """Slices the last preview redid (all of its grid's on a fresh one)."""
+        return 0 if self._live is None else self._live.redone
+
+
+def _inside(inner: Bounds, outer: Bounds) -> bool:
+    return all(o <= i for i, o in zip(inner.lo, outer.lo)) and all(i <= o for i, o in zip(inner.hi, outer.hi))
+
+
+def _grown(b: Bounds, margin: float) -> Bounds:
+    room = [max(4, int(np.ceil(margin * n))) for n in b.shape]
+    return Bounds(tuple(v - r for v, r in zip(b.lo, room)), tuple(v + r for v, r in zip(b.hi, room)))

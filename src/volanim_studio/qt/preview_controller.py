@@ -21,7 +21,7 @@ from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
 
-from ..model.preview import make_preview
+from ..model.preview import LivePreviews, make_preview
 from ..model.settings import Mode
 from .controller import FAILED, Controller
 from .worker import Worker
@@ -31,6 +31,7 @@ class PreviewController(Controller):
     def __init__(self, window):
         super().__init__(window)
         self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
+        self.live = LivePreviews()  # redoes only the slices the moved spheres reach
         self._live_timer = QTimer(window)
         self._live_timer.setSingleShot(True)
         self._live_timer.setInterval(0)
@@ -141,7 +142,7 @@ class PreviewController(Controller):
         mode = mode if mode in ("binary", "bone") else "bone"
         try:
             tskel = self.doc.pose.tskel()
-            p = make_preview(tskel, mode=mode, factor=2, padding=2)
+            p = self.live.make(tskel, mode=mode, factor=2, padding=2)  # only what moved since the last
         except ValueError as exc:
             self.doc.message(str(exc))
             return

@@ -1,0 +1,37 @@
+"""#65: the studio's live previews redo only the slices the moved spheres reach, and each is the very
+preview make_preview makes of the frame: the same voxels on the same grid."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from paths import ASSETS
+from volanim_core import io, samples
+from volanim_core.rig.pose import pose_matrices
+from volanim_studio.model.preview import LivePreviews, make_preview
+
+# a drag of the left forearm in 10-degree steps, then the right thigh, then the whole body walked off
+DRAG = [{"L_FOREARM": (0, 0, a)} for a in range(0, 70, 10)] + [{"R_THIGH": (-30, 0, 0)}]
+
+
+@pytest.mark.parametrize("mode", ["bone", "binary"])
+def test_a_drag_is_the_previews_make_preview_makes_and_redoes_a_part(mode):
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
+    bones = samples.mannequin_bones()
+    live = LivePreviews()
+    roots = [i for i, parent in enumerate(bones.parents()) if parent is None]
+    frames = [conn.posed(pose_matrices(bones, pose)) for pose in DRAG]
+    frames.append(conn.posed(pose_matrices(bones, DRAG[-1], {i: (200.0, 0.0, 0.0) for i in roots})))
+    redone = []
+    for t in frames:
+        got = live.make(t, mode=mode, factor=2, padding=2)
+        want = make_preview(t, mode=mode, factor=2, padding=2)
+        assert got.reconstruction.origin == want.reconstruction.origin
+        assert np.array_equal(got.reconstruction.volume, want.reconstruction.volume)
+        assert np.allclose(got.reconstruction.geometry.origin, want.reconstruction.geometry.origin)
+        assert np.array_equal(got.origin_voxels, want.origin_voxels) and got.factor == 2 and got.mode == mode
+        redone.append(live.redone)
+    nz = live._live.bounds.shape[2]
+    assert all(0 < n < nz // 2 for n in redone[1:7])  # each step of the forearm: its slices only
+    assert redone[-1] == live._live.bounds.shape[2]  # walked off the grid: a new one, every slice
