@@ -190,9 +190,7 @@ def reconstruct(
                           row_lo, row_hi, filled, visits, speedups.box_sweep, K.AHEAD if speedups.prefetch else 0)
             report(z1, total)
         if mode == "sampled":
-            to_source = np.eye(4) if source_geometry is None else tskel.geometry.index_map(source_geometry)
-            minv = np.concatenate([plan.minv_rest, np.linalg.inv(plan.table[len(plan.minv_rest):])])  # blended: rigid
-            out = sample_source(out, source, _grid_to_source(minv, plan.origin, to_source), kernel,
+            out = sample_source(out, source, source_maps(plan, source_geometry), kernel,
                                 (row_lo, row_hi), nthreads, pacer.size, lambda done: report(nz + done, total))
     finally:
         numba.set_num_threads(previous)
@@ -217,6 +215,15 @@ def _output_array(out, shape_zyx, out_dtype, final_dtype) -> np.ndarray:
         out.fill(0)
         return out
     return np.zeros(shape_zyx, out_dtype)
+
+
+def source_maps(plan, source_geometry: Geometry | None, z0: int = 0) -> np.ndarray:
+    """Sampled mode's maps, one per row of the plan's transform table: voxels of the output grid's slab
+    that starts at slice ``z0`` -> source-array coordinates (a smooth joint's blended row is inverted as a
+    rigid map)."""
+    to_source = np.eye(4) if source_geometry is None else plan.tskel.geometry.index_map(source_geometry)
+    minv = np.concatenate([plan.minv_rest, np.linalg.inv(plan.table[len(plan.minv_rest):])])
+    return _grid_to_source(minv, plan.origin + np.array([0.0, 0.0, z0]), to_source)
 
 
 def _grid_to_source(minv_rest: np.ndarray, origin: np.ndarray, to_source: np.ndarray) -> np.ndarray:

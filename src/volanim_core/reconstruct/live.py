@@ -33,8 +33,8 @@ from volanim_core.reconstruct.engine import (
     _MODE_CODE,
     CLIP_ROW_BUDGET,
     Reconstruction,
-    _grid_to_source,
     _stats,
+    source_maps,
 )
 from volanim_core.reconstruct.neighbours import sphere_neighbours
 from volanim_core.reconstruct.plan import plan_frame
@@ -129,10 +129,7 @@ class LiveFrame:
                       plan.max_planes, self.row_lo, self.row_hi, self.filled, self.visits, True, K.AHEAD)
         if self.mode != "sampled":
             return
-        to_source = np.eye(4) if self.source_geometry is None else plan.tskel.geometry.index_map(self.source_geometry)
-        minv = np.concatenate([plan.minv_rest, np.linalg.inv(plan.table[len(plan.minv_rest):])])
-        origin = plan.origin + np.array([0.0, 0.0, z0])  # the slab's voxel [0, 0, 0]
-        slab = sample_source(self.owner[z0:z1], self.source, _grid_to_source(minv, origin, to_source), self.kernel,
+        slab = sample_source(self.owner[z0:z1], self.source, source_maps(plan, self.source_geometry, z0), self.kernel,
                              (self.row_lo[z0:z1], self.row_hi[z0:z1]), self.threads, z1 - z0, lambda done: None)
         if not np.shares_memory(slab, self.volume):  # colour, or a source of another dtype than the owners
             self.volume[z0:z1] = slab

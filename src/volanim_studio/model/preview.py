@@ -93,6 +93,11 @@ class LivePreviews:
         return Preview(cropped, factor, mode)
 
     @property
+    def bounds(self) -> Bounds | None:
+        """The live grid the previews are cut from (None before the first)."""
+        return None if self._live is None else self._live.bounds
+
+    @property
     def redone(self) -> int:
         """Slices the last preview redid (all of its grid's on a fresh one)."""
         return 0 if self._live is None else self._live.redone

@@ -32,6 +32,6 @@ def test_a_drag_is_the_previews_make_preview_makes_and_redoes_a_part(mode):
         assert np.allclose(got.reconstruction.geometry.origin, want.reconstruction.geometry.origin)
         assert np.array_equal(got.origin_voxels, want.origin_voxels) and got.factor == 2 and got.mode == mode
         redone.append(live.redone)
-    nz = live._live.bounds.shape[2]
+    nz = live.bounds.shape[2]
     assert all(0 < n < nz // 2 for n in redone[1:7])  # each step of the forearm: its slices only
-    assert redone[-1] == live._live.bounds.shape[2]  # walked off the grid: a new one, every slice
+    assert redone[-1] == live.bounds.shape[2]  # walked off the grid: a new one, every slice
