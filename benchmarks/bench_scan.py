@@ -71,9 +71,12 @@ def time_tree(root: Path, mats_path: Path, trans: list[Path]) -> dict:
                           str(assets / "mannequin.bones")], env=env, capture_output=True, text=True, check=True)
     rows = json.loads(out.stdout.strip().splitlines()[-1])
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "volanim_core", "scan", str(assets / "mannequin.0.50.connect"),
-                    *map(str, trans), "--top", "1"], env=env, capture_output=True, text=True)  # exit 1: frames broken
+    run = subprocess.run([sys.executable, "-m", "volanim_core", "scan", str(assets / "mannequin.0.50.connect"),
+                          *map(str, trans), "--top", "1"], env=env, capture_output=True, text=True)
     rows["command"] = time.perf_counter() - t0
+    # exit 1 is a verdict (frames broken); anything else is a failure, not a time (an old tree refusing
+    # this tree's .trans files took 1.1 s and was printed as if it had scanned them)
+    rows["failed"] = None if run.returncode in (0, 1) else (run.stderr.strip().splitlines() or ["?"])[-1][:80]
     return rows
 
 
@@ -109,7 +112,9 @@ def main() -> None:
         print(f"| {name} | {r['rigid']['ms']:.1f} | {r['rigid']['ms'] / base['rigid']['ms']:.2f} | "
               + (f"{smooth['ms']:.1f} | " if smooth else "— | ")
               + (f"{smooth['ms'] / base['smooth']['ms']:.2f} | " if smooth and "smooth" in base else "— | ")
-              + f"{r['rigid']['broken']} | {r['command']:.1f} | {r['command'] / base['command']:.2f} |")
+              + f"{r['rigid']['broken']} | "
+              + (f"failed: {r['failed']} | — |" if r["failed"] else
+                 f"{r['command']:.1f} | " + ("— |" if base["failed"] else f"{r['command'] / base['command']:.2f} |")))
 
 
 if __name__ == "__main__":

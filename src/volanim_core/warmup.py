@@ -3,7 +3,8 @@
     compile_kernels()
         skeletonize (euclid, 345) --> auto_connect (path) --> reconstruct
         (every mode x metric, sampled with kernel 1 and 3, and a colour source) --> palette
-        orderings --> breakage report (+ detached pieces; a clip's scan uses the same kernels)
+        orderings --> breakage report (+ detached pieces; a clip's scan uses the same kernels, and its
+        proof of one piece)
         --> a crumble's heap --> a proposed rig's balls
 
 Every kernel a user's command or the studio calls is in that list (a test holds it to that): a fresh
@@ -40,6 +41,7 @@ def compile_kernels(progress=None) -> float:
     ``progress(done, total)`` is called after each step (for a message or a bar).
     """
     from volanim_core.colour.sort import sort_palette
+    from volanim_core.reconstruct._whole_kernels import touches_any
     from volanim_core.reconstruct.breakage import breakage_report, components
     from volanim_core.reconstruct.engine import MODES, reconstruct
     from volanim_core.rig.attach import auto_connect
@@ -82,6 +84,9 @@ def compile_kernels(progress=None) -> float:
     two = np.zeros((6, 6, 6), np.uint8)
     two[1, 1, 1] = two[4, 4, 4] = 1
     components(two)  # a report's detached pieces: where each is nearest the main body
+    # a clip scan's proof of one piece: its small spheres' voxel test, with a scan's own dtypes
+    touches_any(np.zeros((2, 3)), np.array([4.0, 1.0]), np.array([1]), np.array([[0]]), np.array([True, False]),
+                np.zeros(1, np.int8))
     fall(np.pad(source, ((8, 8), (8, 8), (0, 8))), 1.0)  # a crumble's heap (room for it around the bar)
     balls(skel)  # a proposed rig's body of balls (auto-rig)
     _report(progress, total, total)

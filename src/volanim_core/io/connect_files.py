@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.rig.connectivity import BoneSegment, Connectivity, Trans, Tskel
+from volanim_core.rig.connectivity import BoneSegment, Connectivity, Trans, Tskel, close_floats
 from volanim_core.rig.skinning import RIGID, Joints
 
 from ._atomic import atomic_write_text
@@ -56,14 +56,13 @@ def _parse_matrix(rec: TextRecords, records, start: int, root_line: int) -> np.n
         if len(toks) != 4:
             raise rec.error(line, f"expected matrix row {k + 1} of 4 (4 numbers), got {len(toks)} tokens")
         rows.append([parse_float(rec, line, t, f"matrix row {k + 1}") for t in toks])
-    m = np.array(rows)
     # Row-vector convention: the last column of an affine matrix is (0 0 0 1).
     # Checking it also catches a 3-row matrix swallowing the first point line.
-    if not np.allclose(m[:, 3], [0, 0, 0, 1], atol=1e-6):
+    if not close_floats([r[3] for r in rows], (0.0, 0.0, 0.0, 1.0), 1e-6):
         line = records[start][0]
         raise rec.error(line, "matrix is not affine: its last column must be 0 0 0 1 "
                         "(row-vector convention, translation in row 4)")
-    return m
+    return np.array(rows)
 
 
 def _check_point_count(rec: TextRecords, found: int) -> None:

@@ -55,8 +55,12 @@ the cut clear of float32 ties, so every voxel's owner is provably the same as
 without the cut; the oracle tests check it. Planes are written in the sphere's
 own frame (small numbers: rounding far below the margin wherever the grid
 lies) and chosen per slice: one that misses the slice's disc costs nothing
-per row, one that covers it skips the slice. Skipping a cut is always exact
-(more visits, same owners); only cutting needs the margin.
+per row, one that covers it skips the slice. A sphere below radius 10
+(ROW_CUT_R2) stops there: it sweeps the slices no plane covers as a sphere
+without planes does -- clipping rows of a dozen voxels cost more than they
+saved (the mannequin's half-size frames, whose radii are halved, #65).
+Skipping a cut is always exact (more visits, same owners); only cutting needs
+the margin.
 """
 
 from __future__ import annotations
@@ -68,6 +72,7 @@ from volanim_core.reconstruct._prefetch import prefetch1, prefetch2
 
 BINARY, MOTTLED, BONE, SAMPLED, HOTSPOT = 0, 1, 2, 3, 4
 VECTOR = 4  # float64 lanes of the voxel loop (AVX2's, and AVX-512's as LLVM uses it here)
+ROW_CUT_R2 = 100.0  # spheres of radius < 10 clip no rows, only skip the slices a plane covers (fill_slices)
 AHEAD = 8  # spheres prefetched ahead in a slice's list (6 to 12 measure alike on the frog)
 EUCLID, CHAMFER = 0, 1
 
@@ -172,7 +177,8 @@ def _rows_in_box(stencil, out, z, ya, yb, cx, cy, dz2, r2, yhalf, value, lo_z, h
 
 @njit(cache=True, parallel=True)
 def fill_slices(out, scratch, z0, z1, nthreads, offsets, ids, centres, r2s, radii, values, metric, mode,
-                plane_start, planes, max_planes, row_lo, row_hi, filled, visits, box_sweep=True, ahead=AHEAD):
+                plane_start, planes, max_planes, row_lo, row_hi, filled, visits, box_sweep=True, ahead=AHEAD,
+                row_cut_r2=ROW_CUT_R2):
     """Fill output slices ``z0 <= z < z1``; see the module docstring.
 
     ``centres`` are posed centres in output-grid coordinates.
@@ -246,7 +252,9 @@ def fill_slices(out, scratch, z0, z1, nthreads, offsets, ids, centres, r2s, radi
                     yhalf = r / 3.0
                     ya = max(int(np.floor(cy - yhalf)) - 1, 0)
                     yb = min(int(np.ceil(cy + yhalf)) + 1, ny - 1)
-                if box_sweep and metric == EUCLID and relax and plane_start[i + 1] == plane_start[i]:
+                # a sphere below ROW_CUT_R2 uses its planes per slice only (above: a slice a plane covers is
+                # skipped) and sweeps the rest: clipping a short row costs more than the voxels it saves
+                if box_sweep and metric == EUCLID and relax and (n_cut == 0 or r2 < row_cut_r2):
                     n_visits += _rows_in_box(stencil, out, z, ya, yb, cx, cy, dz2, r2, yhalf, values[i], lo_z, hi_z)
                     continue
                 for y in range(ya, yb + 1):

@@ -41,6 +41,15 @@ def sphere_box(centres, extents):
 
 
 @njit(cache=True)
+def _cuts(r2i, r2j, d0, d1, d2):
+    """True when sphere i's plane against j (at ``d`` from it) cuts its ball: a plane that misses it
+    would still cost each slice a test and deny the sphere the cheaper box sweep."""
+    d2sum = d0 * d0 + d1 * d1 + d2 * d2
+    # the plane's distance from c_i, times 2 |d|: |d|^2 + max(0, r_i^2 - r_j^2)
+    return d2sum > 0.0 and d2sum + max(0.0, r2i - r2j) < 2.0 * np.sqrt(d2sum * r2i)
+
+
+@njit(cache=True)
 def build_halfspaces(centres, r2s, neighbours, min_r2):
     """Each big sphere's cut planes against its neighbours, with the float margin, in the sphere's own
     frame ``u = q - c_i``: ``a.u + w <= 0`` keeps ``q``, where ``a = 2 (c_j - c_i)`` and
@@ -50,14 +59,20 @@ def build_halfspaces(centres, r2s, neighbours, min_r2):
     the bisector plane, against a smaller one their power plane (_kernels.py says why each is exact).
     Column 4 is ``|(a_x, a_y)|``, how fast the value changes within a slice. Sphere i's planes are
     rows ``start[i]:start[i + 1]``; spheres with ``r2 < min_r2`` get none: for small spheres
-    clipping each row costs more than it saves."""
+    clipping each row costs more than it saves. Only planes that cut the ball are kept (dropping a
+    cut is always exact): a big sphere among much smaller ones (the frog's) has power planes that
+    all miss it."""
     n, k = neighbours.shape
     start = np.zeros(n + 1, np.int64)
+    keep = np.zeros((n, k), np.bool_)
     for i in range(n):
         c = 0
         if r2s[i] >= min_r2:
             for h in range(k):
-                if neighbours[i, h] >= 0:
+                j = neighbours[i, h]
+                if j >= 0 and _cuts(np.float64(r2s[i]), np.float64(r2s[j]), centres[j, 0] - centres[i, 0],
+                                    centres[j, 1] - centres[i, 1], centres[j, 2] - centres[i, 2]):
+                    keep[i, h] = True
                     c += 1
         start[i + 1] = start[i] + c
     planes = np.empty((start[n], 5))
@@ -67,9 +82,9 @@ def build_halfspaces(centres, r2s, neighbours, min_r2):
         margin = r2s[i] * 2.0**-20 + 1e-6
         row = start[i]
         for h in range(k):
-            j = neighbours[i, h]
-            if j < 0:
+            if not keep[i, h]:
                 continue
+            j = neighbours[i, h]
             d0 = centres[j, 0] - centres[i, 0]
             d1 = centres[j, 1] - centres[i, 1]
             d2 = centres[j, 2] - centres[i, 2]

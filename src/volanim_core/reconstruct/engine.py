@@ -187,7 +187,8 @@ def reconstruct(
         for z0, z1 in pacer.spans(nz):
             K.fill_slices(out, scratch, z0, z1, nthreads, plan.offsets, plan.ids, plan.centres, plan.r2s, plan.radii,
                           plan.values, plan.metric, _MODE_CODE[mode], plan.plane_start, plan.planes, plan.max_planes,
-                          row_lo, row_hi, filled, visits, speedups.box_sweep, K.AHEAD if speedups.prefetch else 0)
+                          row_lo, row_hi, filled, visits, speedups.box_sweep, K.AHEAD if speedups.prefetch else 0,
+                          K.ROW_CUT_R2)
             report(z1, total)
         if mode == "sampled":
             out = sample_source(out, source, source_maps(plan, source_geometry), kernel,

@@ -126,7 +126,7 @@ class LiveFrame:
             self.row_hi[z0:z1] = -1
         K.fill_slices(self.owner, self.scratch, z0, z1, self.threads, plan.offsets, plan.ids, plan.centres, plan.r2s,
                       plan.radii, plan.values, plan.metric, _MODE_CODE[self.mode], plan.plane_start, plan.planes,
-                      plan.max_planes, self.row_lo, self.row_hi, self.filled, self.visits, True, K.AHEAD)
+                      plan.max_planes, self.row_lo, self.row_hi, self.filled, self.visits, True, K.AHEAD, K.ROW_CUT_R2)
         if self.mode != "sampled":
             return
         slab = sample_source(self.owner[z0:z1], self.source, source_maps(plan, self.source_geometry, z0), self.kernel,
@@ -151,8 +151,8 @@ def _moved_slices(centres: np.ndarray, r2s: np.ndarray, plan, nz: int) -> np.nda
         reach = np.sqrt(r2.astype(np.float64)) + 1.0
         lo = np.clip(np.floor(c[:, 2] - reach), 0, nz).astype(np.int64)
         hi = np.clip(np.ceil(c[:, 2] + reach) + 1, 0, nz).astype(np.int64)
-        np.add.at(redo, lo, 1)
-        np.add.at(redo, hi, -1)
+        # counted with bincount: np.add.at took 10 ms of the frog's 70 ms update (#65)
+        redo += np.bincount(lo, minlength=nz + 1) - np.bincount(hi, minlength=nz + 1)
     return np.cumsum(redo[:nz]) > 0
 
 

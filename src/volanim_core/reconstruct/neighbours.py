@@ -19,9 +19,12 @@ from volanim_core.reconstruct.radii import radius_squared
 from volanim_core.rig.connectivity import Connectivity
 
 HALFSPACES = 8  # nearest same-bone neighbours per sphere whose planes clip it (bisector or power plane)
-# Below it, clipping rows costs more than the short runs it saves: with the voxel loop vectorised,
-# the frog gains from no radius and mannequin-large gains nothing below 10 (bench_reconstruct.py).
-CUT_MIN_RADIUS = 10.0
+# Below it, clipping rows costs more than the short runs it saves (the frog's mass of small spheres
+# sweeps its boxes faster). 10 served full-resolution frames, but a half-resolution one halves every
+# radius: the mannequin's live previews and scans then cut nothing (overdraw 160, #65); at 6 they cut
+# (overdraw 37, 2x faster; mannequin-large's half-size frame 105 -> 15, 1.7x) and full-resolution
+# frames stay as fast (benchmarks/bench_live.py).
+CUT_MIN_RADIUS = 6.0
 
 
 def sphere_neighbours(tskel: Connectivity, k: int = HALFSPACES, min_radius: float = CUT_MIN_RADIUS) -> np.ndarray:

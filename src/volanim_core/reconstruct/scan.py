@@ -1,9 +1,13 @@
 """Scan a whole animation for breakage: one verdict per frame, so the user jumps to the worst one.
 
     once:       the sphere pairs that touch at rest, the neighbour lists,
-                the rest pose's pieces on the coarse grid                   (pose-independent)
+                the rest pose's pieces on the coarse grid,
+                the sphere pairs that can prove a frame whole (whole.py)    (pose-independent)
     per frame:  cracks and stumps from the posed sphere centres             (no voxels: cheap)
+                one piece proved from the spheres (whole.py), or else
                 connected components of a ``factor``-times coarser bone reconstruction
+
+The "once" part and the per-frame verdict are a :class:`Scanner`.
 
 The full report (lost voxels, hotspots, detached pieces by joint) stays with
 the studio's full preview of one frame; the scan only has to rank frames.
@@ -22,6 +26,7 @@ from volanim_core.progress import Reporter
 from volanim_core.reconstruct.breakage import components, misplaced_points, stumps
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.reconstruct.whole import WholeProof
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.tskel_tools import coarse_tskel, identity_tskel
 
@@ -55,34 +60,54 @@ class FrameVerdict:
                 -self.gap)
 
 
+class Scanner:
+    """What a scan makes once (pose-independent: the rest pose's pieces, the sphere pairs that touch at rest,
+    the points already misplaced, the joints to name, the pairs that prove a frame whole), then one
+    :meth:`verdict` per frame."""
+
+    def __init__(self, conn: Connectivity, joints: dict | None = None, factor: int = 2):
+        from scipy.spatial import cKDTree
+
+        self.conn, self.joints, self.factor = conn, dict(joints or {}), factor
+        rest = identity_tskel(conn)
+        coarse = coarse_tskel(rest, factor)
+        # a body in several pieces at rest (the frog's specks) is not broken by a pose that keeps them
+        self.rest_pieces = max(len(components(reconstruct(coarse, mode="bone", padding=1).volume)), 1)
+        # a frame proved whole from its spheres needs no voxels (whole.py): most frames of a clip
+        self.whole = WholeProof(coarse) if self.rest_pieces == 1 else None
+        self.pairs = touching_pairs(rest)
+        self.misplaced = misplaced_points(rest)
+        self.names = list(self.joints)
+        self.near = cKDTree(np.array([self.joints[n] for n in self.names], np.float64)) if self.names else None
+
+    def verdict(self, frame: int, mats: np.ndarray) -> FrameVerdict:
+        posed = self.conn.posed(np.asarray(mats))
+        where, gaps = cracks(posed, pairs=self.pairs)
+        worst = ""
+        if len(gaps) and self.near is not None:
+            _, k = self.near.query(where)
+            worst = self.names[int(np.bincount(k, weights=gaps, minlength=len(self.names)).argmax())]
+        coarse = coarse_tskel(posed, self.factor)
+        if self.whole is not None and self.whole.proves(coarse):
+            sizes = [0]  # one piece (its size is not needed: nothing is detached)
+        else:
+            sizes = components(reconstruct(coarse, mode="bone", padding=1).volume)
+        behind = stumps(posed, self.joints, self.misplaced)
+        return FrameVerdict(frame, len(sizes), int(sum(sizes[self.rest_pieces:])) * self.factor ** 3, len(gaps),
+                            float(gaps.sum()), worst or (behind[0].joint if behind else ""),
+                            sum(b.points for b in behind), self.rest_pieces)
+
+
 def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints: dict | None = None,
                 factor: int = 2, progress=None, cancel=None) -> list[FrameVerdict]:
     """One :class:`FrameVerdict` per frame of ``matrices`` (``(F, B, 4, 4)``); ``frames`` numbers them."""
-    from scipy.spatial import cKDTree
-
     frames = list(range(len(matrices))) if frames is None else [int(f) for f in frames]
     report = Reporter(progress, cancel)
-    rest = identity_tskel(conn)
-    # a body in several pieces at rest (the frog's specks) is not broken by a pose that keeps them
-    rest_pieces = max(len(components(reconstruct(coarse_tskel(rest, factor), mode="bone", padding=1).volume)), 1)
-    pairs = touching_pairs(rest)
-    misplaced = misplaced_points(rest)
-    names = list(joints or {})
-    near = cKDTree(np.array([joints[n] for n in names], np.float64)) if names else None
+    scanner = Scanner(conn, joints, factor)
     out = []
     for n, (frame, mats) in enumerate(zip(frames, matrices)):
         report(n, len(frames))
-        posed = conn.posed(np.asarray(mats))
-        where, gaps = cracks(posed, pairs=pairs)
-        worst = ""
-        if len(gaps) and near is not None:
-            _, k = near.query(where)
-            worst = names[int(np.bincount(k, weights=gaps, minlength=len(names)).argmax())]
-        sizes = components(reconstruct(coarse_tskel(posed, factor), mode="bone", padding=1).volume)
-        behind = stumps(posed, joints or {}, misplaced)
-        out.append(FrameVerdict(frame, len(sizes), int(sum(sizes[rest_pieces:])) * factor ** 3, len(gaps),
-                                float(gaps.sum()), worst or (behind[0].joint if behind else ""),
-                                sum(b.points for b in behind), rest_pieces))
+        out.append(scanner.verdict(frame, mats))
     report(len(frames), len(frames))
     return out
 

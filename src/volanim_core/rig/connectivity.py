@@ -22,6 +22,12 @@ from volanim_core.rig.skinning import RIGID, Joints, Skin, cached_skin
 from volanim_core.skeleton.points import check_metric
 
 
+def close_floats(a, b, atol: float) -> bool:
+    """``np.allclose(a, b, rtol=1e-5, atol=atol)`` for short sequences of floats, without NumPy's overhead
+    (a NaN is close to nothing)."""
+    return all(abs(x - y) <= atol + 1e-5 * abs(y) for x, y in zip(a, b, strict=True))
+
+
 @dataclass(eq=False)
 class BoneSegment:
     """A bone as ``Root:`` lines name it: joint coordinates and an optional name."""
@@ -43,10 +49,10 @@ class BoneSegment:
         )
 
     def same_segment(self, other: BoneSegment, tol: float = 1e-6) -> bool:
-        return bool(
-            np.allclose(self.proximal, other.proximal, atol=tol)
-            and np.allclose(self.distal, other.distal, atol=tol)
-        )
+        """Both joints within ``np.allclose(self, other, atol=tol)``, in plain floats: two ``allclose`` per bone
+        were a sixth of ``volanim scan``'s time over a 1064-frame clip (#65)."""
+        return close_floats((*self.proximal.tolist(), *self.distal.tolist()),
+                            (*other.proximal.tolist(), *other.distal.tolist()), tol)
 
     @property
     def label(self) -> str:

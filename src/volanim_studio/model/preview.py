@@ -33,6 +33,7 @@ class Preview:
     rest_parts: RestParts | None = None  # what the report used, for the caller to keep
     joints: dict | None = None  # the posed joints it was made for: playing, the bones drawn are these
     frame: int | None = None  # the timeline frame it shows (None: not a frame of the timeline)
+    live: bool = False  # made while a pose changes (LivePreviews): drawn as a surface, no report
 
     @property
     def spacing(self) -> tuple[float, float, float]:
@@ -68,6 +69,16 @@ def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: 
     return out
 
 
+# grids up to this many voxels are previewed live at full resolution (#65: the mannequin's posed grid,
+# ~4 M, 30 updates a second); larger ones at half (the frog's 43 M, mannequin-large's 97 M)
+LIVE_FULL_VOXELS = 8_000_000
+
+
+def live_factor(tskel: Tskel) -> int:
+    """1 (full resolution) when the frame's grid is small enough to redo live, else 2."""
+    return 1 if np.prod(grid_bounds(tskel, 2).shape, dtype=np.int64) <= LIVE_FULL_VOXELS else 2
+
+
 class LivePreviews:
     """The live previews of one studio: frame after frame on a :class:`LiveFrame` whose grid holds the
     first frame with ``margin`` of its size to spare each side. A frame outside that grid, another mode
@@ -78,10 +89,14 @@ class LivePreviews:
         self._live: LiveFrame | None = None
         self._key = None
 
-    def make(self, tskel: Tskel, *, mode: str = "bone", factor: int = 2, padding: int = 2) -> Preview:
-        """The preview :func:`make_preview` makes of ``tskel`` (same voxels, same grid), redoing only what moved."""
+    def make(self, tskel: Tskel, *, mode: str = "bone", factor: int | None = None, padding: int = 2) -> Preview:
+        """The preview :func:`make_preview` makes of ``tskel`` (same voxels, same grid), redoing only what moved.
+        ``factor`` None: :func:`live_factor`'s, decided on the first frame of a mode and kept after it."""
         if not len(tskel):
             raise ValueError("no attached points to reconstruct: connect points to bones first")
+        if factor is None:  # the live grid's, while there is one of this mode
+            kept = self._live is not None and self._key[0] == mode
+            factor = self._key[1] if kept else live_factor(tskel)
         coarse = coarse_tskel(tskel, factor)
         own = grid_bounds(coarse, max(1, padding // factor))
         if self._live is None or self._key != (mode, factor) or not _inside(own, self._live.bounds):
@@ -89,8 +104,10 @@ class LivePreviews:
         r = self._live.update(coarse, copy=False)
         lo = np.subtract(own.lo, r.origin)
         box = tuple(slice(a, a + n) for a, n in zip(lo, own.shape))
-        cropped = Reconstruction(r.volume[box].copy(), own.lo, r.stats, r.geometry.shifted(lo))
-        return Preview(cropped, factor, mode)
+        # copied in its memory's order (the [x, y, z] view of [z, y, x] arrays, as reconstruct returns them):
+        # a C-order copy of the frog's half-size grid took 18 ms, and the surface then copied it again
+        cropped = Reconstruction(r.volume[box].copy(order="K"), own.lo, r.stats, r.geometry.shifted(lo))
+        return Preview(cropped, factor, mode, live=True)
 
     @property
     def bounds(self) -> Bounds | None:

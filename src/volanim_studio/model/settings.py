@@ -103,7 +103,7 @@ SETTINGS: dict[str, Setting] = {
     "preview_padding": Setting(2, number(0, 64, int), "voxels around the posed spheres"),
     "joints": Setting("rigid", one_of("rigid", "smooth"), "how bones meet: rigid, or smooth (blended near joints)"),
     "blend": Setting(1.0, number(0.1, 10), "smooth joints' blend width, times the bones' thickness"),
-    "live_preview": Setting(True, flag, "half-resolution preview while a pose slider moves"),
+    "live_preview": Setting(True, flag, "a preview while a pose slider moves (half resolution on a large body)"),
     "show_rest": Setting(False, flag, "show the rest pose's reconstruction instead (compare)"),
     # connect tools
     "lasso_depth": Setting("visible", one_of(*DEPTH_MODES), "which points under the lasso it takes"),

@@ -1,7 +1,7 @@
 """Posing and previews: live and full previews, compare, slices, export, poses in and out.
 
     settings.dragging (a pose slider, the timeline held or playing) + doc.events.pose
-        --> live_preview (half resolution, GUI thread, coalesced) --> doc.set_preview
+        --> live_preview (full resolution on a small body, else half; GUI thread, coalesced) --> doc.set_preview
     settings.current_frame (a step) --> live_preview
     dragging back to False in Pose mode, doc.events.pose_settled, F5
         --> preview() --> JobRunner(make_preview + breakage report) --> doc.set_preview
@@ -136,13 +136,14 @@ class PreviewController(Controller):
             self._live_timer.start()
 
     def live_preview(self) -> None:
-        """Half-resolution binary or bone preview on the GUI thread (tens of ms on the mannequin)."""
+        """Binary or bone preview on the GUI thread: full resolution on a small body (the mannequin: ~10 ms),
+        half on a larger one (:func:`live_factor`)."""
         t0 = time.perf_counter()
         mode = self.doc.settings.preview_mode
         mode = mode if mode in ("binary", "bone") else "bone"
         try:
             tskel = self.doc.pose.tskel()
-            p = self.live.make(tskel, mode=mode, factor=2, padding=2)  # only what moved since the last
+            p = self.live.make(tskel, mode=mode, padding=2)  # only what moved; full or half resolution
         except ValueError as exc:
             self.doc.message(str(exc))
             return

@@ -45,7 +45,8 @@ class ReconstructPanel(QWidget):
                                    "so shoulders, hips, elbows and knees bend without breaking")
         self.blend = QDoubleSpinBox(minimum=0.1, maximum=10.0, singleStep=0.25, decimals=2)
         self.blend.setToolTip("smooth joints: how far from a joint the blend reaches, times the bones' thickness")
-        self.live = QCheckBox("Live preview while posing (half resolution)")
+        self.live = QCheckBox("Live preview while posing")
+        self.live.setToolTip("Full resolution on a body of up to 8 M voxels (the mannequin), half on a larger one")
         self.slices = QCheckBox("Orthogonal slices")
         self.show_rest = QCheckBox("Show the rest pose instead (compare)")
         s = doc.settings

@@ -43,6 +43,17 @@ def bone_lines(segments: np.ndarray) -> pv.PolyData:
     return pv.PolyData(np.asarray(segments).reshape(-1, 3).astype(np.float32), lines=lines)
 
 
+def unit_axes() -> pv.PolyData:
+    """Arrows of length 1 along x (red), y (green) and z (blue) from the origin, coloured per cell."""
+    arrows = []
+    for k, colour in enumerate(AXIS_COLOURS):
+        arrow = pv.Arrow(start=(0.0, 0.0, 0.0), direction=np.eye(3)[k], scale=1.0, tip_length=0.2,
+                         shaft_radius=0.03, tip_radius=0.08)
+        arrow.cell_data["rgb"] = np.tile(np.array(colour, np.uint8), (arrow.n_cells, 1))
+        arrows.append(arrow)
+    return pv.merge(arrows)
+
+
 class PoseLayer:
     """Posed bones (following ``doc.events.pose``) and the preview volume or surface."""
 
@@ -51,6 +62,7 @@ class PoseLayer:
         self.preview_actor = None
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
         self._mapper = None  # the volume mapper for full previews, chosen once the GL context exists
+        self._bone_lines = None  # the posed bones' lines as drawn: a drag's step moves their points
         view.doc.events.pose.connect(self.on_pose_changed)
         view.doc.events.preview.connect(lambda **_: self.draw())
         view.doc.events.preview.connect(self.on_report)
@@ -72,42 +84,53 @@ class PoseLayer:
         self.draw_bones(view.doc.pose.posed_joints())
 
     def draw_bones(self, pj: dict) -> None:
-        """The posed bones through the joints ``pj`` (name -> rest-grid voxels), and the working bone's axes."""
+        """The posed bones through the joints ``pj`` (name -> rest-grid voxels), and the working bone's axes.
+        A drag's step moves the drawn lines and axes in place: making their actors anew cost 25 ms of each
+        step on software GL (#65)."""
         view = self.view
-        view.xray.remove("posed_bones")
         bones = view.doc.bones
-        if len(bones):
-            poly = bone_lines(view.world(np.array([[pj[b.proximal], pj[b.distal]] for b in bones.bones])))
-            poly.cell_data["rgb"] = label_table(len(bones))[1:]
-            # over the preview (x-ray): the bones the user poses and clicks are never hidden inside it
-            view.xray.put("posed_bones", view.plotter.add_mesh(
-                poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True, name="posed_bones",
-                render=False, reset_camera=False))
+        if not len(bones):
+            view.xray.remove("posed_bones")
+        else:
+            segments = view.world(np.array([[pj[b.proximal], pj[b.distal]] for b in bones.bones]))
+            actor = view.xray.actors.get("posed_bones")
+            if actor is not None and self._bone_lines is not None and self._bone_lines.n_cells == len(bones):
+                self._bone_lines.points = segments.reshape(-1, 3).astype(np.float32)
+            else:
+                poly = bone_lines(segments)
+                poly.cell_data["rgb"] = label_table(len(bones))[1:]
+                # over the preview (x-ray): the bones the user poses and clicks are never hidden inside it
+                view.xray.put("posed_bones", view.plotter.add_mesh(
+                    poly, scalars="rgb", rgb=True, line_width=5, render_lines_as_tubes=True, name="posed_bones",
+                    render=False, reset_camera=False))
+                self._bone_lines = poly
         self.draw_axes()
 
     def draw_axes(self) -> None:
         """The axes the Pose sliders turn the working bone about, at its posed proximal joint: x red,
-        y green, z blue (the rest axes carried by the parent's pose, as ``pose_frames`` composes them)."""
+        y green, z blue (the rest axes carried by the parent's pose, as ``pose_frames`` composes them):
+        three unit arrows placed by the actor's matrix."""
         view = self.view
-        view.xray.remove("rot_axes")
         doc = view.doc
         b = doc.working_bone
-        if b is not None and b < len(doc.bones):
+        if b is None or b >= len(doc.bones):
+            view.xray.remove("rot_axes")
+        else:
             mats = doc.pose.matrices()  # once: this runs on every step of a slider drag
             parent = doc.bones.parents()[b]
             frame = np.eye(3) if parent is None else mats[parent][:3, :3]  # row k: where axis k points now
             proximal = doc.bones.joints[doc.bones.bones[b].proximal]
             origin = apply_matrices(proximal[None], np.array([b]), mats)[0]  # the joint turns with its bone
             length = max(0.6 * float(np.linalg.norm(np.subtract(*doc.bones.segment(b)))), 8.0)
-            arrows = []
-            for k, colour in enumerate(AXIS_COLOURS):
-                d = frame[k] / np.linalg.norm(frame[k])
-                arrow = pv.Arrow(start=view.world(origin[None])[0], direction=view.world(d[None])[0] * length,
-                                 scale="auto", tip_length=0.2, shaft_radius=0.03, tip_radius=0.08)
-                arrow.cell_data["rgb"] = np.tile(np.array(colour, np.uint8), (arrow.n_cells, 1))
-                arrows.append(arrow)
-            view.xray.put("rot_axes", view.plotter.add_mesh(pv.merge(arrows), scalars="rgb", rgb=True, name="rot_axes",
-                                                            render=False, reset_camera=False, pickable=False))
+            place = np.eye(4)
+            place[:3, :3] = (view.world(frame / np.linalg.norm(frame, axis=1, keepdims=True)) * length).T
+            place[:3, 3] = view.world(origin[None])[0]
+            actor = view.xray.actors.get("rot_axes")
+            if actor is None:
+                actor = view.plotter.add_mesh(unit_axes(), scalars="rgb", rgb=True, name="rot_axes", render=False,
+                                              reset_camera=False, pickable=False)
+                view.xray.put("rot_axes", actor)
+            actor.user_matrix = place
         view.apply_stage()
         view.render()
 
@@ -125,7 +148,7 @@ class PoseLayer:
             self.draw_bones(p.joints)  # the body's own frame: bones and body never show two frames
         if p is None:
             self.clear()
-        elif p.factor > 1 and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
+        elif p.live and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
             self.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
         else:
             self.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)

@@ -132,11 +132,16 @@ def test_in_memory_order_reconstructs_like_the_written_file(tmp_path, rng):
         assert np.array_equal(reconstruct(mixed, mode=mode).volume, reconstruct(back, mode=mode).volume)
 
 
+@pytest.mark.parametrize("rows", [True, False])
 @pytest.mark.parametrize("mode", ["binary", "mottled", "bone", "sampled"])
-def test_overdraw_cut_changes_nothing_but_visits(rng, mode, monkeypatch):
-    from volanim_core.reconstruct import plan
+def test_overdraw_cut_changes_nothing_but_visits(rng, mode, rows, monkeypatch):
+    """Every sphere cut, however small: row by row (``rows``), or as the kernel cuts a sphere below radius 10
+    (slices a plane covers skipped, the rest swept)."""
+    from volanim_core.reconstruct import _kernels, plan
 
-    monkeypatch.setattr(plan, "CUT_MIN_RADIUS", 0.0)  # cut every sphere, however small
+    monkeypatch.setattr(plan, "CUT_MIN_RADIUS", 0.0)
+    if rows:
+        monkeypatch.setattr(_kernels, "ROW_CUT_R2", 0.0)
     source = rng.integers(1, 256, (30, 30, 30)).astype(np.uint8)
     t = random_tskel(rng, n=800, size=30, nbones=2)
     cut = reconstruct(t, mode=mode, source=source)

@@ -49,3 +49,23 @@ def test_lists_are_made_once_per_connectivity_and_remade_when_what_they_depend_o
     assert third is not second and np.array_equal(third, sphere_neighbours(t))
     t.bone[big[1]] = (t.bone[big[1]] + 1) % 3  # re-attached to another bone: new lists
     assert np.array_equal(cached_neighbours(t), sphere_neighbours(t))
+
+
+def test_only_planes_that_cut_the_ball_are_kept():
+    """A big sphere's power plane against a much smaller close neighbour misses its ball: kept, it cost every
+    slice a test and denied the sphere its box sweep (#65). Each kept plane cuts, each dropped one misses:
+    checked against the plane's distance from the centre, worked out here in the plain form."""
+    from volanim_core.reconstruct._plan_kernels import build_halfspaces
+
+    centres = np.array([[0.0, 0, 0], [1.0, 0, 0], [0, 12.0, 0], [0, 0, 30.0], [0, 0, 0]])
+    r2s = np.array([100.0, 4.0, 100.0, 100.0, 100.0], np.float32)  # r = 10, 2, 10, 10 and 10 (coincident)
+    neighbours = np.array([[1, 2, 3, 4]] + [[-1] * 4] * 4, np.int32)
+    start, planes = build_halfspaces(centres, r2s, neighbours, 36.0)
+    kept = []
+    for j in (1, 2, 3, 4):
+        d = np.linalg.norm(centres[j] - centres[0])
+        reach = (d * d + max(0.0, r2s[0] - r2s[j])) / (2 * d) if d else np.inf  # centre -> plane
+        kept.append(reach < 10.0)
+    assert kept == [False, True, False, False]  # tiny neighbour: power plane at 48.5; bisector at 6; at 15
+    assert start[1] - start[0] == 1 and start[-1] == 1
+    np.testing.assert_allclose(planes[0, :3], 2 * (centres[2] - centres[0]))

@@ -35,3 +35,23 @@ def test_a_drag_is_the_previews_make_preview_makes_and_redoes_a_part(mode):
     nz = live.bounds.shape[2]
     assert all(0 < n < nz // 2 for n in redone[1:7])  # each step of the forearm: its slices only
     assert redone[-1] == live.bounds.shape[2]  # walked off the grid: a new one, every slice
+
+
+def test_a_small_body_is_previewed_live_at_full_resolution_a_large_one_at_half():
+    """#65: the mannequin's posed grid (about 4 M voxels) live at full resolution, mannequin-large's (97 M) at
+    half; the choice is made on a mode's first frame and kept while the drag goes on."""
+    from volanim_core.rig.connectivity import Tskel
+    from volanim_core.rig.tskel_tools import identity_tskel
+    from volanim_studio.model.preview import LIVE_FULL_VOXELS, live_factor
+
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
+    small = identity_tskel(conn)
+    # the same body at twice the size each way: 8x the voxels, past the limit
+    large = Tskel(small.bones, small.matrices, small.points * 2, small.dt * 2, small.thinness, small.bone)
+    assert live_factor(small) == 1 and live_factor(large) == 2
+    live = LivePreviews()
+    first = live.make(small, mode="bone")
+    assert first.factor == 1 and first.live
+    assert np.array_equal(first.reconstruction.volume, make_preview(small, mode="bone").reconstruction.volume)
+    assert live.make(small, mode="bone").factor == 1  # kept
+    assert np.prod(live.bounds.shape) < 2 * LIVE_FULL_VOXELS

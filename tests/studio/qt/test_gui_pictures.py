@@ -41,7 +41,7 @@ def full_preview(qtbot, w, mode: str) -> None:
     w.reconstruct_panel.mode.setCurrentText(mode)
     w.previews.preview(report=False)
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.mode == mode
-                    and w.doc.preview.factor == 1, timeout=JOB_TIMEOUT_MS)
+                    and not w.doc.preview.live, timeout=JOB_TIMEOUT_MS)
 
 
 @pytest.fixture

@@ -206,7 +206,8 @@ def test_the_axes_the_sliders_turn_about_are_drawn_on_the_selected_bone(qtbot, p
     doc.select_bones([fa])  # its axes are the rest axes turned with the upper arm
 
     def red_tip():
-        mesh = w.scene.xray.actors["rot_axes"].mapper.dataset
+        actor = w.scene.xray.actors["rot_axes"]
+        mesh = actor.mapper.dataset.transform(actor.user_matrix, inplace=False)  # as drawn: placed by the actor
         red = mesh.extract_cells(np.flatnonzero((mesh.cell_data["rgb"] == [230, 60, 60]).all(1)))
         start = w.scene.world(doc.pose.posed_joints()["L_ELBOW"][None])[0]
         far = red.points[np.argmax(np.linalg.norm(red.points - start, axis=1))]

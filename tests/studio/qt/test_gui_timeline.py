@@ -83,7 +83,7 @@ def test_play_draws_live_previews_dropping_frames_then_previews_in_full(qtbot, r
     assert w.previews.live_timings and w.doc.preview is not None
     # pausing previews the frame stopped on at full resolution, with its report
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
-    assert w.doc.preview.factor == 1
+    assert w.doc.preview.factor == 1 and not w.doc.preview.live
     assert np.allclose(w.doc.pose.matrices(), w.doc.timeline.matrices([w.doc.settings.current_frame])[0], atol=1e-6)
 
 
