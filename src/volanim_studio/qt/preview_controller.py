@@ -4,7 +4,8 @@
         --> live_preview (full resolution on a small body, else half; GUI thread, coalesced) --> doc.set_preview
     settings.current_frame (a step) --> live_preview
     dragging back to False in Pose mode, doc.events.pose_settled, F5
-        --> preview() --> JobRunner(make_preview + breakage report) --> doc.set_preview
+        --> preview() --> JobRunner(make_preview) --> doc.set_preview (the picture)
+                      --> JobRunner(with_report) --> doc.set_preview (the same picture, with its report)
     doc.set_preview --> the scene's PoseLayer draws it (this controller draws nothing)
 
 Owned by the main window (composed, not inherited). Preview mode, kernel and
@@ -21,7 +22,7 @@ from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
 
-from ..model.preview import LivePreviews, make_preview
+from ..model.preview import LivePreviews, make_preview, with_report
 from ..model.settings import Mode
 from .controller import FAILED, Controller
 from .worker import Worker
@@ -154,7 +155,8 @@ class PreviewController(Controller):
         self.live_timings.append(time.perf_counter() - t0)
 
     def preview(self, *, report: bool = True) -> Worker | None:
-        """Full-resolution reconstruction with the breakage report, in the background."""
+        """Full-resolution reconstruction in the background, shown as soon as it is made; then, as a second
+        job, its breakage report (mannequin-large: the picture in 0.2 s, the report 5 s later, #65)."""
         st = self.doc.settings
         settings = {"mode": st.preview_mode, "kernel": st.preview_kernel, "padding": st.preview_padding}
         if self.jobs.busy:
@@ -170,20 +172,33 @@ class PreviewController(Controller):
         except ValueError as exc:
             self.show_error("Preview", str(exc))
             return None
+        source = self.doc.volume if settings["mode"] == "sampled" else None
+
+        def done(p) -> None:
+            self.doc.set_preview(p)
+            if report and not self.jobs.busy:  # (busy: what the picture set off started a job of its own)
+                self._report(p, tskel)
+
+        worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
+            tskel, **settings, source=source, progress=progress, cancel=cancel), done)
+        worker.is_preview = True
+        return worker
+
+    def _report(self, shown, tskel) -> None:
+        """The breakage report of the preview just shown, in a job of its own; applied only while that preview
+        is still the one shown (a newer pose drops it)."""
         joints = dict(self.doc.bones.joints)
         posed = self.doc.pose.posed_joints()
-        source = self.doc.volume if settings["mode"] == "sampled" else None
         rest, version = self.doc.pose.rest_parts(tskel), self.doc.pose.rest_version  # None: the worker makes them
 
         def done(p) -> None:
             self.doc.pose.keep_rest_parts(tskel, p.rest_parts, version)
-            self.doc.set_preview(p)
+            if self.doc.preview is shown:
+                self.doc.set_preview(p)
 
-        worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
-            tskel, **settings, source=source, joints=joints, posed_joints=posed, report=report,
-            rest_parts=rest, progress=progress, cancel=cancel), done)
+        worker = self.jobs.run("Checking the pose for breakage", lambda progress, cancel: with_report(
+            shown, tskel, joints=joints, posed_joints=posed, rest_parts=rest, cancel=cancel), done)
         worker.is_preview = True
-        return worker
 
     def jump_to_joint(self, name: str) -> None:
         posed = self.doc.pose.posed_joints()

@@ -78,6 +78,33 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     assert w.mode == Mode.VIEW
 
 
+def test_the_full_preview_is_drawn_before_its_report_is_made(qtbot, posed_window):
+    """#65: the release showed nothing new until the report's three more reconstructions had run (on
+    mannequin-large: 0.2 s of picture, then 5 s of report). Now the picture is set and drawn by itself, and the
+    same reconstruction comes back with its report; a pose changed meanwhile drops the stale report."""
+    w = posed_window
+    shown = []
+    w.doc.events.preview.connect(lambda **_: shown.append(w.doc.preview))
+    w.doc.select_bones([w.doc.bones.index("L_UPPERARM")])
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -30, 0))
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    shown.clear()
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy and len(shown) >= 2, timeout=JOB_TIMEOUT_MS)
+    first, last = shown[0], shown[-1]
+    assert first.report is None and not first.live and first.factor == 1  # the picture, alone
+    assert last.report is not None and last.reconstruction is first.reconstruction  # then its report
+    actor = w.scene.pose_layer.preview_actor
+    assert actor is not None and actor.GetVisibility()
+    # the picture replaced (a newer preview) the moment it is shown, before its report is even started
+    shown.clear()
+    w.doc.events.preview.connect(lambda **_: w.doc.set_preview(None) if len(shown) == 1 else None)
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.busy and len(shown) == 2, timeout=JOB_TIMEOUT_MS)
+    qtbot.wait(50)
+    assert shown[1] is None and w.doc.preview is None  # the stale report was not applied
+
+
 def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
     w = posed_window
     doc = w.doc
