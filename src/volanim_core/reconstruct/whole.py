@@ -71,7 +71,7 @@ class WholeProof:
             return
         r = np.sqrt(self.r2)
         p = posed_centres(rest)
-        big = r >= BIG
+        big = self.big = r >= BIG
         self.small = np.flatnonzero(~big)
         k = min(NEAREST + 1, self.n)
         dist, nn = cKDTree(p).query(p, k=k, workers=-1)  # each sphere's nearest, itself first
@@ -109,8 +109,7 @@ class WholeProof:
         ok = r[self.i] + r[self.j] - d > SURE
         graph = coo_matrix((np.ones(int(ok.sum()), np.int8), (self.i[ok], self.j[ok])), shape=(self.n, self.n))
         _, label = connected_components(graph, directed=False)
-        big = np.ones(self.n, bool)
-        big[self.small] = False
+        big = self.big
         groups = np.unique(label[big])
         if len(groups) > 1:
             return False

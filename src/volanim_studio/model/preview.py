@@ -82,7 +82,7 @@ def with_report(preview: Preview, tskel: Tskel, *, joints=None, posed_joints=Non
 
 
 # grids up to this many voxels are previewed live at full resolution (#65: the mannequin's posed grid,
-# ~4 M, 30 updates a second); larger ones at half (the frog's 43 M, mannequin-large's 97 M)
+# ~4 M: its redo and surface take ~40 ms); larger ones at half (the frog's 43 M, mannequin-large's 97 M)
 LIVE_FULL_VOXELS = 8_000_000
 
 
