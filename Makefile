@@ -7,7 +7,7 @@ PY     := $(VENV)/bin/python
 APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxcb-keysyms1 \
 	libxcb-image0 libxcb-render-util0 libxcb-xinerama0 libxcb-shape0 libxcb-randr0 \
 	libxcb-xfixes0 libxcb-xkb1 libxkbcommon0 libegl1 libgl1 libglx-mesa0 libgl1-mesa-dri \
-	libfontconfig1 libdbus-1-3
+	libfontconfig1 libdbus-1-3 libgomp1
 DEMO_OUT ?= demo-out
 
 .PHONY: demo test test-all flake explore install install-test system-deps lint bench docs screenshots coverage clean

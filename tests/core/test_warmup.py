@@ -53,3 +53,22 @@ def test_the_warm_up_compiles_every_kernel_called_from_python():
     # three the warm-up missed before: auto-rig's balls, geodesic connect, the default palette sort (ramp)
     assert {"volanim_core.rig._curve_kernels.paint_balls", "volanim_core.rig._attach_kernels._path_inside_many",
             "volanim_core.colour._tour_kernels.or_opt"} <= compiled and len(compiled) >= 25
+
+
+def test_numba_runs_on_a_thread_safe_layer():
+    """The studio reconstructs on its GUI thread (live previews) while a cancelled job's thread ends its chunk,
+    and viewers read in threads of their own: parallel kernels are entered from two threads at once. numba's
+    fallback layer (workqueue) aborts the process on that; OpenMP (libgomp1, in the Makefile's packages) and TBB
+    do not."""
+    import numba
+    import numpy as np
+
+    @numba.njit(parallel=True)
+    def total(a):
+        s = 0.0
+        for i in numba.prange(a.size):
+            s += a[i]
+        return s
+
+    assert total(np.ones(64)) == 64.0  # a parallel kernel has run: numba has chosen its layer
+    assert numba.threading_layer() in ("omp", "tbb")

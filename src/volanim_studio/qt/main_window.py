@@ -351,7 +351,7 @@ class MainWindow(QMainWindow):
     @property
     def busy(self) -> bool:
         """A background job or a read for a viewer is running (its thread has not ended yet)."""
-        return self.jobs.busy or self.readers.busy
+        return self.jobs.running or self.readers.busy
 
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))

@@ -5,7 +5,7 @@
     settings.current_frame (a step) --> live_preview
     dragging back to False in Pose mode, doc.events.pose_settled, F5
         --> preview() --> JobRunner(make_preview) --> doc.set_preview (the picture)
-                      --> JobRunner(with_report) --> doc.set_preview (the same picture, with its report)
+                      --> JobRunner(with_report, background) --> doc.set_preview (the same picture, with its report)
     doc.set_preview --> the scene's PoseLayer draws it (this controller draws nothing)
 
 Owned by the main window (composed, not inherited). Preview mode, kernel and
@@ -185,8 +185,8 @@ class PreviewController(Controller):
         return worker
 
     def _report(self, shown, tskel) -> None:
-        """The breakage report of the preview just shown, in a job of its own; applied only while that preview
-        is still the one shown (a newer pose drops it)."""
+        """The breakage report of the preview just shown, in a background job of its own (no dialog: the user
+        may pose on, which cancels it); applied only while that preview is still the one shown."""
         joints = dict(self.doc.bones.joints)
         posed = self.doc.pose.posed_joints()
         rest, version = self.doc.pose.rest_parts(tskel), self.doc.pose.rest_version  # None: the worker makes them
@@ -197,7 +197,7 @@ class PreviewController(Controller):
                 self.doc.set_preview(p)
 
         worker = self.jobs.run("Checking the pose for breakage", lambda progress, cancel: with_report(
-            shown, tskel, joints=joints, posed_joints=posed, rest_parts=rest, cancel=cancel), done)
+            shown, tskel, joints=joints, posed_joints=posed, rest_parts=rest, cancel=cancel), done, background=True)
         worker.is_preview = True
 
     def jump_to_joint(self, name: str) -> None:

@@ -1,6 +1,7 @@
 """The breakage verdict of the last full preview, shown where the user looks (status bar, Pose tab).
 
     doc.events.preview (with a report) --> the verdict, coloured
+    doc.events.preview (a full preview, its report still being made) --> "Checking for breakage…", greyed
     doc.events.pose --> the same words, greyed: the pose changed since (F5 checks again)
 """
 
@@ -9,6 +10,7 @@ from __future__ import annotations
 from ..model.document import Document
 from .status_line import ElidedLabel
 
+CHECKING = "Checking the pose for breakage…"
 COLOURS = {"healthy": "#2e9d4f", "broken": "#d33c3c", "stale": "#8a8a8a"}
 
 
@@ -36,8 +38,13 @@ class VerdictLabel(ElidedLabel):
         elif p.report is not None:
             self._report = p.report
             self.set_styled(p.report.verdict, COLOURS["healthy" if p.report.healthy else "broken"], bold=True)
+        elif not p.live:  # the picture is shown, its report follows (a background job): no old verdict meanwhile
+            self._report = None
+            self.set_styled(CHECKING, COLOURS["stale"])
 
     def _on_pose(self, **_) -> None:
-        if self._report is not None:
+        if self._report is None and self.plain == CHECKING:  # that check is cancelled: the pose it was of is gone
+            self.setText("")
+        elif self._report is not None:
             self.set_styled(f"{self._report.verdict} (before the last pose change: F5 checks again)",
                             COLOURS["stale"])

@@ -6,6 +6,8 @@
             Cancel button --> cancel() returns True --> Cancelled --> was_cancelled
             return value --succeeded(object)--> on_done on the GUI thread (dropped if cancelled by then)
             on_done raises --> failed(message): said, and whoever waits on the job hears it failed
+    JobRunner.run(..., background=True)   no dialog and nothing modal: the user goes on working; the next
+        job asked for cancels it and starts once its thread has ended (a full preview's breakage report)
     JobRunner.shutdown()   (window close) cancel, show "Finishing…", wait as long as it takes
 
 Why ``shutdown`` never gives up: a QThread object destroyed while its thread
@@ -47,6 +49,7 @@ class Worker(QThread):
         super().__init__(parent)
         self._task = task
         self._cancel = False
+        self.background = False  # JobRunner.run(background=True): no dialog, cancelled by the next job
 
     def cancel(self) -> None:
         self._cancel = True
@@ -89,29 +92,44 @@ class JobRunner(QObject):
 
     @property
     def busy(self) -> bool:
+        """A job the user waits for runs: another is refused. A background job does not count (``run``
+        cancels it first)."""
+        return self.worker is not None and not self.worker.background
+
+    @property
+    def running(self) -> bool:
+        """Any job's thread is running, a background one too."""
         return self.worker is not None
 
-    def run(self, label: str, task: Callable, on_done: Callable) -> Worker:
-        """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel."""
+    def run(self, label: str, task: Callable, on_done: Callable, *, background: bool = False) -> Worker:
+        """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel (``background``: with
+        neither, cancelled by the next job asked for)."""
+        if self.worker is not None and self.worker.background:
+            self._preempt()
         if self.worker is not None:
             raise RuntimeError("another job is running")
-        dialog = QProgressDialog(label, "Cancel", 0, 100, self._window)
-        dialog.setWindowModality(Qt.WindowModal)
-        dialog.setMinimumDuration(300)
         worker = Worker(task, self._window)
-        worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
-        dialog.canceled.connect(worker.cancel)
+        worker.background = background
+        dialog = None
+        if not background:
+            dialog = QProgressDialog(label, "Cancel", 0, 100, self._window)
+            dialog.setWindowModality(Qt.WindowModal)
+            dialog.setMinimumDuration(300)
+            worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
+            dialog.canceled.connect(worker.cancel)
 
         def finish():
             worker.wait()  # run() is returning: make "not busy" mean the thread has ended
-            dialog.reset()
+            if dialog is not None:
+                dialog.reset()
             self.worker = None
             self.dialog = None
             self._on_idle()
 
         def cancelled():
             finish()
-            self._message(f"{label}: cancelled.")
+            if not background:  # a background job is cancelled by what the user did next: nothing to say
+                self._message(f"{label}: cancelled.")
 
         def succeeded(result):
             if worker.cancelled:
@@ -137,6 +155,16 @@ class JobRunner(QObject):
         self.worker, self.dialog = worker, dialog
         worker.start()
         return worker
+
+    def _preempt(self) -> None:
+        """Cancel the background job and wait for its thread (its task checks ``cancel`` between chunks),
+        handling its last signals, so that ``self.worker`` is free again."""
+        worker = self.worker
+        worker.cancel()
+        while not worker.wait(20):
+            QCoreApplication.processEvents(QEventLoop.ExcludeUserInputEvents)
+        while self.worker is worker:  # its queued signal (cancelled, or a result dropped as cancelled)
+            QCoreApplication.processEvents(QEventLoop.ExcludeUserInputEvents)
 
     def shutdown(self) -> None:
         """Cancel the running job and wait until its thread has ended, however long that takes."""

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 import pytest
 
 from volanim_core import io, samples
@@ -130,3 +132,28 @@ def test_a_result_that_cannot_be_applied_is_a_failed_job_said_and_heard(qtbot, w
     window.files.load_demo("mannequin")  # the runner takes the next job
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert window.doc.demo_name == "mannequin"
+
+
+def test_a_background_job_has_no_dialog_and_the_next_job_cancels_it(qtbot, window):
+    """#65: the breakage report ran behind a modal progress dialog for seconds (mannequin-large: 5 s) after the
+    picture was shown, so the user could not pose on. A background job shows nothing modal, does not count as
+    busy for the controllers, and the next job asked for cancels it, waits for its thread and starts: its
+    result is never applied and its cancellation is not announced."""
+    released, applied = threading.Event(), []
+
+    def wait_for_cancel(progress, cancel):
+        while not cancel():  # a chunked task: it looks at cancel between chunks
+            released.wait(0.01)
+        return "stale"
+
+    worker = window.jobs.run("Checking", wait_for_cancel, applied.append, background=True)
+    assert worker.background and window.jobs.dialog is None
+    assert not window.jobs.busy and window.jobs.running and window.busy
+    messages = []
+    window.doc.events.message.connect(lambda text: messages.append(text))
+    window.jobs.run("Next", lambda progress, cancel: "fresh", applied.append)  # starts once the first has ended
+    assert worker.cancelled and worker.isFinished()
+    assert window.jobs.busy and window.jobs.dialog is not None  # a job the user waits for: its dialog
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    assert applied == ["fresh"]
+    assert not any("Checking" in m for m in messages)

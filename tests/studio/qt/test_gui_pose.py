@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QPushButton
 
 from volanim_core import samples
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.render.volume_style import gl_renderer, software_gl
 from volanim_studio.model.modes import Mode
+from volanim_studio.qt.verdict_label import CHECKING
 
 from ..conftest import JOB_TIMEOUT_MS, rig_and_pose
 
@@ -103,6 +104,38 @@ def test_the_full_preview_is_drawn_before_its_report_is_made(qtbot, posed_window
     qtbot.waitUntil(lambda: not w.busy and len(shown) == 2, timeout=JOB_TIMEOUT_MS)
     qtbot.wait(50)
     assert shown[1] is None and w.doc.preview is None  # the stale report was not applied
+
+
+def test_the_report_is_checked_behind_the_picture_and_a_new_drag_cancels_it(qtbot, posed_window):
+    """#65: the report's job showed a modal progress dialog, so the user could not pose on while it ran. Now it
+    runs in the background (no dialog; the verdict reads "Checking…"), and pressing a pose slider cancels it:
+    its report is never applied, the drag's live previews show, and the release checks the new pose."""
+    w = posed_window
+    w.doc.select_bones([w.doc.bones.index("L_UPPERARM")])
+    seen = {}
+
+    def on_picture(**_):  # the picture is shown; its report job starts right after, in this same call
+        p = w.doc.preview
+        if p is not None and p.report is None and not p.live and not seen:
+            QTimer.singleShot(0, lambda: seen.update(job=w.jobs.worker, dialog=w.jobs.dialog, busy=w.jobs.busy,
+                                                     verdict=w.verdict_label.plain) or press())
+
+    def press():
+        w.pose_panel.sliders[1].setSliderDown(True)  # a new drag starts before the report is made
+        w.pose_panel.sliders[1].setValue(-20)
+
+    w.doc.events.preview.connect(on_picture)
+    w.previews.preview()
+    qtbot.waitUntil(lambda: bool(seen) and not w.busy, timeout=JOB_TIMEOUT_MS)
+    job = seen["job"]
+    assert job is not None and job.background and seen["dialog"] is None and not seen["busy"]
+    assert seen["verdict"] == CHECKING
+    assert job.cancelled and w.doc.preview.live and w.doc.preview.report is None  # the stale report: dropped
+    assert w.verdict_label.plain == ""  # no verdict of a pose that is gone
+    w.doc.events.preview.disconnect(on_picture)
+    w.pose_panel.sliders[1].setSliderDown(False)  # the release: the picture, then its report
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    assert w.verdict_label.plain == w.doc.preview.report.verdict
 
 
 def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
