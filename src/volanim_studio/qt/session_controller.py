@@ -1,6 +1,6 @@
 """The session's safety net: autosave, crash recovery, the unsaved-changes marker and "Save changes?".
 
-    undo stack changed / timer --> Autosaver (every N edits, every minute)
+    undo stack changed / timer --> Autosaver (every N edits, every minute; a held drag's steps at its release)
     doc project / skeleton / undo events --> window title "volanim studio — NAME[*]" (* = unsaved edits)
     close, open another volume or project --> when_saved_or_discarded(then): Save / Discard / Cancel
         Discard --> Autosaver.set_aside (kept a week, openable as a project) --> then()
@@ -26,6 +26,7 @@ class SessionController(Controller):
         super().__init__(window)
         self.autosaver = autosave.Autosaver(self.doc, every_edits=every_edits, every_seconds=every_seconds)
         self.doc.undo.events.changed.connect(self._after_edit)
+        self.doc.settings.events.dragging.connect(lambda value, **_: None if value else self._after_edit())
         self.timer = QTimer(window)
         self.timer.timeout.connect(self._tick)
         self.timer.start(int(1000 * min(every_seconds, 60.0)))

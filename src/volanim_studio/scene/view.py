@@ -58,7 +58,7 @@ class SceneView:
         self._shown = np.zeros(0, np.int64)
         self.posing = False
         self.dragging = False  # settings.dragging (a slider held): draw a level-of-detail subset
-        self._fxaa_after_drag: bool | None = None  # the renderer's FXAA, put back on release
+        self._after_drag: tuple[bool, bool] | None = None  # the renderer's FXAA and OIT, put back on release
         self._render_pending = False
         self._drawn_once = False
         plotter.set_background("#1e1f24")
@@ -293,20 +293,27 @@ class SceneView:
     def set_dragging(self, on: bool) -> None:
         """``settings.dragging``: at most LOD_POINTS, the coarse hull, no FXAA (Pose mode: no FXAA only)."""
         self.dragging = bool(on)
-        self.hold_fxaa(self.dragging)
+        self.hold_quality(self.dragging)
         if not self.posing:
             self.hull.set_dragging(self.dragging)
             self._update_cloud()
 
-    def hold_fxaa(self, on: bool) -> None:
-        """No FXAA while held (~16 ms of a held 42 ms frame, software GL 1200x800; live preview 10.3 -> 12.6 f/s)."""
+    def hold_quality(self, on: bool) -> None:
+        """While held: no FXAA (~16 ms of a held 42 ms frame, software GL 1200x800; live preview 10.3 -> 12.6
+        f/s) and no order-independent transparency: the translucent hull blends straight into the frame instead
+        of through OIT's float buffers and full-window composite (#65: a held frame of mannequin-large 60 -> 25
+        ms on llvmpipe). The hull is one colour, so the order it is blended in barely shows; the frame after
+        release has both again."""
         renderer = self.plotter.renderer
-        if on and self._fxaa_after_drag is None:
-            self._fxaa_after_drag = bool(renderer.GetUseFXAA())
+        if on and self._after_drag is None:
+            self._after_drag = (bool(renderer.GetUseFXAA()), bool(renderer.GetUseOIT()))
             renderer.SetUseFXAA(False)
-        elif not on and self._fxaa_after_drag is not None:
-            renderer.SetUseFXAA(self._fxaa_after_drag)
-            self._fxaa_after_drag = None
+            renderer.SetUseOIT(False)
+        elif not on and self._after_drag is not None:
+            fxaa, oit = self._after_drag
+            renderer.SetUseFXAA(fxaa)
+            renderer.SetUseOIT(oit)
+            self._after_drag = None
             self.render()
 
     def _drawn(self) -> tuple[np.ndarray, np.ndarray]:

@@ -36,18 +36,18 @@ def drag(qtbot, window, axis: int, values) -> None:
 
 
 def test_a_held_pose_slider_draws_without_fxaa_and_the_release_with_it(qtbot, posed_window):
-    """FXAA is a full-window pass (~16 ms of software GL at 1200x800): a pose drag's live preview
-    draws without it, and the frame after release has it again."""
+    """FXAA is a full-window pass (~16 ms of software GL at 1200x800), order-independent transparency two more: a
+    pose drag's live preview draws without them, and the frame after release has them again."""
     w = posed_window
     renderer = w.plotter.renderer
     w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
-    assert renderer.GetUseFXAA()
+    assert renderer.GetUseFXAA() and renderer.GetUseOIT()
     slider = w.pose_panel.sliders[1]
     slider.setSliderDown(True)  # what a press on the handle does: sliderPressed, and isSliderDown()
     slider.setValue(-20)
-    assert not renderer.GetUseFXAA()
+    assert not renderer.GetUseFXAA() and not renderer.GetUseOIT()  # OIT: 35 of a held frame's 60 ms (#65)
     slider.setSliderDown(False)  # the release: sliderReleased
-    assert renderer.GetUseFXAA()
+    assert renderer.GetUseFXAA() and renderer.GetUseOIT()
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
 
 
@@ -136,6 +136,25 @@ def test_the_report_is_checked_behind_the_picture_and_a_new_drag_cancels_it(qtbo
     w.pose_panel.sliders[1].setSliderDown(False)  # the release: the picture, then its report
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
     assert w.verdict_label.plain == w.doc.preview.report.verdict
+
+
+def test_a_held_drag_is_autosaved_once_at_its_release(qtbot, posed_window):
+    """#65: every step of a pose drag counts as an edit, so the autosave wrote the whole project every fifth
+    step (45 ms each on the mannequin) while the user dragged. Now the drag saves once, at its release, and
+    what is saved is the pose released."""
+    w = posed_window
+    saver = w.session.autosaver
+    ua = w.doc.bones.index("L_UPPERARM")
+    w.doc.select_bones([ua])
+    saves = saver.saves
+    slider = w.pose_panel.sliders[1]
+    slider.setSliderDown(True)
+    for v in range(-3, -40, -3):  # 13 steps: two autosaves' worth of edits
+        slider.setValue(v)
+    assert saver.saves == saves
+    slider.setSliderDown(False)
+    assert saver.saves == saves + 1 and not saver.dirty
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
 
 
 def test_break_at_the_shoulder_fix_and_preview_again(qtbot, posed_window):
