@@ -22,9 +22,12 @@ minimum thinness 0.5.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from pathlib import Path
+
+import numpy as np
 
 from volanim_core import io
 from volanim_core.errors import FormatError
@@ -42,20 +45,30 @@ DEFAULT_SEGMENTATION = {"lo": 1, "hi": None, "fill": False, "metric": "euclid", 
                         "spacing": None,  # spacing: the voxel size the user confirmed (None: the file's)
                         "series": None}  # series: the DICOM series chosen from a folder of several
 DATA_FILES = ("mskel", "bones", "connect")
-_stored_skeletons: dict = {}  # (store folder, id(skeleton)) -> (skeleton, relative path, sha256): written once
+_stored: dict = {}  # (store folder, kind) -> (fingerprint, skeleton, relative path, sha256): written once
 
 
-def _store_skeleton(path: Path, skeleton) -> tuple[str, str]:
-    """The skeleton's stored file; a skeleton already stored for this project is not written again."""
-    key = (str(bundle.store_folder(path).resolve()), id(skeleton))
-    hit = _stored_skeletons.get(key)
-    if hit is not None and hit[0] is skeleton and (path.parent / hit[1]).is_file():
-        return hit[1], hit[2]
-    rel, digest = bundle.store_file(path, "skeleton", ".mskel", lambda p: io.write_mskel(p, skeleton))
-    if len(_stored_skeletons) > 8:
-        _stored_skeletons.clear()
-    _stored_skeletons[key] = (skeleton, rel, digest)
+def _store_once(path: Path, kind: str, suffix: str, skeleton, fingerprint, write) -> tuple[str, str]:
+    """The stored file of ``kind``; one already stored for this project from the same ``skeleton`` object and
+    ``fingerprint`` is not formatted and written again (an autosave after a pose change wrote the frog's
+    .connect anew: 1 s of number formatting for nothing, #65)."""
+    key = (str(bundle.store_folder(path).resolve()), kind)
+    hit = _stored.get(key)
+    if hit is not None and hit[0] == fingerprint and hit[1] is skeleton and (path.parent / hit[2]).is_file():
+        return hit[2], hit[3]
+    rel, digest = bundle.store_file(path, kind, suffix, write)
+    if len(_stored) > 16:
+        _stored.clear()
+    _stored[key] = (fingerprint, skeleton, rel, digest)
     return rel, digest
+
+
+def _connect_fingerprint(doc) -> tuple:
+    """What a .connect is made of besides the skeleton's own arrays: each point's bone, the bones, the joints."""
+    digest = hashlib.sha256(doc.attachments.bone.tobytes())
+    digest.update(np.ascontiguousarray(doc.bones.segments(), np.float64).tobytes())
+    return (id(doc.skeleton), digest.hexdigest(), tuple(b.label for b in doc.bones.bones),
+            doc.settings.joints, doc.settings.blend)
 
 
 def write_project(doc, path) -> dict:
@@ -65,10 +78,11 @@ def write_project(doc, path) -> dict:
     if len(doc.bones):  # a .bones file with no bones is not a valid file: a project without bones has none
         stored["bones"] = bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones, doc.grid))
     if doc.skeleton is not None:
-        stored["mskel"] = _store_skeleton(path, doc.skeleton)
+        stored["mskel"] = _store_once(path, "skeleton", ".mskel", doc.skeleton, id(doc.skeleton),
+                                      lambda p: io.write_mskel(p, doc.skeleton))
     if len(doc.attachments.bone) and (doc.attachments.bone >= 0).any():
-        conn = doc.attachments.to_connectivity()
-        stored["connect"] = bundle.store_file(path, "connect", ".connect", lambda p: io.write_connect(p, conn))
+        stored["connect"] = _store_once(path, "connect", ".connect", doc.skeleton, _connect_fingerprint(doc),
+                                        lambda p: io.write_connect(p, doc.attachments.to_connectivity()))
 
     volume = relative_path(path, doc.volume_path) if doc.volume_path else None
     data = {

@@ -174,6 +174,31 @@ def test_an_unchanged_skeleton_is_stored_once(tmp_path, doc):
     assert read_project(path)["mskel"] == mskel and os.stat(mskel).st_mtime_ns == stamp
 
 
+def test_a_pose_change_saves_without_writing_the_connect_again_and_an_attachment_change_does(tmp_path, doc,
+                                                                                             monkeypatch):
+    """#65: each autosave formatted and wrote the whole .connect again (the frog's: 1 s on the GUI thread at a
+    drag's release) though only the pose had changed. The file is written again exactly when what it holds
+    changed: a point's bone, a bone, the joints."""
+    written = []
+    real = io.write_connect
+    monkeypatch.setattr(io, "write_connect", lambda p, conn, **kw: written.append(p) or real(p, conn, **kw))
+    path = tmp_path / "p.volanim"
+    make_generation(doc, 3)
+    doc.save_project(path)
+    first = read_project(path)["connect"]
+    doc.pose.set_angles(0, (0, -30, 0))
+    doc.save_project(path)
+    assert read_project(path)["connect"] == first and len(written) == 1  # not formatted again
+    doc.attachments.bone[7] = 1  # even an edit behind the undo stack's back
+    doc.save_project(path)
+    moved = read_project(path)["connect"]
+    assert moved != first and io.read_connect(moved).bone.tolist() == doc.attachments.to_connectivity().bone.tolist()
+    doc.settings.joints = "smooth"
+    doc.save_project(path)
+    smooth = read_project(path)["connect"]
+    assert smooth != moved and io.read_connect(smooth).joints.kind == "smooth"
+
+
 def test_project_from_a_newer_version_is_refused(tmp_path):
     path = tmp_path / "new.volanim"
     path.write_text('{"format": "volanim project", "version": 99}')
