@@ -170,7 +170,7 @@ class Autosaver:
     def edited(self) -> bool:
         """After an edit: save when ``every_edits`` edits are unsaved -- not while a slider or the timeline is
         held: each step of a drag counts as an edit, and writing the project every fifth step cost a pose drag
-        45 ms a save (#65); the release is the edit that saves (SessionController)."""
+        45 ms a save (#65); the release's save follows once the window is idle (SessionController)."""
         if self.doc.settings.dragging:
             return False
         if self.doc.undo.edits - self._saved_edits >= self.every_edits:

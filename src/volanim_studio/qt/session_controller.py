@@ -1,6 +1,7 @@
 """The session's safety net: autosave, crash recovery, the unsaved-changes marker and "Save changes?".
 
-    undo stack changed / timer --> Autosaver (every N edits, every minute; a held drag's steps at its release)
+    undo stack changed / timer --> Autosaver (every N edits, every minute; a held drag's steps once the
+        window is idle after its release)
     doc project / skeleton / undo events --> window title "volanim studio — NAME[*]" (* = unsaved edits)
     close, open another volume or project --> when_saved_or_discarded(then): Save / Discard / Cancel
         Discard --> Autosaver.set_aside (kept a week, openable as a project) --> then()
@@ -20,13 +21,21 @@ from ..model import autosave
 from .controller import Controller
 from .worker import Worker
 
+RELEASE_POLL_MS = 300  # how often a released drag's save looks for an idle window
+
 
 class SessionController(Controller):
     def __init__(self, window, *, every_edits: int = 5, every_seconds: float = 60.0):
         super().__init__(window)
         self.autosaver = autosave.Autosaver(self.doc, every_edits=every_edits, every_seconds=every_seconds)
         self.doc.undo.events.changed.connect(self._after_edit)
-        self.doc.settings.events.dragging.connect(lambda value, **_: None if value else self._after_edit())
+        # a drag's steps are saved after its release, once the window is idle: its preview first (the frog's
+        # first save formats 0.5 M numbers: 2 s on the GUI thread, which held the picture back, #65)
+        self._after_release = QTimer(window)
+        self._after_release.setInterval(RELEASE_POLL_MS)
+        self._after_release.timeout.connect(self._save_after_release)
+        self.doc.settings.events.dragging.connect(
+            lambda value, **_: self._after_release.stop() if value else self._after_release.start())
         self.timer = QTimer(window)
         self.timer.timeout.connect(self._tick)
         self.timer.start(int(1000 * min(every_seconds, 60.0)))
@@ -43,6 +52,12 @@ class SessionController(Controller):
         except (OSError, ValueError) as exc:
             self.doc.message(f"Autosave failed: {exc}")
 
+    def _save_after_release(self) -> None:
+        if self.window.busy:  # the release's preview and report: the save waits for them
+            return
+        self._after_release.stop()
+        self._after_edit()
+
     def _tick(self) -> None:
         try:
             self.autosaver.tick()
@@ -52,6 +67,7 @@ class SessionController(Controller):
     def close(self) -> None:
         """A clean exit (the edits were saved or set aside): nothing left to recover."""
         self.timer.stop()
+        self._after_release.stop()
         self.autosaver.close()
 
     def offer_recovery(self, ask=None) -> Worker | None:
