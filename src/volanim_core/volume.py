@@ -159,6 +159,20 @@ def tight_bounds(vol: np.ndarray, level: float = 0) -> Bounds | None:
     return Bounds((int(xs[0]), int(ys[0]), int(zs[0])), (int(xs[-1]), int(ys[-1]), int(zs[-1])))
 
 
+def each_channel(vol: np.ndarray, fn):
+    """``fn(vol)`` for a 3-D volume; for a colour one ``(X, Y, Z, C)``, ``fn`` of each channel, stacked again
+    along the last axis, so that a tool written for one value a voxel keeps colour (#66: resample, crop and
+    flip made grey of it). ``fn`` returns a volume, or a tuple whose first item is one (the rest is the
+    first channel's: an offset or a geometry, the same for every channel)."""
+    vol = np.asarray(vol)
+    if vol.ndim != 4:
+        return fn(vol)
+    results = [fn(vol[..., c]) for c in range(vol.shape[3])]
+    if isinstance(results[0], tuple):
+        return (np.stack([r[0] for r in results], axis=3), *results[0][1:])
+    return np.stack(results, axis=3)
+
+
 def flip(vol: np.ndarray, axis: str | int) -> np.ndarray:
     """Mirror the volume along ``axis`` ('x', 'y', 'z' or 0..2)."""
     vol = _check3d(vol)

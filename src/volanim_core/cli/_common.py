@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import re
 import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 from volanim_core.geometry import IDENTITY
 from volanim_core.io import read_scan, write_output
 from volanim_core.io._text import is_number
+from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.volume import Bounds
 
 #: What every ``--help`` example assumes; tests/test_documented_commands.py runs them all in order.
@@ -64,9 +68,27 @@ def add_dims(p: argparse.ArgumentParser) -> None:
     p.add_argument("--series", help="the DICOM series to read from a folder holding several (its UID or number)")
 
 
-def load_scan(path: str, args, *, colour: bool = False):
-    """The volume and its geometry (:func:`io.read_scan`) with the command's ``--dims`` and ``--series``."""
-    return read_scan(path, dims=getattr(args, "dims", None), series=getattr(args, "series", None), colour=colour)
+def load_scan(path: str, args, *, colour: bool | str = False):
+    """The volume and its geometry (:func:`io.read_scan`) with the command's ``--dims`` and ``--series``.
+
+    ``colour``: True, the command keeps colour (RGB voxels come as ``data[x, y, z, channel]``);
+    ``"luminance"``, it reads a colour volume's luminance and says so (segmenting a colour scan: its output
+    is no volume to keep colour in); False, a colour volume is refused in words rather than handed over as
+    grey: a tool that quietly turned colour into grey (resample, crop, flip did, #66) loses what the user
+    came for."""
+    scan = read_scan(path, dims=getattr(args, "dims", None), series=getattr(args, "series", None), colour=True)
+    if is_colour(scan.data) and colour == "luminance":
+        print(f"note: {path} is a colour volume; read as its luminance (0.299 R + 0.587 G + 0.114 B, a dark "
+              f"colour at least 1: every non-black voxel is part of the object)")
+        grey = np.asfortranarray(to_grey(scan.data))
+        grey[(grey == 0) & scan.data.any(axis=3)] = 1  # (0, 0, 2) rounds to 0: it would drop out of the body
+        return dataclasses.replace(scan, data=grey)
+    if is_colour(scan.data) and not colour:
+        command = getattr(args, "command", None) or "this command"
+        raise ValueError(f"{path} is a colour (RGB) volume, and `volanim {command}` works on one value a voxel; "
+                         f"it would drop the colour. Make a grey copy first if that is what you want: "
+                         f"volanim convert {path} grey.nrrd --grey")
+    return scan
 
 
 def load_source(args, frame, *, colour: bool = False):
@@ -88,8 +110,8 @@ def load_source(args, frame, *, colour: bool = False):
     return source, geometry
 
 
-def load(path: str, args) -> object:
-    return load_scan(path, args).data
+def load(path: str, args, *, colour: bool | str = False) -> object:
+    return load_scan(path, args, colour=colour).data
 
 
 def save(path: str, vol, geometry=IDENTITY) -> Path:
@@ -178,8 +200,22 @@ def parse_range(text: str) -> tuple[float, float | None]:
         raise argparse.ArgumentTypeError(f"expected LO or LO:HI, got {text!r}") from None
 
 
-def bounds_arg(values) -> Bounds:
-    return Bounds(tuple(values[:3]), tuple(values[3:]))
+def bounds_arg(values, *, inclusive: bool = True, option: str = "--bounds") -> Bounds:
+    """Six numbers ``x0 y0 z0 x1 y1 z1`` as (inclusive) :class:`Bounds`. ``inclusive=False``: the thesis's
+    CropVolume and Fill convention, the stop excluded ("up to, but not including"): ``0 0 0 2 2 2`` is 2x2x2."""
+    lo, hi = tuple(values[:3]), tuple(values[3:])
+    if inclusive:
+        return Bounds(lo, hi)
+    if any(h <= v for v, h in zip(lo, hi)):
+        raise ValueError(f"{option} {' '.join(map(str, values))}: the stop x1 y1 z1 is excluded (the thesis's "
+                         f"convention), so each must be greater than its start; --inclusive takes them as the last "
+                         f"voxels")
+    return Bounds(lo, tuple(h - 1 for h in hi))
+
+
+def stop_exclusive(b: Bounds) -> str:
+    """``b`` as the six numbers crop and fill take: the stop excluded."""
+    return " ".join(str(int(v)) for v in (*b.lo, *(h + 1 for h in b.hi)))
 
 
 def local_workers(args) -> int | None:

@@ -55,7 +55,7 @@ def _report(args):
     from volanim_core.reconstruct.checks import report, report_json
 
     conn = joints_of(args, read_connect(args.connect))
-    source, geometry = load_source(args, conn) if args.source else (None, None)
+    source, geometry = load_source(args, conn, colour="luminance") if args.source else (None, None)
     rep = report(conn, read_trans(args.trans), bones=read_bones(args.bones) if args.bones else None,
                  source=source, source_geometry=geometry)
     if args.json:

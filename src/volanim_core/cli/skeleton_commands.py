@@ -7,14 +7,24 @@ import time
 import numpy as np
 
 from volanim_core.geometry import mm
-from volanim_core.io import read_scan, write_skeleton
+from volanim_core.io import write_skeleton
 from volanim_core.io.mesh_files import write_mesh
 from volanim_core.progress import TextProgress
 from volanim_core.skeleton.hull import isosurface
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 
 from .. import volume
-from ._common import add_command, add_dims, add_volume_in, ascii_float, ascii_int, load, parse_range, positive_float
+from ._common import (
+    add_command,
+    add_dims,
+    add_volume_in,
+    ascii_float,
+    ascii_int,
+    load,
+    load_scan,
+    parse_range,
+    positive_float,
+)
 
 
 def segment(vol: np.ndarray, threshold, fill: bool) -> np.ndarray:
@@ -26,13 +36,13 @@ def segment(vol: np.ndarray, threshold, fill: bool) -> np.ndarray:
 def mask_like_skeleton(args, skeleton):
     """``args.volume`` segmented as skeletonize did (``--threshold``, ``--fill-cavities``) on the skeleton's
     grid: the cubes skeletonize resampled the scan to. What connect's and autorig's paths run inside."""
-    scan = read_scan(args.volume, dims=args.dims, series=args.series)
+    scan = load_scan(args.volume, args, colour="luminance")
     mask = segment(scan.data, args.threshold, args.fill_cavities)
     return volume.isotropic_mask(mask, scan.geometry, min(skeleton.geometry.spacing))[0]
 
 
 def _skeletonize(args):
-    scan = read_scan(args.volume, dims=args.dims, series=args.series)
+    scan = load_scan(args.volume, args, colour="luminance")  # a colour scan is segmented by its luminance
     mask = segment(scan.data, args.threshold, args.fill_cavities)
     mask, geometry = _cubic(mask, scan.geometry, args.voxel_size)
     bar = TextProgress("skeletonize")
@@ -55,7 +65,7 @@ def _cubic(mask: np.ndarray, geometry, voxel_size):
 
 
 def _isosurface(args):
-    vol = load(args.volume, args)
+    vol = load(args.volume, args, colour="luminance")
     mask = segment(vol, args.threshold, args.fill_cavities)
     t0 = time.perf_counter()
     verts, faces = isosurface(mask, step=args.step, engine=args.engine)

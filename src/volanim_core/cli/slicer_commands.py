@@ -25,7 +25,7 @@ def _markups(args):
             raise ValueError(f"cannot write {out}: markups in, so the output is a .bones file")
         if not args.like:
             raise ValueError("give --like SCAN: the .bones file records its joints on the scan's voxel grid")
-        bones = read_markups(args.inputs, load_scan(args.like, args).geometry)
+        bones = read_markups(args.inputs, load_scan(args.like, args, colour=True).geometry)
         write_bones(out, bones)
         print(f"{len(bones.joints)} joints, {len(bones)} bones (on {args.like}'s grid) -> {out}")
         return
@@ -36,7 +36,7 @@ def _markups(args):
     bones = read_bones(args.inputs[0])
     geometry = bones.geometry  # the grid the file records wins; --like places a file that records none
     if geometry.is_identity and args.like:
-        geometry = load_scan(args.like, args).geometry
+        geometry = load_scan(args.like, args, colour=True).geometry
     if geometry.is_identity:
         print(f"note: {args.inputs[0]} records no voxel grid: its voxels are written as 1 mm cubes at the origin "
               "(give --like SCAN to place them in the scan)")
@@ -71,7 +71,7 @@ def _displacement(args):
     if not args.output.endswith(".nrrd"):
         raise ValueError(f"cannot write {args.output}: a displacement field is written as .nrrd")
     conn = read_connect(args.connect)
-    scan = load_scan(args.like, args)
+    scan = load_scan(args.like, args, colour=True)
     if conn.geometry.is_identity and not scan.geometry.is_identity:
         raise ValueError(f"{args.connect} records no voxel grid, so where its voxels lie in {args.like} is not "
                          "known; make the connectivity from a skeleton of this scan")

@@ -29,6 +29,7 @@ from ._common import (
     positive_float,
     positive_int,
     save,
+    stop_exclusive,
 )
 
 
@@ -77,39 +78,47 @@ def _fill(args):
         vol = volume.fill_cavities(vol)
         print(f"filled {np.count_nonzero(vol) - before} cavity voxels")
     if args.box is not None:
-        vol = volume.box_fill(vol, bounds_arg(args.box), args.value)
+        vol = volume.box_fill(vol, bounds_arg(args.box, inclusive=args.inclusive, option="--box"), args.value)
     save(args.output, vol, scan.geometry)
 
 
 def _crop(args):
-    scan = load_scan(args.input, args)
+    scan = load_scan(args.input, args, colour=True)
     vol = scan.data
     if args.bounds:
-        b = bounds_arg(args.bounds)
+        b = bounds_arg(args.bounds, inclusive=args.inclusive)
     else:
-        b = volume.tight_bounds(vol)
+        b = volume.tight_bounds(vol.max(axis=3) if vol.ndim == 4 else vol)  # colour: of the non-black voxels
         if b is None:
             raise ValueError(f"{args.input}: the volume is all zero, there is nothing to crop to")
     if args.pad:
         b = volume.Bounds(tuple(v - args.pad for v in b.lo), tuple(v + args.pad for v in b.hi))
     geometry = scan.geometry.shifted(b.lo)
-    print(f"crop bounds: {b}  (origin of the output in the input: {b.lo}; at ({mm(geometry.origin, ', ')}) mm)")
-    save(args.output, volume.crop(vol, b), geometry)
+    shown = str(b) if args.inclusive else stop_exclusive(b)
+    print(f"crop bounds: {shown} ({'inclusive' if args.inclusive else 'stop excluded'}; the output's origin is "
+          f"voxel {b.lo} of the input, at ({mm(geometry.origin, ', ')}) mm)")
+    save(args.output, volume.each_channel(vol, lambda v: volume.crop(v, b)), geometry)
 
 
 def _tightbounds(args):
-    b = volume.tight_bounds(load(args.input, args), args.level)
-    print(b if b is not None else "none (no voxel above the level)")
+    """The bounds as crop and fill take them (the stop excluded, the thesis's convention), so that
+    ``volanim crop IN OUT --bounds $(volanim tightbounds IN)`` crops to them; ``--inclusive``: the last voxels."""
+    vol = load(args.input, args, colour=True)
+    b = volume.tight_bounds(vol.max(axis=3) if vol.ndim == 4 else vol, args.level)  # colour: its brightest channel
+    if b is None:
+        print("none (no voxel above the level)")
+    else:
+        print(b if args.inclusive else stop_exclusive(b))
 
 
 def _flip(args):
     """Mirror the voxels; the geometry is flipped with them, so the scan stays where it is in space
     unless ``--mirror`` asks for a mirrored body (the old tool's only meaning)."""
-    scan = load_scan(args.input, args)
+    scan = load_scan(args.input, args, colour=True)
     axis = "xyz".index(args.axis)
     keep = args.mirror or scan.geometry.is_identity  # a volume placed nowhere has nowhere to stay
     geometry = scan.geometry if keep else scan.geometry.flipped(axis, scan.data.shape[axis])
-    save(args.output, volume.flip(scan.data, args.axis), geometry)
+    save(args.output, volume.each_channel(scan.data, lambda v: volume.flip(v, args.axis)), geometry)
 
 
 def _count(args):
@@ -142,8 +151,8 @@ def _diff(args):
 
 
 def _reverse(args):
-    scan = load_scan(args.input, args)
-    save(args.output, volume.reverse(scan.data), scan.geometry)
+    scan = load_scan(args.input, args, colour=True)  # colour: each channel, 255 - v (a photographic negative)
+    save(args.output, volume.each_channel(scan.data, volume.reverse), scan.geometry)
 
 
 def read_remap_table(path: str) -> np.ndarray:
@@ -203,8 +212,8 @@ def _rmheader(args):
 
 
 def _fitpow2(args):
-    scan = load_scan(args.input, args)
-    out, offset = volume.fit_pow2(scan.data, center=args.center)
+    scan = load_scan(args.input, args, colour=True)
+    out, offset = volume.each_channel(scan.data, lambda v: volume.fit_pow2(v, center=args.center))
     print(f"old voxel (0,0,0) is at {offset} in the output")
     save(args.output, out, scan.geometry.shifted(np.negative(offset)))
 
@@ -219,7 +228,7 @@ def _float2uchar(args):
 
 
 def _resample(args):
-    scan = load_scan(args.input, args)
+    scan = load_scan(args.input, args, colour=True)  # colour: each channel, as the thesis resampled 24-bit slices
     g = scan.geometry
     if args.spacing:
         spacing = args.spacing if len(args.spacing) == 3 else args.spacing * 3
@@ -230,8 +239,9 @@ def _resample(args):
     else:
         spacing = [min(g.spacing)] * 3
     order = 0 if args.labels else 1
-    vol, geometry = volume.resample(scan.data, g, spacing, order=order, progress=TextProgress("resample"))
-    print(f"{'x'.join(map(str, scan.data.shape))} voxels of {mm(g.spacing)} mm -> "
+    vol, geometry = volume.each_channel(scan.data, lambda v: volume.resample(
+        v, g, spacing, order=order, progress=TextProgress("resample")))
+    print(f"{'x'.join(map(str, scan.data.shape[:3]))} voxels of {mm(g.spacing)} mm -> "
           f"{'x'.join(map(str, vol.shape))} of {mm(geometry.spacing)} mm ({'nearest' if order == 0 else 'linear'})")
     save(args.output, vol, geometry)
 
@@ -311,19 +321,24 @@ def register(sub) -> None:
                     "volanim fill frog-body.VOL frog-filled.VOL --cavities", _fill)
     _io(p)
     p.add_argument("--cavities", action="store_true", help="fill background regions enclosed by the object")
-    p.add_argument("--box", nargs=6, type=ascii_int, metavar="N", help="inclusive box x0 y0 z0 x1 y1 z1 to set")
+    p.add_argument("--box", nargs=6, type=ascii_int, metavar="N",
+                   help="box x0 y0 z0 x1 y1 z1 to set, the stop excluded as in the thesis: 0 0 0 2 2 2 is 8 voxels "
+                        "(volanim included it before: --inclusive)")
+    p.add_argument("--inclusive", action="store_true", help="x1 y1 z1 are the box's last voxels")
     p.add_argument("--value", type=ascii_int, default=255, help="value for --box (default 255)")
 
     p = add_command(sub, "crop", "Crop (or pad) to bounds, or to the tight bounds (CropVolume).",
                     "volanim crop frog.VOL frog-cropped.VOL --pad 2", _crop)
     _io(p)
     p.add_argument("--bounds", nargs=6, type=ascii_int, metavar="N",
-                   help="inclusive x0 y0 z0 x1 y1 z1 (default: tight)")
+                   help="x0 y0 z0 x1 y1 z1, the stop excluded as in the thesis (default: the tight bounds)")
+    p.add_argument("--inclusive", action="store_true", help="x1 y1 z1 are the last voxels kept")
     p.add_argument("--pad", type=ascii_int, default=0, help="grow the bounds by N voxels on every side")
 
-    p = add_command(sub, "tightbounds", "Print the inclusive bounds of the non-zero voxels (TightBounds).",
-                    "volanim tightbounds frog.VOL", _tightbounds)
+    p = add_command(sub, "tightbounds", "Print the bounds of the non-zero voxels as crop and fill take them, the stop "
+                    "excluded (TightBounds).", "volanim tightbounds frog.VOL", _tightbounds)
     _io(p, output=False)
+    p.add_argument("--inclusive", action="store_true", help="print x1 y1 z1 as the last non-zero voxels")
     p.add_argument("--level", type=finite_float, default=0, help="count voxels above this value (default 0)")
 
     p = add_command(sub, "flip", "Reverse a volume's voxels along an axis; the geometry follows, so in a viewer that "

@@ -33,12 +33,13 @@ def test_onevolume_merges_a_numbered_series_above_a_threshold(tmp_path):
     assert r.returncode == 0, r.stderr
     expected = np.zeros_like(parts[0])
     for p in parts:
-        expected = np.where(p > 200, p, expected)
+        expected = np.where(p >= 200, p, expected)  # the thesis: below the threshold is zeroed, equal stays
+    assert (parts[1] == 200).any()  # the case that tells the two apart
     assert np.array_equal(io.read_volume(tmp_path / "one.VOL"), expected)
     assert volanim("onevolume", *names, "-o", tmp_path / "lab.VOL", "--threshold", "200", "--label").returncode == 0
     labels = np.zeros_like(parts[0])
     for k, p in enumerate(parts, start=1):
-        labels[p > 200] = k
+        labels[p >= 200] = k
     assert np.array_equal(io.read_volume(tmp_path / "lab.VOL"), labels)
     io.write_volume(tmp_path / "small.VOL", parts[0][:3])
     bad = volanim("onevolume", tmp_path / "part.1.VOL", tmp_path / "small.VOL", "-o", tmp_path / "x.VOL")
@@ -63,10 +64,16 @@ def test_addskel_burns_points_in_through_physical_space_and_at_half_size(tmp_pat
     assert set(zip(*np.nonzero(o == 200))) == {(2, 3, 2), (10, 8, 9), (19, 15, 11)}
     assert (o == 10).sum() == v.size - 3
     assert volanim("addskel", tmp_path / "v.nrrd", tmp_path / "s.mskel", "-o", tmp_path / "h.nrrd",
-                   "--half").returncode == 0
+                   "--half-grid").returncode == 0
     h = io.read_scan(tmp_path / "h.nrrd")
     assert h.data.shape == (10, 8, 6) and np.allclose(h.geometry.spacing, (2, 2, 4))
     assert set(zip(*np.nonzero(h.data == 255))) == {(1, 1, 1), (5, 4, 4), (9, 7, 5)}
+    # the thesis's Merger (A.28): the scan at half its intensity, the points at 250 over it
+    merger = volanim("addskel", tmp_path / "v.nrrd", tmp_path / "s.mskel", "-o", tmp_path / "m.nrrd", "--half")
+    assert merger.returncode == 0 and "at half its intensity" in merger.stdout
+    m = io.read_volume(tmp_path / "m.nrrd")
+    assert m.shape == v.shape and set(zip(*np.nonzero(m == 250))) == {(2, 3, 2), (10, 8, 9), (19, 15, 11)}
+    assert (m == 5).sum() == v.size - 3
     io.write_skel(tmp_path / "far.skel", Skeleton(np.array([[500, 500, 500]]), [1.0], None))
     far = volanim("addskel", tmp_path / "v.nrrd", tmp_path / "far.skel", "-o", tmp_path / "x.nrrd")
     assert far.returncode == 2 and "far.skel: none of its 1 points is inside" in far.stderr

@@ -67,7 +67,38 @@ def test_other_tools_run(tmp_path, vol_file, capsys):
         assert main([str(a) for a in args]) == 0, args
     assert set(np.unique(io.read_volume(tmp_path / "m.VOL"))) == {0, 7, 9}
     assert io.read_volume(tmp_path / "p.vti").shape == (16, 16, 8)
-    assert "2 2 2 8 7 5" in capsys.readouterr().out
+    assert "2 2 2 9 8 6" in capsys.readouterr().out  # tight bounds as crop takes them: the stop excluded
+
+
+def test_crop_and_fill_exclude_the_stop_as_the_thesis_does(tmp_path, capsys):
+    """The thesis's CropVolume and Fill (A.13) run "up to, but not including" the stop; volanim included it, so
+    ``fill --box 0 0 0 2 2 2`` set 27 voxels, not 8, and the one-slice form gave two slices (#66)."""
+    io.write_volume(tmp_path / "z.VOL", np.zeros((6, 5, 8), np.uint8))
+    boxes = {"8": ["0", "0", "0", "2", "2", "2"], "slice": ["0", "0", "5", "6", "5", "6"]}
+    assert main(["fill", str(tmp_path / "z.VOL"), str(tmp_path / "b.VOL"), "--box", *boxes["8"]]) == 0
+    assert np.count_nonzero(io.read_volume(tmp_path / "b.VOL")) == 8  # counted by hand: 2 x 2 x 2
+    assert main(["fill", str(tmp_path / "z.VOL"), str(tmp_path / "s.VOL"), "--box", *boxes["slice"]]) == 0
+    s = io.read_volume(tmp_path / "s.VOL")
+    assert np.count_nonzero(s) == 6 * 5 and np.flatnonzero(s.any(axis=(0, 1))).tolist() == [5]  # one slice
+    assert main(["fill", str(tmp_path / "z.VOL"), str(tmp_path / "i.VOL"), "--box", *boxes["8"], "--inclusive"]) == 0
+    assert np.count_nonzero(io.read_volume(tmp_path / "i.VOL")) == 27  # the old meaning, asked for
+    v = np.arange(6 * 5 * 8, dtype=np.uint8).reshape(6, 5, 8)
+    io.write_volume(tmp_path / "v.VOL", v)
+    assert main(["crop", str(tmp_path / "v.VOL"), str(tmp_path / "c.nrrd"), "--bounds", *"1 1 1 3 3 3".split()]) == 0
+    assert np.array_equal(io.read_volume(tmp_path / "c.nrrd"), v[1:3, 1:3, 1:3])  # numpy's slices mean the same
+    capsys.readouterr()
+    bad = run("fill", tmp_path / "z.VOL", tmp_path / "x.VOL", "--box", "0", "0", "0", "2", "0", "2")
+    assert bad.returncode == 2 and "--box 0 0 0 2 0 2: the stop x1 y1 z1 is excluded" in bad.stderr
+    assert not (tmp_path / "x.VOL").exists()
+    # what tightbounds prints, crop takes: the chain crops to the tight box
+    body = np.zeros((9, 9, 9), np.uint8)
+    body[2:5, 3:7, 1:8] = 9
+    io.write_volume(tmp_path / "t.VOL", body)
+    assert main(["tightbounds", str(tmp_path / "t.VOL")]) == 0
+    printed = capsys.readouterr().out.split()
+    assert printed == ["2", "3", "1", "5", "7", "8"]
+    assert main(["crop", str(tmp_path / "t.VOL"), str(tmp_path / "tc.nrrd"), "--bounds", *printed]) == 0
+    assert np.array_equal(io.read_volume(tmp_path / "tc.nrrd"), body[2:5, 3:7, 1:8])
 
 
 def test_bad_input_is_one_line_error_not_traceback(tmp_path):
