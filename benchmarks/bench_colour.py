@@ -26,7 +26,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).parent))
 from _harness import best_of, table  # noqa: E402
 
-ORDERINGS = ("unsorted", "intensity", "rgb-radix", "cluster-seeds", "gradient-penalty", "supergradient", "ramp", "path")
+ORDERINGS = ("unsorted", "intensity", "rgb-radix", "cluster-seeds", "gradient-penalty", "supergradient", "lightness",
+             "moved", "ramp", "path")
 
 
 def datasets():

@@ -78,7 +78,7 @@ def compile_kernels(progress=None) -> float:
     rgb = np.repeat(source[..., None], 3, axis=3)
     reconstruct(tskel, mode="sampled", source=rgb, kernel=3)  # a colour source: float32 linear light
     sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "path")  # all moves
-    sort_palette(np.arange(12, dtype=np.uint8).repeat(3).reshape(-1, 3), "cluster-seeds")
+    sort_palette(np.arange(12, dtype=np.uint8).repeat(3).reshape(-1, 3), "farthest-seeds")
     sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "ramp")  # the default
     breakage_report(tskel, dict(bones.joints), dict(bones.joints))
     two = np.zeros((6, 6, 6), np.uint8)

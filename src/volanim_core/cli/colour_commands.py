@@ -14,7 +14,7 @@ import numpy as np
 
 from volanim_core.progress import TextProgress
 
-from ._common import EXAMPLES_HEADER, add_command, add_dims, ascii_int, finite_float, non_negative_int
+from ._common import EXAMPLES_HEADER, add_command, add_dims, ascii_int, finite_float, non_negative_int, positive_int
 
 PALETTE_EXAMPLES = (
     "volanim palette build mannequin-colour.VOL -o mannequin.palette.txt --colours 255",
@@ -92,7 +92,8 @@ def _sort(args):
         pairs, weights = sort.near_pairs(palette)  # once, for both scores
     before = sort.score(palette, np.arange(len(palette)), pairs, weights)
     t0 = time.perf_counter()
-    order = sort.sort_palette(palette, args.method, keep_first=args.keep_first)
+    order = sort.sort_palette(palette, args.method, keep_first=args.keep_first, interval=args.interval,
+                              penalty=args.penalty)
     seconds = time.perf_counter() - t0
     after = sort.score(palette, order, pairs, weights)
     where = f"colours touching in {Path(args.volume).name}" if args.volume else "each colour's 4 nearest colours"
@@ -213,13 +214,20 @@ def register(sub) -> None:
 
     p = _action(palette, "sort", "Reorder a palette so similar colours get neighbouring indices; writes the sorted "
                 "palette and the table for 'volanim remap'.", PALETTE_EXAMPLES[2], _sort)
-    from volanim_core.colour.sort import DEFAULT_METHOD, METHODS
+    from volanim_core.colour.sort import CLUSTER_INTERVAL, DEFAULT_METHOD, GRADIENT_PENALTY, METHODS
 
     p.add_argument("palette", help="palette file")
     p.add_argument("-o", "--output", required=True, help="sorted palette file to write")
     p.add_argument("--remap", required=True, help="remap table to write (old index -> new index)")
     p.add_argument("--method", choices=METHODS, default=DEFAULT_METHOD,
-                   help=f"ordering (default {DEFAULT_METHOD}: a shortest path through the colours)")
+                   help=f"ordering (default {DEFAULT_METHOD}: lightness order, then runs of colours moved to "
+                        f"where they fit best); intensity, cluster-seeds, gradient-penalty and supergradient are "
+                        f"the thesis's sorts as section 4.2 describes them (intensity = R + G + B); lightness, "
+                        f"farthest-seeds, darker-penalty and moved are what those names meant in volanim before")
+    p.add_argument("--interval", type=positive_int, default=CLUSTER_INTERVAL,
+                   help=f"cluster-seeds: a seed every N colours of the intensity order (default {CLUSTER_INTERVAL})")
+    p.add_argument("--penalty", type=finite_float, default=GRADIENT_PENALTY,
+                   help=f"gradient-penalty: the weight of turning back, P in D + {GRADIENT_PENALTY:g}P")
     p.add_argument("--volume", help="the index volume, to score the midpoint error on colours that touch in it")
     p.add_argument("--keep-first", action="store_true", help="keep index 0 (a background colour) in place")
     add_dims(p)

@@ -4,25 +4,51 @@ A renderer interpolates the *index* between two voxels and then looks the colour
 up; halfway between indices 3 and 200 it shows whatever colour sits at 101. An
 ordering is good when colours that meet in the volume sit at nearby indices.
 
+The thesis's sorts (section 4.2) under the thesis's names, as the thesis describes them (#66; the
+distances are in RGB, as the thesis's were):
+
 =================  =========================================================
 method             ordering
 =================  =========================================================
 unsorted           as built
-intensity          by CIELAB lightness (the thesis's pre-sort)
+intensity          by R + G + B, the thesis's intensity
 rgb-radix          by red, then green, then blue (a radix sort on R, G, B)
-cluster-seeds      colours grouped round far-apart seeds; groups chained
+cluster-seeds      ClusterSort: a seed every ``interval`` colours of the
+                   intensity order (adjustable), each colour in the cell of
+                   its nearest seed; the seeds in intensity order, each
+                   followed by its cell ordered by distance from the seed
+gradient-penalty   GradientSort: a greedy walk from the darkest colour,
+                   each next colour the one of least D + 2P -- D the step's
+                   length, P the part of the step that turns back in any of
+                   R, G or B against the step before (``penalty`` 2)
+supergradient      SuperGradientSort: a walk that extrapolates the last two
+                   colours (2 a[1] - a[0]) and takes the first unused colour
+                   within a step of that line, looking up to 20 steps along
+                   it (GetClosestFuturePoint); the nearest colour when none
+=================  =========================================================
+
+volanim's own, and what these names meant in volanim before #66:
+
+=================  =========================================================
+lightness          by CIELAB lightness (``intensity`` before)
+farthest-seeds     colours grouped round far-apart seeds; groups chained
                    nearest-first from the darkest, each dark to light
-gradient-penalty   a greedy walk from the darkest colour to the nearest
-                   next one, with a penalty for each step darker
-supergradient      intensity, then each colour moved to where it fits best
-                   while that helps (our reading of SuperGradientSort)
-ramp               ours (the default): intensity order as the backbone, then
+                   (``cluster-seeds`` before)
+darker-penalty     a greedy walk to the nearest next colour (CIEDE2000) with
+                   a penalty for each step darker (``gradient-penalty``)
+moved              lightness, then each colour moved to where it fits best
+                   while that helps (``supergradient`` before)
+ramp               ours (the default): lightness order as the backbone, then
                    runs of 1-3 colours moved (either way round) to where they
                    fit best while that helps (Or-opt)
 path               ours: a shortest Hamiltonian path through the palette in
                    CIEDE2000 -- nearest-neighbour starts, then 2-opt and
                    Or-opt to a local optimum -- dark end first
 =================  =========================================================
+
+The thesis's texts give no code; where they leave a detail open (which end a walk starts from, what
+"a change of direction" weighs, when GetClosestFuturePoint gives up), the reading above is ours and
+the tests name it.
 
 Measured (benchmarks/bench_colour.py): ``path`` has the smallest steps between
 neighbouring indices, but it wanders through colour space, so two colours that
@@ -43,8 +69,11 @@ from scipy.spatial import cKDTree
 from volanim_core.colour import _tour_kernels as T
 from volanim_core.colour.space import delta_e_lab, to_lab
 
-METHODS = ("unsorted", "intensity", "rgb-radix", "cluster-seeds", "gradient-penalty", "supergradient", "ramp",
-           "path")
+METHODS = ("unsorted", "intensity", "rgb-radix", "cluster-seeds", "gradient-penalty", "supergradient",
+           "lightness", "farthest-seeds", "darker-penalty", "moved", "ramp", "path")
+CLUSTER_INTERVAL = 16  # ClusterSort's seed interval: a seed every 16 colours of the intensity order
+GRADIENT_PENALTY = 2.0  # GradientSort's weight of P in D + 2P
+FUTURE_STEPS = 20  # how far SuperGradientSort looks along its extrapolated line (GetClosestFuturePoint)
 DEFAULT_METHOD = "ramp"
 
 
@@ -58,11 +87,14 @@ def distance_matrix(lab: np.ndarray) -> np.ndarray:
 
 
 def sort_palette(palette: np.ndarray, method: str = DEFAULT_METHOD, *, keep_first: bool = False,
-                 starts: int = 8) -> np.ndarray:
+                 starts: int = 8, interval: int = CLUSTER_INTERVAL, penalty: float = GRADIENT_PENALTY,
+                 steps: int = FUTURE_STEPS) -> np.ndarray:
     """The ordering ``order`` (``order[new] = old``) of ``palette`` by ``method``.
 
     ``keep_first`` keeps index 0 where it is (a background colour that a transfer
-    function makes transparent) and orders the rest.
+    function makes transparent) and orders the rest. ``interval`` is ClusterSort's seed interval,
+    ``penalty`` GradientSort's weight of P, ``steps`` how far SuperGradientSort looks along its line;
+    ``starts`` how many greedy paths ``path`` improves.
     """
     if method not in METHODS:
         raise ValueError(f"sort method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -72,23 +104,111 @@ def sort_palette(palette: np.ndarray, method: str = DEFAULT_METHOD, *, keep_firs
     if len(rest) <= 1:
         return np.arange(len(palette))
     lab = to_lab(rest)
-    order = _ORDERINGS[method](rest, lab, starts)
+    options = {"starts": starts, "interval": interval, "penalty": penalty, "steps": steps}
+    order = _ORDERINGS[method](rest, lab, options)
     return np.concatenate((np.arange(first), np.asarray(order, np.int64) + first))
 
 
-def _unsorted(rgb, lab, starts):
+def _unsorted(rgb, lab, options):
     return np.arange(len(rgb))
 
 
-def _intensity(rgb, lab, starts):
+def _intensity(rgb, lab, options):
+    """The thesis's intensity: R + G + B."""
+    return np.argsort(np.asarray(rgb, np.int64).sum(axis=1), kind="stable")
+
+
+def _lightness(rgb, lab, options):
     return np.argsort(lab[:, 0], kind="stable")
 
 
-def _rgb_radix(rgb, lab, starts):
+def thesis_cluster(rgb: np.ndarray, interval: int = CLUSTER_INTERVAL) -> np.ndarray:
+    """ClusterSort: a seed every ``interval`` colours of the intensity (R + G + B) order; each colour joins
+    its nearest seed (RGB distance; a tie goes to the earlier seed); the seeds in intensity order, each
+    followed by the rest of its cell, nearest to the seed first."""
+    if interval < 1:
+        raise ValueError(f"the seed interval is at least 1, got {interval}")
+    rgb = np.asarray(rgb, np.float64)
+    by_intensity = _intensity(rgb, None, None)
+    seeds = by_intensity[::interval]
+    d = np.linalg.norm(rgb[:, None, :] - rgb[None, seeds, :], axis=2)  # (N, seeds)
+    cell = np.argmin(d, axis=1)  # argmin: the first of equal distances, the earlier seed
+    cell[seeds] = np.arange(len(seeds))  # a seed is its own cell's first
+    order = []
+    for k, seed in enumerate(seeds):
+        members = np.flatnonzero(cell == k)
+        members = members[members != seed]
+        order += [seed, *members[np.argsort(d[members, k], kind="stable")]]
+    return np.array(order, np.int64)
+
+
+def thesis_gradient(rgb: np.ndarray, penalty: float = GRADIENT_PENALTY) -> np.ndarray:
+    """GradientSort: from the darkest colour (least R + G + B), each next colour the unused one of least
+    ``D + penalty * P``: D the step's RGB length, P the part of the step that turns back against the step
+    before, summed over R, G and B (|step_c| where step_c and the previous step_c have opposite signs)."""
+    rgb = np.asarray(rgb, np.float64)
+    left = np.ones(len(rgb), bool)
+    order = [int(np.argmin(rgb.sum(axis=1)))]
+    left[order[0]] = False
+    before = np.zeros(3)
+    for _ in range(len(rgb) - 1):
+        step = rgb - rgb[order[-1]]
+        turn = np.where(step * before < 0, np.abs(step), 0.0).sum(axis=1)
+        cost = np.linalg.norm(step, axis=1) + penalty * turn
+        cost[~left] = np.inf
+        nxt = int(np.argmin(cost))
+        before = step[nxt]
+        order.append(nxt)
+        left[nxt] = False
+    return np.array(order, np.int64)
+
+
+def thesis_supergradient(rgb: np.ndarray, steps: int = FUTURE_STEPS) -> np.ndarray:
+    """SuperGradientSort: from the darkest colour and its nearest, each next colour found along the line
+    the last two make: at t = 1 .. ``steps`` the point ``a1 + t (a1 - a0)`` (t = 1: ``2 a1 - a0``), the
+    first unused colour within one step's length of it (GetClosestFuturePoint); when the line finds
+    none, the unused colour nearest to ``a1``."""
+    rgb = np.asarray(rgb, np.float64)
+    left = np.ones(len(rgb), bool)
+    first = int(np.argmin(rgb.sum(axis=1)))
+    left[first] = False
+    order = [first]
+    while left.any():
+        a1 = rgb[order[-1]]
+        unused = np.flatnonzero(left)
+        nxt = None
+        if len(order) >= 2:
+            trend = a1 - rgb[order[-2]]
+            reach = np.linalg.norm(trend)
+            for t in range(1, steps + 1) if reach > 0 else ():
+                d = np.linalg.norm(rgb[unused] - (a1 + t * trend), axis=1)
+                if d.min() <= reach:
+                    nxt = int(unused[np.argmin(d)])
+                    break
+        if nxt is None:
+            nxt = int(unused[np.argmin(np.linalg.norm(rgb[unused] - a1, axis=1))])
+        order.append(nxt)
+        left[nxt] = False
+    return np.array(order, np.int64)
+
+
+def _thesis_cluster(rgb, lab, options):
+    return thesis_cluster(rgb, options["interval"])
+
+
+def _thesis_gradient(rgb, lab, options):
+    return thesis_gradient(rgb, options["penalty"])
+
+
+def _thesis_supergradient(rgb, lab, options):
+    return thesis_supergradient(rgb, options["steps"])
+
+
+def _rgb_radix(rgb, lab, options):
     return np.lexsort((rgb[:, 2], rgb[:, 1], rgb[:, 0]))
 
 
-def _cluster_seeds(rgb, lab, starts):
+def _cluster_seeds(rgb, lab, options):
     n = len(lab)
     k = max(2, int(round(np.sqrt(n))))
     seeds = [int(np.argmin(lab[:, 0]))]
@@ -102,7 +222,7 @@ def _cluster_seeds(rgb, lab, starts):
                            for g in chain])
 
 
-def _gradient_penalty(rgb, lab, starts, penalty: float = 1.0):
+def _gradient_penalty(rgb, lab, options, penalty: float = 1.0):
     D = distance_matrix(lab)
     light = lab[:, 0]
     left = np.ones(len(lab), bool)
@@ -124,23 +244,24 @@ def _with_dummy(D: np.ndarray) -> np.ndarray:
     return out
 
 
-def _moved_from_intensity(lab, max_run: int) -> np.ndarray:
-    """Intensity order, then runs of up to ``max_run`` colours moved while that shortens the path."""
+def _moved_from_lightness(lab, max_run: int) -> np.ndarray:
+    """Lightness order, then runs of up to ``max_run`` colours moved while that shortens the path."""
     n = len(lab)
-    P = np.concatenate(([n], _intensity(None, lab, 0), [n])).astype(np.int64)
+    P = np.concatenate(([n], _lightness(None, lab, None), [n])).astype(np.int64)
     T.or_opt(_with_dummy(distance_matrix(lab)), P, max_run)
     return P[1:-1]
 
 
-def _supergradient(rgb, lab, starts):
-    return _moved_from_intensity(lab, 1)
+def _moved(rgb, lab, options):
+    return _moved_from_lightness(lab, 1)
 
 
-def _ramp(rgb, lab, starts):
-    return _moved_from_intensity(lab, 3)
+def _ramp(rgb, lab, options):
+    return _moved_from_lightness(lab, 3)
 
 
-def _path(rgb, lab, starts):
+def _path(rgb, lab, options):
+    starts = options["starts"]
     D = distance_matrix(lab)
     Dd = _with_dummy(D)
     n = len(lab)
@@ -159,8 +280,9 @@ def _path(rgb, lab, starts):
 
 
 _ORDERINGS = {"unsorted": _unsorted, "intensity": _intensity, "rgb-radix": _rgb_radix,
-              "cluster-seeds": _cluster_seeds, "gradient-penalty": _gradient_penalty,
-              "supergradient": _supergradient, "ramp": _ramp, "path": _path}
+              "cluster-seeds": _thesis_cluster, "gradient-penalty": _thesis_gradient,
+              "supergradient": _thesis_supergradient, "lightness": _lightness, "farthest-seeds": _cluster_seeds,
+              "darker-penalty": _gradient_penalty, "moved": _moved, "ramp": _ramp, "path": _path}
 
 
 def remap_table(order: np.ndarray) -> np.ndarray:

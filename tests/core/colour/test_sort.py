@@ -48,9 +48,56 @@ def test_intensity_and_radix_orders_are_what_they_say(rng):
     from volanim_core.colour.space import to_lab
 
     palette = rng.integers(0, 256, (30, 3)).astype(np.uint8)
-    assert np.all(np.diff(to_lab(palette[S.sort_palette(palette, "intensity")])[:, 0]) >= 0)
+    assert np.all(np.diff(palette[S.sort_palette(palette, "intensity")].astype(int).sum(axis=1)) >= 0)
+    assert np.all(np.diff(to_lab(palette[S.sort_palette(palette, "lightness")])[:, 0]) >= 0)
     keys = [tuple(c) for c in palette[S.sort_palette(palette, "rgb-radix")]]
     assert keys == sorted(keys)
+
+
+def test_intensity_is_the_thesis_s_r_plus_g_plus_b_not_lightness():
+    """Section 4.2: intensity is R + G + B. Green (0, 255, 0) sums to 255 and magenta (200, 0, 200) to 400, so
+    green comes first; by CIELAB lightness (volanim's `intensity` before #66, now `lightness`) magenta does."""
+    palette = np.array([[200, 0, 200], [0, 255, 0]], np.uint8)
+    assert S.sort_palette(palette, "intensity").tolist() == [1, 0]
+    assert S.sort_palette(palette, "lightness").tolist() == [0, 1]
+
+
+def test_cluster_sort_by_hand():
+    """ClusterSort, counted by hand: intensities 0, 30, 60, 90, 300, 330 -> with a seed every 4 colours the
+    seeds are the 1st and 5th (0 and 300); 30, 60 and 90 are nearer seed 0, 330 nearer seed 300; each cell
+    follows its seed, nearest first; a seed every 2 colours makes three cells."""
+    palette = np.array([[110, 110, 110], [0, 0, 0], [30, 30, 30], [100, 100, 100], [20, 20, 20], [10, 10, 10]],
+                       np.uint8)  # intensities 330, 0, 90, 300, 60, 30
+    assert S.thesis_cluster(palette, 4).tolist() == [1, 5, 4, 2, 3, 0]
+    # seeds every 2: intensity order 1 (0), 5 (30), 4 (60), 2 (90), 3 (300), 0 (330) -> seeds 1, 4, 3
+    assert S.thesis_cluster(palette, 2).tolist() == [1, 5, 4, 2, 3, 0]
+    with pytest.raises(ValueError, match="interval"):
+        S.thesis_cluster(palette, 0)
+    # seeds every 3: 0 and 90; 30 is nearer 0, 60 and 95 nearer 90, and in 90's cell 95 (5 away) comes first
+    spread = np.array([[0, 0, 0], [30, 0, 0], [60, 0, 0], [90, 0, 0], [95, 0, 0]], np.uint8)
+    assert S.thesis_cluster(spread, 3).tolist() == [0, 1, 3, 4, 2]
+
+
+def test_gradient_sort_penalises_turning_back():
+    """GradientSort's D + 2P, counted by hand: from black the walk goes up red to (50, 0, 0) and (100, 0, 0)
+    ((92, 30, 0) is 51.6 from (50, 0, 0), not 50). There, (92, 30, 0) is 31.0 away but turns back 8 in R: cost
+    31.0 + 2 x 8 = 47.0; (100, 0, 38) is 38 away without turning: cost 38, so it is next. Without the
+    penalty the nearer one is."""
+    palette = np.array([[0, 0, 0], [50, 0, 0], [100, 0, 0], [92, 30, 0], [100, 0, 38]], np.uint8)
+    assert S.thesis_gradient(palette).tolist()[:4] == [0, 1, 2, 4]
+    assert S.thesis_gradient(palette, penalty=0.0).tolist()[:4] == [0, 1, 2, 3]
+
+
+def test_supergradient_follows_the_line_its_last_two_colours_make():
+    """SuperGradientSort, counted by hand: after black and (10, 10, 10) the line runs through (20, 20, 20),
+    (30, 30, 30), ... with steps of 17.3. (0, 25, 0) is nearer (10, 10, 10) (20.6) than (40, 40, 40) is (52),
+    but it is 28.7 from the line's first point; (40, 40, 40) is within a step of its second, so it is next;
+    from there the line finds nothing in 20 steps, and the walk takes the nearest colour."""
+    palette = np.array([[0, 0, 0], [10, 10, 10], [0, 25, 0], [40, 40, 40], [200, 0, 0]], np.uint8)
+    assert S.thesis_supergradient(palette).tolist() == [0, 1, 3, 2, 4]
+    # 20 steps along the line at most: a colour 30 steps out is not found by it
+    far = np.array([[0, 0, 0], [1, 1, 1], [31, 31, 31], [0, 9, 0]], np.uint8)
+    assert S.thesis_supergradient(far).tolist() == [0, 1, 3, 2]
 
 
 def test_a_colour_ramp_shuffled_is_sorted_back_to_a_ramp(rng):
