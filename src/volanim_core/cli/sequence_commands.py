@@ -87,13 +87,19 @@ def _crumble(args):
     paths = natural_order(args.volumes)
     scans = [load_scan(p, args) for p in paths]
     bar = TextProgress("crumble")
-    frames = fall_series([s.data for s in scans], args.n, args.down, acceleration=args.acceleration, heap=args.heap)
-    for k, vol in enumerate(frames, start=args.start):
-        save(args.output % k, vol, scans[0].geometry)
-        bar(k - args.start + 1, args.n)
+    wanted = None if args.frame is None else [args.frame - args.start + 1]  # the thesis's desiredFrame
+    frames = fall_series([s.data for s in scans], args.n, args.down, acceleration=args.acceleration, heap=args.heap,
+                         frames=wanted)
+    for done, (k, vol) in enumerate(frames, start=1):
+        save(args.output % (k + args.start - 1), vol, scans[0].geometry)
+        bar(done, args.n if wanted is None else 1)
     bar.close()
-    print(f"{args.n} frames from {len(paths)} volume{'s' * (len(paths) > 1)} -> {args.output % args.start} .. "
-          f"{args.output % (args.start + args.n - 1)}")
+    if wanted is None:
+        print(f"{args.n} frames from {len(paths)} volume{'s' * (len(paths) > 1)} -> {args.output % args.start} .. "
+              f"{args.output % (args.start + args.n - 1)}")
+    else:
+        print(f"frame {args.frame} of {args.n} from {len(paths)} volume{'s' * (len(paths) > 1)} -> "
+              f"{args.output % args.frame}")
 
 
 def format_report(rep) -> str:
@@ -128,11 +134,15 @@ def register(sub) -> None:
                      "volanim crumble mannequin-heap.0001.VOL mannequin-heap.0002.VOL -n 2 --acceleration 20 "
                      "-o again.%04d.nrrd   # a series: one volume a frame"),
                     _crumble)
-    p.add_argument("volumes", nargs="+", help="one volume (held), or one for each frame (numbered: taken in order)")
+    p.add_argument("volumes", nargs="+",
+                   help="one volume (held), one for each frame, or fewer than frames, each held for an equal run "
+                        "of them, as the thesis fed multiVolumeMelt a few frames (numbered: taken in order)")
     p.add_argument("-n", type=positive_int, required=True, help="frames; the top lands on the last one")
     p.add_argument("-o", "--output", required=True, metavar="DIR/NAME.%%04d.VOL",
                    help="the frames' files (any volume format; %%04d = frame number)")
     p.add_argument("--start", type=non_negative_int, default=1, help="number of the first frame (default 1)")
+    p.add_argument("--frame", type=non_negative_int, metavar="K",
+                   help="write frame K alone, as the thesis's desiredFrame (numbered as --start numbers them)")
     _fall_options(p, "")
     add_dims(p)
 

@@ -178,23 +178,33 @@ def fall(volume: np.ndarray, fraction: float, down: str = "-z", *, heap: str = "
     return np.ascontiguousarray(np.moveaxis(out, -1, axis))
 
 
-def fall_series(volumes, n: int, down: str = "-z", *, acceleration: float = 0.0, heap: str = "keep"):
-    """The thesis's multiVolumeMelt on any volumes: ``n`` frames, frame k (1..n) the k-th volume (or the one
-    volume, held) fallen as :func:`fall` makes it, all onto the floor under the first one's lowest voxel;
-    ``acceleration`` as in :func:`crumble`. Yields the frames one at a time (volumes on one grid)."""
+def fall_series(volumes, n: int, down: str = "-z", *, acceleration: float = 0.0, heap: str = "keep",
+                frames=None):
+    """The thesis's multiVolumeMelt on any volumes: ``n`` frames, frame k (1..n) fallen as :func:`fall` makes
+    it, all onto the floor under the first volume's lowest voxel; ``acceleration`` as in :func:`crumble`.
+
+    ``volumes``: one (held), or as many as frames, or -- as the thesis fed it "a few frames ... to produce a
+    large number of crumbling volumes" -- fewer: each held for an equal run of frames, in order (2 volumes,
+    6 frames: the first for frames 1-3, the second for 4-6). ``frames``: only these frame numbers (the
+    thesis's desiredFrame; a frame does not depend on the others). Yields ``(k, volume)`` one at a time."""
     if n < 1:
         raise ValueError(f"a crumble needs at least one frame, got {n}")
-    if len(volumes) not in (1, n):
-        raise ValueError(f"give one volume, or one for each of the {n} frames, not {len(volumes)}")
+    m = len(volumes)
+    if not 1 <= m <= n:
+        raise ValueError(f"give at most one volume a frame: {m} volumes for {n} frames")
+    wanted = range(1, n + 1) if frames is None else list(frames)
+    bad = [k for k in wanted if not 1 <= k <= n]
+    if bad:
+        raise ValueError(f"frame {bad[0]} is not one of the crumble's frames 1..{n}")
     axis, sign = parse_axis(down)
     first = volumes[0]
     if any(v.shape != first.shape for v in volumes):
         raise ValueError("the volumes of a series must share one grid")
     filled = np.flatnonzero(np.moveaxis(first, axis, 0).reshape(first.shape[axis], -1).any(axis=1))
     floor, height = (int(filled[0] if sign < 0 else filled[-1]), int(np.ptp(filled))) if len(filled) else (0, 0)
-    for k in range(1, n + 1):
+    for k in wanted:
         drop = 0.5 * acceleration * k * k if acceleration else height * (k / n) ** 2
-        yield fall(volumes[k - 1 if len(volumes) == n else 0], k / n, down, heap=heap, floor=floor, drop=drop)
+        yield k, fall(volumes[(k - 1) * m // n], k / n, down, heap=heap, floor=floor, drop=drop)
 
 
 def _resting_sums(stacks: np.ndarray, values: np.ndarray, dtype) -> np.ndarray:
