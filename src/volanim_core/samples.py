@@ -40,7 +40,7 @@ from volanim_core.mannequin_body import (  # noqa: F401 -- the body's names are 
 from volanim_core.progress import stage
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
-NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog")
+NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog", "curved-tube")
 #: Samples that are files rather than volumes: ``volanim samples walk`` copies the clip and its licence;
 #: ``mannequin-ct`` writes the mannequin as a CT scan arrives, a DICOM series (:func:`write_mannequin_ct`);
 #: ``ant`` copies the closed ant mesh pyvista's wheel ships (``ant.ply``), a model to voxelize, with joints
@@ -94,6 +94,30 @@ def mannequin() -> Sample:
     and bone rods inside the limbs; a skull and brain in the head.
     """
     return _mannequin(np.ones(3), "mannequin")
+
+
+TUBE_RADIUS = 6.0  # the curved tube's radius (voxels)
+
+
+def curved_tube(radius: float = TUBE_RADIUS, bend: float = 40.0, n_bones: int = 8) -> Sample:
+    """A tube bent through half a circle, the thesis's colon case (section 5.3): its centre line runs along
+    the arc of radius ``bend`` in the x-z plane, a chain of ``n_bones`` bones (S1 .. Sn) on its chords.
+    ``volanim straighten`` lays it straight."""
+    pad = int(np.ceil(radius)) + 3
+    size = (int(2 * (bend + pad)) + 1, 2 * pad + 1, int(bend + 2 * pad) + 1)
+    centre = np.array([bend + pad, pad, pad], np.float64)
+    x, y, z = np.meshgrid(*(np.arange(n, dtype=np.float64) for n in size), indexing="ij")
+    dx, dy, dz = x - centre[0], y - centre[1], z - centre[2]
+    angle = np.arctan2(dz, dx)
+    on_arc = (angle >= 0) & (angle <= np.pi)
+    ends = [centre + bend * np.array([np.cos(a), 0.0, np.sin(a)]) for a in (0.0, np.pi)]
+    to_end = np.minimum(*(np.sqrt((x - e[0]) ** 2 + (y - e[1]) ** 2 + (z - e[2]) ** 2) for e in ends))
+    distance = np.where(on_arc, np.sqrt((np.hypot(dx, dz) - bend) ** 2 + dy * dy), to_end)
+    volume = np.where(distance <= radius, 200, 0).astype(np.uint8)
+    angles = np.linspace(0.0, np.pi, n_bones + 1)
+    joints = {f"j{k}": centre + bend * np.array([np.cos(a), 0.0, np.sin(a)]) for k, a in enumerate(angles)}
+    bones = BoneSkeleton(joints, [Bone(f"j{k}", f"j{k + 1}", f"S{k + 1}") for k in range(n_bones)])
+    return Sample("curved-tube", np.asfortranarray(volume), bones)
 
 
 def mannequin_large(progress=None) -> Sample:
@@ -232,7 +256,7 @@ def _deepest_near(mask: np.ndarray, target, radius: float = 60.0, step: int = 4)
 def load(name: str) -> Sample:
     """A demo dataset by name: one of :data:`NAMES`."""
     makers = {"mannequin": mannequin, "mannequin-colour": mannequin_colour, "mannequin-large": mannequin_large,
-              "aliascube": aliascube, "frog": frog}
+              "aliascube": aliascube, "frog": frog, "curved-tube": curved_tube}
     if name not in makers:
         raise ValueError(f"unknown sample {name!r}; choose one of {', '.join(NAMES)}")
     return makers[name]()

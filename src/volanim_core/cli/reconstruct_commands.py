@@ -83,6 +83,18 @@ def _pose(args):
     print(f"posed {len(rotations)} of {len(bones)} bones (children follow) -> {args.output}")
 
 
+def _straighten(args):
+    from volanim_core.rig.straighten import chain, straighten
+
+    bones = read_bones(args.bones).on_cubes()
+    first, last = args.chain if args.chain else (None, None)
+    matrices, axis = straighten(bones, first, last)
+    names = [bones.bones[i].label for i in chain(bones, first, last)]
+    write_trans(args.output, Trans(root_bones(bones), matrices, bones.geometry))
+    print(f"straightened {len(names)} bones ({names[0]} .. {names[-1]}) along ({', '.join(f'{v:.3f}' for v in axis)}) "
+          f"from joint {bones.bones[bones.index(names[0])].proximal} -> {args.output}")
+
+
 def _connect2tskel(args):
     t = connect_to_tskel(joints_of(args, read_connect(args.connect)), read_trans(args.trans))
     transform_table(t)  # a frame smooth joints cannot blend (a sheared bone) is refused now, not at reconstruct
@@ -226,6 +238,17 @@ def register(sub) -> None:
     p.add_argument("bones", help=".bones file")
     p.add_argument("--rotate", action="append", type=parse_rotation, metavar="BONE=RX,RY,RZ",
                    help="Euler angles in degrees about x, y, z (repeatable)")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "straighten", "Write a .trans frame that lays a chain of bones straight along its principal "
+                    "axis, each bone keeping its length, the first joint in place (the thesis's colon uncoiled, "
+                    "section 5.3).",
+                    ("volanim straighten curved-tube.bones -o straight.trans",
+                     "volanim straighten mannequin.bones --chain L_UPPERARM L_HAND -o arm-straight.trans"), _straighten)
+    p.add_argument("bones", help=".bones file")
+    p.add_argument("--chain", nargs=2, metavar=("FIRST", "LAST"),
+                   help="the chain's first and last bones, each the child of the one before (default: the whole "
+                        "skeleton, when it is one chain)")
     p.add_argument("-o", "--output", required=True)
 
     p = add_command(sub, "connect2tskel", "A .connect plus one .trans frame -> .tskel (root orders must match).",
