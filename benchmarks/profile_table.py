@@ -71,7 +71,7 @@ def main() -> None:
         stats = pstats.Stats(profile, stream=text_io.StringIO())
         total = stats.total_tt
         rows = []
-        for (path, line, name), (_, calls, own, _, _) in sorted(stats.stats.items(), key=lambda kv: -kv[1][2])[:top]:
+        for (path, _line, name), (_, calls, own, _, _) in sorted(stats.stats.items(), key=lambda kv: -kv[1][2])[:top]:
             where = Path(path).name if path != "~" else "builtin"
             rows.append([f"{where}:{name}" if where != "builtin" else name, calls, f"{own:.3f}",
                          f"{100 * own / total:.1f}"])
