@@ -116,6 +116,7 @@ screenshots: install-test system-deps
 	$(PY) docs/make_colour_renders.py
 	$(PY) docs/make_shape_pictures.py
 	$(PY) docs/make_autorig_pictures.py
+	$(PY) docs/make_thesis_figures.py
 
 clean:
 	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .coverage-data htmlcov
