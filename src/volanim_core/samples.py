@@ -6,6 +6,7 @@
     aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
     frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
                                          with a two-bone principal-axis chain
+    curved_tube()  (99, 19, 59) uint8  a tube bent through half a circle, 8 chained bones (the colon case)
     walk_clip()  the real motion-capture walk (BVH, 1064 frames, MIT licence beside it)
 
 The mannequin faces -y with z up, so its left side (``L_`` bones) is at +x;
