@@ -70,8 +70,9 @@ class Sample:
 
     @property
     def mask(self) -> np.ndarray:
-        grey = self.volume.max(axis=3) if self.volume.ndim == 4 else self.volume
-        return grey >= self.mask_level
+        from volanim_core.volume import brightest
+
+        return brightest(self.volume) >= self.mask_level
 
 
 def mannequin_limb(bone_label: str) -> str:

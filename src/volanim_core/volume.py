@@ -159,6 +159,13 @@ def tight_bounds(vol: np.ndarray, level: float = 0) -> Bounds | None:
     return Bounds((int(xs[0]), int(ys[0]), int(zs[0])), (int(xs[-1]), int(ys[-1]), int(zs[-1])))
 
 
+def brightest(vol: np.ndarray) -> np.ndarray:
+    """One value a voxel: a colour volume's brightest channel (non-zero exactly where the voxel is not
+    black), any other volume as it is -- what bounds and masks of a colour volume are taken on."""
+    vol = np.asarray(vol)
+    return vol.max(axis=3) if vol.ndim == 4 else vol
+
+
 def each_channel(vol: np.ndarray, fn):
     """``fn(vol)`` for a 3-D volume; for a colour one ``(X, Y, Z, C)``, ``fn`` of each channel, stacked again
     along the last axis, so that a tool written for one value a voxel keeps colour (#66: resample, crop and

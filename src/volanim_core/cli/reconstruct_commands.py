@@ -84,15 +84,15 @@ def _pose(args):
 
 
 def _straighten(args):
-    from volanim_core.rig.straighten import chain, straighten
+    from volanim_core.rig.straighten import straighten
 
     bones = read_bones(args.bones).on_cubes()
     first, last = args.chain if args.chain else (None, None)
-    matrices, axis = straighten(bones, first, last)
-    names = [bones.bones[i].label for i in chain(bones, first, last)]
+    matrices, axis, ids = straighten(bones, first, last)
     write_trans(args.output, Trans(root_bones(bones), matrices, bones.geometry))
-    print(f"straightened {len(names)} bones ({names[0]} .. {names[-1]}) along ({', '.join(f'{v:.3f}' for v in axis)}) "
-          f"from joint {bones.bones[bones.index(names[0])].proximal} -> {args.output}")
+    ends = bones.bones[ids[0]], bones.bones[ids[-1]]
+    print(f"straightened {len(ids)} bones ({ends[0].label} .. {ends[1].label}) along "
+          f"({', '.join(f'{v:.3f}' for v in axis)}) from joint {ends[0].proximal} -> {args.output}")
 
 
 def _connect2tskel(args):

@@ -85,13 +85,15 @@ def _crumble(args):
 
     check_frame_pattern(args.output, "-o", tuple(s.lower() for s in dict.fromkeys(WRITE_SUFFIXES)))
     paths = natural_order(args.volumes)
-    scans = [load_scan(p, args) for p in paths]
+    last = args.start + args.n - 1
+    if args.frame is not None and not args.start <= args.frame <= last:
+        raise ValueError(f"--frame {args.frame} is not one of the crumble's frames {args.start}..{last}")
+    scans = _Scans(paths, args)  # read when a frame needs them: --frame K reads the first and its own
     bar = TextProgress("crumble")
     wanted = None if args.frame is None else [args.frame - args.start + 1]  # the thesis's desiredFrame
-    frames = fall_series([s.data for s in scans], args.n, args.down, acceleration=args.acceleration, heap=args.heap,
-                         frames=wanted)
+    frames = fall_series(scans, args.n, args.down, acceleration=args.acceleration, heap=args.heap, frames=wanted)
     for done, (k, vol) in enumerate(frames, start=1):
-        save(args.output % (k + args.start - 1), vol, scans[0].geometry)
+        save(args.output % (k + args.start - 1), vol, scans.geometry)
         bar(done, args.n if wanted is None else 1)
     bar.close()
     if wanted is None:
@@ -100,6 +102,28 @@ def _crumble(args):
     else:
         print(f"frame {args.frame} of {args.n} from {len(paths)} volume{'s' * (len(paths) > 1)} -> "
               f"{args.output % args.frame}")
+
+
+class _Scans:
+    """The crumble's volumes as a sequence read on first use (and kept: a held volume serves many frames)."""
+
+    def __init__(self, paths, args):
+        self.paths, self.args, self.read = paths, args, {}
+
+    def __len__(self) -> int:
+        return len(self.paths)
+
+    def scan(self, i: int):
+        if i not in self.read:
+            self.read[i] = load_scan(self.paths[i], self.args)
+        return self.read[i]
+
+    def __getitem__(self, i: int):
+        return self.scan(i).data
+
+    @property
+    def geometry(self):
+        return self.scan(0).geometry
 
 
 def format_report(rep) -> str:

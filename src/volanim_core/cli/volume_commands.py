@@ -37,8 +37,7 @@ def _info(args):
     scan = load_scan(args.volume, args, colour=True)
     vol = scan.data
     kind = f"{vol.dtype} RGB" if vol.ndim == 4 else str(vol.dtype)
-    if vol.ndim == 4:  # values and bounds of a colour volume: of its brightest channel
-        vol = vol.max(axis=3)
+    vol = volume.brightest(vol)  # values and bounds of a colour volume: of its brightest channel
     bad = non_finite_count(vol)
     with np.errstate(invalid="ignore"):
         b = volume.tight_bounds(vol)
@@ -88,7 +87,7 @@ def _crop(args):
     if args.bounds:
         b = bounds_arg(args.bounds, inclusive=args.inclusive)
     else:
-        b = volume.tight_bounds(vol.max(axis=3) if vol.ndim == 4 else vol)  # colour: of the non-black voxels
+        b = volume.tight_bounds(volume.brightest(vol))  # colour: of the non-black voxels
         if b is None:
             raise ValueError(f"{args.input}: the volume is all zero, there is nothing to crop to")
     if args.pad:
@@ -103,8 +102,7 @@ def _crop(args):
 def _tightbounds(args):
     """The bounds as crop and fill take them (the stop excluded, the thesis's convention), so that
     ``volanim crop IN OUT --bounds $(volanim tightbounds IN)`` crops to them; ``--inclusive``: the last voxels."""
-    vol = load(args.input, args, colour=True)
-    b = volume.tight_bounds(vol.max(axis=3) if vol.ndim == 4 else vol, args.level)  # colour: its brightest channel
+    b = volume.tight_bounds(volume.brightest(load(args.input, args, colour=True)), args.level)
     if b is None:
         print("none (no voxel above the level)")
     else:

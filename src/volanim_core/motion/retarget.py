@@ -33,7 +33,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.rig.bones import BoneSkeleton
-from volanim_core.rig.pose import parents_first
+from volanim_core.rig.pose import least_rotation, parents_first
 
 from .body import (
     Sampled,
@@ -170,22 +170,6 @@ def axes_matrix(up: str = "y", forward: str = "z") -> np.ndarray:
     source = np.column_stack([u, f, np.cross(f, u)])  # up, forward, right in BVH axes
     target = np.column_stack([OUR_UP, OUR_FORWARD, np.cross(OUR_FORWARD, OUR_UP)])
     return target @ source.T
-
-
-def _align(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The smallest rotation taking unit direction ``a`` onto ``b``."""
-    from scipy.spatial.transform import Rotation
-
-    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
-    axis = np.cross(a, b)
-    s, c = np.linalg.norm(axis), float(np.clip(a @ b, -1, 1))
-    if s < 1e-12:
-        if c > 0:
-            return np.eye(3)
-        other = np.eye(3)[np.argmin(np.abs(a))]  # opposite: half a turn about any perpendicular
-        axis = np.cross(a, other)
-        return Rotation.from_rotvec(np.pi * axis / np.linalg.norm(axis)).as_matrix()
-    return Rotation.from_rotvec(axis / s * np.arctan2(s, c)).as_matrix()
 
 
 def rest_pose(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
@@ -331,7 +315,7 @@ class Retarget:
         up_clip = axes.T @ OUR_UP  # the clip's up, in its own axes
         align = np.tile(np.eye(3), (len(bones), 1, 1))
         for b, (ours, clip) in rest_directions(bones, motion, index, pose).items():
-            align[b] = _align(ours, axes @ clip)
+            align[b] = least_rotation(ours, axes @ clip)
         legs = _legs(bones, motion, index)
         if legs:
             scale = float(np.mean([ours / clip for ours, clip in legs]))

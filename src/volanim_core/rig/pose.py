@@ -69,6 +69,24 @@ def euler(degrees) -> np.ndarray:
     return Rotation.from_euler("xyz", np.asarray(degrees, np.float64), degrees=True).as_matrix()
 
 
+def least_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The smallest rotation (3x3, column convention) taking direction ``a`` onto ``b``: about ``a x b``, so
+    nothing turns about the direction itself (a retargeted bone's rest, a straightened chain's bones)."""
+    from scipy.spatial.transform import Rotation
+
+    a = np.asarray(a, np.float64) / np.linalg.norm(a)
+    b = np.asarray(b, np.float64) / np.linalg.norm(b)
+    axis = np.cross(a, b)
+    s, c = np.linalg.norm(axis), float(np.clip(a @ b, -1, 1))
+    if s < 1e-12:
+        if c > 0:
+            return np.eye(3)
+        other = np.eye(3)[np.argmin(np.abs(a))]  # opposite: half a turn about any perpendicular
+        axis = np.cross(a, other)
+        return Rotation.from_rotvec(np.pi * axis / np.linalg.norm(axis)).as_matrix()
+    return Rotation.from_rotvec(axis / s * np.arctan2(s, c)).as_matrix()
+
+
 def bend_across(bones: BoneSkeleton, label: str, degrees: float) -> np.ndarray:
     """The 3x3 rotation bending bone ``label`` by ``degrees`` towards the grid axis most across it, about
     an axis across the bone: a real bend whichever way the bone lies (a fixed ``0,45,0`` only twists a

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from volanim_core.rig.bones import BoneSkeleton
-from volanim_core.rig.pose import pose_matrices
+from volanim_core.rig.pose import least_rotation, pose_matrices
 
 
 def chain(bones: BoneSkeleton, first: str | None = None, last: str | None = None) -> list[int]:
@@ -55,30 +55,17 @@ def principal_axis(points: np.ndarray) -> np.ndarray:
     return u if np.dot(p[-1] - p[0], u) >= 0 else -u
 
 
-def least_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The 3x3 rotation (column convention) of least angle taking unit direction ``a`` to ``b``."""
-    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
-    v, c = np.cross(a, b), float(np.dot(a, b))
-    if c < -1 + 1e-12:  # opposite: half a turn about any axis perpendicular to a
-        axis = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
-        axis /= np.linalg.norm(axis)
-        return 2.0 * np.outer(axis, axis) - np.eye(3)
-    k = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return np.eye(3) + k + k @ k / (1.0 + c)
-
-
 def straighten(bones: BoneSkeleton, first: str | None = None, last: str | None = None,
-               axis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+               axis: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, list[int]]:
     """Pose matrices (``(B, 4, 4)``, as :func:`~volanim_core.rig.pose.pose_matrices` makes) that lay the chain
-    ``first`` .. ``last`` straight along ``axis`` (default: its principal axis), and that axis."""
+    ``first`` .. ``last`` straight along ``axis`` (default: its principal axis); that axis; the chain's bones."""
     ids = chain(bones, first, last)
     segments = [bones.segment(i) for i in ids]
     joints = np.array([segments[0][0], *(d for _, d in segments)])
     u = principal_axis(joints) if axis is None else np.asarray(axis, np.float64) / np.linalg.norm(axis)
     rotations, parent_global = {}, np.eye(3)
     for i, (p, d) in zip(ids, segments):
-        rest = (np.asarray(d, np.float64) - p) / np.linalg.norm(np.asarray(d, np.float64) - p)
-        global_rotation = least_rotation(rest, u)
+        global_rotation = least_rotation(np.asarray(d, np.float64) - p, u)
         rotations[i] = parent_global.T @ global_rotation  # FK composes the parent's rotation after the bone's own
         parent_global = global_rotation
-    return pose_matrices(bones, rotations), u
+    return pose_matrices(bones, rotations), u, ids

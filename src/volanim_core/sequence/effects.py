@@ -186,7 +186,9 @@ def fall_series(volumes, n: int, down: str = "-z", *, acceleration: float = 0.0,
     ``volumes``: one (held), or as many as frames, or -- as the thesis fed it "a few frames ... to produce a
     large number of crumbling volumes" -- fewer: each held for an equal run of frames, in order (2 volumes,
     6 frames: the first for frames 1-3, the second for 4-6). ``frames``: only these frame numbers (the
-    thesis's desiredFrame; a frame does not depend on the others). Yields ``(k, volume)`` one at a time."""
+    thesis's desiredFrame; a frame does not depend on the others). Yields ``(k, volume)`` one at a time.
+    Only the first volume and the frames' own are looked at, so ``volumes`` may be a lazy sequence: one
+    frame of a long series reads two files, not all of them."""
     if n < 1:
         raise ValueError(f"a crumble needs at least one frame, got {n}")
     m = len(volumes)
@@ -198,7 +200,7 @@ def fall_series(volumes, n: int, down: str = "-z", *, acceleration: float = 0.0,
         raise ValueError(f"frame {bad[0]} is not one of the crumble's frames 1..{n}")
     axis, sign = parse_axis(down)
     first = volumes[0]
-    if any(v.shape != first.shape for v in volumes):
+    if any(volumes[i].shape != first.shape for i in sorted({(k - 1) * m // n for k in wanted})):
         raise ValueError("the volumes of a series must share one grid")
     filled = np.flatnonzero(np.moveaxis(first, axis, 0).reshape(first.shape[axis], -1).any(axis=1))
     floor, height = (int(filled[0] if sign < 0 else filled[-1]), int(np.ptp(filled))) if len(filled) else (0, 0)

@@ -25,6 +25,7 @@ class VerdictLabel(ElidedLabel):
         super().__init__(parent)
         self.doc = doc
         self._report = None
+        self._checking = False  # a full preview is shown and its report is being made
         self.base_tip = ("The breakage verdict of the last full preview (F5); the Reconstruct tab has the report.")
         self.setToolTip(self.base_tip)
         doc.events.preview.connect(self._on_preview)
@@ -33,17 +34,18 @@ class VerdictLabel(ElidedLabel):
     def _on_preview(self, **_) -> None:
         p = self.doc.preview
         if p is None:
-            self._report = None
+            self._report, self._checking = None, False
             self.setText("")
         elif p.report is not None:
-            self._report = p.report
+            self._report, self._checking = p.report, False
             self.set_styled(p.report.verdict, COLOURS["healthy" if p.report.healthy else "broken"], bold=True)
         elif not p.live:  # the picture is shown, its report follows (a background job): no old verdict meanwhile
-            self._report = None
+            self._report, self._checking = None, True
             self.set_styled(CHECKING, COLOURS["stale"])
 
     def _on_pose(self, **_) -> None:
-        if self._report is None and self.plain == CHECKING:  # that check is cancelled: the pose it was of is gone
+        if self._checking:  # that check is cancelled: the pose it was of is gone
+            self._checking = False
             self.setText("")
         elif self._report is not None:
             self.set_styled(f"{self._report.verdict} (before the last pose change: F5 checks again)",

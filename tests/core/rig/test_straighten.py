@@ -10,8 +10,8 @@ from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.rig.attach import connect_nearest
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.connectivity import Trans
-from volanim_core.rig.pose import posed_joints, root_bones
-from volanim_core.rig.straighten import chain, least_rotation, principal_axis, straighten
+from volanim_core.rig.pose import least_rotation, posed_joints, root_bones
+from volanim_core.rig.straighten import chain, principal_axis, straighten
 from volanim_core.rig.tskel_tools import connect_to_tskel
 from volanim_core.samples import TUBE_RADIUS, curved_tube
 from volanim_core.skeleton.skeletonize import skeletonize
@@ -49,7 +49,8 @@ def test_the_curved_tube_is_reconstructed_straight():
     first joint where it was; the reconstruction is one piece lying around that line, as long as the chain, and
     matches the straight tube (the true shape) within a voxel at its surface."""
     tube = curved_tube()
-    matrices, u = straighten(tube.bones)
+    matrices, u, ids = straighten(tube.bones)
+    assert ids == chain(tube.bones)
     joints = posed_joints(tube.bones, matrices)
     order = [tube.bones.bones[0].proximal] + [b.distal for b in tube.bones.bones]
     start = tube.bones.joints[order[0]]
@@ -95,7 +96,7 @@ def test_the_command_writes_the_straight_pose_and_names_a_chain_it_needs(tmp_pat
     r = volanim("straighten", tmp_path / "curved-tube.bones", "-o", tmp_path / "s.trans")
     assert r.returncode == 0, r.stderr
     assert "straightened 8 bones (S1 .. S8)" in r.stdout
-    want, _ = straighten(io.read_bones(tmp_path / "curved-tube.bones").on_cubes())
+    want, _, _ = straighten(io.read_bones(tmp_path / "curved-tube.bones").on_cubes())
     assert np.allclose(io.read_trans(tmp_path / "s.trans").matrices, want, atol=1e-9)
     many = volanim("straighten", tmp_path / "mannequin.bones", "-o", tmp_path / "x.trans")
     assert many.returncode == 2 and "not one chain" in many.stderr and not (tmp_path / "x.trans").exists()

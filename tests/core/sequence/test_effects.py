@@ -216,7 +216,20 @@ def test_a_few_volumes_make_many_crumbling_frames_and_one_frame_can_be_asked_for
     assert [p.name for p in tmp_path.glob("only.*")] == ["only.5.nrrd"]
     assert np.array_equal(io.read_volume(tmp_path / "only.5.nrrd"), io.read_volume(tmp_path / "f.5.nrrd"))
     out = volanim("crumble", tmp_path / "b.1.nrrd", "-n", "6", "--frame", "7", "-o", tmp_path / "x.%d.nrrd")
-    assert out.returncode == 2 and "frame 7 is not one of the crumble's frames 1..6" in out.stderr
+    assert out.returncode == 2 and "--frame 7 is not one of the crumble's frames 1..6" in out.stderr
+    # numbered from --start, as the files are; the error says the user's numbers, not internal ones
+    late = volanim("crumble", tmp_path / "b.1.nrrd", "-n", "6", "--start", "10", "--frame", "3", "-o",
+                   tmp_path / "x.%d.nrrd")
+    assert late.returncode == 2 and "--frame 3 is not one of the crumble's frames 10..15" in late.stderr
+    # one frame of a long series reads the first volume and its own: a missing middle file is never opened
+    for k in range(1, 7):
+        io.write_volume(tmp_path / f"s.{k}.nrrd", body if k != 3 else moved)
+    (tmp_path / "s.4.nrrd").write_bytes(b"not a volume")
+    five = volanim("crumble", *[tmp_path / f"s.{k}.nrrd" for k in range(1, 7)], "-n", "6", "--frame", "5", "-o",
+                   tmp_path / "five.%d.nrrd")
+    assert five.returncode == 0, five.stderr
+    want = fall(body, 5 / 6, drop=height * (5 / 6) ** 2, floor=floor)
+    assert np.array_equal(io.read_volume(tmp_path / "five.5.nrrd"), want)
 
 
 def test_crumble_command_drops_any_volume_series_onto_the_first_ones_floor(tmp_path):
