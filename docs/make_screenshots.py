@@ -14,8 +14,9 @@ HERE = Path(__file__).parent
 ROOT = HERE.parent
 
 
-def grab(window, path: Path) -> None:
-    """The whole window: Qt widgets from grab(), the 3D view from VTK (grab() cannot read GL)."""
+def grab(window, path: Path, beside=None) -> None:
+    """The whole window: Qt widgets from grab(), the 3D view from VTK (grab() cannot read GL); ``beside``, a
+    dialog (drawn by Qt alone), to the window's right as it stands on the desktop."""
     from PySide6.QtCore import QPoint
     from PySide6.QtGui import QImage, QPainter
 
@@ -26,6 +27,17 @@ def grab(window, path: Path) -> None:
     painter = QPainter(pix)
     painter.drawImage(window.plotter.mapTo(window, QPoint(0, 0)), img)
     painter.end()
+    if beside is not None:
+        from PySide6.QtGui import QColor, QPixmap
+
+        other = beside.grab()
+        both = QPixmap(pix.width() + other.width() + 12, max(pix.height(), other.height()))
+        both.fill(QColor(60, 60, 60))
+        painter = QPainter(both)
+        painter.drawPixmap(0, 0, pix)
+        painter.drawPixmap(pix.width() + 12, 0, other)
+        painter.end()
+        pix = both
     pix.save(str(path))
     print(f"wrote {path}")
 
@@ -130,6 +142,23 @@ def main() -> None:
     preview_and_wait()
     w.panel_tabs.setCurrentWidget(w.pose_panel)
     grab(w, HERE / "studio-timeline.png")
+
+    # The transfer-function editor (View -> Transfer function, Ctrl+T) over the same frame: flesh faint,
+    # the bones opaque ivory, the skin clear, its points on the preview's histogram
+    from volanim_core.transfer_function import TransferFunction
+
+    editor = w.show_transfer_editor()
+    editor.resize(620, 420)
+    doc.transfer.set(TransferFunction(
+        [0, 80, 90, 130, 165, 200, 215, 230, 250],
+        [[0, 0, 0, 0], [0, 0, 0, 0], [0.95, 0.85, 0.35, 0.02], [0.8, 0.2, 0.15, 0.05], [0.9, 0.45, 0.4, 0.06],
+         [0.9, 0.5, 0.45, 0.0], [0.9, 0.5, 0.45, 0.0], [0.95, 0.92, 0.8, 0.9], [1, 1, 1, 1]]), "screenshot")
+    editor.select(7)
+    for _ in range(5):
+        app.processEvents()
+    grab(w, HERE / "studio-transfer.png", beside=editor)
+    doc.transfer.set(None, "back to the mode's look")
+    editor.close()
 
     # A colour scan: the colour mannequin, arm raised, its sampled preview in colour and the hull tinted
     w.timeline.stop()

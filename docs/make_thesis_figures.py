@@ -6,10 +6,18 @@ each voxel inverse-transformed: benchmarks/_old_reconstruct.py) and by ours, in 
 Fig 5.2: the aliasing cube's skeleton turned 45 degrees about z, sampled from the checkerboard: the cube
 scan and ours with nearest sampling, and ours with the 3^3 kernel; the middle slice of each.
 
+Fig 5.17: one skeleton at the caption's three thinness levels, 1.50, 1.35 and 1.10, read two ways: as the
+thesis's 3-4-5 chamfer units (skeletonize --metric 345, the thesis's tools' units) and as Euclidean
+thinness in those units (ours, a third of the value: 0.50, 0.45, 0.37). Taken at face value in Euclidean
+voxels they give 0, 0 and 8 points on the mannequin: a Euclidean thinness can never exceed the mean length
+of the 26 neighbour steps, (6 + 12*sqrt(2) + 8*sqrt(3)) / 26 = 1.416 (each neighbour's DT is at least
+DT(p) minus its step), so the caption's 1.50 cannot be Euclidean voxels. Front views of the points
+(nearer is brighter), drawn from the coordinates (no renderer).
+
 Each figure also prints how many voxels the two reconstructions differ in (0 where both are exact: the
 old algorithm and ours fill the same voxels; only the time differs, Fig 5.2's table in the README).
 
-Run: .venv/bin/python docs/make_thesis_figures.py  (writes docs/thesis-fig-5-1.png, docs/thesis-fig-5-2.png)
+Run: .venv/bin/python docs/make_thesis_figures.py  (writes docs/thesis-fig-5-1.png, -5-2.png, -5-17.png)
 """
 
 from __future__ import annotations
@@ -99,8 +107,58 @@ def fig_5_2(path: Path) -> int:
     return differ
 
 
-def _side_by_side(path: Path, pictures: list[Image.Image], scale: int) -> None:
-    gap = 8
+FIG_5_17_LEVELS = (1.50, 1.35, 1.10)
+NEIGHBOUR_STEP_MEAN = (6 + 12 * np.sqrt(2) + 8 * np.sqrt(3)) / 26  # the largest Euclidean thinness there is
+
+
+def front_view(points: np.ndarray, shape: tuple[int, int, int], depth: tuple[int, int]) -> Image.Image:
+    """Skeleton points seen from -y (x right, z up), each a 2x2 dot, brighter the nearer within ``depth``."""
+    nx, _, nz = shape
+    rgb = np.full((nz, nx, 3), 24, np.uint8)
+    order = np.argsort(-points[:, 1])  # far first, so near points are drawn over them
+    x, y, z = points[order].T
+    near, far = depth
+    shade = (255 - 190 * np.clip((y - near) / max(far - near, 1), 0, 1)).astype(np.uint8)
+    for dx in (0, 1):
+        for dz in (0, 1):
+            xi, zi = np.minimum(x + dx, nx - 1), np.minimum(z + dz, nz - 1)
+            rgb[nz - 1 - zi, xi] = np.stack([shade, shade, (shade * 0.8).astype(np.uint8)], axis=1)
+    return Image.fromarray(rgb)
+
+
+def fig_5_17(path: Path) -> list[tuple[str, float, int]]:
+    """Returns (reading, level, points) for the three readings of the caption's levels."""
+    from PIL import ImageDraw
+
+    from volanim_core import samples
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.load("mannequin")
+    chamfer = skeletonize(s.mask, metric="345", min_thinness=1.0)
+    euclid = skeletonize(s.mask, metric="euclid", min_thinness=0.0)
+    rows = [("3-4-5 chamfer units (--metric 345)", chamfer, 1.0, "345"),
+            ("Euclidean, in the thesis's units (ours x 3)", euclid, 1 / 3, "euclid")]
+    ys = np.flatnonzero(s.mask.any(axis=(0, 2)))
+    depth = (int(ys.min()), int(ys.max()))
+    counts = [("euclid voxels, at face value", t, int((euclid.thinness >= t).sum())) for t in FIG_5_17_LEVELS]
+    panels = []
+    for label, sk, scale, metric in rows:
+        for t in FIG_5_17_LEVELS:
+            keep = sk.thinness >= t * scale
+            counts.append((label, t, int(keep.sum())))
+            pic = front_view(sk.points[keep], s.mask.shape, depth)
+            ImageDraw.Draw(pic).text((4, 4), f"{metric} >= {t * scale:.2f}\n{int(keep.sum())} points",
+                                     fill=(255, 220, 120))
+            panels.append(pic)
+    top, bottom = _row(panels[:3]), _row(panels[3:])
+    out = Image.new("RGB", (top.width, top.height * 2 + 8), (60, 60, 60))
+    out.paste(top, (0, 0))
+    out.paste(bottom, (0, top.height + 8))
+    out.resize((out.width * 2, out.height * 2), Image.NEAREST).save(path)
+    return counts
+
+
+def _row(pictures: list[Image.Image], gap: int = 8) -> Image.Image:
     w = sum(p.width for p in pictures) + gap * (len(pictures) - 1)
     h = max(p.height for p in pictures)
     out = Image.new("RGB", (w, h), (60, 60, 60))
@@ -108,7 +166,12 @@ def _side_by_side(path: Path, pictures: list[Image.Image], scale: int) -> None:
     for p in pictures:
         out.paste(p, (x, h - p.height))
         x += p.width + gap
-    out.resize((w * scale, h * scale), Image.NEAREST).save(path)
+    return out
+
+
+def _side_by_side(path: Path, pictures: list[Image.Image], scale: int) -> None:
+    out = _row(pictures)
+    out.resize((out.width * scale, out.height * scale), Image.NEAREST).save(path)
 
 
 def main() -> None:
@@ -117,6 +180,11 @@ def main() -> None:
     d2 = fig_5_2(ROOT / "docs" / "thesis-fig-5-2.png")
     print(f"Fig 5.2: the aliasing cube turned 45 degrees, cube scan | ours | ours 3^3: {d2} voxels differ between "
           f"the first two -> docs/thesis-fig-5-2.png")
+    counts = fig_5_17(ROOT / "docs" / "thesis-fig-5-17.png")
+    print(f"Fig 5.17: the mannequin's skeleton at thinness 1.50, 1.35, 1.10 -> docs/thesis-fig-5-17.png "
+          f"(no Euclidean thinness exceeds {NEIGHBOUR_STEP_MEAN:.3f})")
+    for reading, level, n in counts:
+        print(f"  {reading:<45} {level:.2f}: {n} points")
 
 
 if __name__ == "__main__":

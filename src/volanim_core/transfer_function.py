@@ -42,3 +42,4 @@ class TransferFunction:
         """RGBA of ``x`` (linear between points, held beyond the ends), shape ``x.shape + (4,)``."""
         x = np.asarray(x, np.float64)
         return np.stack([np.interp(x, self.values, self.rgba[:, k]) for k in range(4)], axis=-1)
+

@@ -103,8 +103,8 @@ def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> d
 
 def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, kernel: int = 1, spacing=(1.0, 1.0, 1.0),
                  style: str = "surface", size=(640, 480), fps: float = 24.0, frame_numbers: bool = False,
-                 background: str = "#1e1f24", workers: int | None = None, follow: bool = False, progress=None,
-                 cancel=None) -> dict:
+                 background: str = "#1e1f24", workers: int | None = None, follow: bool = False, transfer=None,
+                 progress=None, cancel=None) -> dict:
     """The timeline's frames reconstructed (a sequence in one grid) and rendered to ``out`` with the
     studio's camera: the command line's ``volanim sequence`` + ``volanim render``, in worker processes.
 
@@ -114,6 +114,9 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, ker
     A colour ``source`` gives a colour movie: the sequence holds its palette indices and the render draws
     them in the palette's colours (:mod:`volanim_core.colour.indexed`).
 
+    ``transfer``: the user's transfer function (the studio's editor) instead of the mode's colours; over a
+    colour movie it reads each voxel's luminance, as the preview does (``through_palette``).
+
     The sequence is kept beside the movie (``.NAME.zarr``) until the movie is written, and the render's
     pictures likewise, so a cancelled run picks up where it stopped when started again with the same pose.
     """
@@ -122,9 +125,11 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, ker
     from dataclasses import replace
     from pathlib import Path
 
+    from volanim_core.colour.indexed import through_palette
     from volanim_core.parallel import default_workers
     from volanim_core.render.movie import open_inputs, output_kind, render
     from volanim_core.render.scene import RenderSettings
+    from volanim_core.sequence.checked import read_store
     from volanim_core.sequence.frames import FrameSpec
     from volanim_core.sequence.run import run_sequence
 
@@ -147,8 +152,11 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, ker
     inputs = replace(open_inputs([cache]), spacing=tuple(float(s) for s in spacing))  # the studio's world
     if follow:
         inputs = replace(inputs, frames=inputs.follow("front", size[0] / size[1], base=camera))
+    palette = read_store(cache).palette
+    if transfer is not None and palette is not None:
+        transfer = through_palette(transfer, palette)  # the frames hold indices: the function of their colours
     settings = RenderSettings(camera, style=style, preset=mode, vmax=inputs.vmax, size=tuple(size),
-                              background=background, frame_numbers=frame_numbers,
+                              background=background, frame_numbers=frame_numbers, transfer=transfer,
                               spacing=tuple(float(s) for s in spacing))
     rep = render(inputs, settings, out, fps=fps, workers=workers, isolate=True,
                  on_frame=lambda number, done, n: report(len(frames) + done, total))

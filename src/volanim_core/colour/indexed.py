@@ -19,7 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.colour.palette import NearestColour, build_palette, pack, quantisation_error, unique_colours
+from volanim_core.io.volume_files import to_grey
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
+from volanim_core.transfer_function import MAX_POINTS, TransferFunction
 
 #: Indices a byte holds besides the background's 0.
 COLOURS = 255
@@ -63,3 +65,16 @@ def index_colours(rgb: np.ndarray, *, progress: ProgressFn | None = None,
     index[(rgb == 0).all(axis=3)] = 0
     report(3, 3)
     return Indexed(np.asfortranarray(index), palette, len(used), exact, error)
+
+
+def through_palette(tf: TransferFunction, palette: np.ndarray) -> TransferFunction:
+    """``tf`` over a colour volume's luminance, as a function of its palette indices: index k maps to
+    ``tf(luminance(palette[k]))``. A colour sequence stores indices (``volanim_core.colour.indexed``), so a
+    movie drawn with this shows each voxel as ``tf`` shows the colour volume itself (the studio's preview
+    draws a colour volume through ``tf`` by its luminance, rounded as ``to_grey`` rounds it)."""
+    palette = np.asarray(palette).reshape(-1, 3)
+    if not 1 <= len(palette) <= MAX_POINTS:
+        raise ValueError(f"a palette of {len(palette)} colours cannot become a transfer function "
+                         f"(1..{MAX_POINTS} points)")
+    grey = to_grey(palette.astype(np.uint8) if palette.dtype != np.uint8 else palette).astype(np.float64)
+    return TransferFunction(np.arange(len(palette), dtype=np.float64), tf(grey))

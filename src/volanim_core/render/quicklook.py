@@ -34,8 +34,10 @@ class Look:
 
 
 def read_look(path, *, style: str = "surface", preset: str | None = None, view: str = "three-quarter",
-              frame: int = 0, dims=None, size=(800, 600)) -> Look:
-    """Read ``path`` (a mesh, a volume, or frame ``frame`` of a sequence) for :func:`draw_look`."""
+              frame: int = 0, dims=None, size=(800, 600), transfer=None) -> Look:
+    """Read ``path`` (a mesh, a volume, or frame ``frame`` of a sequence) for :func:`draw_look`;
+    ``transfer`` (a :class:`~volanim_core.transfer_function.TransferFunction`) colours a volume instead of
+    its preset (a colour volume by its luminance; a colour sequence's frame likewise, through its palette)."""
     from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh
 
     from .camera import named_view, place_camera
@@ -50,9 +52,9 @@ def read_look(path, *, style: str = "surface", preset: str | None = None, view: 
         return Look(settings, f"{mesh.n_points:,} points, {mesh.n_cells:,} faces", mesh=mesh)
     camera, inputs = place_camera(open_inputs([path], slice(frame, frame + 1), dims=dims), view, aspect=w / h)
     settings = RenderSettings(camera, style=style, preset=preset or inputs.mode or "sampled", vmax=inputs.vmax,
-                              size=(w, h), spacing=inputs.spacing)
+                              size=(w, h), spacing=inputs.spacing, transfer=transfer)
     ref = inputs.frames[0]
-    volume, origin = read_frame(ref, dims)
+    volume, origin = read_frame(ref, dims)  # a colour sequence's frame in colours: the function reads luminance
     shown = "RGB" if volume.ndim == 4 else settings.preset
     what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {shown} colours"
     if ref.index >= 0:

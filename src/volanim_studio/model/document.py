@@ -39,6 +39,7 @@ from .posing import PoseState
 from .proposal import BoneProposal
 from .settings import Settings
 from .timeline import Timeline
+from .transfer import TransferState
 from .undo import UndoStack
 
 
@@ -48,7 +49,8 @@ class Document:
     def __init__(self):
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
-                                   "point_selection", "pose", "pose_settled", "preview", "timeline", "camera")
+                                   "point_selection", "pose", "pose_settled", "preview", "timeline", "camera",
+                                   "transfer")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -75,6 +77,7 @@ class Document:
         self.attachments = Attachments(self)
         self.pose = PoseState(self)
         self.timeline = Timeline(self)
+        self.transfer = TransferState(self)
         self.preview = None  # the last preview.Preview shown
         self.only_unconnected = False
         self.only_working = False
@@ -304,6 +307,7 @@ class Document:
         self.point_selection = np.zeros(0, np.int64)
         self._symmetry_x = None
         self.camera = None
+        self.transfer._write(None)
         self.set_volume(None)
         self.bones_path = self.project_path = self.demo_name = None
         self.undo.clear()

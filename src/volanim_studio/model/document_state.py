@@ -8,6 +8,7 @@
         pose       the current pose (after the timeline: the user's pose wins over its frame's)
         selection  the selected bones (by joints), the clicked joint and point
         camera     the view's camera (the scene lends doc.view_camera; doc.set_camera puts one back)
+        transfer   the user's transfer function (None: each mode's own look)
 
     write_project --> part.save(doc, path)          one JSON value per part
     read_project  --> part.parse(value, path)       checked before anything is applied (FormatError names the file)
@@ -32,6 +33,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 
+from . import transfer
 from .posing import PoseState
 from .timeline import Timeline
 
@@ -165,6 +167,8 @@ PARTS: tuple[Part, ...] = (
     Part("pose", lambda doc, _: doc.pose.to_json(), _object("pose", PoseState.parse), _apply_pose),
     Part("selection", _save_selection, _parse_selection, _apply_selection),
     Part("camera", lambda doc, _: doc.camera_now(), _object("camera", check_camera), _apply_camera),
+    Part("transfer", lambda doc, _: transfer.to_json(doc.transfer.function), transfer.parse,
+         lambda doc, tf, _: doc.transfer._write(tf) or []),
 )
 
 #: Where each Document attribute is kept by a project (a part, a data file, a key of the manifest), or why
@@ -185,7 +189,7 @@ ATTRIBUTES = {
     "hull": "made again from the volume", "hull_lod": "made again from the volume",
     "preview": "a reconstruction: made again with F5", "only_unconnected": "a filter of the Connect tab, per visit",
     "only_working": "a filter of the Connect tab, per visit", "cube_centre": "placed again with a click in Cube mode",
-    "point_selection": "the last cube or lasso, per visit",
+    "point_selection": "the last cube or lasso, per visit", "transfer": "the transfer part",
 }
 
 

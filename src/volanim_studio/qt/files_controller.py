@@ -54,12 +54,14 @@ class FilesController(Controller):
     # ------------------------------------------------------------ looking
     def view_file(self, path) -> Worker | None:
         """Read a volume, a sequence's first frame or a mesh in the background and show it in a window of
-        its own (``viewers[-1]``); the document is untouched. See :meth:`_read_then_view`."""
+        its own (``viewers[-1]``), coloured by the user's transfer function when there is one; the document
+        is untouched. See :meth:`_read_then_view`."""
         from volanim_core.render.quicklook import read_look
 
         from .quicklook_window import SIZE, QuickLookWindow
 
-        return self._read_then_view(path, "View", lambda: read_look(path, size=SIZE),
+        tf = self.doc.transfer.function  # the editor's, as the preview draws with it
+        return self._read_then_view(path, "View", lambda: read_look(path, size=SIZE, transfer=tf),
                                     lambda look: QuickLookWindow(path, look, self.window), f"Viewing {Path(path).name}")
 
     def view_file_dialog(self) -> LookDialog:

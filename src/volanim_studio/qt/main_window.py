@@ -73,6 +73,7 @@ SHORTCUTS = [
     ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
     ("Ctrl+1 / Ctrl+3 / Ctrl+7 / Ctrl+5 / Ctrl+Shift+1", "Front / side / top / three-quarter / back view"),
     ("F / Shift+F / Ctrl+0", "Frame the selection / frame everything / reset the view"),
+    ("Ctrl+T", "Transfer function: colour and opacity by value for the preview, View windows and movies"),
     ("F1", "This list"),
 ]
 
@@ -104,6 +105,7 @@ class MainWindow(QMainWindow):
         self._error_box: QMessageBox | None = None
 
         self.files = FilesController(self)
+        self.transfer_editor = None  # made when first shown (View → Transfer function…)
         self.previews = PreviewController(self)
         self.naming = NamingController(self)
         self.connecting = ConnectController(self)
@@ -217,6 +219,7 @@ class MainWindow(QMainWindow):
         self._action("Reset view", self.scene.front_view, "Ctrl+0", menu=view)
         view.addSeparator()
         self._action("Save view as camera file…", lambda: self.timeline.save_camera_dialog(), menu=view)
+        self._action("Transfer function…", self.show_transfer_editor, "Ctrl+T", menu=view)
         self.timeline.wire(self.timeline_panel)
         self.connect_panel.auto_button.clicked.connect(self.connecting.auto_connect)
         self.connect_panel.mirror_button.clicked.connect(self.connecting.mirror_connectivity)
@@ -327,6 +330,16 @@ class MainWindow(QMainWindow):
         box.setTextFormat(Qt.RichText)
         self._shortcut_box = box
         box.open()
+
+    def show_transfer_editor(self):
+        """The transfer-function editor (one per window, not modal: the preview follows its edits)."""
+        from .transfer_editor import TransferEditor
+
+        if self.transfer_editor is None:
+            self.transfer_editor = TransferEditor(self)
+        self.transfer_editor.show()
+        self.transfer_editor.raise_()
+        return self.transfer_editor
 
     # -------------------------------------------------------------- errors
     def show_error(self, title: str, message: str) -> None:

@@ -10,6 +10,7 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QFormLayout,
     QHBoxLayout,
+    QLabel,
     QLineEdit,
     QPushButton,
     QSpinBox,
@@ -22,7 +23,7 @@ SIZES = ("640x480", "1280x720", "1920x1080", "320x240")
 class MovieDialog(QDialog):
     """Ask for the movie's file, frame range, style, size and overlay; :meth:`options` reads them."""
 
-    def __init__(self, parent, frame_count: int, default_path: str, follow: bool = True):
+    def __init__(self, parent, frame_count: int, default_path: str, follow: bool = True, colours: str = ""):
         super().__init__(parent)
         self.setWindowTitle("Render movie")
         form = QFormLayout(self)
@@ -47,6 +48,8 @@ class MovieDialog(QDialog):
         self.style_box.addItems(["surface", "volume"])
         self.style_box.setToolTip("surface: the filled voxels' boundary, fast; volume: ray-cast, slower")
         form.addRow("Style", self.style_box)
+        if colours:
+            form.addRow("Colours", QLabel(colours))
         self.size_box = QComboBox()
         self.size_box.addItems(SIZES)
         form.addRow("Size", self.size_box)

@@ -308,7 +308,7 @@ class TimelineController(Controller):
                      follow: bool | None = None):
         """Reconstruct frames ``first..last`` (every ``step``) in the preview's mode and render them with
         the view's camera -- moved with the body when ``follow`` (default: the Follow the body setting) --
-        in the background with progress and cancel."""
+        and the user's transfer function when there is one, in the background with progress and cancel."""
         from volanim_studio.tasks import render_movie
 
         tl, st = self.doc.timeline, self.doc.settings
@@ -340,10 +340,11 @@ class TimelineController(Controller):
                              "indices, which cannot be averaged.")
         follow = st.follow_body if follow is None else follow
         fps = tl.frame_rate / step
+        transfer = self.doc.transfer.function  # the editor's (None: the mode's colours)
         return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
             conn, mats, numbers, out, mode=mode, source=source, kernel=kernel, camera=camera, spacing=spacing,
             style=style, size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, follow=follow,
-            progress=progress, cancel=cancel),
+            transfer=transfer, progress=progress, cancel=cancel),
             lambda r: self.doc.message(f"Rendered {r['frames']} frames to {r['out']} in {r['seconds']:.1f} s "
                                        f"({r['workers']}){'; ' + r['colours'] if r['colours'] else ''}."))
 
@@ -353,8 +354,11 @@ class TimelineController(Controller):
             self.show_error("Render movie", "nothing to render: load a clip or set keys first")
             return
         stem = tl.clip.name if tl.clip is not None else "keys"
+        tf = self.doc.transfer.function
         dialog = MovieDialog(self.window, tl.frame_count, str(Path.cwd() / f"{stem}.mp4"),
-                             self.doc.settings.follow_body)
+                             self.doc.settings.follow_body,
+                             colours=f"your transfer function ({len(tf.values)} points; View → Transfer function)"
+                             if tf is not None else f"the {self.doc.settings.preview_mode} mode's own")
         if dialog.exec() != QDialog.Accepted:
             return
         options = dialog.options()

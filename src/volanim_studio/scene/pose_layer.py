@@ -4,6 +4,7 @@
                         the preview drawn (its ``joints``), so bones and body are always one frame
     doc.events.preview, settings.show_rest / slices --> draw(): the preview (or the rest pose's, to compare)
     doc.events.preview (with a report) --> the stumps' red boxes, the lumps' white ones
+    doc.events.transfer --> the full preview's colours and opacities (the user's function, or the mode's own)
 
 Owned by :class:`~volanim_studio.scene.view.SceneView`. Full previews are
 volumes with a transfer function per mode (``volanim_core.render``); live
@@ -16,9 +17,11 @@ import numpy as np
 import pyvista as pv
 from matplotlib.colors import ListedColormap
 
+from volanim_core.io.volume_files import to_grey
 from volanim_core.render.bone_colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
 from volanim_core.render.volume_style import (
+    LABEL_MODES,
     add_volume_uncopied,
     apply_labels,
     apply_rgba,
@@ -28,6 +31,7 @@ from volanim_core.render.volume_style import (
     software_gl,
     volume_mapper,
     volume_style,
+    vtk_functions,
 )
 from volanim_core.rig.pose import apply_matrices
 
@@ -68,6 +72,7 @@ class PoseLayer:
         view.doc.events.preview.connect(self.on_report)
         view.doc.settings.events.show_rest.connect(lambda **_: self.draw())
         view.doc.settings.events.slices.connect(lambda **_: self.draw())
+        view.doc.events.transfer.connect(self.on_transfer)
         view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
         # stopped: the bones follow the pose again (drawn now, not at the next pose change)
         view.doc.settings.events.playing.connect(lambda value: None if value else self.on_pose_changed())
@@ -196,15 +201,43 @@ class PoseLayer:
         img.point_data["values"] = rgba_points(volume) if colour else np.asarray(volume).ravel(order="F")
         return img
 
+    def on_transfer(self, function, **_) -> None:
+        """The user's transfer function changed: recolour the preview drawn with one in place (an edit is
+        drawn at once, with no new actor), or draw it again when it gains or loses one."""
+        if function is not None and self.preview_actor is not None and self.preview_key[-1]:
+            self._apply_transfer(function, self.preview_key[0])
+            if self.view.settings.slices:
+                self.draw()  # the slices' colours too
+            else:
+                self.view.render()
+        elif self.preview_actor is not None:
+            self.draw()
+
+    def _apply_transfer(self, tf, mode: str) -> None:
+        ctf, otf = vtk_functions(tf)
+        prop = self.preview_actor.GetProperty()
+        prop.SetColor(ctf)
+        prop.SetScalarOpacity(otf)
+        if mode in LABEL_MODES:  # labels are never blended between voxels, whatever colours they have
+            prop.SetInterpolationTypeToNearest()
+        else:
+            prop.SetInterpolationTypeToLinear()
+
     def show_volume(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
-        """Draw a reconstruction; a live update with the same grid and mode only swaps the data."""
+        """Draw a reconstruction; a live update with the same grid and mode only swaps the data. With the
+        user's transfer function (``doc.transfer``) its colours and opacities replace the mode's; a colour
+        volume is then drawn by its luminance (the function reads one value a voxel), as ``volanim render``
+        draws it."""
         view, plotter = self.view, self.view.plotter
         n_bones = len(view.doc.bones)
+        tf = view.doc.transfer.function
         if mode == "binary":
             volume = binary_view(volume)
+        if tf is not None and volume.ndim == 4:
+            volume = to_grey(volume)
         img = self._image(volume, origin_voxels, spacing_voxels)
         key = (mode, volume.shape, tuple(img.origin), tuple(img.spacing), n_bones,
-               float(volume.max()) if mode == "hotspot" else 0)
+               float(volume.max()) if mode == "hotspot" else 0, tf is not None)
         if self.preview_actor is not None and key == self.preview_key:
             self.preview_actor.mapper.SetInputData(img)
         else:
@@ -222,11 +255,18 @@ class PoseLayer:
             if volume.ndim == 4:
                 apply_rgba(self.preview_actor)
             self.preview_key = key
+        if tf is not None:
+            self._apply_transfer(tf, mode)
         self.preview_actor.SetVisibility(view.posing)
         plotter.remove_actor("slices", render=False)
         if view.settings.slices and volume.ndim == 4:
             plotter.add_mesh(img.slice_orthogonal(), scalars="values", rgb=True, name="slices", render=False,
                              reset_camera=False)
+        elif view.settings.slices and tf is not None:  # the function's colours, over its values' range
+            lo, hi = float(tf.values[0]), float(tf.values[-1]) if len(tf.values) > 1 else float(tf.values[0]) + 1
+            cmap = ListedColormap(np.clip(tf(np.linspace(lo, hi, 256))[:, :3], 0, 1))
+            plotter.add_mesh(img.slice_orthogonal(), scalars="values", cmap=cmap, clim=(lo, hi), n_colors=256,
+                             show_scalar_bar=False, name="slices", render=False, reset_camera=False)
         elif view.settings.slices:
             style = volume_style(mode, volume, n_bones)
             labels = style.get("categories")

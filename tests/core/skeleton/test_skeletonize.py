@@ -155,3 +155,20 @@ def test_chamfer_two_passes_equal_the_brute_force_3_4_5_distance():
         off = np.sort(np.abs(background - (p + 1)), axis=1)[:, ::-1]
         assert got[tuple(p)] == (3 * off[:, 0] + off[:, 1] + off[:, 2]).min()
     assert (got[mask == 0] == 0).all()
+
+
+def test_no_euclidean_thinness_reaches_the_thesis_figure_5_17_top_level(rng):
+    """Fig 5.17's caption says Euclidean at 1.50: impossible in voxels, so the thesis's units are chamfer's.
+
+    Each neighbour's DT is at least DT(p) minus its step's length, so DT(p) - mean(neighbours' DT) is at most
+    the mean step, (6 + 12*sqrt(2) + 8*sqrt(3)) / 26 = 1.416; a single voxel (all neighbours background,
+    DT 1) has thinness 1, far below. docs/formats.md and docs/make_thesis_figures.py rely on this bound.
+    """
+    bound = (6 + 12 * np.sqrt(2) + 8 * np.sqrt(3)) / 26
+    shapes = [random_blob(rng) for _ in range(4)] + [np.ones((9, 9, 9), bool), np.pad(np.ones((1, 1, 1), bool), 2)]
+    for m in shapes:
+        s = skeletonize(m, metric="euclid", min_thinness=-np.inf)
+        assert s.thinness.max() <= bound + 1e-9
+        assert not (s.thinness >= 1.5).any()
+    chamfer = skeletonize(shapes[-2], metric="345", min_thinness=-np.inf)
+    assert chamfer.thinness.max() >= 1.5  # in 3-4-5 units the caption's level exists

@@ -1,0 +1,121 @@
+"""The user's transfer function (the thesis's Icol): value -> colour and opacity, edited with undo (Qt-free).
+
+    editor (qt/transfer_editor) --add / move / recolour / remove / load / reset--> TransferState.set
+        --undo.push(Command)--> _write --> doc.events.transfer(function=...)
+            --> the preview (scene/pose_layer), View windows and Render movie draw with it
+
+``function`` is None until the user makes one: then every reconstruction mode keeps its own look (bone
+colours, the grey ramp, the heat map). The first edit starts from the look of the mode shown
+(:func:`starting_function`), so nothing changes on screen until the user moves something. Edits are pure
+functions on :class:`~volanim_core.transfer_function.TransferFunction` (``with_point``, ``moved``,
+``recoloured``, ``without``); each is one undo step, a drag of one point one step (merged).
+A project keeps the function (``document_state``'s ``transfer`` part); ``.tf`` files hold it alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from volanim_core import io
+from volanim_core.errors import FormatError
+from volanim_core.render.scene import preset_transfer
+from volanim_core.render.volume_style import label_colours
+from volanim_core.transfer_function import TransferFunction
+
+from .undo import Command
+
+LABEL_STEP = 0.49  # a label k is its colour over k +- 0.49 (as the studio draws labels): neighbours never mix
+GAP = 1e-6  # the least distance between two points' values (the function's values are strictly ascending)
+
+
+def starting_function(mode: str, vmax: float, n_bones: int) -> TransferFunction:
+    """The look of reconstruction ``mode`` as an editable function: a step of colour per bone (bone),
+    one skin step (binary), or the mode's ramp (sampled grey, hotspot heat, mottled over its labels)."""
+    if mode in ("bone", "binary"):
+        colours = label_colours(mode, n_bones)
+        values, rgba = [0.0, 0.5], [[0, 0, 0, 0], [0, 0, 0, 0]]
+        for k, c in enumerate(colours, start=1):
+            values += [k - LABEL_STEP, k + LABEL_STEP]
+            rgba += [[*c, 0.85]] * 2
+        return TransferFunction(values, rgba)
+    return preset_transfer("hotspot" if mode == "hotspot" else "sampled", vmax)
+
+
+def with_point(tf: TransferFunction, value: float, opacity: float) -> tuple[TransferFunction, int]:
+    """A new point at ``value`` with the colour the function has there and ``opacity``; (function, its index)."""
+    value = float(value)
+    if np.any(np.abs(tf.values - value) < GAP):
+        raise ValueError(f"there is a point at {value:g} already")
+    rgba = tf(value).copy()
+    rgba[3] = np.clip(opacity, 0, 1)
+    i = int(np.searchsorted(tf.values, value))
+    return TransferFunction(np.insert(tf.values, i, value), np.insert(tf.rgba, i, rgba, axis=0)), i
+
+
+def moved(tf: TransferFunction, i: int, value: float, opacity: float) -> TransferFunction:
+    """Point ``i`` at ``value`` (kept between its neighbours: points never pass each other) and ``opacity``."""
+    lo = tf.values[i - 1] + GAP if i > 0 else -np.inf
+    hi = tf.values[i + 1] - GAP if i + 1 < len(tf.values) else np.inf
+    values, rgba = tf.values.copy(), tf.rgba.copy()
+    values[i] = min(max(float(value), lo), hi)
+    rgba[i, 3] = float(np.clip(opacity, 0, 1))
+    return TransferFunction(values, rgba)
+
+
+def recoloured(tf: TransferFunction, i: int, rgb) -> TransferFunction:
+    """Point ``i`` in colour ``rgb`` (0..1), its opacity kept."""
+    rgba = tf.rgba.copy()
+    rgba[i, :3] = np.clip(np.asarray(rgb, np.float64)[:3], 0, 1)
+    return TransferFunction(tf.values, rgba)
+
+
+def without(tf: TransferFunction, i: int) -> TransferFunction:
+    """The function without point ``i``; the last point cannot go (a function needs one)."""
+    if len(tf.values) == 1:
+        raise ValueError("a transfer function keeps at least one point")
+    return TransferFunction(np.delete(tf.values, i), np.delete(tf.rgba, i, axis=0))
+
+
+def to_json(tf: TransferFunction | None):
+    return None if tf is None else {"values": tf.values.tolist(), "rgba": tf.rgba.tolist()}
+
+
+def parse(value, path) -> TransferFunction:
+    """A project's ``transfer`` part; FormatError naming the project file."""
+    try:
+        if not isinstance(value, dict) or set(value) != {"values", "rgba"}:
+            raise ValueError(f"must be {{\"values\": [...], \"rgba\": [[r, g, b, a], ...]}}, got {value!r:.80}")
+        return TransferFunction(np.asarray(value["values"], np.float64), np.asarray(value["rgba"], np.float64))
+    except (ValueError, TypeError) as exc:
+        raise FormatError(path, f"\"transfer\": {exc}") from None
+
+
+class TransferState:
+    """``doc.transfer``: the user's function (``function``; None: each mode's own look), with undo."""
+
+    def __init__(self, doc):
+        self.doc = doc
+        self.function: TransferFunction | None = None
+
+    def _write(self, tf: TransferFunction | None) -> None:
+        self.function = tf
+        self.doc.events.transfer.emit(function=tf)
+
+    def set(self, tf: TransferFunction | None, label: str, merge_key: str | None = None) -> None:
+        """Make ``tf`` the function (None: back to each mode's look) as one undo step; ``merge_key`` merges
+        consecutive steps (one point dragged)."""
+        old = self.function
+        if tf is old or (tf is not None and tf == old):
+            return
+        self.doc.undo.push(Command(label, lambda: self._write(tf), lambda: self._write(old), merge_key))
+
+    def current(self, mode: str, vmax: float) -> TransferFunction:
+        """The function to edit: the user's, or the look of ``mode`` (not set until an edit)."""
+        return self.function or starting_function(mode, vmax, len(self.doc.bones))
+
+    def load(self, path) -> None:
+        """A ``.tf`` file as the function (one undo step); FormatError naming the file and line."""
+        self.set(io.read_transfer_function(path), f"Open transfer function {path}")
+
+    def save(self, path, mode: str, vmax: float) -> None:
+        io.write_transfer_function(path, self.current(mode, vmax))

@@ -1,0 +1,176 @@
+"""The transfer-function editor (#66, the thesis's Icol) through real widgets and real VTK: points added,
+dragged and removed with the mouse on the histogram, each one undo step; the preview draws through the
+function (checked against the voxels it keeps); .tf files; View windows and movies use it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, Qt
+
+from picture_oracle import compare, foreground, silhouette
+from volanim_core import io, samples
+from volanim_core.render.bone_colours import rgb
+from volanim_core.render.camera import Camera
+from volanim_core.transfer_function import TransferFunction
+
+from ..conftest import JOB_TIMEOUT_MS, rig_and_pose, viewer_opened
+
+pytestmark = pytest.mark.gui
+
+BACKGROUND = "#1e1f24"
+BONE_RED = TransferFunction([0.0, 225.0, 232.0, 255.0], [[0, 0, 0, 0], [1, 0, 0, 0], [1, 0, 0, 1], [1, 0, 0, 1]])
+
+
+def sampled_preview(qtbot, w) -> None:
+    w.reconstruct_panel.mode.setCurrentText("sampled")
+    w.previews.preview(report=False)
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.mode == "sampled"
+                    and not w.doc.preview.live, timeout=JOB_TIMEOUT_MS)
+
+
+def actor_function(w, values) -> np.ndarray:
+    """What the preview's VTK volume property gives each value: (N, 4) RGB and opacity."""
+    prop = w.scene.pose_layer.preview_actor.GetProperty()
+    ctf, otf = prop.GetRGBTransferFunction(0), prop.GetScalarOpacity(0)
+    return np.array([[*ctf.GetColor(float(v)), otf.GetValue(float(v))] for v in values])
+
+
+def pixel(canvas, value, opacity) -> QPoint:
+    p = canvas.to_pixel(value, opacity)
+    return QPoint(round(p.x()), round(p.y()))
+
+
+def test_points_are_edited_with_the_mouse_each_one_undo_step_and_the_preview_follows(qtbot, window):
+    w = rig_and_pose(qtbot, window)
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -50, 0), merge=False)
+    sampled_preview(qtbot, w)
+    mode_look = actor_function(w, [100.0, 200.0])
+    qtbot.keyClick(w, Qt.Key_T, Qt.ControlModifier)
+    editor = w.transfer_editor
+    qtbot.waitExposed(editor)
+    canvas = editor.canvas
+    vol = w.doc.preview.reconstruction.volume
+    want, _ = np.histogram(vol, bins=256, range=(0.0, float(vol.max())))
+    assert np.array_equal(editor.counts, want) and editor.top == vol.max()  # the histogram of what is shown
+    assert w.doc.transfer.function is None and "the sampled look" in editor.info.text()
+    steps = len(w.doc.undo._done)
+
+    at = pixel(canvas, 170.0, 0.5)
+    qtbot.mouseDClick(canvas, Qt.LeftButton, pos=at)
+    tf = w.doc.transfer.function
+    value, opacity = canvas.to_value(at.x(), at.y())
+    i = int(np.flatnonzero(np.isclose(tf.values, value))[0])
+    assert np.isclose(tf.rgba[i, 3], opacity) and len(w.doc.undo._done) == steps + 1
+    probe = np.linspace(0, 255, 18)
+    assert np.allclose(actor_function(w, probe), tf(probe), atol=1e-6)  # the preview draws through it
+    assert w.scene.pose_layer.preview_key[-1]
+
+    qtbot.mousePress(canvas, Qt.LeftButton, pos=at)  # a drag: up and left, three moves, one undo step
+    for k in (1, 2, 3):
+        qtbot.mouseMove(canvas, QPoint(at.x() - 6 * k, at.y() - 10 * k))
+    qtbot.mouseRelease(canvas, Qt.LeftButton, pos=QPoint(at.x() - 18, at.y() - 30))
+    dragged = w.doc.transfer.function
+    assert dragged.values[i] < value and dragged.rgba[i, 3] > opacity and len(w.doc.undo._done) == steps + 2
+    assert np.allclose(actor_function(w, probe), dragged(probe), atol=1e-6)
+    editor.colour((0.1, 0.9, 0.2))  # what the colour dialog's OK does
+    assert np.allclose(w.doc.transfer.function.rgba[i, :3], (0.1, 0.9, 0.2))
+
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)  # the colour
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)  # the whole drag
+    assert w.doc.transfer.function == tf and f"value {tf.values[i]:.4g}" in editor.info.text()
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)  # the point: back to the mode's own look
+    assert w.doc.transfer.function is None and not w.scene.pose_layer.preview_key[-1]
+    assert np.allclose(actor_function(w, [100.0, 200.0]), mode_look)
+    qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
+    assert np.allclose(w.doc.pose.angles_of(w.doc.bones.index("L_UPPERARM")), 0)  # the history is one
+
+    w.doc.transfer.set(tf, "again")
+    n = len(tf.values)
+    qtbot.mouseClick(canvas, Qt.RightButton, pos=pixel(canvas, tf.values[i], tf.rgba[i, 3]))
+    assert len(w.doc.transfer.function.values) == n - 1 and value not in w.doc.transfer.function.values
+
+
+def test_the_preview_shows_the_voxels_the_function_keeps(qtbot, window):
+    """Bones (values 210..250) opaque red, the rest clear: the picture is the silhouette of those voxels
+    (the oracle projects them without VTK), and red; every value clear: nothing is drawn."""
+    w = rig_and_pose(qtbot, window)
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -50, 0), merge=False)
+    sampled_preview(qtbot, w)
+    w.doc.transfer.set(BONE_RED, "bones red")
+    w.scene.xray.show(False)
+    w.plotter.render()
+    image = np.asarray(w.plotter.screenshot(return_img=True))[..., :3]
+    p = w.doc.preview
+    size = (image.shape[1], image.shape[0])
+    sil, outside = silhouette(p.reconstruction.volume >= 232, p.origin_voxels * w.scene.spacing,
+                              np.asarray(p.spacing) * w.scene.spacing, Camera.of(w.plotter.renderer.GetActiveCamera()),
+                              size)
+    fg = foreground(image, np.round(np.asarray(rgb(BACKGROUND)) * 255))
+    h, w_ = fg.shape
+    fg[int(h * 0.75):, : int(w_ * 0.25)] = sil[int(h * 0.75):, : int(w_ * 0.25)] = False  # the axes widget
+    got = compare(fg, sil)
+    assert outside == 0.0 and got["iou_rim"] >= 0.9 and got["stray"] < 0.01, got
+    body = image[fg].astype(int)
+    assert (body[:, 0] > 2 * body[:, 1] + 20).mean() > 0.95  # red, not the grey of the mode's look
+    w.doc.transfer.set(TransferFunction([0.0, 255.0], [[1, 1, 1, 0], [1, 1, 1, 0]]), "clear")
+    w.plotter.render()
+    image = np.asarray(w.plotter.screenshot(return_img=True))[..., :3]
+    fg = foreground(image, np.round(np.asarray(rgb(BACKGROUND)) * 255))
+    fg[int(h * 0.75):, : int(w_ * 0.25)] = False
+    assert fg.mean() < 0.001
+    w.scene.xray.show(True)
+
+
+def test_tf_files_are_saved_and_opened_and_a_bad_one_is_named(qtbot, window, tmp_path):
+    w = window
+    editor = w.show_transfer_editor()
+    w.doc.transfer.set(BONE_RED, "bones red")
+    editor.save_file(tmp_path / "bones.tf")
+    assert io.read_transfer_function(tmp_path / "bones.tf") == BONE_RED
+    editor.reset()
+    assert w.doc.transfer.function is None
+    editor.open_file(tmp_path / "bones.tf")
+    assert w.doc.transfer.function == BONE_RED and "Opened the transfer function" in w.statusBar().currentMessage()
+    (tmp_path / "bad.tf").write_text("0 0 0 0 0\n9 1 1 1 2\n")
+    editor.open_file(tmp_path / "bad.tf")
+    assert "bad.tf:2" in w.last_error and w.doc.transfer.function == BONE_RED
+
+
+GREEN = TransferFunction([0.0, 0.5, 1.0, 255.0], [[0, 0, 0, 0], [0, 1, 0, 0], [0, 1, 0, 1], [0, 1, 0, 1]])
+
+
+def test_a_view_window_draws_with_the_function(qtbot, window, tmp_path):
+    w = window
+    green = GREEN
+    w.doc.transfer.set(green, "green")
+    path = tmp_path / "mannequin.VOL"
+    io.write_volume(path, samples.mannequin().volume)
+    viewer = viewer_opened(w, qtbot, w.files.view_file, path)
+    assert viewer is not None and viewer.renderer.settings.transfer == green
+    pic = np.asarray(viewer.plotter.screenshot(return_img=True))[..., :3].astype(int)
+    body = pic[np.abs(pic - pic[0, 0]).max(axis=2) > 12]
+    assert len(body) > 1000 and (body[:, 1] > body[:, 0] + 40).mean() > 0.9  # green, not the grey look
+    viewer.close()
+
+
+@pytest.mark.slow  # worker processes reconstruct and render: 12 s
+def test_a_movie_draws_with_the_function(qtbot, window, tmp_path):
+    import imageio.v3 as iio
+
+    w = rig_and_pose(qtbot, window)
+    w.doc.transfer.set(GREEN, "green")
+    w.timeline_panel.length.setValue(2)
+    w.timeline_panel.length.editingFinished.emit()
+    qtbot.keyClick(w, Qt.Key_S)
+    w.doc.settings.current_frame = 1
+    w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -60, 0))
+    w.timeline_panel.set_key.click()
+    w.doc.settings.preview_mode = "bone"  # label values 1..N: the function paints every bone green
+    assert w.timeline.render_movie(tmp_path / "pics", first=0, last=1, size=(160, 120), workers=1) is not None
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert "Rendered 2 frames" in w.statusBar().currentMessage()
+    for png in sorted((tmp_path / "pics").glob("*.png")):
+        pic = iio.imread(png)[..., :3].astype(int)
+        body = pic[np.abs(pic - (0x1E, 0x1F, 0x24)).max(axis=2) > 12]
+        assert len(body) > 300 and (body[:, 1] > body[:, 0] + 40).mean() > 0.9
