@@ -95,7 +95,9 @@ def _leaves(bones) -> list[str]:
     return [bones.bones[i].label for i in bones.leaves()]
 
 
-@pytest.mark.long("18 poses of a real model through the commands a user runs, each judged with both joints")
+# full tier only, so that make test stays under 10 minutes: 18 poses of a real model through the commands a user
+# runs, each judged with both joints
+@pytest.mark.slow
 def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
     """#62: the ant's proposal connected by autorig itself, each leaf bone turned 45 and 90 degrees: `volanim
     report` exits 0 for every one. Its legs are separate shells; the path method (the old default) left a

@@ -45,7 +45,9 @@ def test_an_island_touching_no_other_bone_stays_and_the_input_is_not_changed():
     assert (out == 0).all() and out is not bone
 
 
-@pytest.mark.long("Spot the cow voxelized, skeletonized, proposed, connected and each leaf bent twice")
+# full tier only, so that make test stays under 10 minutes: Spot the cow voxelized, skeletonized, proposed,
+# connected and each leaf bent twice
+@pytest.mark.slow
 def test_every_leaf_of_spot_bends_without_tearing_a_speck(tmp_path):
     """Spot's front leg bent 45 degrees tore off an 8-voxel speck: one ball of radius 1 at the knee, given
     to the shin by its distance to the bone, touching 43 balls of the thigh and trunk and none of the

@@ -24,7 +24,9 @@ from volanim_core.skeleton.skeletonize import skeletonize
 SMOOTH = Joints("smooth")
 
 
-@pytest.mark.long("the 46 M-voxel sample skeletonized, proposed, connected and each leaf bent")
+# full tier only, so that make test stays under 10 minutes: the 46 M-voxel sample skeletonized, proposed,
+# connected and each leaf bent
+@pytest.mark.slow
 def test_mannequin_large_bends_every_leaf_90_degrees_with_smooth_joints():
     """A one-voxel sphere at the ankle's surface, its centre just inside a shin sphere of radius 10, was
     linked only to spheres a radius away: the foot's reach along the body stopped one link short of it, so
@@ -35,7 +37,9 @@ def test_mannequin_large_bends_every_leaf_90_degrees_with_smooth_joints():
     assert leaf_bends(skel, autorig(skel).bones, (90,), "smooth") == []
 
 
-@pytest.mark.long("the frog skeletonized, proposed, connected and one leg bent")
+# full tier only, so that make test stays under 10 minutes: the frog skeletonized, proposed, connected and one leg
+# bent
+@pytest.mark.slow
 def test_the_frogs_thin_sheets_keep_their_own_weights():
     """The frog's tissue is thin in places: a sheet of 120 one-voxel spheres with a few of radius 2 in it.
     Each sheet point given the weights of the radius-2 sphere that held it best (weights 0.44 and 0.86 a

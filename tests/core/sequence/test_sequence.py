@@ -50,7 +50,9 @@ def frames_of(path) -> list[np.ndarray]:
     return [np.asarray(f) for f in store.open_frames(path)[:]]
 
 
-@pytest.mark.long("the one proof that a real Dask cluster (loopback) makes the frames one worker and a local pool make")
+# full tier only, so that make test stays under 10 minutes: the one proof that a real Dask cluster (loopback)
+# makes the frames one worker and a local pool make
+@pytest.mark.slow
 def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_path, conn):
     """24 short frames: Dask gets them several to a task once the first are timed (a task costs the
     workers milliseconds of scheduling), and that changes nothing in the frames. Each frame counts as

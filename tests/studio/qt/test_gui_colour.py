@@ -63,6 +63,8 @@ def test_the_threshold_is_chosen_on_the_luminance(colour_file):
     assert loaded["grey"].dtype == np.uint8 and loaded["grey"].max() > 100
 
 
+# full tier only, so that make test stays under 10 minutes: a colour movie rendered by worker processes
+@pytest.mark.slow
 def test_the_colour_body_s_movie_is_in_colour(qtbot, window, colour_file, tmp_path):
     """#61 item 7: the movie sampled the colour volume's luminance (grey) while the preview showed colours;
     now the sequence holds palette indices and the movie draws the palette's colours."""
