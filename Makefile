@@ -10,7 +10,7 @@ APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxc
 	libfontconfig1 libdbus-1-3 libgomp1
 DEMO_OUT ?= demo-out
 
-.PHONY: demo test test-all flake explore install install-test system-deps lint bench docs screenshots coverage clean
+.PHONY: demo test test-all flake explore install install-test system-deps lint bench docs tables screenshots coverage clean
 
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -107,9 +107,15 @@ bench: install-test system-deps
 	$(PY) benchmarks/bench_colour.py
 	$(PY) benchmarks/bench_scans.py
 
-# The README's generated tables (volume tools, every benchmark's figures): about 15 minutes on 2 cores.
+# The docs pages' generated tables (volume tools, every benchmark's figures): about 15 minutes on 2 cores.
+tables: install-test system-deps
+	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/update_tables.py
+
+# The documentation site (Sphinx: docs/conf.py) into docs/_build/html, strict: a warning, a broken link or a
+# missing API name fails it. The gallery's scripts run as it builds.
 docs: install-test system-deps
-	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/update_readme.py
+	xvfb-run -a $(PY) -m sphinx -W --keep-going -n -b html docs docs/_build/html
+	@echo "open docs/_build/html/index.html"
 
 screenshots: install-test system-deps
 	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py
@@ -119,4 +125,4 @@ screenshots: install-test system-deps
 	$(PY) docs/make_thesis_figures.py
 
 clean:
-	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .coverage-data htmlcov
+	rm -rf $(VENV) $(DEMO_OUT) .pytest_cache .coverage-data htmlcov docs/_build docs/auto_examples

@@ -50,45 +50,49 @@ def test_the_readme_links_the_contract():
     assert "(docs/formats.md)" in readme and "../shared/" not in readme  # a clone has no ../shared
 
 
-def test_the_readme_commands_table_is_what_make_docs_writes():
-    """Tables are written by the code that knows them (docs/update_readme.py), never typed: the volume
-    tools table must equal what the parser gives now (the benchmark tables need the benchmarks, so
-    they are only checked to be generated regions)."""
+def _update_tables():
     import importlib.util
 
-    spec = importlib.util.spec_from_file_location("update_readme", REPO / "docs" / "update_readme.py")
+    spec = importlib.util.spec_from_file_location("update_tables", REPO / "docs" / "update_tables.py")
     update = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(update)
-    text = (REPO / "README.md").read_text(encoding="utf-8")
+    return update
+
+
+def test_the_commands_table_is_what_make_tables_writes():
+    """Tables are written by the code that knows them (docs/update_tables.py), never typed: the volume
+    tools table must equal what the parser gives now (the benchmark tables need the benchmarks, so
+    they are only checked to be generated regions, each in one page)."""
+    update = _update_tables()
+    home = update.where("commands")
+    text = home.read_text(encoding="utf-8")
     regions = update.regions(text)
-    assert regions["commands"] == update.commands_table(), "README's command table is stale: run `make docs`"
-    assert set(update.SCRIPTS) <= set(regions), "every benchmark's tables have their README region"
-    for name in update.SCRIPTS:
-        assert "*Written by `benchmarks/" in regions[name] and "cores" in regions[name], name
+    assert regions["commands"] == update.commands_table(), f"{home.name}'s command table is stale: make tables"
+    found = {n: update.where(n) for n in update.SCRIPTS}  # each benchmark's tables have one region, in one page
+    for name, page in found.items():
+        body = update.regions(page.read_text(encoding="utf-8"))[name]
+        assert "*Written by `benchmarks/" in body and "cores" in body, name
     new = update.replace_region(text, "commands", "| a |\n")
-    assert update.regions(new)["commands"] == "| a |\n" and update.regions(new)["thesis_tables"] == \
-        regions["thesis_tables"]
+    assert update.regions(new)["commands"] == "| a |\n"
+    assert {n: b for n, b in update.regions(new).items() if n != "commands"} == \
+        {n: b for n, b in regions.items() if n != "commands"}
 
 
-def test_make_docs_keeps_prose_edited_while_the_benchmarks_ran(tmp_path, monkeypatch):
+def test_make_tables_keeps_prose_edited_while_the_benchmarks_ran(tmp_path, monkeypatch):
     """The benchmarks take minutes; make docs read the README before them and wrote that text back
     with the new tables, losing any edit made meanwhile."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("update_readme", REPO / "docs" / "update_readme.py")
-    update = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(update)
-    readme = tmp_path / "README.md"
-    readme.write_text("intro\n<!-- make docs: commands -->\nold\n<!-- end: commands -->\n", encoding="utf-8")
-    monkeypatch.setattr(update, "README", readme)
+    update = _update_tables()
+    page = tmp_path / "page.md"
+    page.write_text("intro\n<!-- make tables: commands -->\nold\n<!-- end: commands -->\n", encoding="utf-8")
+    monkeypatch.setattr(update, "pages", lambda: [page])
     real = update.generate
 
     def generate_while_someone_edits(name):
         body = real(name)
-        readme.write_text(readme.read_text(encoding="utf-8").replace("intro", "intro, edited"), encoding="utf-8")
+        page.write_text(page.read_text(encoding="utf-8").replace("intro", "intro, edited"), encoding="utf-8")
         return body
 
     monkeypatch.setattr(update, "generate", generate_while_someone_edits)
     assert update.main(["commands"]) == 0
-    text = readme.read_text(encoding="utf-8")
+    text = page.read_text(encoding="utf-8")
     assert text.startswith("intro, edited\n") and update.regions(text)["commands"] == update.commands_table()

@@ -1,7 +1,9 @@
-"""The documented commands run as printed: every ```sh block of the README, and every example in
-``volanim --help`` and ``volanim COMMAND --help``.
+"""The documented commands run as printed: every ```sh block of the README and of the docs site's tutorials,
+and every example in ``volanim --help`` and ``volanim COMMAND --help``.
 
-**README.** Every ```sh block, in order, in one fresh folder. The opening block is the two
+**README and tutorials.** Every ```sh block of the README, then of each tutorial page in the order of
+``docs/tutorials/index.md``'s table of contents, in one fresh folder (a page may use what an earlier one
+made, as a reader following them in order has it). The README's opening block is the two
 commands every newcomer types: ``make demo`` runs against this repository with its output folder
 in the fresh folder (``DEMO_OUT``; later blocks use ``demo-out/``), and ``make test`` is skipped
 because it is the command running this test. Studio commands start the real window, load what
@@ -41,19 +43,32 @@ def _commands(block: str) -> list[str]:
     return [line.split("#")[0].strip() for line in block.splitlines() if line.split("#")[0].strip()]
 
 
+def tutorial_pages() -> list:
+    """The tutorials in the order of their table of contents (``docs/tutorials/index.md``)."""
+    index = (REPO / "docs" / "tutorials" / "index.md").read_text(encoding="utf-8")
+    toc = index.split("```{toctree}", 1)[1].split("```", 1)[0]
+    names = [line.strip() for line in toc.splitlines() if line.strip() and not line.strip().startswith(":")]
+    return [REPO / "docs" / "tutorials" / f"{name}.md" for name in names]
+
+
 def _readme_blocks() -> list[str]:
     return shell_blocks((REPO / "README.md").read_text(encoding="utf-8"))
 
 
 def _readme_lines() -> list[str]:
-    """Every command of the README after its opening block, continuation lines joined."""
-    return [c for b in _readme_blocks()[1:] for c in join_continuations(b.splitlines())]
+    """Every command of the README after its opening block, then of every tutorial, continuation lines joined."""
+    blocks = _readme_blocks()[1:] + [b for page in tutorial_pages() for b in shell_blocks(page.read_text("utf-8"))]
+    return [c for b in blocks for c in join_continuations(b.splitlines())]
 
 
 def test_the_readme_opens_with_the_two_commands():
     blocks = _readme_blocks()
     assert _commands(blocks[0]) == FIRST_BLOCK
-    assert len(blocks) >= 8, "the workflow's command blocks"
+    assert len(blocks) >= 2, "the quick start"
+    pages = tutorial_pages()
+    assert len(pages) >= 12 and all(p.is_file() for p in pages), pages
+    blocks += [b for page in pages for b in shell_blocks(page.read_text(encoding="utf-8"))]
+    assert len(blocks) >= 20, "the tutorials' command blocks"
     commands = [c for b in blocks[1:] for c in _commands(b)]
     assert not [c for c in commands if "..." in c or "HOST" in c], "a shell block is run: no placeholders in it"
 
@@ -70,7 +85,7 @@ def test_the_help_examples_are_commands_of_their_own_program():
 
 
 def test_every_documented_volanim_line_is_accepted_by_its_subcommand_s_parser(capsys):
-    """The default tier's check of the chains: every README and --help line that runs ``volanim`` parses
+    """The default tier's check of the chains: every README, tutorial and --help line that runs ``volanim`` parses
     (an option renamed or removed, a typo, a missing argument); running them is ``make test-all``'s."""
     lines = _readme_lines() + [c for _, c in help_examples(build_parser())]
     plain = [(line, documented_argv(line)) for line in lines]
@@ -88,7 +103,7 @@ def test_every_documented_volanim_line_is_accepted_by_its_subcommand_s_parser(ca
 
 
 @pytest.mark.slow
-def test_the_readme_runs_as_printed_in_a_fresh_folder(tmp_path):
+def test_the_readme_and_the_tutorials_run_as_printed_in_a_fresh_folder(tmp_path):
     folder = tmp_path / "newcomer"
     folder.mkdir()
     demo = run(f"make -s -C {REPO} demo DEMO_OUT={folder / 'demo-out'}", folder)

@@ -18,8 +18,9 @@ _API = {
     "scan": "volanim_core.reconstruct.checks",
     "transforms": "volanim_core.reconstruct.displacement",
     "displacement": "volanim_core.reconstruct.displacement",
-    "reconstruct": "volanim_core.reconstruct.engine",
 }
+# Not ``reconstruct``: the subpackage of that name is this attribute once anything imports it, so a function
+# there could not be reached; it is ``volanim_core.reconstruct.reconstruct``.
 __all__ = ["__version__", *_API]
 
 

@@ -256,7 +256,7 @@ def _deepest_near(mask: np.ndarray, target, radius: float = 60.0, step: int = 4)
 
 
 def load(name: str) -> Sample:
-    """A demo dataset by name: one of :data:`NAMES`."""
+    """A demo dataset by name: one of :data:`~volanim_core.samples.NAMES`."""
     makers = {"mannequin": mannequin, "mannequin-colour": mannequin_colour, "mannequin-large": mannequin_large,
               "aliascube": aliascube, "frog": frog, "curved-tube": curved_tube}
     if name not in makers:

@@ -399,7 +399,7 @@ def write_volume(path: str | Path, vol: np.ndarray, geometry: Geometry = IDENTIT
     ``mode``: the reconstruction mode of a result, recorded in ``.vti`` and ``.nrrd`` so a viewer draws
     it in that mode's colours (a bone volume in bone colours, not a grey ramp).
 
-    ``.vol``/``.VOL`` hold uint8 only and no geometry: :func:`write_output` says so.
+    ``.vol``/``.VOL`` hold uint8 only and no geometry: :func:`~volanim_core.io.write_output` says so.
     """
     path = Path(path)
     vol = np.asarray(vol)

@@ -100,7 +100,8 @@ def report_json(rep: BreakageReport) -> dict:
 
 def scan(conn: Connectivity, frames: list[Trans], *, bones: BoneSkeleton | None = None, numbers=None,
          factor: int = 2, progress=None, cancel=None) -> list[FrameVerdict]:
-    """Scan a clip for breakage (``volanim scan``): one :class:`FrameVerdict` per frame, worst first.
+    """Scan a clip for breakage (``volanim scan``): one
+    :class:`~volanim_core.reconstruct.scan.FrameVerdict` per frame, worst first.
 
     ``numbers``: each frame's number (default 0, 1, ...); ``factor``: the coarse grid of the piece count.
     """

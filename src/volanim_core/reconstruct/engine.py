@@ -118,11 +118,11 @@ def reconstruct(
     mode : {'binary', 'mottled', 'bone', 'sampled', 'hotspot'}
     source : (X, Y, Z) ndarray indexed ``[x, y, z]``, required for 'sampled'
         The rest-pose volume; positions outside it read 0. A colour source
-        ``(X, Y, Z, 3)`` uint8 gives a colour result (:mod:`.sampling`).
+        ``(X, Y, Z, 3)`` uint8 gives a colour result (``volanim_core.reconstruct.sampling``).
     source_geometry : Geometry, optional
         Where the source's voxels are: each output voxel samples the source at the same physical
         point as its rest position in the frame's grid (``tskel.geometry``). None: the source is
-        on the frame's own grid. :func:`check_source_overlap` refuses a source the frame misses.
+        on the frame's own grid. ``check_source_overlap`` refuses a source the frame misses.
     kernel : {1, 3, 5}
         Sampled mode: nearest voxel (1) or a Gaussian-weighted average over
         a 3^3 / 5^3 neighbourhood (anti-aliasing; leave 1 for label volumes).
@@ -134,7 +134,7 @@ def reconstruct(
     threads : int, optional
         numba threads (default: all cores). The result does not depend on it.
     neighbours : (N, k) int ndarray, optional
-        :func:`sphere_neighbours` of this connectivity (made once per connectivity and remembered when not
+        ``sphere_neighbours`` of this connectivity (made once per connectivity and remembered when not
         given); lets each sphere skip voxels a larger neighbour provably wins.
         The result does not depend on it; ``speedups=Speedups(cut=False)`` turns the cut off.
     out : ndarray, optional
@@ -144,7 +144,8 @@ def reconstruct(
         ``progress(done, total)`` in output slices; ``cancel() -> True``
         raises :class:`~volanim_core.errors.Cancelled`.
     speedups : Speedups
-        Optimisations to switch off, to measure them (:mod:`.speedups`); the result does not depend on it.
+        Optimisations to switch off, to measure them (``volanim_core.reconstruct.speedups``); the result does not
+        depend on it.
     clock : callable
         Seconds (``time.perf_counter``): sizes the launches (:class:`~volanim_core.progress.Pacer`) and
         times the call (``stats['seconds']``). The result does not depend on it; a test passes a fake one.

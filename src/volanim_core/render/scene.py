@@ -207,7 +207,7 @@ class PreparedFrame:
 def prepare_frame(settings: RenderSettings, volume: np.ndarray, origin, table=None) -> PreparedFrame:
     """The heavy part of drawing a frame, which needs no window (a reader thread may run it: the studio's
     quick look of a large volume, #61): the cut, the colours' one value a voxel, the surface style's mesh.
-    ``table``: :func:`colour_table` of the settings, when the caller keeps it."""
+    ``table``: ``colour_table`` of the settings, when the caller keeps it."""
     from volanim_core.render.surfaces import label_surface
 
     s = settings
@@ -284,7 +284,8 @@ class Renderer:
         self.show(prepare_frame(self.settings, volume, origin, self._table), number, camera)
 
     def show(self, frame: PreparedFrame, number: int | None = None, camera: Camera | None = None) -> None:
-        """Put a frame :func:`prepare_frame` made (any thread) in the scene: only VTK actors here."""
+        """Put a frame :func:`~volanim_core.render.scene.prepare_frame` made (any thread) in the scene: only VTK
+        actors here."""
         s = self.settings
         if s.style == "surface":
             self._draw_surface(frame.mesh)

@@ -328,8 +328,9 @@ def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str 
     ``template``: ``humanoid`` and ``quadruped`` name joints and bones as those rigs do (the humanoid's
     are the mannequin's); ``none`` names chains by position; ``auto`` takes the template that fits.
     ``bones`` (template ``none`` only) asks for that many bones, split where branches bend most.
-    Raises :class:`NotRiggable` with where and why when the skeleton cannot be rigged. ``progress(done,
-    total)`` after each of its ``STEPS`` stages; ``cancel()`` returning True stops it (:class:`Cancelled`).
+    Raises :class:`~volanim_core.rig.curve_skeleton.NotRiggable` with where and why when the skeleton cannot be
+    rigged. ``progress(done, total)`` after each of its ``STEPS`` stages; ``cancel()`` returning True stops it
+    (:class:`~volanim_core.errors.Cancelled`).
     """
     from volanim_core.progress import Reporter
     from volanim_core.rig import templates

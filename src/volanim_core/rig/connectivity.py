@@ -185,7 +185,8 @@ class Trans:
         and the 1 mm cubes skeletonize resampled it to) are one frame: the roots go where they are in
         the body, each matrix is conjugated by the map between the grids (``A M A^-1``, row vectors).
         Between cube grids that is a similarity, so a rotation stays a rotation. A frame recording no
-        grid is taken as on the other, as :meth:`BoneSkeleton.on_grid` does; the identity grid (no line)
+        grid is taken as on the other, as :meth:`~volanim_core.rig.bones.BoneSkeleton.on_grid` does; the identity
+        grid (no line)
         is a grid like any other to a frame that records one.
         """
         if self.geometry.is_identity or self.geometry == geometry:

@@ -30,7 +30,7 @@ def _coords(b) -> str:
 
 def connect_to_tskel(conn: Connectivity, trans: Trans) -> Tskel:
     """One frame ready to reconstruct: the connectivity with the frame's matrices (the frame taken onto the
-    connectivity's grid first, :meth:`Trans.on_grid`)."""
+    connectivity's grid first, :meth:`~volanim_core.rig.connectivity.Trans.on_grid`)."""
     trans = trans.on_grid(conn.geometry)
     check_root_order(conn.bones, trans.bones)
     return conn.posed(trans.matrices)

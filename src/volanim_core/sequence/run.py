@@ -145,14 +145,15 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str 
                  on_frame=None, frame_seconds=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
-    ``source_geometry``: where the source's voxels are (:func:`reconstruct`); the store records the
+    ``source_geometry``: where the source's voxels are (:func:`~volanim_core.reconstruct.reconstruct`); the store
+    records the
     frames' geometry (``conn.geometry`` at the shared grid's origin) in physical units.
     ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
     ``on_frame(record, done, total)`` after each finished frame (progress).
     ``replace_other``: a store of another sequence at ``out`` is replaced instead of refused (a
     cache, like the studio's movie); the same sequence still resumes, and ``--force`` redoes it.
     ``frame_seconds(record) -> float``: what a finished frame cost, for sizing Dask's tasks
-    (:func:`frames_per_task`); default the ``seconds`` its worker measured. The frames never depend on
+    (``frames_per_task``); default the ``seconds`` its worker measured. The frames never depend on
     it; a test passes a constant, so the tasks are known whatever the machine's load.
     """
     if not frames:

@@ -55,7 +55,7 @@ def test_vol_with_header_gets_hint(tmp_path, vol):
         io.read_volume(tmp_path / "b.7x5x3.vol")
 
 
-# spec: docs/formats.md#VOL
+# spec: docs/formats.md#VOL-header
 def test_VOL_header_layout_and_round_trip(tmp_path, vol):
     path = tmp_path / "a.VOL"
     io.write_volume(path, vol)
@@ -66,14 +66,14 @@ def test_VOL_header_layout_and_round_trip(tmp_path, vol):
     assert np.array_equal(io.read_volume(path), vol)
 
 
-# spec: docs/formats.md#VOL
+# spec: docs/formats.md#VOL-header
 def test_VOL_header_reader_ignores_rest(tmp_path, vol):
     head = b"7 5 3 extra words 99\nmore".ljust(100, b"\0")
     (tmp_path / "h.VOL").write_bytes(head + np.ascontiguousarray(vol.T).tobytes())
     assert np.array_equal(io.read_volume(tmp_path / "h.VOL"), vol)
 
 
-# spec: docs/formats.md#VOL
+# spec: docs/formats.md#VOL-header
 @pytest.mark.parametrize("head", [b"", b"abc", b"x y z".ljust(100)])
 def test_VOL_bad_header(tmp_path, head):
     (tmp_path / "h.VOL").write_bytes(head)
@@ -81,7 +81,7 @@ def test_VOL_bad_header(tmp_path, head):
         io.read_volume(tmp_path / "h.VOL")
 
 
-# spec: docs/formats.md#VOL
+# spec: docs/formats.md#VOL-header
 def test_VOL_truncated(tmp_path, vol):
     io.write_volume(tmp_path / "a.VOL", vol)
     data = (tmp_path / "a.VOL").read_bytes()
@@ -90,7 +90,7 @@ def test_VOL_truncated(tmp_path, vol):
         io.read_volume(tmp_path / "a.VOL")
 
 
-# spec: docs/formats.md#VOL
+# spec: docs/formats.md#VOL-header
 def test_header_add_remove_streaming_round_trip(tmp_path, vol, monkeypatch):
     monkeypatch.setattr(raw_volumes, "CHUNK", 16)  # force many chunks
     io.write_volume(tmp_path / "a.7x5x3.vol", vol)

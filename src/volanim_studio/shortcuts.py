@@ -1,0 +1,35 @@
+"""The studio's keyboard and mouse shortcuts: the table F1 shows and the docs site prints (Qt-free)."""
+
+from __future__ import annotations
+
+SHORTCUTS = [
+    ("V", "View mode: click points to inspect them"),
+    ("B", "Bones mode: click point A, then B to add a bone; keep clicking to chain"),
+    ("R", "Root order mode: click bones in order"),
+    ("K", "Cube mode: click a point to place the cube"),
+    ("Up / Down / Left / Right, PgUp / PgDown, + / -", "Cube mode: nudge the cube, resize it"),
+    ("C / X", "Cube mode: connect the points in the cube to the working bone / remove them"),
+    ("L", "Lasso mode: drag an outline to connect the points under it to the working bone (Ctrl: remove)"),
+    ("Ctrl+A", "Auto-connect"),
+    ("P", "Pose mode: click a bone, turn it with the Pose sliders; the preview follows live"),
+    ("F5", "Preview the reconstruction at full resolution, with the breakage report"),
+    ("Esc", "End the bone chain / restart the root order"),
+    ("Right click", "End the bone chain"),
+    ("Del", "Remove the selected bones (the Delete key)"),
+    ("M", "Symmetrize the selected bones (L_ ↔ R_)"),
+    ("Ctrl+Shift+B", "Propose bones (auto-rig): a template, a preview, accept or discard"),
+    ("F2", "Rename the joint clicked last"),
+    ("Ctrl+F2", "Name the selected bone's chain in one line: SHOULDER, ELBOW, WRIST (L_/R_ added by side)"),
+    ("Space", "Play / pause the timeline (a BVH clip, .trans frames or keys)"),
+    ("Left / Right, Home / End", "Previous / next frame, first / last frame (outside Cube mode)"),
+    ("S / Shift+S", "Set / delete the pose key at the current frame"),
+    ("Ctrl+Z / Ctrl+Shift+Z", "Undo / redo"),
+    ("Ctrl+O", "Open a volume"),
+    ("Ctrl+S / Ctrl+Shift+S", "Save the project / save it under a new name"),
+    ("Ctrl+Q", "Quit (a running job is cancelled and waited for)"),
+    ("Left drag / right drag / wheel", "Rotate / zoom / zoom the view"),
+    ("Ctrl+1 / Ctrl+3 / Ctrl+7 / Ctrl+5 / Ctrl+Shift+1", "Front / side / top / three-quarter / back view"),
+    ("F / Shift+F / Ctrl+0", "Frame the selection / frame everything / reset the view"),
+    ("Ctrl+T", "Transfer function: colour and opacity by value for the preview, View windows and movies"),
+    ("F1", "This list"),
+]
