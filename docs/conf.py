@@ -40,7 +40,6 @@ exclude_patterns = ["_build", "examples/README.txt", "auto_examples/*.ipynb", "a
 
 myst_heading_anchors = 4  # [text](page.md#a-heading) resolves, and a wrong one is a warning
 myst_enable_extensions = ["colon_fence"]
-suppress_warnings = []
 
 nitpicky = True  # a reference to a missing API name fails the build ...
 nitpick_ignore_regex = [  # ... except names outside volanim (no network here for intersphinx inventories)
