@@ -115,9 +115,10 @@ def test_no_module_over_450_lines():
 LAYERS = [
     {"errors", "limits", "progress", "geometry", "modes", "camera", "transfer_function", "isosurface", "parallel",
      "memo"},
-    # files hold skeletons and bones (io reads them into their types), volume tools convert with io's:
-    # one layer, which never imports the renderer
-    {"volume", "io", "skeleton", "colour", "rig", "mannequin_body"},
+    # volume tools and the values every file and tool reads (float_to_uint8, to_grey, finite_range): below io
+    {"volume"},
+    # files hold skeletons and bones (io reads them into their types): one layer, which never imports the renderer
+    {"io", "skeleton", "colour", "rig", "mannequin_body"},
     {"reconstruct", "motion"},
     {"sequence", "render", "samples", "ant_sample", "warmup", "posed_truth"},
     {"pipeline_demo"},

@@ -14,11 +14,10 @@ import numpy as np
 from volanim_core import samples
 from volanim_core.geometry import IDENTITY
 from volanim_core.io import read_scan, read_skeleton
-from volanim_core.io.volume_files import is_colour, to_grey
 from volanim_core.progress import Reporter, stage
 from volanim_core.skeleton.hull import display_hulls
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
-from volanim_core.volume import isotropic_mask, resample, segment
+from volanim_core.volume import is_colour, isotropic_mask, resample, segment, to_grey
 
 
 def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: bool, metric: str = "euclid",

@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.geometry import axis_codes, mm
-from volanim_core.io import add_header, float_to_uint8, histogram_file, remove_header
-from volanim_core.io.volume_files import finite_range, non_finite_count
+from volanim_core.io import add_header, histogram_file, remove_header
+from volanim_core.volume import finite_range, float_to_uint8, non_finite_count
 
 from .. import samples, volume
 from ..io._text import parse_int, read_records

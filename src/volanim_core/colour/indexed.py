@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.colour.palette import NearestColour, build_palette, pack, quantisation_error, unique_colours
-from volanim_core.io.volume_files import to_grey
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.transfer_function import MAX_POINTS, TransferFunction
+from volanim_core.volume import to_grey
 
 #: Indices a byte holds besides the background's 0.
 COLOURS = 255

@@ -22,6 +22,7 @@ from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.io import raw_volumes, volume_files
 from volanim_core.io._atomic import atomic_open
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
+from volanim_core.volume import is_colour
 
 SLAB_VOXELS = 1 << 22  # voxels a slab holds (12 MiB of RGB): memory stays flat whatever the volume
 
@@ -50,7 +51,7 @@ class ColourSlabs:
             vol = raw_volumes.read_raw(path, dims, mmap=True)
         else:
             vol, geometry, _ = volume_files.read_scan(path, dims=dims, colour=True)
-        if not volume_files.is_colour(vol):
+        if not is_colour(vol):
             raise FormatError(path, "is a grey volume (one value a voxel); the palette tools need colour "
                                     "(RGB: 3 bytes a voxel, RGB slices, or a 3-component .vti/.nrrd)")
         return cls(path, tuple(int(n) for n in vol.shape[:3]), vol, geometry=geometry)

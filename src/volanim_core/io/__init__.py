@@ -29,7 +29,6 @@ from .render_files import read_camera, read_transfer_function, write_camera, wri
 from .skeleton_files import read_mskel, read_skel, read_skeleton, skeleton_at, write_mskel, write_skel, write_skeleton
 from .volume_files import (
     Scan,
-    float_to_uint8,
     read_image_folder,
     read_scan,
     read_volume,
@@ -48,7 +47,6 @@ __all__ = [
     "connect_filename",
     "dims_from_name",
     "raw_name_for",
-    "float_to_uint8",
     "histogram_file",
     "read_bones",
     "read_connect",

@@ -33,6 +33,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.geometry import IDENTITY, Geometry
+from volanim_core.volume import float_to_uint8, is_colour, to_grey
 
 from . import raw_volumes
 from ._atomic import atomic_vtk_save
@@ -72,70 +73,6 @@ class Scan:
 def _suffix(path: Path) -> str:
     name = path.name.lower()
     return ".nii.gz" if name.endswith(".nii.gz") else path.suffix.lower()
-
-
-def finite_range(vol: np.ndarray) -> tuple[float, float] | None:
-    """``(min, max)`` over the finite values (NaN and infinity are background); None if there are none."""
-    vol = np.asarray(vol)
-    if vol.dtype.kind != "f":
-        return (float(vol.min()), float(vol.max())) if vol.size else None
-    lo, hi = np.inf, -np.inf
-    for z in range(vol.shape[-1] if vol.ndim else 0):  # a slice at a time: no volume-sized mask
-        s = vol[..., z]
-        s = s[np.isfinite(s)]
-        if s.size:
-            lo, hi = min(lo, float(s.min())), max(hi, float(s.max()))
-    return (lo, hi) if lo <= hi else None
-
-
-def non_finite_count(vol: np.ndarray) -> int:
-    """How many voxels are NaN or infinite (0 for integer data)."""
-    vol = np.asarray(vol)
-    if vol.dtype.kind not in "fc":
-        return 0
-    return int(sum(int(np.count_nonzero(~np.isfinite(vol[..., z]))) for z in range(vol.shape[-1])))
-
-
-def float_to_uint8(vol: np.ndarray, lo: float | None = None, hi: float | None = None) -> np.ndarray:
-    """Map ``[lo, hi]`` linearly onto 0..255 and clip (float2uchar).
-
-    ``lo``/``hi`` default to the data's finite minimum and maximum; NaN and infinite voxels are
-    background (0), not part of the range.
-    """
-    vol = np.asarray(vol)
-    if lo is None or hi is None:
-        found = finite_range(vol) or (0.0, 0.0)
-        lo = found[0] if lo is None else float(lo)
-        hi = found[1] if hi is None else float(hi)
-    lo, hi = float(lo), float(hi)
-    if hi <= lo:
-        if vol.size == 0 or hi < lo:
-            return np.zeros(vol.shape, np.uint8)
-        with np.errstate(invalid="ignore"):
-            return ((vol > lo) & np.isfinite(vol)).astype(np.uint8) * 255
-    with np.errstate(invalid="ignore", over="ignore"):
-        out = (np.asarray(vol, np.float64) - lo) * (255.0 / (hi - lo))
-        out[~np.isfinite(out)] = 0  # NaN, +-inf: background
-        return np.clip(np.rint(out), 0, 255).astype(np.uint8)
-
-
-LUMA = np.array([0.2125, 0.7154, 0.0721])  # Rec. 709, as skimage.color.rgb2gray
-
-
-def to_grey(rgb: np.ndarray) -> np.ndarray:
-    """Luminance of ``[..., 3]`` colour data, rounded, in the input's dtype."""
-    rgb = np.asarray(rgb)
-    if rgb.ndim < 4:
-        return np.rint(rgb[..., :3] @ LUMA).astype(rgb.dtype)
-    out = np.empty(rgb.shape[:-1], rgb.dtype, order="F")
-    for z in range(rgb.shape[2]):  # a slice at a time: float64 of a whole volume is 24 bytes a voxel
-        out[:, :, z] = np.rint(rgb[:, :, z, :3] @ LUMA)
-    return out
-
-
-def is_colour(vol) -> bool:
-    """Whether ``vol`` is a colour volume ``[x, y, z, 3]``."""
-    return np.ndim(vol) == 4 and np.shape(vol)[3] == 3
 
 
 def _read_vtk(path: Path):

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from volanim_core.io.volume_files import to_grey
 from volanim_core.render.bone_colours import SKIN, rgb
 from volanim_core.render.camera import Camera
 from volanim_core.render.volume_style import (
@@ -38,6 +37,7 @@ from volanim_core.render.volume_style import (
     vtk_functions,
 )
 from volanim_core.transfer_function import TransferFunction
+from volanim_core.volume import to_grey
 
 STYLES = ("surface", "volume")
 MAPPERS = ("auto", "cpu", "gpu")

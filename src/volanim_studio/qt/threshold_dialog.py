@@ -18,8 +18,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from volanim_core.io.volume_files import finite_range
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
+from volanim_core.volume import finite_range
 
 
 class HistogramWidget(QWidget):

@@ -29,7 +29,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from volanim_core.io.volume_files import to_grey
+from volanim_core.volume import to_grey
 from volanim_studio.model.transfer import moved, recoloured, with_point, without
 
 MARGIN = 10  # pixels around the plot, so a dot at either end is whole

@@ -17,7 +17,6 @@ import numpy as np
 import pyvista as pv
 from matplotlib.colors import ListedColormap
 
-from volanim_core.io.volume_files import to_grey
 from volanim_core.render.bone_colours import SKIN, label_table
 from volanim_core.render.surfaces import label_surface
 from volanim_core.render.volume_style import (
@@ -34,6 +33,7 @@ from volanim_core.render.volume_style import (
     vtk_functions,
 )
 from volanim_core.rig.pose import apply_matrices
+from volanim_core.volume import to_grey
 
 STUMP_COLOUR = "#ff3030"  # over a black halo, seen on a red bone colour too
 LUMP_COLOUR = "#ffffff"  # flesh carried off (reconstruct/lumps.py): white over a black halo, seen on any bone colour

@@ -8,7 +8,7 @@ import pytest
 
 from volanim_core import io
 from volanim_core.errors import FormatError
-from volanim_core.io.volume_files import to_grey
+from volanim_core.volume import to_grey
 
 
 @pytest.fixture

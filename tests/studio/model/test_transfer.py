@@ -99,7 +99,7 @@ def test_a_tf_file_is_one_undo_step_and_a_bad_one_changes_nothing(tmp_path):
 
 
 def test_through_palette_is_the_function_of_each_colour_s_luminance():
-    from volanim_core.io.volume_files import to_grey
+    from volanim_core.volume import to_grey
 
     palette = np.array([[0, 0, 0], [255, 0, 0], [10, 200, 30], [255, 255, 255]], np.uint8)
     tf = TransferFunction([0.0, 60.0, 255.0], [[0, 0, 0, 0], [0, 1, 0, 0.5], [1, 1, 1, 1]])
