@@ -21,9 +21,9 @@ from itertools import combinations
 import numpy as np
 
 from volanim_core.rig import landmarks
-from volanim_core.rig.autorig import Tree, splits
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.rig.curve_skeleton import NotRiggable
+from volanim_core.rig.tree_walks import Tree, splits
 
 SYMMETRY = 0.15  # a pairing is symmetric when its mirror error is below this fraction of the body's size
 ELBOW, WRIST = 0.42, 0.76  # upper arm 0.186 H, forearm 0.146 H, hand 0.108 H (Drillis & Contini)

@@ -13,10 +13,11 @@ import pytest
 from volanim_core import samples
 from volanim_core.reconstruct.checks import report
 from volanim_core.rig.attach import connect
-from volanim_core.rig.autorig import autorig, splits
+from volanim_core.rig.autorig import autorig
 from volanim_core.rig.connectivity import Trans
 from volanim_core.rig.curve_skeleton import NotRiggable, balls
 from volanim_core.rig.pose import pose_matrices, root_bones
+from volanim_core.rig.tree_walks import splits
 from volanim_core.skeleton.skeletonize import skeletonize
 
 
