@@ -37,17 +37,17 @@ def per_frame(seq: Path, style: str, mapper: str = "gpu") -> float:
     from volanim_core.render.camera import named_view
     from volanim_core.render.movie import open_inputs
     from volanim_core.render.scene import Renderer, RenderSettings
-    from volanim_core.sequence import store
+    from volanim_core.sequence.checked import read_store
 
     inputs = open_inputs([seq])
     settings = RenderSettings(named_view("three-quarter", inputs.lo, inputs.hi), style=style, mapper=mapper,
                               preset=inputs.mode, vmax=inputs.vmax, size=(640, 480))
     r = Renderer(settings)
-    origin = store.origin(seq)
+    origin = read_store(seq).origin_xyz
     times = []
     try:
         for i, ref in enumerate(inputs.frames):
-            vol = store.read_frame(seq, ref.index)
+            vol = read_store(seq).read_frame(ref.index)
             t0 = time.perf_counter()
             r.render(vol, origin, ref.number)
             if i:

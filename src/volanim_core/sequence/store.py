@@ -9,8 +9,8 @@
     OUT.zarr/volanim-frames.jsonl one line per finished frame: index, number, sha256 of its bytes and the
                                   region it hashed (z, y, x), stats
 
-Reading for pictures goes through :mod:`~volanim_core.sequence.checked`, which checks this
-metadata once and verifies each frame against its sha256.
+This module writes; reading goes through :mod:`~volanim_core.sequence.checked` (``read_store``), which
+checks this metadata once and verifies each frame against its sha256.
 
 A task's frames are appended to the manifest only after their shards are
 written, by the one process that runs the sequence, in one ``write`` +
@@ -182,17 +182,3 @@ def open_frames(path: str | Path, mode: str = "r"):
     array = zarr.open_array(str(Path(path) / "0"), mode=mode)
     return array if mode == "r" else array.with_config(WRITE_CONFIG)  # runtime config: not kept in the store
 
-
-def read_frame(path: str | Path, index: int) -> np.ndarray:
-    """Frame ``index`` as a ``[x, y, z]`` volume (like every volanim volume), its metadata checked and the
-    frame verified against its sha256 (:func:`~volanim_core.sequence.checked.read_store`)."""
-    from .checked import read_store
-
-    return read_store(path).read_frame(index)
-
-
-def origin(path: str | Path) -> tuple[int, int, int]:
-    """The grid's voxel ``[0, 0, 0]`` in the frames' voxel indices (checked metadata)."""
-    from .checked import read_store
-
-    return read_store(path).origin_xyz

@@ -115,6 +115,7 @@ def sequence_store(full: Path, spare: Path) -> dict:
     from volanim_core import io
     from volanim_core.samples import mannequin_bones
     from volanim_core.sequence import store
+    from volanim_core.sequence.checked import read_store
     from volanim_core.sequence.frames import frames_from_files
     from volanim_core.sequence.run import run_sequence
 
@@ -133,8 +134,8 @@ def sequence_store(full: Path, spare: Path) -> dict:
     result["recorded"] = len(recorded)
     result["frames"] = len(walk)
     want = store.open_frames(spare / "roomy.zarr")
-    result["recorded_verify"] = all(np.array_equal(store.read_frame(full / "s.zarr", i),
-                                                   store.read_frame(spare / "roomy.zarr", i)) for i in recorded)
+    result["recorded_verify"] = all(np.array_equal(read_store(full / "s.zarr").read_frame(i),
+                                                   read_store(spare / "roomy.zarr").read_frame(i)) for i in recorded)
     ballast.unlink()
     again = run_sequence(conn, walk, full / "s.zarr", mode="bone", workers=1)
     result["skipped_on_resume"] = again.skipped

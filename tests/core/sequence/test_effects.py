@@ -16,6 +16,7 @@ from volanim_core.cli import main
 from volanim_core.reconstruct.engine import posed_centres, reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
+from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.effects import crumble, fall, melt, parse_axis, teleport
 from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import run_sequence, shared_bounds
@@ -100,12 +101,12 @@ def test_a_walk_then_a_crumble_runs_on_two_workers_and_keeps_every_voxel(tmp_pat
     rep = run_sequence(conn, frames, tmp_path / "c.zarr", mode="mottled", workers=2)
     last = rep.records[1]["filled"]
     assert [r["filled"] for r in rep.records[2:]] == [last] * 3  # falling loses nothing
-    standing = store.read_frame(tmp_path / "c.zarr", 1)
+    standing = read_store(tmp_path / "c.zarr").read_frame(1)
     for i in (2, 3, 4):
-        assert np.array_equal(store.read_frame(tmp_path / "c.zarr", i), fall(standing, (i - 1) / 3)), i
+        assert np.array_equal(read_store(tmp_path / "c.zarr").read_frame(i), fall(standing, (i - 1) / 3)), i
     alone = reconstruct(walk[-1].tskel(conn), mode="mottled")
     assert np.count_nonzero(alone.volume) == last
-    heap = store.read_frame(tmp_path / "c.zarr", 4)
+    heap = read_store(tmp_path / "c.zarr").read_frame(4)
     z = np.nonzero(standing)[2]
     assert np.ptp(np.nonzero(heap)[2]) < np.ptp(z) / 3  # a heap, not a body
     assert np.nonzero(heap)[2].min() == z.min()  # on the floor the body stood on
@@ -120,7 +121,7 @@ def test_cli_effects_and_the_down_option(tmp_path, capsys):
             "--mode", "bone", "--workers", "1"]
     assert main([*base, "--teleport", "2", "-o", str(tmp_path / "t.zarr")]) == 0
     assert "3 made" in capsys.readouterr().out
-    assert not store.read_frame(tmp_path / "t.zarr", 2).any()  # gone
+    assert not read_store(tmp_path / "t.zarr").read_frame(2).any()  # gone
     assert main([*base, "--crumble", "2", "--down", "-z", "-o", str(tmp_path / "c.zarr")]) == 0  # a dash value
     assert len(store.finished(tmp_path / "c.zarr")) == 3
     assert [f.number for f in melt(frames_from_files(io.read_connect(CONNECT), [WALK], bones=mannequin_bones(),
@@ -171,11 +172,11 @@ def test_melt_and_crumble_at_once_shrink_the_falling_body_onto_the_standing_floo
     rep = run_sequence(conn, frames, tmp_path / "m.zarr", mode="mottled", workers=1)
     filled = [r["filled"] for r in rep.records]
     assert filled[0] > filled[1] > filled[2] > filled[3] > 0 and filled[4] == 0  # melting while it falls
-    floor = np.nonzero(store.read_frame(tmp_path / "m.zarr", 0))[2].min()
+    floor = np.nonzero(read_store(tmp_path / "m.zarr").read_frame(0))[2].min()
     for i in (1, 2, 3):  # the shrunken body falls to the floor the whole body stood on, not to its own lowest voxel
-        z = np.nonzero(store.read_frame(tmp_path / "m.zarr", i))[2]
+        z = np.nonzero(read_store(tmp_path / "m.zarr").read_frame(i))[2]
         assert z.min() >= floor - 1
-    assert np.nonzero(store.read_frame(tmp_path / "m.zarr", 3))[2].min() <= floor
+    assert np.nonzero(read_store(tmp_path / "m.zarr").read_frame(3))[2].min() <= floor
 
 
 def test_cli_melt_with_crumble_an_acceleration_and_a_summed_heap(tmp_path):
@@ -186,7 +187,7 @@ def test_cli_melt_with_crumble_an_acceleration_and_a_summed_heap(tmp_path):
     r = volanim(*base, "--crumble", "2", "--melt", "3", "--acceleration", "40", "--heap", "sum",
                 "-o", tmp_path / "c.zarr")
     assert r.returncode == 0, r.stderr
-    assert "4 made" in r.stdout and not store.read_frame(tmp_path / "c.zarr", 3).any()
+    assert "4 made" in r.stdout and not read_store(tmp_path / "c.zarr").read_frame(3).any()
     both = volanim(*base, "--teleport", "2", "--melt", "3", "-o", tmp_path / "x.zarr")
     assert both.returncode == 2 and "--melt and --teleport" in both.stderr and not (tmp_path / "x.zarr").exists()
     neg = volanim(*base, "--crumble", "2", "--acceleration", "-1", "-o", tmp_path / "x.zarr")

@@ -16,7 +16,7 @@ import pytest
 from paths import ASSETS, WALK
 from volanim_core import io
 from volanim_core.samples import mannequin_bones
-from volanim_core.sequence import store
+from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import run_sequence
 
@@ -48,7 +48,7 @@ def test_napari_opens_a_sequence_as_a_4d_image_of_its_frames(tmp_path):
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
     (layer,) = json.loads(done.stdout.strip().splitlines()[-1])
-    frame = store.read_frame(out, 2)
+    frame = read_store(out).read_frame(2)
     assert layer["kind"] == "Image" and layer["axes"] == ["t", "z", "y", "x"]
     assert layer["shape"] == [4, *rep.bounds.shape[::-1]] and layer["dtype"] == "uint8"
     assert np.allclose(layer["scale"], [1 / 30, 1, 1, 1])  # seconds per frame, then voxels
@@ -102,7 +102,7 @@ def test_a_frame_of_a_scan_stored_ras_lies_on_the_scan(tmp_path):
     import zarr
 
     stored = zarr.open_array(str(tmp_path / "rest.zarr" / "0"), mode="r")[0]
-    assert np.array_equal(store.read_frame(tmp_path / "rest.zarr", 0), stored.transpose(2, 1, 0))  # ours reads it
+    assert np.array_equal(read_store(tmp_path / "rest.zarr").read_frame(0), stored.transpose(2, 1, 0))  # ours reads it
     index = np.argwhere(stored > 0)  # z, y, x as stored
     placed = index * scale[1:] + translation[1:]
     lps = nib.affines.apply_affine(affine, np.argwhere(vol > 0)) * (-1, -1, 1)

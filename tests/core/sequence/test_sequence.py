@@ -21,6 +21,7 @@ from volanim_core.motion.frame_files import write_frames
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
+from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.effects import melt
 from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import (
@@ -105,7 +106,7 @@ def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_gri
     frames = walk + melt(walk, 2)
     rep = run_sequence(conn, frames, tmp_path / "s.zarr", mode="mottled", padding=3)
     bounds = shared_bounds(conn, frames, 3)
-    assert rep.bounds == bounds and store.origin(tmp_path / "s.zarr") == bounds.lo
+    assert rep.bounds == bounds and read_store(tmp_path / "s.zarr").origin_xyz == bounds.lo
     assert store.open_frames(tmp_path / "s.zarr").shape == (8, *bounds.shape[::-1])
     for i, spec in enumerate(frames):
         alone = reconstruct(spec.tskel(conn), mode="mottled")  # its own tight grid
@@ -113,7 +114,7 @@ def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_gri
         at = np.subtract(alone.origin, bounds.lo)
         placed[at[0]:at[0] + alone.volume.shape[0], at[1]:at[1] + alone.volume.shape[1],
                at[2]:at[2] + alone.volume.shape[2]] = alone.volume
-        assert np.array_equal(store.read_frame(tmp_path / "s.zarr", i), placed), f"frame {i}"
+        assert np.array_equal(read_store(tmp_path / "s.zarr").read_frame(i), placed), f"frame {i}"
     assert rep.records[-1]["filled"] < rep.records[0]["filled"] / 2  # melting
     # OME-Zarr (NGFF 0.5) metadata a viewer reads: axes t, z, y, x and the origin as a translation
     import zarr
@@ -191,7 +192,8 @@ def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tm
     assert "loss %" in text and "wrote" in text and "2 made, 0 already complete" in text
     vol, placed, _ = io.read_scan(tmp_path / "f" / "w.0020.nrrd")
     origin = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
-    assert np.array_equal(vol, store.read_frame(out, 1)) and tuple(int(v) for v in origin) == store.origin(out)
+    assert np.array_equal(vol, read_store(out).read_frame(1))
+    assert tuple(int(v) for v in origin) == read_store(out).origin_xyz
     assert main(args) == 0 and "0 made, 2 already complete" in capsys.readouterr().out
     assert main(args[:-4] + ["-o", str(out), "--padding", "5"]) == 2
     assert "holds another sequence" in capsys.readouterr().err
