@@ -181,7 +181,7 @@ def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Pat
 def _movie(sequence: Path, out: Path) -> Path:
     """The sequence as a small looping GIF, seen from the side (where a walk reads best), off-screen."""
     from volanim_core.parallel import default_workers
-    from volanim_core.render.camera import place_camera
+    from volanim_core.render.framing import place_camera
     from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings
 

@@ -50,7 +50,7 @@ def _render(args):
     import numpy as np
 
     from volanim_core import io
-    from volanim_core.render.camera import place_camera
+    from volanim_core.render.framing import place_camera
     from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings, transfer_of
 

@@ -12,17 +12,11 @@ left, a little above.
 
 from __future__ import annotations
 
-from dataclasses import replace
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from volanim_core.camera import Camera
 
-if TYPE_CHECKING:
-    from .movie import RenderInputs
-
-__all__ = ["VIEWS", "Camera", "follow_cameras", "named_view", "natural_axes", "place_camera", "union_box"]
+__all__ = ["VIEWS", "Camera", "follow_cameras", "named_view", "natural_axes", "union_box"]
 
 VIEWS = ("front", "side", "top", "three-quarter", "back")
 _DIRECTIONS = {  # from the focal point to the camera, and the picture's up
@@ -131,23 +125,3 @@ def union_box(boxes, lo, hi) -> tuple[tuple, tuple]:
         return tuple(lo), tuple(hi)
     return (tuple(int(v) for v in np.min([b[0] for b in known], 0)),
             tuple(int(v) for v in np.max([b[1] for b in known], 0)))
-
-
-def place_camera(inputs: RenderInputs, view: str = "three-quarter", camera: Camera | str | None = None,
-                 aspect: float = 4 / 3, axes=None) -> tuple[Camera, RenderInputs]:
-    """The camera a render uses and the inputs to draw (``volanim render`` and ``view``, the demo; the
-    studio's movie follows with its own view, :meth:`RenderInputs.follow`).
-
-    ``camera``: None (the named ``view`` framing every frame's body: the union of their boxes), a
-    :class:`Camera` in world units, or ``"follow"`` (each frame its own camera, :meth:`RenderInputs.follow`;
-    the one returned is the middle frame's, for ``--save-camera``).
-    """
-    if camera == "follow":
-        frames = inputs.follow(view, aspect, axes)
-        return frames[len(frames) // 2].camera, replace(inputs, frames=frames)
-    if isinstance(camera, Camera):
-        return camera, inputs
-    if camera is not None:
-        raise ValueError(f"camera: a Camera or 'follow', got {camera!r}")
-    lo, hi = inputs.world_box()
-    return named_view(view, lo, hi, aspect=aspect, axes=axes, faces=0.0), inputs
