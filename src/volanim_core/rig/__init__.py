@@ -6,5 +6,5 @@
     autorig.py ...... propose bones from the skeleton: curve_skeleton.py (the tree), tree_walks.py (its
                       paths and bends), templates.py (names)
     pose.py ......... forward kinematics: rotations about joints -> one 4x4 matrix per bone
-    tskel.py ........ the old pipeline's little tools on frames (connect2tskel, sorttskel, ...)
+    tskel_tools.py .. the old pipeline's little tools on frames (connect2tskel, sorttskel, ...)
 """
