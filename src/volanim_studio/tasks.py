@@ -151,8 +151,8 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, ker
     inputs = replace(open_inputs([cache]), spacing=tuple(float(s) for s in spacing))  # the studio's world
     if follow:
         inputs = replace(inputs, frames=inputs.follow("front", size[0] / size[1], base=camera))
-    palette = read_store(cache).palette
-    if transfer is not None and palette is not None:
+    palette = read_store(cache).palette if transfer is not None else None
+    if palette is not None:
         transfer = through_palette(transfer, palette)  # the frames hold indices: the function of their colours
     settings = RenderSettings(camera, style=style, preset=mode, vmax=inputs.vmax, size=tuple(size),
                               background=background, frame_numbers=frame_numbers, transfer=transfer,

@@ -76,5 +76,4 @@ def through_palette(tf: TransferFunction, palette: np.ndarray) -> TransferFuncti
     if not 1 <= len(palette) <= MAX_POINTS:
         raise ValueError(f"a palette of {len(palette)} colours cannot become a transfer function "
                          f"(1..{MAX_POINTS} points)")
-    grey = to_grey(palette.astype(np.uint8) if palette.dtype != np.uint8 else palette).astype(np.float64)
-    return TransferFunction(np.arange(len(palette), dtype=np.float64), tf(grey))
+    return TransferFunction(np.arange(len(palette), dtype=np.float64), tf(to_grey(palette).astype(np.float64)))

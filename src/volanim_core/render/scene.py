@@ -32,6 +32,7 @@ from volanim_core.render.volume_style import (
     apply_labels,
     apply_rgba,
     label_colours,
+    label_steps,
     rgba_points,
     volume_mapper,
     vtk_functions,
@@ -110,12 +111,7 @@ def transfer_of(settings: RenderSettings) -> TransferFunction:
         return settings.transfer
     if settings.preset not in LABEL_MODES:
         return preset_transfer(settings.preset, settings.vmax)
-    colours = colour_table(settings).astype(np.float64) / 255
-    values, rgba = [0.0, 0.5], [[0, 0, 0, 0], [0, 0, 0, 0]]
-    for k in range(1, len(colours)):  # label k is its colour over k +- 0.49, a quick blend between labels
-        values += [k - 0.49, k + 0.49]
-        rgba += [[*colours[k], 0.85]] * 2
-    return TransferFunction(values, rgba)
+    return label_steps(colour_table(settings)[1:].astype(np.float64) / 255)  # row 0: the background
 
 
 def crop(volume: np.ndarray, origin, pad: int = 1):

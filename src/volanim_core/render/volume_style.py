@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from volanim_core.render.bone_colours import SKIN, bone_colours, rgb
+from volanim_core.transfer_function import TransferFunction
 
 LABEL_MODES = ("bone", "mottled", "binary")
 
@@ -51,22 +52,24 @@ def label_colours(mode: str, n_bones: int) -> np.ndarray:
     return np.array([rgb(SKIN)])
 
 
-def apply_labels(volume_actor, colours: np.ndarray, opacity: float = 0.85) -> None:
-    """Label transfer functions: value v (1..N) -> colours[v - 1], 0 transparent, no blending.
+LABEL_STEP = 0.49  # label v is its colour over v +- 0.49: neighbouring labels never mix
+LABEL_OPACITY = 0.85
 
-    Set on VTK directly: steps at half-integers, so neighbouring labels never mix.
-    """
-    import vtk
 
-    ctf = vtk.vtkColorTransferFunction()
-    otf = vtk.vtkPiecewiseFunction()
-    otf.AddPoint(0.0, 0.0)
-    otf.AddPoint(0.5, 0.0)
-    for v, c in enumerate(colours, start=1):
-        ctf.AddRGBPoint(v - 0.49, *c)
-        ctf.AddRGBPoint(v + 0.49, *c)
-        otf.AddPoint(v - 0.49, opacity)
-        otf.AddPoint(v + 0.49, opacity)
+def label_steps(colours: np.ndarray, opacity: float = LABEL_OPACITY) -> TransferFunction:
+    """Labels as a transfer function: value v (1..N) -> ``colours[v - 1]`` (RGB 0..1) at ``opacity``, flat over
+    v +- 0.49; 0 transparent. The one rule the studio's label previews, ``render --save-tf`` and the studio's
+    transfer-function editor (its starting point in a label mode) share."""
+    values, rgba = [0.0, 0.5], [[0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0]]
+    for v, c in enumerate(np.asarray(colours, np.float64).reshape(-1, 3), start=1):
+        values += [v - LABEL_STEP, v + LABEL_STEP]
+        rgba += [[*c, opacity]] * 2
+    return TransferFunction(values, rgba)
+
+
+def apply_labels(volume_actor, colours: np.ndarray, opacity: float = LABEL_OPACITY) -> None:
+    """Label transfer functions (:func:`label_steps`) on a VTK volume, with no blending between voxels."""
+    ctf, otf = vtk_functions(label_steps(colours, opacity))
     prop = volume_actor.GetProperty()
     prop.SetColor(ctf)
     prop.SetScalarOpacity(otf)

@@ -19,12 +19,11 @@ import numpy as np
 from volanim_core import io
 from volanim_core.errors import FormatError
 from volanim_core.render.scene import preset_transfer
-from volanim_core.render.volume_style import label_colours
+from volanim_core.render.volume_style import label_colours, label_steps
 from volanim_core.transfer_function import TransferFunction
 
 from .undo import Command
 
-LABEL_STEP = 0.49  # a label k is its colour over k +- 0.49 (as the studio draws labels): neighbours never mix
 GAP = 1e-6  # the least distance between two points' values (the function's values are strictly ascending)
 
 
@@ -32,12 +31,7 @@ def starting_function(mode: str, vmax: float, n_bones: int) -> TransferFunction:
     """The look of reconstruction ``mode`` as an editable function: a step of colour per bone (bone),
     one skin step (binary), or the mode's ramp (sampled grey, hotspot heat, mottled over its labels)."""
     if mode in ("bone", "binary"):
-        colours = label_colours(mode, n_bones)
-        values, rgba = [0.0, 0.5], [[0, 0, 0, 0], [0, 0, 0, 0]]
-        for k, c in enumerate(colours, start=1):
-            values += [k - LABEL_STEP, k + LABEL_STEP]
-            rgba += [[*c, 0.85]] * 2
-        return TransferFunction(values, rgba)
+        return label_steps(label_colours(mode, n_bones))
     return preset_transfer("hotspot" if mode == "hotspot" else "sampled", vmax)
 
 

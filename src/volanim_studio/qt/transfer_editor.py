@@ -180,21 +180,25 @@ class TransferEditor(QDialog):
         layout.addLayout(buttons)
         self.doc.events.transfer.connect(self._on_changed)
         self.doc.events.preview.connect(self._on_preview)
-        self._on_preview()
 
     # ---------------------------------------------------------------- state
     def function(self):
         return self.doc.transfer.current(self.mode, self.top)
 
     def _on_preview(self, **_) -> None:
-        """The histogram (and the look a first edit starts from) of what is shown: the full preview, or the scan."""
+        """The histogram (and the look a first edit starts from) of what is shown: the full preview, or the
+        scan. Not while the editor is closed (it is counted again when shown), and not for a live preview
+        (a drag's half-resolution stand-in, many a second: the full one follows its release)."""
         p = self.doc.preview
-        if p is not None and not p.live:
-            volume, self.mode = p.reconstruction.volume, p.mode
-        else:
-            volume, self.mode = self.doc.volume, "sampled"
+        if not self.isVisible() or (p is not None and p.live):
+            return
+        volume, self.mode = (p.reconstruction.volume, p.mode) if p is not None else (self.doc.volume, "sampled")
         self.counts, self.top = histogram(volume)
         self._on_changed()
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        self._on_preview()
 
     def _on_changed(self, **_) -> None:
         tf = self.function()

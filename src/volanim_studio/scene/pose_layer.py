@@ -263,7 +263,8 @@ class PoseLayer:
             plotter.add_mesh(img.slice_orthogonal(), scalars="values", rgb=True, name="slices", render=False,
                              reset_camera=False)
         elif view.settings.slices and tf is not None:  # the function's colours, over its values' range
-            lo, hi = float(tf.values[0]), float(tf.values[-1]) if len(tf.values) > 1 else float(tf.values[0]) + 1
+            lo = float(tf.values[0])
+            hi = max(float(tf.values[-1]), lo + 1)  # one point: a range of 1 around it
             cmap = ListedColormap(np.clip(tf(np.linspace(lo, hi, 256))[:, :3], 0, 1))
             plotter.add_mesh(img.slice_orthogonal(), scalars="values", cmap=cmap, clim=(lo, hi), n_colors=256,
                              show_scalar_bar=False, name="slices", render=False, reset_camera=False)

@@ -85,6 +85,13 @@ def test_points_are_edited_with_the_mouse_each_one_undo_step_and_the_preview_fol
     qtbot.keyClick(w, Qt.Key_Z, Qt.ControlModifier)
     assert np.allclose(w.doc.pose.angles_of(w.doc.bones.index("L_UPPERARM")), 0)  # the history is one
 
+    counted = editor.counts  # closed, the editor counts nothing: a preview event costs it no pass over a volume
+    editor.hide()
+    w.doc.events.preview.emit()
+    assert editor.counts is counted
+    editor.show()
+    assert editor.counts is not counted and np.array_equal(editor.counts, want)
+
     w.doc.transfer.set(tf, "again")
     n = len(tf.values)
     qtbot.mouseClick(canvas, Qt.RightButton, pos=pixel(canvas, tf.values[i], tf.rgba[i, 3]))
