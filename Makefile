@@ -97,6 +97,7 @@ coverage: install-test system-deps
 
 lint: install-test
 	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/lint-imports --no-cache
 
 bench: install-test system-deps
 	$(PY) benchmarks/bench_skeleton.py

@@ -33,8 +33,8 @@ from volanim_core.progress import Reporter
 from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import OWNER, Reconstruction, reconstruct
-from volanim_core.rig.attach import segment_distances
 from volanim_core.rig.connectivity import Connectivity, Tskel
+from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.pose import apply_matrices, apply_rows
 from volanim_core.rig.skinning import blended_with, links, transform_table
 from volanim_core.rig.tskel_tools import identity_tskel

@@ -31,7 +31,7 @@ import numpy as np
 from scipy import ndimage
 
 from volanim_core.reconstruct.shape import OPENING, PIECES
-from volanim_core.rig.attach import segment_distances
+from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.skinning import segment_distance
 
 REACH_PERCENTILE, REACH_SCALE, REACH_MARGIN = 75, 1.3, 1.0

@@ -159,7 +159,7 @@ def _nearest(points: np.ndarray, named: dict[str, np.ndarray]) -> tuple[list[str
 
 def _nearest_segment(points: np.ndarray, segments: dict) -> tuple[list[str], np.ndarray]:
     """Each point's nearest bone segment (ties: the first named), as the nearest-bone connect finds it."""
-    from volanim_core.rig.attach import segment_distances
+    from volanim_core.rig.nearest import segment_distances
 
     names = list(segments)
     segs = np.array([[np.asarray(p, float) for p in segments[n]] for n in names])

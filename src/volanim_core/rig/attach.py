@@ -38,37 +38,15 @@ import numpy as np
 from volanim_core.progress import Reporter
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.connectivity import Connectivity
+from volanim_core.rig.islands import one_piece_each
+from volanim_core.rig.limb_tubes import carry_up
+from volanim_core.rig.nearest import attach_nearest_bone, segment_distances
+from volanim_core.rig.pieces import attach_by_piece
 from volanim_core.rig.pose import root_bones
 from volanim_core.skeleton.points import Skeleton
 
 UNATTACHED = -1
 PART = 131072  # points attached between two progress reports (nearest, path): a few tenths of a second
-
-
-def segment_positions(points: np.ndarray, segments: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(N, B)`` position of points ``(N, 3)`` along segments ``(B, 2, 3)`` (0 at the first end, 1 at the
-    second; not clipped) and their distance to each segment."""
-    p = np.asarray(points, np.float64)[:, None, :]
-    a, b = segments[None, :, 0, :], segments[None, :, 1, :]
-    ab = b - a
-    t = ((p - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-12)
-    return t, np.linalg.norm(p - (a + np.clip(t, 0.0, 1.0)[..., None] * ab), axis=-1)
-
-
-def segment_distances(points: np.ndarray, segments: np.ndarray) -> np.ndarray:
-    """``(N, B)`` distances from points ``(N, 3)`` to segments ``(B, 2, 3)``."""
-    return segment_positions(points, segments)[1]
-
-
-def attach_nearest_bone(points: np.ndarray, bones: BoneSkeleton) -> np.ndarray:
-    """Index of the nearest bone segment for each point (ties: first in root order)."""
-    if not len(bones):
-        raise ValueError("the bone skeleton has no bones to attach to")
-    out = np.empty(len(points), np.int32)
-    segs = bones.segments()
-    for s in range(0, len(points), 65536):  # bounded memory: (chunk, B) at a time
-        out[s : s + 65536] = segment_distances(points[s : s + 65536], segs).argmin(1)
-    return out
 
 
 def connect_nearest(skeleton: Skeleton, bones: BoneSkeleton) -> Connectivity:
@@ -200,18 +178,12 @@ def auto_connect(points: np.ndarray, bones: BoneSkeleton, mask: np.ndarray, *, m
     elif method == "geodesic":
         found = _geodesic_method(sub, bones, mask)
     elif method == "pieces":
-        from volanim_core.rig.pieces import attach_by_piece
-
         found = attach_by_piece(sub, bones, mask)
         if radii is not None and len(radii) == n:
-            from volanim_core.rig.islands import one_piece_each
-
             found = one_piece_each(sub, radii[todo], found)
     elif method == "fitted":
         if radii is None or len(radii) != n:
             raise ValueError("the 'fitted' method needs every point's radius (its distance transform)")
-        from volanim_core.rig.limb_tubes import carry_up  # (it measures with this module's projections)
-
         found = carry_up(points, radii, bones, attach_nearest_bone(points, bones))[todo]
     else:
         raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")

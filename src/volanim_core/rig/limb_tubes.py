@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.rig.attach import segment_positions
 from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.nearest import segment_positions
 
 #: voxels a ball may reach past its bone's tube and still be carried by it (the tube is a straight fit)
 TOLERANCE = 2.0

@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from volanim_core.rig.attach import attach_nearest_bone, segment_distances
 from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.nearest import attach_nearest_bone, segment_distances
 
 STEP = 0.5  # voxels between a segment's samples
 CHUNK = 65536  # points measured against the bones at a time: (chunk, bones, 3) of memory, not (points, ...)

@@ -44,14 +44,14 @@ limb lies against the torso and the segment distances change fastest.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from volanim_core.memo import Recent, content_key
+from volanim_core.rig.skin import INFLUENCES, Skin
 from volanim_core.rig.thin_spheres import SPECK, with_thin_spheres
 
-INFLUENCES = 4  # bones per point at most: its own and three neighbours' (a fork's bone near two children)
 LINK = np.sqrt(3.0)  # points this close (26-neighbours) are always linked, whatever their radii
 KNN = 12  # neighbours examined per point for links (a medial curve or surface is dense: these are within ~2 voxels)
 DEFAULT_BLEND = 1.0
@@ -123,40 +123,6 @@ class Joints:
 
 
 RIGID = Joints()
-
-
-@dataclass(frozen=True)
-class Skin:
-    """Blend weights of the points that have any: ``index`` (K,) point indices, ``influence`` (K, J)
-    bone indices (the point's own bone first, -1 padding) and ``weight`` (K, J), each row summing to 1.
-
-    ``sheet``: the blended points on a medial sheet, whose radii follow its stretch (:func:`posed_radii`);
-    ``pairs`` (L, 2): their links (point indices), ``rest`` (L,): the links' rest lengths."""
-
-    index: np.ndarray
-    influence: np.ndarray
-    weight: np.ndarray
-    sheet: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
-    rest: np.ndarray = field(default_factory=lambda: np.zeros(0))
-
-    def __len__(self) -> int:
-        return len(self.index)
-
-    def take(self, order: np.ndarray, n: int) -> Skin:
-        """The skin of ``points[order]`` (a permutation or subset of ``n`` points)."""
-        order = np.asarray(order)
-        row = np.full(n, -1, np.int64)
-        row[self.index] = np.arange(len(self.index))
-        picked = row[order]
-        keep = np.flatnonzero(picked >= 0)
-        at = np.full(n, -1, np.int64)  # each old point's place in the new order
-        at[order] = np.arange(len(order))
-        sheet = at[self.sheet]
-        pairs = at[self.pairs]
-        both = (pairs >= 0).all(axis=1)
-        return Skin(keep.astype(np.int64), self.influence[picked[keep]], self.weight[picked[keep]],
-                    np.sort(sheet[sheet >= 0]), pairs[both], self.rest[both])
 
 
 def skin_weights(points, dt, bone, bones, joints: Joints, spacing: float = 1.0) -> Skin:

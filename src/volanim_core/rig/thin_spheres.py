@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from volanim_core.rig.skin import INFLUENCES, Skin
+
 SPECK = 2.0  # spheres thinner than this are one voxel: the surface's noise
 NEAREST = 16  # centres examined per point for the sphere that holds it best (with the deepest by power)
 
@@ -132,8 +134,6 @@ def _copied(skin, take, host, bone):
     is among the host's bones, or in the last place with weight 0. A host with no row (rigid on its bone)
     makes a point of its own bone rigid too; a speck whose host is rigid on another bone keeps its own
     bone (what a rigid frame does with it)."""
-    from volanim_core.rig.skinning import INFLUENCES, Skin
-
     n = len(bone)
     row = np.full(n, -1, np.int64)
     row[skin.index] = np.arange(len(skin))
