@@ -1,8 +1,22 @@
 """The ``volanim`` command line: one subcommand per tool of the old pipeline.
 
-Each subcommand lives in a small module with a ``register(subparsers)``
-function; ``main`` turns library errors into one-line messages (exit 2) and a
-cancel (Ctrl+C) into exit 130, never a traceback.
+Each subcommand lives in the module of the core package it runs, with a
+``register(subparsers)`` function; ``main`` turns library errors into one-line
+messages (exit 2) and a cancel (Ctrl+C) into exit 130, never a traceback.
+
+    volume_commands.py ....... info, convert, threshold, fill, crop, ... (volume.py, io)
+    skeleton_commands.py ..... skeletonize, isosurface (skeleton/)
+    combine_commands.py ...... peek, onevolume, addskel (volumes with skeletons)
+    rig_commands.py .......... autorig, connect, pose, straighten, the .tskel tools, mirror (rig/)
+    motion_commands.py ....... keys, bvh2trans, trans2bvh, trans2positions, positions2trans, trans2tskel (motion/)
+    reconstruct_commands.py .. bounds, reconstruct, compare, report, scan (reconstruct/)
+    sequence_commands.py ..... crumble, sequence (sequence/)
+    render_commands.py ....... render (render/)
+    colour_commands.py ....... the palette tools (colour/)
+    slicer_commands.py ....... markups, transforms, displacement (3D Slicer's files)
+    view_command.py .......... view (a quick look)
+    demo_command.py .......... warmup, demo
+    _common.py ............... the options and argument types the commands share
 """
 
 from __future__ import annotations
@@ -16,7 +30,6 @@ from pathlib import Path
 from volanim_core.errors import Cancelled, FormatError
 
 from . import (
-    check_commands,
     colour_commands,
     combine_commands,
     demo_command,
@@ -52,9 +65,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     parser.add_argument("--version", action="version", version=f"volanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (volume_commands, skeleton_commands, combine_commands, rig_commands, reconstruct_commands,
-                   check_commands, motion_commands, sequence_commands, render_commands, colour_commands,
-                   slicer_commands, view_command, demo_command):
+    # the pipeline's order: a volume, its skeleton, the rig, its motion, the reconstruction and its checks,
+    # sequences and movies (each command's example runs on the files the ones before it wrote)
+    for module in (volume_commands, skeleton_commands, combine_commands, rig_commands, motion_commands,
+                   reconstruct_commands, sequence_commands, render_commands, colour_commands, slicer_commands,
+                   view_command, demo_command):
         module.register(sub)
     return parser
 

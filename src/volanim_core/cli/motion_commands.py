@@ -1,5 +1,6 @@
-"""Motion subcommands: bvh2trans (motion capture -> one .trans per frame), trans2tskel, trans2bvh (back to an
-animation package)."""
+"""Motion subcommands: keys (keyframes -> one .trans per frame, the studio's timeline), bvh2trans (motion
+capture -> one .trans per frame), trans2tskel, trans2bvh (back to an animation package), trans2positions and
+positions2trans (joint positions per frame, as a CSV)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,28 @@ from volanim_core.motion.retarget import Retarget, check_mapping_file, format_ma
 from volanim_core.progress import TextProgress
 from volanim_core.rig.tskel_tools import connect_to_tskel
 
-from ._common import add_command, positive_float
+from ._common import (
+    add_command,
+    positive_float,
+    positive_int,
+)
+
+
+def _keys(args):
+    from volanim_core.motion.frame_files import write_frames
+    from volanim_core.motion.keyframes import keys
+    from volanim_core.motion.keys_files import read_keys
+
+    bones = read_bones(args.bones).on_cubes()
+    k = read_keys(args.keys, bones)
+    key_fps = k.fps or 24.0
+    ease = args.ease if args.ease is not None else bool(k.ease)
+    mats = keys(k.keys, bones, length=args.length, fps=args.fps, key_fps=key_fps, key_length=k.length, ease=ease)
+    conn = read_connect(args.connect) if args.connect else None
+    write_frames(args.output, args.name or Path(args.keys).stem, bones, mats, range(len(mats)), connect=conn,
+                 progress=TextProgress(f"writing {len(mats)} frames"))
+    print(f"{len(k.keys)} keys -> {len(mats)} frames at {args.fps or key_fps:g} fps"
+          f"{' (eased)' if ease else ''} -> {args.output}")
 
 
 def parse_frames(text: str) -> slice:
@@ -186,6 +208,20 @@ def _bones_and_frames_args(p) -> None:
 
 
 def register(sub) -> None:
+    p = add_command(sub, "keys", "Keyframes (a .keys file) -> one .trans per frame, slerped (the studio's timeline).",
+                    ("volanim keys mannequin.keys --bones mannequin.bones -o wave/",
+                     "volanim keys mannequin.keys --bones mannequin.bones --fps 12 --no-ease -o wave12/  # 13 frames"),
+                    _keys)
+    p.add_argument("keys", help="FRAME BONE RX RY RZ [TX TY TZ] per line (docs/formats.md, 'Keys')")
+    p.add_argument("--bones", required=True)
+    p.add_argument("--length", type=positive_int, help="frames to write (default: the file's, else to the last key)")
+    p.add_argument("--fps", type=positive_float, help="frames per second to write (default: the file's, else 24)")
+    p.add_argument("--ease", action="store_true", default=None, help="slow in and out at each key")
+    p.add_argument("--no-ease", dest="ease", action="store_false", help="constant speed (over the file's 'ease on')")
+    p.add_argument("--connect", help="also write each frame's .tskel for this .connect")
+    p.add_argument("--name", help="file name stem (default: the keys file's)")
+    p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
+
     p = add_command(sub, "bvh2trans", "Motion capture onto the bone skeleton: one .trans (and .tskel) per frame.",
                     "volanim bvh2trans walk.bvh --bones mannequin.bones --frames 0:200:10 -o walk/", _bvh2trans)
     p.add_argument("clip", help="a .bvh motion-capture clip")

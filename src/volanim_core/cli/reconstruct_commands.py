@@ -1,31 +1,25 @@
-"""Posing and reconstruction subcommands: connect, pose, connect2tskel,
-connect2identitytskel, sorttskel, bounds, reconstruct, compare."""
+"""Reconstruction and its checks: bounds, reconstruct, compare, report, scan.
+
+``report`` and ``scan`` are the studio's verdicts for scripts (``volanim_core.report``, ``.scan``): they exit
+0 when healthy, 1 when broken, 2 on bad input."""
 
 from __future__ import annotations
 
-import argparse
+import json
 
 import numpy as np
 
 from volanim_core.io import (
     read_bones,
     read_connect,
-    read_skeleton,
     read_trans,
     read_tskel,
-    skeleton_at,
-    write_connect,
     write_output,
-    write_trans,
-    write_tskel,
 )
 from volanim_core.progress import TextProgress
 from volanim_core.reconstruct.engine import MODES, grid_bounds, reconstruct
-from volanim_core.rig.attach import METHODS
-from volanim_core.rig.connectivity import Trans
-from volanim_core.rig.pose import pose_matrices, root_bones
-from volanim_core.rig.skinning import transform_table
-from volanim_core.rig.tskel_tools import check_root_order, connect_to_tskel, identity_tskel, sort_tskel
+from volanim_core.rig.pose import root_bones
+from volanim_core.rig.tskel_tools import check_root_order, identity_tskel
 
 from ._common import (
     add_command,
@@ -33,84 +27,10 @@ from ._common import (
     add_joints,
     ascii_int,
     bounds_arg,
-    finite_float,
     joints_of,
     load_source,
-    parse_range,
+    positive_int,
 )
-
-
-def _connect(args):
-    from volanim_core.rig.attach import connect
-
-    skel = skeleton_at(read_skeleton(args.mskel), args.thinness, args.mskel)
-    mask = None
-    if args.volume:
-        from .skeleton_commands import mask_like_skeleton
-
-        mask = mask_like_skeleton(args, skel)
-    conn, report = connect(skel, read_bones(args.bones).on_grid(skel.geometry), method=args.method, mask=mask,
-                           progress=TextProgress(f"attaching {len(skel)} points"))
-    write_connect(args.output, conn, thinness=args.thinness)
-    counts = np.bincount(conn.bone, minlength=len(conn.bones))
-    print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")
-
-
-def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
-    """``BONE=RX,RY,RZ`` (degrees)."""
-    name, sep, angles = text.partition("=")
-    try:
-        values = tuple(finite_float(v) for v in angles.split(","))
-    except argparse.ArgumentTypeError:
-        values = ()
-    if not sep or len(values) != 3:
-        raise argparse.ArgumentTypeError(f"expected BONE=RX,RY,RZ in degrees, got {text!r}")
-    return name, values
-
-
-def _pose(args):
-    bones = read_bones(args.bones).on_cubes()
-    rotations = {}
-    for name, angles in args.rotate or []:
-        try:
-            bones.index(name)
-        except KeyError:
-            raise ValueError(f"{args.bones}: no bone named {name!r}; bones are "
-                             + ", ".join(b.label for b in bones.bones)) from None
-        rotations[name] = angles
-    trans = Trans(root_bones(bones), pose_matrices(bones, rotations), bones.geometry)
-    write_trans(args.output, trans)
-    print(f"posed {len(rotations)} of {len(bones)} bones (children follow) -> {args.output}")
-
-
-def _straighten(args):
-    from volanim_core.rig.straighten import straighten
-
-    bones = read_bones(args.bones).on_cubes()
-    first, last = args.chain if args.chain else (None, None)
-    matrices, axis, ids = straighten(bones, first, last)
-    write_trans(args.output, Trans(root_bones(bones), matrices, bones.geometry))
-    ends = bones.bones[ids[0]], bones.bones[ids[-1]]
-    print(f"straightened {len(ids)} bones ({ends[0].label} .. {ends[1].label}) along "
-          f"({', '.join(f'{v:.3f}' for v in axis)}) from joint {ends[0].proximal} -> {args.output}")
-
-
-def _connect2tskel(args):
-    t = connect_to_tskel(joints_of(args, read_connect(args.connect)), read_trans(args.trans))
-    transform_table(t)  # a frame smooth joints cannot blend (a sheared bone) is refused now, not at reconstruct
-    write_tskel(args.output, t)
-    print(f"{len(t)} points, {len(t.bones)} bones, {t.joints.text()} joints -> {args.output}")
-
-
-def _connect2identity(args):
-    t = identity_tskel(read_connect(args.connect))
-    write_tskel(args.output, t)
-    print(f"{len(t)} points, {len(t.bones)} bones, identity matrices -> {args.output}")
-
-
-def _sorttskel(args):
-    write_tskel(args.output, sort_tskel(read_tskel(args.tskel)))
-    print(f"sorted -> {args.output}")
 
 
 def _bounds(args):
@@ -210,66 +130,49 @@ def _offset(geometry, base, name) -> tuple[int, int, int]:
     return tuple(int(v) for v in np.rint(m[3, :3]))
 
 
+def _report(args):
+    from volanim_core.reconstruct.checks import report, report_json
+
+    conn = joints_of(args, read_connect(args.connect))
+    source, geometry = load_source(args, conn, colour="luminance") if args.source else (None, None)
+    rep = report(conn, read_trans(args.trans), bones=read_bones(args.bones) if args.bones else None,
+                 source=source, source_geometry=geometry)
+    if args.json:
+        print(json.dumps(report_json(rep), indent=1))
+    else:
+        print(rep.verdict)
+        for line in rep.lines():
+            print(f"  {line}")
+        for j in rep.joints:
+            print(f"  near {j.name}: {j.lost} cracks, opening {j.gap:.1f} voxels")
+    return 0 if rep.healthy else 1
+
+
+def _scan(args):
+    from volanim_core.motion.frame_files import frame_number
+    from volanim_core.reconstruct.checks import scan, scan_json
+    from volanim_core.reconstruct.scan import scan_summary
+
+    conn = joints_of(args, read_connect(args.connect))
+    frames = [read_trans(p) for p in args.frames]
+    numbers = [frame_number(p) for p in args.frames]
+    if None in numbers or len(set(numbers)) < len(numbers):
+        numbers = list(range(len(args.frames)))  # names without (distinct) numbers: their order on the line
+    verdicts = scan(conn, frames, bones=read_bones(args.bones) if args.bones else None, numbers=numbers,
+                    progress=None if args.json else TextProgress(f"scanning {len(frames)} frames"))
+    bad = [v for v in verdicts if v.broken]
+    if args.json:
+        print(json.dumps(scan_json(verdicts), indent=1))
+    else:
+        print(f"{scan_summary(verdicts)}; worst first")
+        for v in verdicts[:args.top]:
+            print(f"  frame {v.frame}: {v.pieces} piece(s) ({v.rest_pieces} at rest), {v.detached} voxels "
+                  f"detached, {v.stump} stump points, {v.cracks} cracks"
+                  + (f" near {v.worst_joint}" if v.worst_joint else "") + (": BROKEN" if v.broken else ""))
+    return 1 if bad else 0
+
+
 def register(sub) -> None:
-    p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
-                    ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
-                     "volanim connect mannequin.mskel mannequin.bones --method path --volume mannequin.VOL "
-                     "-o mannequin.path.connect",
-                     "volanim connect mannequin.mskel mannequin.bones --thinness 0.5 --method fitted "
-                     "-o mannequin.fitted.connect"),
-                    _connect)
-    p.add_argument("mskel", metavar="SKELETON", help="the skeleton: .mskel, or a .skel (one resolution)")
-    p.add_argument("bones")
-    p.add_argument("--thinness", type=finite_float, help="only points with thinness >= this")
-    p.add_argument("--method", choices=METHODS, default="nearest",
-                   help="nearest segment (default); path: the nearest bone reachable by a straight path inside "
-                        "the object; path-or-nearest: path, else nearest; geodesic: along the skeleton inside "
-                        "the object (these three need --volume); fitted: nearest, then flesh a limb's own tube "
-                        "cannot hold (the armpit, the groin) to the bone above")
-    p.add_argument("--volume", help="the scan the skeleton was made from (segmented like skeletonize)")
-    add_dims(p)
-    p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
-                   help="object = LO <= v <= HI (default: every non-zero voxel)")
-    p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background first")
-    p.add_argument("-o", "--output", required=True)
-
-    p = add_command(sub, "pose", "Write a .trans frame: rotate bones about their proximal joints (FK).",
-                    "volanim pose mannequin.bones --rotate L_UPPERARM=0,-45,0 -o arm.trans", _pose)
-    p.add_argument("bones", help=".bones file")
-    p.add_argument("--rotate", action="append", type=parse_rotation, metavar="BONE=RX,RY,RZ",
-                   help="Euler angles in degrees about x, y, z (repeatable)")
-    p.add_argument("-o", "--output", required=True)
-
-    p = add_command(sub, "straighten", "Write a .trans frame that lays a chain of bones straight along its principal "
-                    "axis, each bone keeping its length, the first joint in place (the thesis's colon uncoiled, "
-                    "section 5.3).",
-                    ("volanim straighten curved-tube.bones -o straight.trans",
-                     "volanim straighten mannequin.bones --chain L_UPPERARM L_HAND -o arm-straight.trans"), _straighten)
-    p.add_argument("bones", help=".bones file")
-    p.add_argument("--chain", nargs=2, metavar=("FIRST", "LAST"),
-                   help="the chain's first and last bones, each the child of the one before (default: the whole "
-                        "skeleton, when it is one chain)")
-    p.add_argument("-o", "--output", required=True)
-
-    p = add_command(sub, "connect2tskel", "A .connect plus one .trans frame -> .tskel (root orders must match).",
-                    ("volanim connect2tskel mannequin.0.50.connect arm.trans -o arm.tskel",
-                     "volanim connect2tskel mannequin.0.50.connect arm.trans --joints smooth -o arm-smooth.tskel"),
-                    _connect2tskel)
-    p.add_argument("connect")
-    p.add_argument("trans")
-    add_joints(p, "the .connect's (rigid when it records none)")
-    p.add_argument("-o", "--output", required=True)
-
-    p = add_command(sub, "connect2identitytskel", "The identity (rest) .tskel of a .connect.",
-                    "volanim connect2identitytskel mannequin.0.50.connect -o rest.tskel", _connect2identity)
-    p.add_argument("connect")
-    p.add_argument("-o", "--output", required=True)
-
-    p = add_command(sub, "sorttskel", "Sort each bone's points by decreasing DT.",
-                    "volanim sorttskel arm.tskel -o arm.sorted.tskel", _sorttskel)
-    p.add_argument("tskel")
-    p.add_argument("-o", "--output", required=True)
-
     p = add_command(sub, "bounds", "Inclusive bounds of the posed spheres of one or more frames (tskelbounds).",
                     "volanim bounds arm.tskel rest.tskel --padding 2", _bounds)
     p.add_argument("tskel", nargs="+")
@@ -307,3 +210,26 @@ def register(sub) -> None:
     p.add_argument("--bones", help="the .bones of --pose (default: the sample's): blobs named by joint and bone")
     p.add_argument("--tissue", action="store_true", help="also compare values (a sampled reconstruction)")
     p.add_argument("--json", action="store_true", help="the figures as JSON")
+
+    p = add_command(sub, "report", "The breakage report of one frame; exit 0 healthy, 1 broken, 2 bad input.",
+                    ("volanim report mannequin.0.50.connect arm.trans",
+                     "volanim report mannequin.0.50.connect arm.trans --bones mannequin.bones --json",
+                     "volanim report mannequin.0.50.connect arm.trans --joints smooth   # the same frame, blended"),
+                    _report)
+    p.add_argument("connect")
+    p.add_argument("trans")
+    p.add_argument("--bones", help="name the joints as this .bones file does (default: after their bones)")
+    p.add_argument("--source", help="the scan: also how much of its object the rest pose re-grows")
+    add_dims(p)
+    p.add_argument("--json", action="store_true", help="the report as JSON on stdout")
+    add_joints(p, "the .connect's (rigid when it records none)")
+
+    p = add_command(sub, "scan", "Scan frames for breakage, worst first; exit 0 none broken, 1 any broken.",
+                    ("volanim scan mannequin.0.50.connect wave/*.trans --top 5",
+                     "volanim scan mannequin.0.50.connect wave/*.trans --joints smooth"), _scan)
+    p.add_argument("connect")
+    p.add_argument("frames", nargs="+", help=".trans files")
+    p.add_argument("--bones", help="name the joints as this .bones file does")
+    p.add_argument("--top", type=positive_int, default=10, help="frames to list (default 10)")
+    p.add_argument("--json", action="store_true", help="every frame's verdict as JSON, worst first")
+    add_joints(p, "the .connect's (rigid when it records none)")

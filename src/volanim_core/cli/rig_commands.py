@@ -1,19 +1,41 @@
-"""Auto-rig from the command line: ``volanim autorig`` (``volanim_core.autorig``).
-
-    .mskel --autorig--> .bones (named by a template, or chains by position)
-           --connect (pieces: each piece of the scan, or of the skeleton's own balls, to its bones)--> .connect
-"""
+"""The rig's subcommands: autorig, connect, pose, straighten, connect2tskel, connect2identitytskel,
+sorttskel, mirror -- proposing bones, attaching points to them, and posing them one frame at a time."""
 
 from __future__ import annotations
 
+import argparse
 import time
 
 import numpy as np
 
-from volanim_core.io import read_skeleton, skeleton_at, write_bones, write_connect
+from volanim_core.io import (
+    read_bones,
+    read_connect,
+    read_skeleton,
+    read_trans,
+    read_tskel,
+    skeleton_at,
+    write_bones,
+    write_connect,
+    write_trans,
+    write_tskel,
+)
 from volanim_core.progress import TextProgress
+from volanim_core.rig.attach import METHODS
+from volanim_core.rig.connectivity import Trans
+from volanim_core.rig.pose import pose_matrices, root_bones
+from volanim_core.rig.skinning import transform_table
+from volanim_core.rig.tskel_tools import connect_to_tskel, identity_tskel, sort_tskel
 
-from ._common import add_command, add_dims, finite_float, parse_range, positive_int
+from ._common import (
+    add_command,
+    add_dims,
+    add_joints,
+    finite_float,
+    joints_of,
+    parse_range,
+    positive_int,
+)
 
 
 def _autorig(args):
@@ -46,8 +68,89 @@ def _mask(args, skel):
     return balls(skel)
 
 
+def _connect(args):
+    from volanim_core.rig.attach import connect
+
+    skel = skeleton_at(read_skeleton(args.mskel), args.thinness, args.mskel)
+    mask = None
+    if args.volume:
+        from .skeleton_commands import mask_like_skeleton
+
+        mask = mask_like_skeleton(args, skel)
+    conn, report = connect(skel, read_bones(args.bones).on_grid(skel.geometry), method=args.method, mask=mask,
+                           progress=TextProgress(f"attaching {len(skel)} points"))
+    write_connect(args.output, conn, thinness=args.thinness)
+    counts = np.bincount(conn.bone, minlength=len(conn.bones))
+    print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")
+
+
+def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
+    """``BONE=RX,RY,RZ`` (degrees)."""
+    name, sep, angles = text.partition("=")
+    try:
+        values = tuple(finite_float(v) for v in angles.split(","))
+    except argparse.ArgumentTypeError:
+        values = ()
+    if not sep or len(values) != 3:
+        raise argparse.ArgumentTypeError(f"expected BONE=RX,RY,RZ in degrees, got {text!r}")
+    return name, values
+
+
+def _pose(args):
+    bones = read_bones(args.bones).on_cubes()
+    rotations = {}
+    for name, angles in args.rotate or []:
+        try:
+            bones.index(name)
+        except KeyError:
+            raise ValueError(f"{args.bones}: no bone named {name!r}; bones are "
+                             + ", ".join(b.label for b in bones.bones)) from None
+        rotations[name] = angles
+    trans = Trans(root_bones(bones), pose_matrices(bones, rotations), bones.geometry)
+    write_trans(args.output, trans)
+    print(f"posed {len(rotations)} of {len(bones)} bones (children follow) -> {args.output}")
+
+
+def _straighten(args):
+    from volanim_core.rig.straighten import straighten
+
+    bones = read_bones(args.bones).on_cubes()
+    first, last = args.chain if args.chain else (None, None)
+    matrices, axis, ids = straighten(bones, first, last)
+    write_trans(args.output, Trans(root_bones(bones), matrices, bones.geometry))
+    ends = bones.bones[ids[0]], bones.bones[ids[-1]]
+    print(f"straightened {len(ids)} bones ({ends[0].label} .. {ends[1].label}) along "
+          f"({', '.join(f'{v:.3f}' for v in axis)}) from joint {ends[0].proximal} -> {args.output}")
+
+
+def _connect2tskel(args):
+    t = connect_to_tskel(joints_of(args, read_connect(args.connect)), read_trans(args.trans))
+    transform_table(t)  # a frame smooth joints cannot blend (a sheared bone) is refused now, not at reconstruct
+    write_tskel(args.output, t)
+    print(f"{len(t)} points, {len(t.bones)} bones, {t.joints.text()} joints -> {args.output}")
+
+
+def _connect2identity(args):
+    t = identity_tskel(read_connect(args.connect))
+    write_tskel(args.output, t)
+    print(f"{len(t)} points, {len(t.bones)} bones, identity matrices -> {args.output}")
+
+
+def _sorttskel(args):
+    write_tskel(args.output, sort_tskel(read_tskel(args.tskel)))
+    print(f"sorted -> {args.output}")
+
+
+def _mirror(args):
+    from volanim_core.rig.symmetry import mirror
+
+    conn = read_connect(args.connect)
+    out, rep = mirror(conn, read_bones(args.bones), side=args.side, only=args.bone, plane=args.plane)
+    write_connect(args.output, out, thinness=conn.thinness_threshold)
+    print(f"{rep} -> {args.output}")
+
+
 def register(sub) -> None:
-    from volanim_core.rig.attach import METHODS
     from volanim_core.rig.autorig import TEMPLATES
 
     p = add_command(sub, "autorig", "Propose a bone skeleton from the volume's own skeleton -> .bones (and .connect).",
@@ -71,3 +174,72 @@ def register(sub) -> None:
     add_dims(p)
     p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]", help="segment the scan as skeletonize did")
     p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background, as skeletonize did")
+
+    p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
+                    ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
+                     "volanim connect mannequin.mskel mannequin.bones --method path --volume mannequin.VOL "
+                     "-o mannequin.path.connect",
+                     "volanim connect mannequin.mskel mannequin.bones --thinness 0.5 --method fitted "
+                     "-o mannequin.fitted.connect"),
+                    _connect)
+    p.add_argument("mskel", metavar="SKELETON", help="the skeleton: .mskel, or a .skel (one resolution)")
+    p.add_argument("bones")
+    p.add_argument("--thinness", type=finite_float, help="only points with thinness >= this")
+    p.add_argument("--method", choices=METHODS, default="nearest",
+                   help="nearest segment (default); path: the nearest bone reachable by a straight path inside "
+                        "the object; path-or-nearest: path, else nearest; geodesic: along the skeleton inside "
+                        "the object (these three need --volume); fitted: nearest, then flesh a limb's own tube "
+                        "cannot hold (the armpit, the groin) to the bone above")
+    p.add_argument("--volume", help="the scan the skeleton was made from (segmented like skeletonize)")
+    add_dims(p)
+    p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
+                   help="object = LO <= v <= HI (default: every non-zero voxel)")
+    p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background first")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "pose", "Write a .trans frame: rotate bones about their proximal joints (FK).",
+                    "volanim pose mannequin.bones --rotate L_UPPERARM=0,-45,0 -o arm.trans", _pose)
+    p.add_argument("bones", help=".bones file")
+    p.add_argument("--rotate", action="append", type=parse_rotation, metavar="BONE=RX,RY,RZ",
+                   help="Euler angles in degrees about x, y, z (repeatable)")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "straighten", "Write a .trans frame that lays a chain of bones straight along its principal "
+                    "axis, each bone keeping its length, the first joint in place (the thesis's colon uncoiled, "
+                    "section 5.3).",
+                    ("volanim straighten curved-tube.bones -o straight.trans",
+                     "volanim straighten mannequin.bones --chain L_UPPERARM L_HAND -o arm-straight.trans"), _straighten)
+    p.add_argument("bones", help=".bones file")
+    p.add_argument("--chain", nargs=2, metavar=("FIRST", "LAST"),
+                   help="the chain's first and last bones, each the child of the one before (default: the whole "
+                        "skeleton, when it is one chain)")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "connect2tskel", "A .connect plus one .trans frame -> .tskel (root orders must match).",
+                    ("volanim connect2tskel mannequin.0.50.connect arm.trans -o arm.tskel",
+                     "volanim connect2tskel mannequin.0.50.connect arm.trans --joints smooth -o arm-smooth.tskel"),
+                    _connect2tskel)
+    p.add_argument("connect")
+    p.add_argument("trans")
+    add_joints(p, "the .connect's (rigid when it records none)")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "connect2identitytskel", "The identity (rest) .tskel of a .connect.",
+                    "volanim connect2identitytskel mannequin.0.50.connect -o rest.tskel", _connect2identity)
+    p.add_argument("connect")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "sorttskel", "Sort each bone's points by decreasing DT.",
+                    "volanim sorttskel arm.tskel -o arm.sorted.tskel", _sorttskel)
+    p.add_argument("tskel")
+    p.add_argument("-o", "--output", required=True)
+
+    p = add_command(sub, "mirror", "Copy one side's attachments to the twin bones (the studio's Mirror connectivity).",
+                    "volanim mirror mannequin.0.50.connect --bones mannequin.bones -o mirrored.connect", _mirror)
+    p.add_argument("connect")
+    p.add_argument("--bones", required=True, help="the .bones file (joint names L_/R_ or Left/Right)")
+    p.add_argument("--side", choices=("L", "R"), default="L", help="copy this side to the other (default L)")
+    p.add_argument("--bone", action="append", metavar="NAME", help="only this bone (repeatable)")
+    p.add_argument("--plane", type=finite_float, metavar="X",
+                   help="x of the mirror plane in voxels (default: midway between the L_/R_ joints)")
+    p.add_argument("-o", "--output", required=True)
