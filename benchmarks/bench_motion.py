@@ -52,9 +52,10 @@ def per_frame_baseline(motion):
 
 
 def bench_clip() -> None:
-    from volanim_core.motion.bvh import read_bvh
-    from volanim_core.motion.keyframes import KeyPose, interpolate
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.motion.keyframes import interpolate
     from volanim_core.motion.retarget import Retarget
+    from volanim_core.rig.key_pose import KeyPose
     from volanim_core.rig.pose import pose_matrices
     from volanim_core.samples import mannequin_bones
 
@@ -147,7 +148,7 @@ def bench_real_clip() -> None:
     7184-frame test.bvh, against parsing it, measured in the same run. Target: at most +20 %."""
     sys.path.insert(0, str(ROOT / "tests"))
     from real_clips import clip
-    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.io.bvh_files import read_bvh
     from volanim_core.motion.plausible import check_clip
     from volanim_core.motion.retarget import Retarget
     from volanim_core.samples import mannequin_bones

@@ -53,7 +53,7 @@ print(json.dumps(out))
 
 
 def walk_matrices(every: int) -> np.ndarray:
-    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.io.bvh_files import read_bvh
     from volanim_core.motion.retarget import Retarget
     from volanim_core.samples import mannequin_bones
 

@@ -179,7 +179,7 @@ def print_lumps(rows: list[dict]) -> None:
 def walk_rows(sample, every: int) -> list[dict]:
     """The real walk clip (MIT, bundled) retargeted onto the mannequin, every ``every``-th frame, each method
     against the capsules posed by the same matrices (#60: Dice >= 0.97 in every frame)."""
-    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.io.bvh_files import read_bvh
     from volanim_core.motion.retarget import Retarget
     from volanim_core.posed_truth import posed_sample
     from volanim_core.reconstruct.engine import reconstruct

@@ -196,9 +196,10 @@ def _timed(run) -> float:
 def animations(picture: Path | None = None) -> str:
     """Fig 5.3: the walk (the real clip, retargeted) and keyed animations on mannequin-large at thinness >= 0.5
     (its ready .connect), sampled, 2 threads; and a strip of each one's frames in bone colours."""
-    from volanim_core.motion.bvh import read_bvh
-    from volanim_core.motion.keyframes import KeyPose, keys
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.motion.keyframes import keys
     from volanim_core.motion.retarget import Retarget
+    from volanim_core.rig.key_pose import KeyPose
 
     s = samples.mannequin_large()
     conn = samples.part_connectivity(s, 0.5)

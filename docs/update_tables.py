@@ -143,7 +143,7 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         bodies[name] = generate(name)
         print(f"{time.perf_counter() - t0:.0f} s", flush=True)
-    from volanim_core.io._atomic import atomic_write_text
+    from volanim_core.io.atomic import atomic_write_text
 
     stale = []
     for page in sorted(set(homes.values())):

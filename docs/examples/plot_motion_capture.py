@@ -2,7 +2,7 @@
 A motion-capture clip on the mannequin's bones
 ==============================================
 
-:func:`~volanim_core.motion.bvh.read_bvh` reads a BVH clip (here the real walk, MIT); ``Retarget`` binds it
+:func:`~volanim_core.io.bvh_files.read_bvh` reads a BVH clip (here the real walk, MIT); ``Retarget`` binds it
 to our bones (names matched, axes and units found) and gives each frame's matrices, which pose the bones as
 any ``.trans`` does. The plot follows both ankles through the clip, and draws the posed bones of four frames.
 """
@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from volanim_core import samples
-from volanim_core.motion.bvh import read_bvh
+from volanim_core.io.bvh_files import read_bvh
 from volanim_core.motion.retarget import Retarget
 from volanim_core.rig.pose import posed_joints
 

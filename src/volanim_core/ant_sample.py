@@ -58,7 +58,7 @@ def keys_text() -> str:
 
 def write_ant_rig(folder: str | Path) -> list[Path]:
     """``ant.mrk.json`` and ``ant.keys`` into ``folder``."""
-    from volanim_core.io._atomic import atomic_write_text
+    from volanim_core.io.atomic import atomic_write_text
 
     folder = Path(folder)
     written = [folder / "ant.mrk.json", folder / "ant.keys"]

@@ -135,8 +135,8 @@ def run_demo(folder: Path, sample: str = "mannequin") -> dict:
 
 def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
     """Motion capture onto the mannequin: a few frames across the clip written and reconstructed."""
-    from volanim_core.motion.bvh import read_bvh
-    from volanim_core.motion.frame_files import frame_path, write_frames
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.frame_files import frame_path, write_frames
     from volanim_core.motion.retarget import Retarget
 
     t = time.perf_counter()

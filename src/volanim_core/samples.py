@@ -301,8 +301,8 @@ def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
 
 def write_mannequin_keys(path: str | Path, bones: BoneSkeleton) -> None:
     """A one-second wave of the mannequin's left arm as a ``.keys`` file (docs/formats.md, "Keys")."""
-    from volanim_core.motion.keyframes import KeyPose
-    from volanim_core.motion.keys_files import Keys, write_keys
+    from volanim_core.io.keys_files import Keys, write_keys
+    from volanim_core.rig.key_pose import KeyPose
 
     def key(**angles) -> KeyPose:
         k = KeyPose()
@@ -320,7 +320,7 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     ``walk`` the clip ``walk.bvh`` and its licence. ``progress(done, total)`` is reported for
     ``mannequin-large`` (its body, then the skeleton of its ``.connect``: ~10 s on 2 cores)."""
     from volanim_core.io import write_bones, write_connections, write_raw
-    from volanim_core.io._atomic import atomic_write_bytes
+    from volanim_core.io.atomic import atomic_write_bytes
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

@@ -67,7 +67,7 @@ def test_write_sample_files(tmp_path):
     assert [p.name for p in paths] == ["mannequin.VOL", "mannequin.bones", "mannequin.connections", "mannequin.keys"]
     assert np.array_equal(io.read_volume(paths[0]), samples.mannequin().volume)
     assert io.read_bones(paths[1]) == samples.mannequin_bones()
-    from volanim_core.motion.keys_files import read_keys
+    from volanim_core.io.keys_files import read_keys
 
     keys = read_keys(paths[3], samples.mannequin_bones())
     assert sorted(keys.keys) == [0, 12, 24] and (keys.fps, keys.length, keys.ease) == (24.0, 25, True)

@@ -31,7 +31,7 @@ def api_call(path):
     """The call the file names, given what the files' readers refuse (round3_cases.API)."""
     from volanim_core.camera import Camera
     from volanim_core.colour.palette import build_palette
-    from volanim_core.motion.frame_files import write_frames
+    from volanim_core.io.frame_files import write_frames
     from volanim_core.render.scene import RenderSettings, prepare_frame
     from volanim_core.rig.bones import Bone, BoneSkeleton
     from volanim_core.rig.connectivity import BoneSegment, Trans
@@ -62,11 +62,11 @@ def api_call(path):
 def readers() -> dict:
     from volanim_core import io
     from volanim_core.geometry import IDENTITY
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.marker_files import read_c3d
     from volanim_core.io.mesh_files import read_mesh
     from volanim_core.io.palette_files import read_alpha_map, read_palette
     from volanim_core.io.slicer_files import read_markups
-    from volanim_core.motion.bvh import read_bvh
-    from volanim_core.motion.markers import read_c3d
     from volanim_studio.model import Document
     from volanim_studio.model.project import apply_project, read_project
 

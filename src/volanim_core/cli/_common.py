@@ -14,7 +14,7 @@ import numpy as np
 
 from volanim_core.geometry import IDENTITY
 from volanim_core.io import read_scan, write_output
-from volanim_core.io._text import is_number
+from volanim_core.io.text import is_number
 from volanim_core.volume import Bounds, is_colour, to_grey
 
 #: What every ``--help`` example assumes; tests/test_documented_commands.py runs them all in order.

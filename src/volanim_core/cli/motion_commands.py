@@ -11,10 +11,11 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
-from volanim_core.motion.bvh import read_bvh
-from volanim_core.motion.frame_files import write_frames
+from volanim_core.io.bvh_files import read_bvh
+from volanim_core.io.frame_files import write_frames
+from volanim_core.io.mapping_files import format_mapping, read_mapping
 from volanim_core.motion.plausible import check_clip, refuse_failed
-from volanim_core.motion.retarget import Retarget, check_mapping_file, format_mapping, read_mapping
+from volanim_core.motion.retarget import Retarget, check_mapping_file
 from volanim_core.progress import TextProgress
 from volanim_core.rig.tskel_tools import connect_to_tskel
 
@@ -26,9 +27,9 @@ from ._common import (
 
 
 def _keys(args):
-    from volanim_core.motion.frame_files import write_frames
+    from volanim_core.io.frame_files import write_frames
+    from volanim_core.io.keys_files import read_keys
     from volanim_core.motion.keyframes import keys
-    from volanim_core.motion.keys_files import read_keys
 
     bones = read_bones(args.bones).on_cubes()
     k = read_keys(args.keys, bones)
@@ -114,7 +115,7 @@ def _trans2tskel(args):
 
 def _bones_and_frames(args):
     """``args.bones`` and the matrices of ``args.trans`` (files or a folder), in frame-number order."""
-    from volanim_core.motion.frame_files import read_frames
+    from volanim_core.io.frame_files import read_frames
 
     bones = read_bones(args.bones).on_cubes()
     bar = TextProgress("reading frames")
@@ -124,7 +125,7 @@ def _bones_and_frames(args):
 
 
 def _trans2bvh(args):
-    from volanim_core.motion.bvh_export import write_bvh
+    from volanim_core.io.bvh_export import write_bvh
 
     bones, mats, paths = _bones_and_frames(args)
     worst = write_bvh(args.output, bones, mats, args.fps, args.scale)
@@ -136,8 +137,9 @@ def _trans2bvh(args):
 
 
 def _trans2positions(args):
-    from volanim_core.motion.frame_files import frame_number
-    from volanim_core.motion.positions import posed_joints, write_positions
+    from volanim_core.io.frame_files import frame_number
+    from volanim_core.io.positions_files import write_positions
+    from volanim_core.motion.positions import posed_joints
 
     bones, mats, paths = _bones_and_frames(args)
     names, positions = posed_joints(bones, mats)
@@ -170,13 +172,14 @@ def _positions2trans(args):
 
 def _joint_positions(args, bones, names):
     """(frame numbers, (F, J, 3) in the bones' space, what was read and fitted) from a CSV or a C3D file."""
+    from volanim_core.io.marker_files import read_c3d, read_marker_map
+    from volanim_core.io.positions_files import read_positions
     from volanim_core.motion import markers
-    from volanim_core.motion.positions import read_positions
 
-    mapping = markers.read_marker_map(args.map) if args.map else None
+    mapping = read_marker_map(args.map) if args.map else None
     c3d = Path(args.positions).suffix.lower() == ".c3d"
     if c3d:
-        labels, data, rate, unit = markers.read_c3d(args.positions)
+        labels, data, rate, unit = read_c3d(args.positions)
         numbers = np.arange(len(data))
         what = f" ({len(labels)} markers at {rate:g} Hz, in {unit or 'unnamed units'})"
     else:

@@ -149,7 +149,7 @@ def _report(args):
 
 
 def _scan(args):
-    from volanim_core.motion.frame_files import frame_number
+    from volanim_core.io.frame_files import frame_number
     from volanim_core.reconstruct.checks import scan, scan_json
     from volanim_core.reconstruct.scan import scan_summary
 

@@ -37,7 +37,7 @@ EXAMPLE = (
 
 def _sequence(args):
     from volanim_core.io import read_bones, read_connect
-    from volanim_core.motion.retarget import read_mapping
+    from volanim_core.io.mapping_files import read_mapping
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
     from volanim_core.sequence.run import run_sequence

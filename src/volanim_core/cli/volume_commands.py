@@ -13,8 +13,8 @@ from volanim_core.io import add_header, histogram_file, remove_header
 from volanim_core.volume import finite_range, float_to_uint8, non_finite_count
 
 from .. import samples, volume
-from ..io._text import parse_int, read_records
 from ..io.raw_volumes import raw_layout
+from ..io.text import parse_int, read_records
 from ..progress import TextProgress
 from ._common import (
     add_command,

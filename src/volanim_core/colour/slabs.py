@@ -20,7 +20,7 @@ from volanim_core.colour.palette import NearestColour, unique_colours
 from volanim_core.errors import FormatError
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.io import raw_volumes, volume_files
-from volanim_core.io._atomic import atomic_open
+from volanim_core.io.atomic import atomic_open
 from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.volume import is_colour
 

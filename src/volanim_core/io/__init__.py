@@ -2,6 +2,34 @@
 
 All readers raise :class:`volanim_core.errors.FormatError` (and nothing else)
 for a bad file; all writers are atomic.
+
+    volumes
+      volume_files.py ..... every volume format behind read_scan/read_volume and write_volume
+      raw_volumes.py ...... .vol and .VOL (the thesis's raw voxels, 100-byte header)
+      nrrd_files.py, metaimage_files.py  NRRD and MetaImage, our own; medical_files.py: NIfTI and the
+                            others through SimpleITK/nibabel; dicom_files.py: DICOM through pydicom
+      vtk_headers.py ...... what a VTK-family header claims, checked before VTK allocates it
+    skeletons and the rig
+      skeleton_files.py ... .skel and .mskel
+      bones_files.py ...... .bones and .connections
+      connect_files.py .... .connect, .trans and .tskel (and the smooth-joints line)
+    motion
+      frame_files.py ...... an animation on disk: one .trans (and .tskel) per frame, NAME.0000.trans
+      keys_files.py ....... .keys (keyframes)
+      bvh_files.py ........ BVH clips read (the clip's own hierarchy and forward kinematics); bvh_export.py: written
+      mapping_files.py .... BONE BVH_JOINT mapping files
+      positions_files.py .. joint positions per frame (CSV)
+      marker_files.py ..... C3D marker data and marker maps; c3d_layout.py: a C3D file checked before ezc3d
+    rendering, colour, meshes, other programs
+      render_files.py ..... the Rendering section's files: .camera and .tf
+      palette_files.py .... palettes, alpha maps, remap tables
+      mesh_files.py ....... surfaces out (.ply .vtp .obj .stl); mesh_checks.py: meshes checked before VTK reads them
+      slicer_files.py ..... 3D Slicer's markups and transform files
+      bundle.py ........... several files saved as one unit (a project): data files, then the manifest
+    what every reader and writer shares
+      atomic.py ........... atomic writes (a temporary beside the target, then a rename)
+      text.py ............. the line reader of every text format; files.py: a named file read safely
+      _columns.py, _inflate.py  numeric columns parsed fast; gzip inflated with a cap (io's own)
 """
 
 from volanim_core.errors import FormatError

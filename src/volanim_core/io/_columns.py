@@ -10,7 +10,7 @@ import numpy as np
 
 from volanim_core.limits import MAX_COORD
 
-from ._text import TextRecords, parse_float, parse_int
+from .text import TextRecords, parse_float, parse_int
 
 _NUMBER_CHARS = set("0123456789+-.eE")
 
@@ -64,7 +64,7 @@ def parse_point_rows(
 
 def format_point_rows(points, dt, thinness=None) -> list[str]:
     """``x y z dt [thinness]`` lines, floats in shortest round-trip form."""
-    from ._text import fmt_float
+    from .text import fmt_float
 
     pts = np.asarray(points).tolist()
     dts = np.asarray(dt, dtype=np.float64).tolist()

@@ -11,8 +11,8 @@ from pathlib import Path
 
 from volanim_core.rig.bones import Bone, BoneSkeleton, bone_cycle
 
-from ._atomic import atomic_write_text
-from ._text import fmt_float, parse_float, parse_geometry, read_records
+from .atomic import atomic_write_text
+from .text import fmt_float, parse_float, parse_geometry, read_records
 
 
 def read_bones(path: str | Path) -> BoneSkeleton:

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from volanim_core.errors import FormatError
 
-from ._atomic import atomic_write_text, clean_stale, fsync_folder, pending_name
+from .atomic import atomic_write_text, clean_stale, fsync_folder, pending_name
 
 PREVIOUS = "previous.json"
 _CONTENT_NAME = re.compile(r"^[a-z]+-[0-9a-f]{12}\.[A-Za-z0-9]+$")
@@ -162,7 +162,7 @@ def load(manifest: str | Path, parse: Callable[[Path, str], dict]) -> tuple[dict
 
 def read_manifest_text(path: Path) -> str:
     """A manifest's text: a regular file of at most MAX_MANIFEST_BYTES (``/dev/zero`` read forever)."""
-    from ._files import regular_file_bytes
+    from .files import regular_file_bytes
 
     try:
         return regular_file_bytes(path, MAX_MANIFEST_BYTES, "project file").decode("utf-8-sig")

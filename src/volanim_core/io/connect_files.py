@@ -14,9 +14,9 @@ import numpy as np
 from volanim_core.rig.connectivity import BoneSegment, Connectivity, Trans, Tskel, close_floats
 from volanim_core.rig.skinning import RIGID, Joints
 
-from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
-from ._text import TextRecords, fmt_float, parse_float, parse_geometry, parse_header, parse_metric, read_records
+from .atomic import atomic_write_text
+from .text import TextRecords, fmt_float, parse_float, parse_geometry, parse_header, parse_metric, read_records
 
 ROOT_SYNTAX = "'Root: x y z :: x y z [NAME]'"
 

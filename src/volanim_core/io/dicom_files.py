@@ -343,7 +343,7 @@ def write_dicom_series(folder: str | Path, volume: np.ndarray, geometry: Geometr
     from pydicom.dataset import FileDataset, FileMetaDataset
     from pydicom.uid import CTImageStorage, ExplicitVRLittleEndian, MRImageStorage, generate_uid
 
-    from ._atomic import atomic_open
+    from .atomic import atomic_open
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)

@@ -168,7 +168,7 @@ def write_tiff_stack(path: str | Path, vol: np.ndarray, geometry) -> None:
     :func:`read_tiff_stack` and Fiji read back (the thesis's Toolbar wrote slice stacks)."""
     import tifffile
 
-    from ._atomic import atomic_open
+    from .atomic import atomic_open
 
     vol = _imagej_voxels(path, vol)
     zyx = np.ascontiguousarray(np.moveaxis(vol, (0, 1, 2), (2, 1, 0)))  # colour keeps its channels last
@@ -220,7 +220,7 @@ def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
 
     import imageio.v3 as iio
 
-    from ._atomic import clean_stale, fsync_folder, naming_the_output, pending_name
+    from .atomic import clean_stale, fsync_folder, naming_the_output, pending_name
 
     out = [Path(pattern % z) for z in range(vol.shape[2])]
     folder = out[0].parent

@@ -17,7 +17,7 @@ def write_mesh(path, vertices: np.ndarray, faces: np.ndarray) -> None:
     suffix = path.suffix.lower()
     if suffix not in MESH_SUFFIXES:
         raise ValueError(f"cannot write a mesh as {suffix!r}: use .ply, .vtp, .obj or .stl")
-    from volanim_core.io._atomic import atomic_vtk_save
+    from volanim_core.io.atomic import atomic_vtk_save
 
     cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
     atomic_vtk_save(path, pv.PolyData(np.asarray(vertices, np.float32), cells))

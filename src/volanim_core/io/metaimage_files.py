@@ -21,8 +21,8 @@ import numpy as np
 from volanim_core.errors import FormatError
 from volanim_core.geometry import IDENTITY, Geometry
 
-from ._atomic import atomic_open
 from ._inflate import inflate_capped
+from .atomic import atomic_open
 from .vtk_headers import check_claims, metaimage_header
 
 _MET_DTYPES = {"MET_CHAR": "i1", "MET_UCHAR": "u1", "MET_SHORT": "i2", "MET_USHORT": "u2", "MET_INT": "i4",

@@ -26,9 +26,9 @@ from volanim_core.errors import FormatError
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.limits import checked_grid, expect_bytes
 
-from ._atomic import atomic_open
 from ._inflate import inflate_capped
-from ._text import is_number
+from .atomic import atomic_open
+from .text import is_number
 
 _TYPES = {
     "uchar": "u1", "unsigned char": "u1", "uint8": "u1", "uint8_t": "u1",

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._atomic import atomic_write_text
-from ._text import fmt_float, parse_float, parse_int, read_records
+from .atomic import atomic_write_text
+from .text import fmt_float, parse_float, parse_int, read_records
 
 MAX_COLOURS = 256
 

@@ -18,7 +18,7 @@ import numpy as np
 from volanim_core.errors import FormatError
 from volanim_core.limits import checked_grid
 
-from ._atomic import atomic_open
+from .atomic import atomic_open
 
 HEADER_BYTES = 100
 _NAME_DIMS = re.compile(r"\.(\d+)x(\d+)x(\d+)\.vol$", re.IGNORECASE)

@@ -24,8 +24,8 @@ import numpy as np
 from volanim_core.camera import Camera
 from volanim_core.transfer_function import TransferFunction
 
-from ._atomic import atomic_write_text
-from ._text import fmt_float, parse_float, read_records
+from .atomic import atomic_write_text
+from .text import fmt_float, parse_float, read_records
 
 _VECTORS = ("position", "focal_point", "view_up")
 _SCALARS = ("view_angle", "parallel_scale")

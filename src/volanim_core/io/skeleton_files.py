@@ -12,9 +12,9 @@ import numpy as np
 
 from volanim_core.skeleton.points import Skeleton
 
-from ._atomic import atomic_write_text
 from ._columns import format_point_rows, parse_point_rows
-from ._text import parse_geometry, parse_metric, read_records
+from .atomic import atomic_write_text
+from .text import parse_geometry, parse_metric, read_records
 
 
 def _header(kind: str, skel: Skeleton) -> list[str]:

@@ -25,8 +25,8 @@ from volanim_core.errors import FormatError
 from volanim_core.geometry import Geometry
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
-from ._atomic import atomic_write_text
-from ._files import load_json
+from .atomic import atomic_write_text
+from .files import load_json
 
 SCHEMA = ("https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/Schema/"
           "markups-schema-v1.0.3.json#")
@@ -136,7 +136,7 @@ def write_transform(path: str | Path, matrix: np.ndarray) -> None:
                              ".tfm needs nothing") from None
         import tempfile
 
-        from ._atomic import atomic_write_bytes
+        from .atomic import atomic_write_bytes
 
         tx = sitk.AffineTransform(3)
         tx.SetMatrix(m[:3, :3].ravel().tolist())

@@ -36,7 +36,7 @@ from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.volume import float_to_uint8, is_colour, to_grey
 
 from . import raw_volumes
-from ._atomic import atomic_vtk_save
+from .atomic import atomic_vtk_save
 from .metaimage_files import read_metaimage, write_metaimage
 from .nrrd_files import read_nrrd, write_nrrd
 from .vtk_headers import check_claims
@@ -369,7 +369,7 @@ def _write_nifti(path: Path, vol: np.ndarray, geometry: Geometry) -> None:
     """NIfTI-1 through nibabel, qform and sform both set (scanner space), atomically."""
     import nibabel as nib
 
-    from ._atomic import atomic_open
+    from .atomic import atomic_open
 
     if is_colour(vol):
         raise ValueError(f"cannot write a colour volume to {path.name}: NIfTI colour is not supported; use .nrrd")

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .bvh import Motion
+from volanim_core.io.bvh_files import Motion
+
 from .presets import part_key
 
 SAMPLES = 64  # frames looked at: enough to see a stride, cheap on a 7000-frame clip

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.io.bvh_files import Motion
+
 from .body import Sampled, children, longest_path, reach, sizes, twins
-from .bvh import Motion
 from .presets import part_of
 
 BIPED = 120.0  # degrees between the spine and the legs: a person's are near 180, sitting near 135

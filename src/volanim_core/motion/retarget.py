@@ -27,11 +27,11 @@ instead of at its OFFSET pose.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from volanim_core.errors import FormatError
+from volanim_core.io.bvh_files import Motion
 from volanim_core.rig.bones import BoneSkeleton
 from volanim_core.rig.pose import least_rotation, parents_first
 
@@ -46,7 +46,6 @@ from .body import (
     up_over,
     upright,
 )
-from .bvh import Motion
 from .kind import clip_kind
 from .presets import best_preset, part_key, part_of
 
@@ -123,31 +122,6 @@ def _key_of(parts: dict[str, int], joint: int) -> str | None:
 def suggest_mapping(bones: BoneSkeleton, motion: Motion) -> dict[str, str]:
     """Our bone label -> BVH joint (:func:`match`'s mapping)."""
     return match(bones, motion).mapping
-
-
-def read_mapping(path: str | Path) -> dict[str, str]:
-    """A mapping file: ``BONE BVH_JOINT`` per line, ``#`` comments."""
-    from volanim_core.io._text import read_records
-
-    rec = read_records(path)
-    out: dict[str, str] = {}
-    for line, toks in rec.records:
-        if len(toks) != 2:
-            raise rec.error(line, f"expected 'BONE BVH_JOINT', got {len(toks)} tokens")
-        if toks[0] in out:
-            raise rec.error(line, f"bone {toks[0]!r} is mapped twice")
-        out[toks[0]] = toks[1]
-    return out
-
-
-def format_mapping(mapping: dict[str, str], bones: BoneSkeleton, how: dict[str, str] | None = None) -> str:
-    """The mapping file's text; ``how`` adds to each line, as a comment, what placed it."""
-    how = how or {}
-    lines = ["# volanim bone mapping: BONE BVH_JOINT (the BVH joint whose rotation drives the bone)"]
-    lines += [f"{b.label} {mapping[b.label]}" + (f"  # {how[b.label]}" if b.label in how else "")
-              for b in bones.bones if b.label in mapping]
-    lines += [f"# {b.label} (unmapped: follows its parent)" for b in bones.bones if b.label not in mapping]
-    return "\n".join(lines) + "\n"
 
 
 def axis_vector(text: str) -> np.ndarray:

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.io._files import resolved
+from volanim_core.io.files import resolved
 from volanim_core.parallel import executor
 
 from .camera import Camera, union_box
@@ -129,7 +129,7 @@ def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
 
 
 def _file_inputs(paths: list[Path], frames: slice, dims) -> RenderInputs:
-    from volanim_core.motion.frame_files import frame_number
+    from volanim_core.io.frame_files import frame_number
 
     numbers = [frame_number(p) for p in paths]
     if None in numbers or len(set(numbers)) != len(numbers):
@@ -370,7 +370,7 @@ def frame_path(folder: Path, number: int) -> Path:
 def write_png(path, image: np.ndarray) -> None:
     import imageio.v3 as iio
 
-    from volanim_core.io._atomic import atomic_write_bytes
+    from volanim_core.io.atomic import atomic_write_bytes
 
     atomic_write_bytes(path, iio.imwrite("<bytes>", image, extension=".png"))
 
@@ -388,7 +388,7 @@ def _key(inputs: RenderInputs, settings: RenderSettings) -> str:
 
 def _plan_folder(folder: Path, key: str, frames: list[FrameRef], force: bool) -> tuple[list[FrameRef], int]:
     """The frames still to draw into ``folder``: all of them unless the folder holds this render's pictures."""
-    from volanim_core.io._atomic import atomic_write_text
+    from volanim_core.io.atomic import atomic_write_text
 
     if folder.exists() and not folder.is_dir():
         raise ValueError(f"{folder} is a file; render to a folder, a .png, an .mp4 or a .gif")
@@ -410,7 +410,7 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
     import imageio.v2 as iio2
     import imageio.v3 as iio
 
-    from volanim_core.io._atomic import clean_stale, naming_the_output, pending_name
+    from volanim_core.io.atomic import clean_stale, naming_the_output, pending_name
 
     out.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(out.parent, out.name)

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.io._files import load_json, parse_json, regular_file_bytes, resolved
+from volanim_core.io.files import load_json, parse_json, regular_file_bytes, resolved
 from volanim_core.limits import MAX_AXIS, checked_grid
 from volanim_core.modes import MODES
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.motion.frame_files import check_complete, frame_number
+from volanim_core.io.frame_files import check_complete, frame_number
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.tskel_tools import check_root_order
 
@@ -92,7 +92,7 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
 
 
 def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward, check) -> list[FrameSpec]:
-    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.io.bvh_files import read_bvh
     from volanim_core.motion.retarget import Retarget, check_mapping_file
     from volanim_core.rig.pose import root_bones
 

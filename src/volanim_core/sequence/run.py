@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.colour.indexed import index_colours
-from volanim_core.io._atomic import naming_the_output
-from volanim_core.io._files import resolved
+from volanim_core.io.atomic import naming_the_output
+from volanim_core.io.files import resolved
 from volanim_core.limits import available_bytes, human_bytes
 from volanim_core.parallel import executor
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype

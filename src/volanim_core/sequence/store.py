@@ -77,7 +77,7 @@ def create(path: str | Path, shape_zyx, n_frames: int, dtype, origin_xyz, plan: 
     import zarr
 
     from volanim_core.geometry import Geometry
-    from volanim_core.io._atomic import atomic_write_text, clean_stale, pending_name
+    from volanim_core.io.atomic import atomic_write_text, clean_stale, pending_name
 
     final = Path(path)
     # made whole beside the target, then renamed: a run killed while creating its store leaves no half-made
@@ -137,7 +137,7 @@ def ome_scale(geometry) -> tuple[tuple[float, float, float], bool]:
 def read_plan(path: str | Path) -> dict | None:
     """The plan of the store at ``path``, or None when there is none or it is not a plan (a rerun replaces it)."""
     from volanim_core.errors import FormatError
-    from volanim_core.io._files import load_json
+    from volanim_core.io.files import load_json
 
     p = Path(path) / PLAN_FILE
     if not p.is_file():

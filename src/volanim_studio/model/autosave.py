@@ -22,7 +22,7 @@ import shutil
 import time
 from pathlib import Path
 
-from volanim_core.io._atomic import atomic_write_text
+from volanim_core.io.atomic import atomic_write_text
 
 RECOVERY_FILE = "recovery.volanim"
 DECLINED = "declined"

@@ -32,7 +32,7 @@ import numpy as np
 from volanim_core import io
 from volanim_core.errors import FormatError
 from volanim_core.io import bundle
-from volanim_core.io._files import CHECKED_NUMBERS
+from volanim_core.io.files import CHECKED_NUMBERS
 from volanim_core.limits import checked_grid
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 

@@ -17,10 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.motion.bvh import Motion, read_bvh
-from volanim_core.motion.frame_files import frame_number, read_frames
-from volanim_core.motion.keyframes import KeyPose, interpolate
+from volanim_core.io.bvh_files import Motion, read_bvh
+from volanim_core.io.frame_files import frame_number, read_frames
+from volanim_core.motion.keyframes import interpolate
 from volanim_core.motion.retarget import Retarget, check_mapping_file
+from volanim_core.rig.key_pose import KeyPose
 
 from .undo import Command
 
@@ -232,7 +233,7 @@ class Timeline:
     # ------------------------------------------------------------ .keys
     def export_keys(self, path) -> int:
         """Write the keys and their options as a ``.keys`` file (``volanim keys`` makes the same frames)."""
-        from volanim_core.motion.keys_files import Keys, write_keys
+        from volanim_core.io.keys_files import Keys, write_keys
 
         if not self.keys:
             raise ValueError("no keys to export: set keys on the timeline first (S)")
@@ -241,7 +242,7 @@ class Timeline:
 
     def import_keys(self, path) -> int:
         """Replace the keys (and the options the file gives) by a ``.keys`` file's; one undo step."""
-        from volanim_core.motion.keys_files import read_keys
+        from volanim_core.io.keys_files import read_keys
 
         self._refuse_with_clip()
         k = read_keys(path, self.doc.bones)

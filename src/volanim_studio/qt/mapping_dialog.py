@@ -26,7 +26,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from volanim_core.motion.bvh import Motion
+from volanim_core.io.bvh_files import Motion
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget, match
 from volanim_core.rig.bones import BoneSkeleton

@@ -20,8 +20,8 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QDialog, QFileDialog
 
 from volanim_core import io
-from volanim_core.motion.bvh import read_bvh
-from volanim_core.motion.frame_files import read_frames, write_frames
+from volanim_core.io.bvh_files import read_bvh
+from volanim_core.io.frame_files import read_frames, write_frames
 from volanim_core.reconstruct.scan import scan_frames, scan_summary, worst_first
 from volanim_core.render.camera import Camera
 

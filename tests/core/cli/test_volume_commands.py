@@ -139,7 +139,7 @@ def test_a_headerless_vol_output_is_named_by_its_size(tmp_path, vol_file, capsys
 
 
 def test_samples_walk_copies_the_clip_and_its_licence(tmp_path):
-    from volanim_core.motion.bvh import read_bvh
+    from volanim_core.io.bvh_files import read_bvh
 
     assert main(["samples", "walk", "-o", str(tmp_path)]) == 0
     assert read_bvh(tmp_path / "walk.bvh").frames == 1064

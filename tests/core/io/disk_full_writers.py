@@ -23,14 +23,14 @@ OLD = b"the file that was there\n"
 def writers(spare: Path):
     from volanim_core import io
     from volanim_core.geometry import Geometry
+    from volanim_core.io.bvh_export import write_bvh
+    from volanim_core.io.keys_files import Keys, write_keys
     from volanim_core.io.mesh_files import write_mesh
     from volanim_core.io.slicer_files import write_markups, write_transform
-    from volanim_core.motion.bvh_export import write_bvh
-    from volanim_core.motion.keyframes import KeyPose
-    from volanim_core.motion.keys_files import Keys, write_keys
     from volanim_core.render.movie import encode, write_png
     from volanim_core.rig.bones import Bone, BoneSkeleton
     from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
+    from volanim_core.rig.key_pose import KeyPose
     from volanim_core.skeleton.points import Skeleton
 
     rng = np.random.default_rng(0)
@@ -151,8 +151,8 @@ def frame_folder(full: Path, spare: Path) -> dict:
     sys.path.insert(0, str(Path(__file__).parents[2]))
     from paths import WALK
     from volanim_core.errors import FormatError
-    from volanim_core.motion.bvh import read_bvh
-    from volanim_core.motion.frame_files import incomplete_marker, read_frames, write_frames
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.frame_files import incomplete_marker, read_frames, write_frames
     from volanim_core.motion.retarget import Retarget
     from volanim_core.samples import mannequin_bones
 

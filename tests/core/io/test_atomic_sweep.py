@@ -13,12 +13,12 @@ import time
 import numpy as np
 
 from volanim_core import io
-from volanim_core.io._atomic import pending_name
+from volanim_core.io.atomic import pending_name
 
 WRITE_AND_WAIT = """
 import sys, time
 from pathlib import Path
-from volanim_core.io._atomic import pending_name
+from volanim_core.io.atomic import pending_name
 tmp = Path(sys.argv[1]) / pending_name("dest.vti", ".tmp.vti")
 tmp.write_bytes(b"x" * 4096)
 print(tmp, flush=True)

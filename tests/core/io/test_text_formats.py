@@ -277,7 +277,7 @@ def test_writer_is_atomic_keeps_old_file_on_failure(tmp_path, small_bones, monke
     def explode(*a, **k):
         raise Boom
 
-    import volanim_core.io._atomic as atomic
+    import volanim_core.io.atomic as atomic
 
     monkeypatch.setattr(atomic.os, "fsync", explode)  # fail after writing, before rename
     with pytest.raises(Boom):

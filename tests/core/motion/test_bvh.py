@@ -9,7 +9,7 @@ import pytest
 
 from paths import WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core.errors import FormatError
-from volanim_core.motion.bvh import read_bvh
+from volanim_core.io.bvh_files import read_bvh
 
 
 def clip(order: str, frames: list[str], root_channels: str = "Xposition Yposition Zposition",

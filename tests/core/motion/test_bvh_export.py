@@ -11,8 +11,8 @@ from scipy.spatial.transform import Rotation
 from paths import ASSETS, WALK
 from runnable import volanim
 from volanim_core import io
-from volanim_core.motion.bvh_export import bvh_text
-from volanim_core.motion.frame_files import read_frames
+from volanim_core.io.bvh_export import bvh_text
+from volanim_core.io.frame_files import read_frames
 from volanim_core.rig.bones import Bone, BoneSkeleton
 
 

@@ -12,8 +12,9 @@ import pytest
 from paths import ASSETS, REPO
 from runnable import volanim
 from volanim_core import io
+from volanim_core.io.marker_files import read_c3d
+from volanim_core.io.positions_files import read_positions
 from volanim_core.motion import markers
-from volanim_core.motion.positions import read_positions
 
 C3D = REPO / "tests" / "data" / "c3d"
 QUALISYS, OPTOTRAK, MAP = C3D / "Qualisys.c3d", C3D / "Optotrak.c3d", C3D / "qualisys-mannequin.map"
@@ -22,9 +23,9 @@ QUALISYS, OPTOTRAK, MAP = C3D / "Qualisys.c3d", C3D / "Optotrak.c3d", C3D / "qua
 def _read(path):
     """ezc3d's Optotrak.c3d claims 1149 frames (POINT:FRAMES) and holds 29, ending on a frame: read, and said."""
     if path != OPTOTRAK:
-        return markers.read_c3d(path)
+        return read_c3d(path)
     with pytest.warns(UserWarning, match="POINT:FRAMES says 1149 frames; it holds 29"):
-        return markers.read_c3d(path)
+        return read_c3d(path)
 
 
 def _py_c3d(path):

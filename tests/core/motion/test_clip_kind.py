@@ -16,8 +16,8 @@ from tests.paths import WALK
 
 from real_clips import CLIPS, clip
 from volanim_core.cli import main
+from volanim_core.io.bvh_files import read_bvh
 from volanim_core.motion.body import sample
-from volanim_core.motion.bvh import read_bvh
 from volanim_core.motion.kind import clip_kind
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget

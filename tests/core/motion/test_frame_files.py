@@ -7,9 +7,10 @@ import pytest
 
 from volanim_core import io
 from volanim_core.errors import Cancelled, FormatError
-from volanim_core.motion.frame_files import frame_number, read_frames, write_frames
-from volanim_core.motion.keyframes import KeyPose, interpolate
+from volanim_core.io.frame_files import frame_number, read_frames, write_frames
+from volanim_core.motion.keyframes import interpolate
 from volanim_core.rig.connectivity import Connectivity
+from volanim_core.rig.key_pose import KeyPose
 from volanim_core.rig.pose import root_bones
 
 from .test_retarget import arms_down

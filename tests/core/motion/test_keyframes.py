@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from volanim_core.motion.keyframes import KeyPose, interpolate
+from volanim_core.motion.keyframes import interpolate
+from volanim_core.rig.key_pose import KeyPose
 from volanim_core.rig.pose import pose_matrices
 from volanim_core.samples import mannequin_bones
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from volanim_core.motion.bvh import Motion
+from volanim_core.io.bvh_files import Motion
 
 
 def motion(**change) -> Motion:

@@ -8,8 +8,9 @@ from scipy.spatial.transform import Rotation
 from paths import ASSETS, WALK
 from runnable import volanim
 from volanim_core import io
-from volanim_core.motion.frame_files import read_frames
-from volanim_core.motion.positions import posed_joints, read_positions, solve, write_positions
+from volanim_core.io.frame_files import read_frames
+from volanim_core.io.positions_files import read_positions, write_positions
+from volanim_core.motion.positions import posed_joints, solve
 from volanim_core.reconstruct.engine import grid_bounds, reconstruct
 from volanim_core.rig.bones import Bone, BoneSkeleton
 

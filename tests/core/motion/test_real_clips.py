@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from real_clips import clip
-from volanim_core.motion.bvh import read_bvh
+from volanim_core.io.bvh_files import read_bvh
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget
 from volanim_core.samples import mannequin_bones

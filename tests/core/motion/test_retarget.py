@@ -10,8 +10,9 @@ import pytest
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
-from volanim_core.motion.bvh import read_bvh
-from volanim_core.motion.retarget import Retarget, axes_matrix, read_mapping, suggest_mapping
+from volanim_core.io.bvh_files import read_bvh
+from volanim_core.io.mapping_files import read_mapping
+from volanim_core.motion.retarget import Retarget, axes_matrix, suggest_mapping
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.samples import mannequin_bones
 

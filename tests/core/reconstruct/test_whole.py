@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from volanim_core import io, samples
-from volanim_core.motion.bvh import read_bvh
+from volanim_core.io.bvh_files import read_bvh
 from volanim_core.motion.retarget import Retarget
 from volanim_core.reconstruct.breakage import components
 from volanim_core.reconstruct.engine import reconstruct

@@ -17,7 +17,7 @@ from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT lice
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
-from volanim_core.motion.frame_files import write_frames
+from volanim_core.io.frame_files import write_frames
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store

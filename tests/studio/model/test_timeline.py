@@ -10,8 +10,8 @@ import pytest
 from paths import WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core import samples
 from volanim_core.errors import FormatError
-from volanim_core.motion.frame_files import write_frames
-from volanim_core.motion.keyframes import KeyPose
+from volanim_core.io.frame_files import write_frames
+from volanim_core.rig.key_pose import KeyPose
 from volanim_studio.model import Document
 from volanim_studio.model.project import apply_project, read_project, write_project
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from real_clips import clip
-from volanim_core.motion.bvh import read_bvh
+from volanim_core.io.bvh_files import read_bvh
 from volanim_core.samples import mannequin_bones
 from volanim_studio.qt.mapping_dialog import MappingDialog
 

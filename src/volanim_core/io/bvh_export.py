@@ -131,8 +131,8 @@ def bvh_text(bones: BoneSkeleton, matrices: np.ndarray, fps: float, scale: float
 
 
 def write_bvh(path: str | Path, bones: BoneSkeleton, matrices: np.ndarray, fps: float, scale: float = 1.0) -> float:
-    """Write :func:`bvh_text` atomically; returns the largest joint distance it could not hold."""
-    from volanim_core.io._atomic import atomic_write_text
+    """Write ``bvh_text``'s clip atomically; returns the largest joint distance it could not hold."""
+    from volanim_core.io.atomic import atomic_write_text
 
     text, worst = bvh_text(bones, matrices, fps, scale)
     atomic_write_text(path, text)

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.io._atomic import atomic_write_text
-from volanim_core.io._text import fmt_float, parse_float, parse_int, read_records
-from volanim_core.motion.keyframes import MAX_FRAMES, KeyPose
+from volanim_core.io.atomic import atomic_write_text
+from volanim_core.io.text import fmt_float, parse_float, parse_int, read_records
 from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.key_pose import MAX_FRAMES, KeyPose
 
 MAX_FRAME = 10_000_000
 SETTINGS = ("fps", "length", "ease")

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.errors import FormatError
-from volanim_core.io._text import is_number
+from volanim_core.io.text import is_number
 from volanim_core.limits import available_bytes, human_bytes
 
 MAX_JOINTS = 10_000
@@ -198,8 +198,8 @@ def _tokens(text: str):
 
 def read_bvh(path: str | Path) -> Motion:
     """Read a BVH file; a bad one is a :class:`FormatError` naming the file and line."""
-    from volanim_core.io._files import regular_file_bytes
-    from volanim_core.io._text import MAX_TEXT_BYTES
+    from volanim_core.io.files import regular_file_bytes
+    from volanim_core.io.text import MAX_TEXT_BYTES
 
     path = Path(path)
     raw = regular_file_bytes(path, MAX_TEXT_BYTES, "BVH file")

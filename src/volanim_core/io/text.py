@@ -46,7 +46,7 @@ def read_records(path: str | Path, *, allow_empty: bool = False) -> TextRecords:
     Header comments of the form ``# key: value`` (e.g. ``# metric: 345``) are
     collected in ``header`` with lower-case keys.
     """
-    from volanim_core.io._files import regular_file_bytes
+    from volanim_core.io.files import regular_file_bytes
 
     path = Path(path)
     raw = regular_file_bytes(path, MAX_TEXT_BYTES, "text file")  # /dev/zero's size reads 0: it read forever
