@@ -139,10 +139,10 @@ def _trans2bvh(args):
 def _trans2positions(args):
     from volanim_core.io.frame_files import frame_number
     from volanim_core.io.positions_files import write_positions
-    from volanim_core.motion.positions import posed_joints
+    from volanim_core.rig.pose import joint_positions
 
     bones, mats, paths = _bones_and_frames(args)
-    names, positions = posed_joints(bones, mats)
+    names, positions = list(bones.joints), joint_positions(bones, mats)
     numbers = [frame_number(p) if frame_number(p) is not None else i for i, p in enumerate(paths)]
     write_positions(args.output, numbers, names, positions)
     print(f"wrote {args.output}: {len(names)} joints in {len(paths)} frames")

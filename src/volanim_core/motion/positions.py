@@ -29,20 +29,6 @@ from volanim_core.rig.bones import BoneSkeleton
 MIN_SIN = 0.2  # a third marker nearer the bone's line than this (as a fraction of its distance) gives no twist
 
 
-def posed_joints(bones: BoneSkeleton, matrices: np.ndarray) -> tuple[list[str], np.ndarray]:
-    """Every joint's place in each frame of ``(F, B, 4, 4)`` matrices: a bone's proximal joint moved by it,
-    a joint that starts no bone (a hand's tip) by the bone it ends."""
-    names = list(bones.joints)
-    out = np.full((len(matrices), len(names), 3), np.nan)
-    for j, name in enumerate(names):
-        b = next((i for i, bone in enumerate(bones.bones) if bone.proximal == name), None)
-        if b is None:
-            b = next((i for i, bone in enumerate(bones.bones) if bone.distal == name), None)
-        if b is not None:
-            out[:, j] = np.asarray(bones.joints[name], float) @ matrices[:, b, :3, :3] + matrices[:, b, 3, :3]
-    return names, out
-
-
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 

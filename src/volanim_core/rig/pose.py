@@ -200,12 +200,33 @@ def root_bones(bones: BoneSkeleton) -> list[BoneSegment]:
     return [BoneSegment(*bones.segment(i), b.label) for i, b in enumerate(bones.bones)]
 
 
-def posed_joints(bones: BoneSkeleton, matrices: np.ndarray) -> dict[str, np.ndarray]:
-    """Where each joint goes: a bone's distal joint moves with the bone, a top-level proximal joint too."""
-    out = {}
+def joint_bones(bones: BoneSkeleton) -> list[int]:
+    """Per joint (in ``bones.joints`` order), the bone whose matrix places it: the first bone that starts at
+    it, else (a tip: a hand's end) the bone that ends at it.
+
+    The one rule for where a posed joint is (#68): the studio's bones and names, the breakage report's
+    joints and ``trans2positions`` all use it. A bone's own matrix carries its start, so a shifted child
+    bone (a keyed translation) takes its joint with it; the parent's far end and the child's start agree
+    whenever nothing is shifted."""
+    first_start, end = {}, {}
     for i, b in enumerate(bones.bones):
-        m = matrices[i]
-        for name in (b.proximal, b.distal):
-            if name == b.distal or name not in out:
-                out[name] = np.append(bones.joints[name], 1.0) @ m
-    return {k: v[:3] for k, v in out.items()}
+        first_start.setdefault(b.proximal, i)
+        end[b.distal] = i
+    return [first_start.get(name, end.get(name, -1)) for name in bones.joints]
+
+
+def joint_positions(bones: BoneSkeleton, matrices: np.ndarray) -> np.ndarray:
+    """Every joint's posed place, ``(J, 3)`` for one frame's ``(B, 4, 4)`` matrices or ``(F, J, 3)`` for
+    ``(F, B, 4, 4)``, in ``bones.joints`` order (:func:`joint_bones` says which bone places each)."""
+    m = np.asarray(matrices, np.float64)
+    which = np.array(joint_bones(bones), np.int64)
+    rest = np.array([bones.joints[n] for n in bones.joints], np.float64).reshape(-1, 3)
+    if (which < 0).any():  # (a .bones file's every joint is on a bone; only a hand-made skeleton lacks one)
+        raise ValueError("a joint is on no bone: " + ", ".join(n for n, w in zip(bones.joints, which) if w < 0))
+    rot, shift = m[..., which, :3, :3], m[..., which, 3, :3]
+    return np.einsum("jk,...jkl->...jl", rest, rot) + shift
+
+
+def posed_joints(bones: BoneSkeleton, matrices: np.ndarray) -> dict[str, np.ndarray]:
+    """Where each joint goes in one frame, by name (:func:`joint_positions`)."""
+    return dict(zip(bones.joints, joint_positions(bones, matrices)))

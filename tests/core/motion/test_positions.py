@@ -10,9 +10,10 @@ from runnable import volanim
 from volanim_core import io
 from volanim_core.io.frame_files import read_frames
 from volanim_core.io.positions_files import read_positions, write_positions
-from volanim_core.motion.positions import posed_joints, solve
+from volanim_core.motion.positions import solve
 from volanim_core.reconstruct.engine import grid_bounds, reconstruct
 from volanim_core.rig.bones import Bone, BoneSkeleton
+from volanim_core.rig.pose import joint_positions
 
 
 def test_a_rigidly_moved_body_comes_back_exactly_twist_included():
@@ -22,7 +23,7 @@ def test_a_rigidly_moved_body_comes_back_exactly_twist_included():
     for f in range(6):  # the whole body turned about a random axis (twist of every bone) and moved
         mats[f, :, :3, :3] = Rotation.from_rotvec(rng.normal(size=3)).as_matrix().T
         mats[f, :, 3, :3] = rng.normal(size=3) * 30
-    names, positions = posed_joints(bones, mats)
+    names, positions = list(bones.joints), joint_positions(bones, mats)
     got = solve(bones, positions, names)
     assert np.abs(got - mats).max() < 1e-9
 
@@ -49,7 +50,7 @@ def test_the_walks_joints_come_back_exactly_and_the_body_nearly_so(tmp_path):
     assert "reading frames" in out.stderr and "solving bones" in back.stderr  # a clip's thousand frames take seconds
     a, _ = read_frames(tmp_path / "w", bones)
     b, _ = read_frames(tmp_path / "p", bones)
-    assert np.abs(posed_joints(bones, a)[1] - posed_joints(bones, b)[1]).max() < 1e-4  # what positions hold
+    assert np.abs(joint_positions(bones, a) - joint_positions(bones, b)).max() < 1e-4  # what positions hold
     # the twist is an estimate (joints cannot tell it): the posed body still matches the clip's closely
     conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
     for f in (1, 3):
@@ -63,7 +64,7 @@ def test_the_walks_joints_come_back_exactly_and_the_body_nearly_so(tmp_path):
 # spec: docs/formats.md#positions
 def test_missing_joints_follow_their_parent_and_bad_rows_name_their_line(tmp_path):
     bones = io.read_bones(ASSETS / "mannequin.bones")
-    names, positions = posed_joints(bones, np.tile(np.eye(4), (2, len(bones), 1, 1)))
+    names, positions = list(bones.joints), joint_positions(bones, np.tile(np.eye(4), (2, len(bones), 1, 1)))
     keep = [j for j, n in enumerate(names) if not n.startswith("L_")]  # the left side's markers fell off
     write_positions(tmp_path / "j.csv", [0, 1], [names[j] for j in keep], positions[:, keep])
     frames, read = read_positions(tmp_path / "j.csv", names)
