@@ -21,7 +21,7 @@ from volanim_core import samples  # noqa: E402
 from volanim_core.rig.attach import auto_connect  # noqa: E402
 from volanim_core.skeleton.skeletonize import skeletonize  # noqa: E402
 from volanim_studio.model import Document  # noqa: E402
-from volanim_studio.model.modes import CubeMode, LassoMode  # noqa: E402
+from volanim_studio.model.interaction import CubeMode, LassoMode  # noqa: E402
 from volanim_studio.scene.projection import project  # noqa: E402
 
 

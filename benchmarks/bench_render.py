@@ -34,9 +34,9 @@ def make_sequence(case, folder: Path, mode: str) -> Path:
 
 def per_frame(seq: Path, style: str, mapper: str = "gpu") -> float:
     """Median seconds per frame of one warm plotter (the first frame, which builds it, is not counted)."""
-    from volanim_core.render.camera import named_view
     from volanim_core.render.movie import open_inputs
     from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.render.views import named_view
     from volanim_core.sequence.checked import read_store
 
     inputs = open_inputs([seq])
@@ -60,9 +60,9 @@ def per_frame(seq: Path, style: str, mapper: str = "gpu") -> float:
 def whole_run(seq: Path, folder: Path, workers: int) -> tuple[float, float]:
     """(frames/s over the whole run, steady frames/s after each worker's first picture): worker start-up
     (a process, VTK, an OpenGL context) is paid once per run, not per frame."""
-    from volanim_core.render.camera import named_view
     from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings
+    from volanim_core.render.views import named_view
 
     inputs = open_inputs([seq])
     settings = RenderSettings(named_view("three-quarter", inputs.lo, inputs.hi), preset=inputs.mode,

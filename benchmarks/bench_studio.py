@@ -79,7 +79,7 @@ def bench_preview(app) -> None:
     its report), in the real window."""
     from volanim_core import samples
     from volanim_core.rig.attach import auto_connect
-    from volanim_studio.model.modes import Mode
+    from volanim_studio.model.interaction import Mode
     from volanim_studio.model.preview import live_factor
     from volanim_studio.qt.main_window import MainWindow
 

@@ -97,9 +97,9 @@ def tables(name: str, pose: tuple | None = None) -> tuple[str, str]:
 
 def left_leg_picture(path: Path) -> None:
     """Fig 5.1's picture: the mannequin at thinness >= 0.5 with its left leg turned, in bone colours."""
-    from volanim_core.render.camera import named_view
     from volanim_core.render.movie import write_png
     from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.render.views import named_view
 
     s = samples.load("mannequin")
     conn = connect_nearest(skeletonize(s.mask, min_thinness=0.5), s.bones)
@@ -248,8 +248,8 @@ def _strip(n: int) -> set[int]:
 
 def _cell(r) -> np.ndarray:
     """One frame of the strip: bone colours, three-quarter view (a kick and a bow show), 160 x 240."""
-    from volanim_core.render.camera import named_view
     from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.render.views import named_view
 
     lo = np.asarray(r.origin)
     camera = named_view("three-quarter", tuple(lo), tuple(lo + np.asarray(r.volume.shape) - 1), aspect=160 / 240)

@@ -46,8 +46,8 @@ def row(name: str, view: str) -> np.ndarray:
 
     from volanim_core.reconstruct.checks import report
     from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.render.camera import named_view
     from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.render.views import named_view
     from volanim_core.rig.attach import connect
     from volanim_core.rig.autorig import autorig
     from volanim_core.rig.connectivity import Trans

@@ -38,7 +38,7 @@ def palettes() -> None:
     from volanim_core.colour.alpha import black_indices, merge_maps
     from volanim_core.colour.palette import NearestColour, build_palette, unique_colours
     from volanim_core.colour.sort import remap_table, sort_palette
-    from volanim_core.render.camera import named_view
+    from volanim_core.render.views import named_view
 
     rgb = samples.mannequin_colour().volume
     camera = named_view("front", (0, 0, 0), np.array(rgb.shape[:3]) - 1)
@@ -62,7 +62,7 @@ def posed() -> None:
 
     from volanim_core import io, samples
     from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.render.camera import named_view
+    from volanim_core.render.views import named_view
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.pose import pose_matrices, root_bones
     from volanim_core.rig.tskel_tools import connect_to_tskel

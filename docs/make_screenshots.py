@@ -46,7 +46,7 @@ def main() -> None:
     from PySide6.QtWidgets import QApplication
 
     from volanim_core import samples
-    from volanim_studio.model.modes import Mode
+    from volanim_studio.model.interaction import Mode
     from volanim_studio.qt.main_window import MainWindow
 
     app = QApplication.instance() or QApplication(sys.argv[:1])
@@ -96,7 +96,7 @@ def main() -> None:
 
     # Pose: a deliberate mistake (the shoulder's points on the torso), the break, the fix
 
-    from volanim_studio.model.modes import Mode as M
+    from volanim_studio.model.interaction import Mode as M
 
     doc = w.doc
     ua, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")

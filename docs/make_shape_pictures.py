@@ -36,8 +36,8 @@ def panels(name: str, bone: str, rotation, view: str, joint: str | None) -> list
     from volanim_core import samples
     from volanim_core.posed_truth import posed_sample
     from volanim_core.reconstruct.engine import reconstruct
-    from volanim_core.render.camera import named_view
     from volanim_core.render.scene import Renderer, RenderSettings
+    from volanim_core.render.views import named_view
     from volanim_core.rig.pose import pose_matrices, posed_joints
 
     sample = samples.load(name)

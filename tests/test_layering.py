@@ -27,7 +27,7 @@ def test_core_never_imports_qt():
 
 
 def test_studio_model_never_imports_qt():
-    code = "import sys, volanim_studio.model, volanim_studio.model.modes, volanim_studio.tasks; " \
+    code = "import sys, volanim_studio.model, volanim_studio.model.interaction, volanim_studio.tasks; " \
            "print(sorted(n for n in sys.modules if n.startswith(('PySide6', 'pyvistaqt'))))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.stdout.strip() == "[]", out.stdout + out.stderr

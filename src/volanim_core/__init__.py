@@ -3,6 +3,26 @@
     volume (.vol/.VOL/.vti/...) --volume--> mask --skeletonize--> Skeleton (.mskel)
     Skeleton + BoneSkeleton (.bones) --attach--> Connectivity (.connect)
     Connectivity + pose matrices (.trans) --> Tskel (.tskel) --reconstruct--> volume
+
+The packages, lowest layer first (the ``core-layers`` contract in pyproject.toml keeps each importing
+only those below it): skeleton/, rig/, io/, colour/, reconstruct/ and motion/, sequence/ and render/,
+cli/. The modules beside them:
+
+    errors.py ............ the exceptions every layer raises (FormatError names file and line)
+    limits.py ............ input size limits, checked from a header before anything is allocated
+    progress.py .......... progress and cancel without Qt (Reporter, TextProgress)
+    geometry.py .......... where each voxel is in physical space: spacing, origin, direction
+    modes.py ............. the reconstruction modes' names
+    camera.py ............ a camera as plain data; transfer_function.py: value -> colour and opacity
+    isosurface.py ........ an isosurface as plain arrays (VTK's flying edges) for code below render/
+    memo.py .............. a few recent results kept by a hash of their inputs
+    parallel.py .......... where many tasks run: this process, a spawn pool, or a Dask cluster
+    volume.py ............ the old pipeline's volume tools as pure functions, and the value helpers
+    mannequin_body.py .... the mannequin's analytic body: bones and a tapered capsule per bone
+    posed_truth.py ....... the mannequin's true shape in any pose (what volanim compare scores against)
+    samples.py ........... demo data: the mannequins, the aliascube, the frog; ant_sample.py: the ant
+    warmup.py ............ every numba kernel compiled once on tiny inputs
+    pipeline_demo.py ..... the headless demo behind make demo and volanim demo
 """
 
 __version__ = "0.1.0"

@@ -4,7 +4,7 @@
     Camera --apply--> a ``vtkCamera``; a ``vtkCamera`` --Camera.of--> Camera (duck-typed: no VTK import)
 
 Here, below ``render/``, so that ``io`` reads and writes camera files without importing the renderer
-(the ``core-layers`` contract, pyproject.toml); the named views and the follow camera are in ``render/camera.py``.
+(the ``core-layers`` contract, pyproject.toml); the named views and the follow camera are in ``render/views.py``.
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
     if scheduler is not None:
         from distributed import Client
 
-        client = scheduler if isinstance(scheduler, Client) else connect(scheduler)
+        client = scheduler if isinstance(scheduler, Client) else dask_client(scheduler)
         try:
             shared = client.scatter(payload, broadcast=True, hash=False)  # shipped to each worker once
             ex = client.get_executor(pure=False)
@@ -62,7 +62,7 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def connect(address: str):
+def dask_client(address: str):
     """A ``distributed.Client`` of the scheduler at ``address``; one not reached (within Dask's
     ``distributed.comm.timeouts.connect``, 30 s by default) is a ConnectionError that names it."""
     from distributed import Client

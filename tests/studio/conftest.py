@@ -23,7 +23,7 @@ def front_view(window) -> None:
 def rig_and_pose(qtbot, window):
     """The mannequin's bones and attachments from assets/, the front view, then Pose mode (P)."""
     from paths import ASSETS
-    from volanim_studio.model.modes import Mode
+    from volanim_studio.model.interaction import Mode
 
     assert window.files.open_bones(ASSETS / "mannequin.bones")
     assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")

@@ -4,7 +4,7 @@ Each subcommand lives in the module of the core package it runs, with a
 ``register(subparsers)`` function; ``main`` turns library errors into one-line
 messages (exit 2) and a cancel (Ctrl+C) into exit 130, never a traceback.
 
-    volume_commands.py ....... info, convert, threshold, fill, crop, ... (volume.py, io)
+    volume_commands.py ....... info, convert, threshold, fill, crop, ... (the volume tools, io)
     skeleton_commands.py ..... skeletonize, isosurface (skeleton/)
     combine_commands.py ...... peek, onevolume, addskel (volumes with skeletons)
     rig_commands.py .......... autorig, connect, pose, straighten, the .tskel tools, mirror (rig/)

@@ -91,8 +91,8 @@ def _render(args):
 
 def register(sub) -> None:
     from volanim_core.reconstruct.engine import MODES
-    from volanim_core.render.camera import VIEWS
     from volanim_core.render.scene import MAPPERS, STYLES
+    from volanim_core.render.views import VIEWS
 
     from .motion_commands import parse_frames
 

@@ -77,8 +77,8 @@ def _view_slices(args):
 
 def register(sub) -> None:
     from volanim_core.reconstruct.engine import MODES
-    from volanim_core.render.camera import VIEWS
     from volanim_core.render.scene import STYLES
+    from volanim_core.render.views import VIEWS
 
     from .render_commands import parse_size
 

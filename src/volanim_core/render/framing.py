@@ -2,7 +2,7 @@
 
     RenderInputs (render/movie.py) + a view name or a Camera or "follow" --place_camera--> (Camera, inputs)
 
-Apart from camera.py (views and cameras from boxes: no frames, no files) so that camera.py never reads the
+Apart from views.py (views and cameras from boxes: no frames, no files) so that views.py never reads the
 movie's inputs; the movie, the quick look, the demo and ``volanim render`` call this.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from .camera import Camera, named_view
+from .views import Camera, named_view
 
 if TYPE_CHECKING:
     from .movie import RenderInputs

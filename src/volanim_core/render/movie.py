@@ -26,8 +26,8 @@ import numpy as np
 from volanim_core.io.files import resolved
 from volanim_core.parallel import executor
 
-from .camera import Camera, union_box
 from .scene import Renderer, RenderSettings
+from .views import Camera, union_box
 
 KEY_FILE = "volanim-render.json"
 MOVIES = (".mp4", ".gif")
@@ -64,7 +64,7 @@ class RenderInputs:
     def follow(self, view: str, aspect: float, axes=None, base: Camera | None = None) -> list[FrameRef]:
         """The frames, each with a camera that keeps its body in the middle (:func:`follow_cameras`; ``base``:
         a camera whose direction and distance every frame keeps, e.g. the studio's view)."""
-        from .camera import follow_cameras
+        from .views import follow_cameras
 
         boxes = self.boxes or [(self.lo, self.hi)] * len(self.frames)
         world = [None if b is None else self.world_box(b) for b in boxes]

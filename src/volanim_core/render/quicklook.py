@@ -40,9 +40,9 @@ def read_look(path, *, style: str = "surface", preset: str | None = None, view: 
     its preset (a colour volume by its luminance; a colour sequence's frame likewise, through its palette)."""
     from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh
 
-    from .camera import named_view
     from .framing import place_camera
     from .movie import open_inputs, read_frame
+    from .views import named_view
 
     path = Path(path)
     w, h = size

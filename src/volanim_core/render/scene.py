@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.render.bone_colours import SKIN, rgb
-from volanim_core.render.camera import Camera
+from volanim_core.render.views import Camera
 from volanim_core.render.volume_style import (
     LABEL_MODES,
     add_volume_uncopied,

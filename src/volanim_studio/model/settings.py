@@ -17,6 +17,9 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
+from volanim_core.modes import MODES
+from volanim_core.rig.attach import METHODS
+
 from .events import EventEmitter
 from .selection import DEPTH_MODES
 
@@ -33,9 +36,10 @@ class Mode(StrEnum):
 
 
 COLOUR_BY = ("thinness", "dt", "bone")
-PREVIEW_MODES = ("bone", "binary", "mottled", "hotspot", "sampled")
+# the core's names, the studio's default first: a preview in bone colours; auto-connect by a path inside
+PREVIEW_MODES = ("bone", *(m for m in MODES if m != "bone"))
 AUTO_SCOPES = ("unconnected", "all", "selection")
-AUTO_METHODS = ("path", "path-or-nearest", "nearest", "geodesic", "fitted", "pieces")
+AUTO_METHODS = ("path", *(m for m in METHODS if m != "path"))
 
 
 def one_of(*choices) -> Callable[[str, Any], Any]:

@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (
 )
 
 from ..model.document import Document
-from ..model.modes import CubeMode
+from ..model.interaction import CubeMode
 from ..model.settings import AUTO_METHODS, AUTO_SCOPES, DEPTH_MODES
 from .bindings import bind
 

@@ -23,7 +23,7 @@ from PySide6.QtWidgets import (
 from pyvistaqt import QtInteractor
 
 from ..model.document import Document
-from ..model.modes import HANDLERS, Mode, PickEvent
+from ..model.interaction import HANDLERS, Mode, PickEvent
 from ..scene.view import SceneView
 from ..shortcuts import SHORTCUTS
 from .bone_panel import BonePanel

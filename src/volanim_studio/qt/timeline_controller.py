@@ -23,7 +23,7 @@ from volanim_core import io
 from volanim_core.io.bvh_files import read_bvh
 from volanim_core.io.frame_files import read_frames, write_frames
 from volanim_core.reconstruct.scan import scan_frames, scan_summary, worst_first
-from volanim_core.render.camera import Camera
+from volanim_core.render.views import Camera
 
 from ..model.settings import Mode
 from .controller import FAILED, Controller

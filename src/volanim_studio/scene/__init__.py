@@ -1,7 +1,13 @@
 """The rendering layer: VTK actors that follow model events (no widgets, no edits).
 
-    view.py ......... SceneView: hull, cloud, bones, joints, picking
-    pose_layer.py ... posed bones and preview reconstructions
-    overlays.py ..... the connect cube and the lasso outline
-    projection.py ... world -> display pixels with the renderer's own matrices (picking)
+view.py ......... SceneView: the point cloud and picking; composes the layers below
+hull_layer.py ... the translucent hull with its clipping plane
+bones_layer.py .. the rest pose's bones, their joints and the selected bones' halo
+names_layer.py .. joint names (label_layout.py: where each goes, none over another), the name under
+                  the cursor, the bone being built
+pose_layer.py ... posed bones and preview reconstructions
+xray_layer.py ... actors drawn over everything (the posed bones through the preview)
+overlays.py ..... the connect cube and the lasso outline
+projection.py ... world -> display pixels with the renderer's own matrices (picking)
+camera_moves.py . the plotter's camera: named views, framing, saved state
 """

@@ -20,8 +20,8 @@ from volanim_core.render.bone_colours import label_table, scalar_colours
 from volanim_core.render.scene import reset_clipping
 
 from ..model.document import Document
-from ..model.modes import PickEvent
-from . import camera
+from ..model.interaction import PickEvent
+from . import camera_moves
 from .bones_layer import BonesLayer
 from .hull_layer import HullLayer
 from .names_layer import ACTORS as NAME_ACTORS
@@ -118,7 +118,7 @@ class SceneView:
 
     def project_world(self, world_points) -> tuple[np.ndarray, np.ndarray]:
         """Display pixels (device, bottom-left origin) and depth of world points."""
-        matrix, viewport = camera.composite_matrix(self.plotter.renderer)
+        matrix, viewport = camera_moves.composite_matrix(self.plotter.renderer)
         return project(world_points, matrix, viewport)
 
     def display_of_point(self, index: int) -> np.ndarray:
@@ -129,13 +129,13 @@ class SceneView:
         """``(shown indices, display xy, normalised depth, distance along the view)`` of the shown points."""
         world = self._world[self._shown].astype(np.float64)
         xy, depth = self.project_world(world)
-        return self._shown, xy, depth, camera.view_distances(self.plotter.renderer, world)
+        return self._shown, xy, depth, camera_moves.view_distances(self.plotter.renderer, world)
 
     def camera(self) -> dict:  # the view's camera as plain lists (saved in projects)
-        return camera.camera_state(self.plotter.renderer)
+        return camera_moves.camera_state(self.plotter.renderer)
 
     def set_camera(self, data: dict) -> None:
-        camera.set_camera_state(self.plotter.renderer, data)
+        camera_moves.set_camera_state(self.plotter.renderer, data)
         self.render()
 
     def front_view(self) -> None:  # the front of the object (stood up by its shape), everything in view
@@ -147,11 +147,11 @@ class SceneView:
         shape = (self._world.min(0), self._world.max(0)) if len(self._world) else None
         box = self.doc.pose.posed_box() if self.posing else None
         box = None if box is None else (self.world(box[0]), self.world(box[1]))
-        if camera.preset_view(self.plotter.renderer, name, box, shape):
+        if camera_moves.preset_view(self.plotter.renderer, name, box, shape):
             self.render()
 
     def frame_all(self) -> None:
-        if camera.frame(self.plotter.renderer):
+        if camera_moves.frame(self.plotter.renderer):
             self.render()
 
     def shown_joints(self) -> dict:  # joints as drawn: where the pose put them in Pose mode, else at rest
@@ -172,12 +172,12 @@ class SceneView:
         if not len(pts):
             return False
         world = self.world(pts)
-        camera.frame(self.plotter.renderer, world.min(0), world.max(0))
+        camera_moves.frame(self.plotter.renderer, world.min(0), world.max(0))
         self.render()
         return True
 
     def jump_to(self, voxel_xyz) -> None:  # centre the view on a point and move closer
-        camera.move_closer_to(self.plotter.renderer, self.world(voxel_xyz))
+        camera_moves.move_closer_to(self.plotter.renderer, self.world(voxel_xyz))
         self.render()
 
     def pixel_ratio(self) -> float:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from volanim_core.render.camera import named_view, natural_axes
+from volanim_core.render.views import named_view, natural_axes
 
 
 def _look(cam) -> np.ndarray:

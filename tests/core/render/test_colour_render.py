@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from test_render import H, W, ball, lit
 
-from volanim_core.render.camera import Camera
 from volanim_core.render.scene import Renderer, RenderSettings
+from volanim_core.render.views import Camera
 
 
 @pytest.mark.parametrize(("style", "mapper"), [("volume", "gpu"), ("volume", "cpu"), ("surface", "gpu")])

@@ -17,10 +17,10 @@ from picture_oracle import compare, foreground, silhouette
 from volanim_core import io, samples
 from volanim_core.camera import Camera
 from volanim_core.geometry import Geometry
-from volanim_core.render.camera import VIEWS
 from volanim_core.render.framing import place_camera
 from volanim_core.render.movie import open_inputs, read_frame, render
 from volanim_core.render.scene import RenderSettings
+from volanim_core.render.views import VIEWS
 from volanim_core.sequence import store
 
 SIZE = (320, 240)

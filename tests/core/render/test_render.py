@@ -14,9 +14,9 @@ from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
 from volanim_core.geometry import Geometry
-from volanim_core.render.camera import Camera, named_view
 from volanim_core.render.movie import frame_path, open_inputs, render
 from volanim_core.render.scene import Renderer, RenderSettings
+from volanim_core.render.views import Camera, named_view
 from volanim_core.sequence import store
 from volanim_core.transfer_function import TransferFunction
 

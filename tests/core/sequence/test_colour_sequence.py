@@ -16,9 +16,9 @@ from volanim_core.colour.indexed import index_colours
 from volanim_core.colour.space import delta_e
 from volanim_core.errors import FormatError
 from volanim_core.reconstruct.engine import reconstruct
-from volanim_core.render.camera import named_view
 from volanim_core.render.movie import open_inputs, read_frame, render
 from volanim_core.render.scene import Renderer, RenderSettings
+from volanim_core.render.views import named_view
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.frames import frames_from_files

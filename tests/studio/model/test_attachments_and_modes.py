@@ -7,7 +7,7 @@ import pytest
 
 from volanim_core import io, samples
 from volanim_studio.model import Document
-from volanim_studio.model.modes import CubeMode, LassoMode, PickEvent
+from volanim_studio.model.interaction import CubeMode, LassoMode, PickEvent
 from volanim_studio.model.selection import in_cube, in_polygon, select_lasso, visible_mask
 
 

@@ -8,7 +8,7 @@ import pytest
 from volanim_core import io, samples
 from volanim_core.errors import FormatError
 from volanim_studio.model import Document
-from volanim_studio.model.modes import BonesMode, PickEvent, RootOrderMode
+from volanim_studio.model.interaction import BonesMode, PickEvent, RootOrderMode
 from volanim_studio.model.project import read_project
 
 

@@ -41,3 +41,14 @@ def test_update_applies_what_is_valid_and_reports_the_rest():
     refused = s.update({"cube_size": 20, "preview_mode": "weird", "nonsense": 1})
     assert s.cube_size == 20 and s.preview_mode == "bone"
     assert len(refused) == 2 and any("nonsense" in r for r in refused)
+
+
+def test_the_studio_offers_exactly_the_core_s_modes_and_attachment_methods():
+    """One list each (#68): a mode or method the core adds shows in the studio's menus, a name the core drops
+    cannot linger there."""
+    from volanim_core.modes import MODES
+    from volanim_core.rig.attach import METHODS
+    from volanim_studio.model.settings import AUTO_METHODS, PREVIEW_MODES, SETTINGS
+
+    assert sorted(PREVIEW_MODES) == sorted(MODES) and sorted(AUTO_METHODS) == sorted(METHODS)
+    assert PREVIEW_MODES[0] == SETTINGS["preview_mode"].default and AUTO_METHODS[0] == SETTINGS["auto_method"].default

@@ -14,7 +14,7 @@ from PySide6.QtCore import Qt
 
 from paths import ASSETS
 from volanim_core import io, samples
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 
 from ..conftest import click, clickable_point, front_view, open_project
 

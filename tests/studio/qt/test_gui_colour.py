@@ -10,7 +10,7 @@ from PySide6.QtCore import Qt
 from paths import ASSETS
 from volanim_core import io, samples
 from volanim_core.reconstruct.engine import reconstruct
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 
 from ..conftest import JOB_TIMEOUT_MS
 

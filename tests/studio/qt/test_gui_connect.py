@@ -16,7 +16,7 @@ from paths import ASSETS
 from volanim_core import io, samples
 from volanim_core.render.bone_colours import label_table
 from volanim_core.skeleton.points import Skeleton
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 from volanim_studio.model.project import read_project
 
 from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view, open_project

@@ -11,7 +11,7 @@ from PySide6.QtWidgets import QMessageBox
 from paths import ASSETS
 from volanim_core import io
 from volanim_studio.model import autosave
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 from volanim_studio.model.project import read_project
 
 from ..conftest import JOB_TIMEOUT_MS, open_project

@@ -7,7 +7,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from volanim_core import samples
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 
 from ..conftest import click, clickable_point, qt_pos
 

@@ -8,7 +8,7 @@ from PySide6.QtCore import QPoint, Qt
 
 from paths import ASSETS
 from volanim_core import samples
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 
 from ..conftest import click, clickable_point
 

@@ -9,7 +9,7 @@ import pytest
 from picture_oracle import compare, foreground, mask_region, silhouette
 from volanim_core import io, samples
 from volanim_core.render.bone_colours import rgb
-from volanim_core.render.camera import Camera
+from volanim_core.render.views import Camera
 
 from ..conftest import JOB_TIMEOUT_MS, rig_and_pose
 

@@ -10,7 +10,7 @@ from PySide6.QtWidgets import QPushButton
 from volanim_core import samples
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.render.volume_style import gl_renderer, software_gl
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 from volanim_studio.qt.verdict_label import CHECKING
 
 from ..conftest import JOB_TIMEOUT_MS, rig_and_pose

@@ -60,7 +60,7 @@ def test_propose_on_the_ant_accept_connect_and_pose_a_leg_healthy(qtbot, window,
     import numpy as np
 
     from volanim_core.cli import main
-    from volanim_studio.model.modes import Mode
+    from volanim_studio.model.interaction import Mode
 
     from ..conftest import JOB_TIMEOUT_MS
     from .test_gui_pose import drag

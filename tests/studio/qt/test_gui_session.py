@@ -6,7 +6,7 @@ import numpy as np
 from PySide6.QtCore import Qt
 
 from paths import ASSETS
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 
 from ..conftest import JOB_TIMEOUT_MS, new_window, open_project, rig_and_pose
 

@@ -10,7 +10,7 @@ from PySide6.QtCore import Qt
 from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT licence
 from runnable import run_in_process
 from volanim_core import io
-from volanim_studio.model.modes import Mode
+from volanim_studio.model.interaction import Mode
 from volanim_studio.qt.mapping_dialog import UNMAPPED
 
 from ..conftest import JOB_TIMEOUT_MS
@@ -169,7 +169,7 @@ def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
 def test_render_a_movie_of_the_keys_with_the_views_camera_and_save_the_view(qtbot, rigged, tmp_path):
     import imageio.v3 as iio
 
-    from volanim_core.render.camera import Camera
+    from volanim_core.render.views import Camera
 
     w = rigged
     doc = w.doc

@@ -11,7 +11,7 @@ from PySide6.QtCore import QPoint, Qt
 from picture_oracle import compare, foreground, silhouette
 from volanim_core import io, samples
 from volanim_core.render.bone_colours import rgb
-from volanim_core.render.camera import Camera
+from volanim_core.render.views import Camera
 from volanim_core.transfer_function import TransferFunction
 
 from ..conftest import JOB_TIMEOUT_MS, rig_and_pose, viewer_opened

@@ -16,12 +16,12 @@ def composite_matrix(renderer) -> tuple[np.ndarray, tuple[float, float, float, f
 
 
 def preset_view(renderer, name: str = "front", box=None, shape=None) -> bool:
-    """Look from a named direction (``volanim_core.render.camera.VIEWS``) at the world box ``box``
+    """Look from a named direction (``volanim_core.render.views.VIEWS``) at the world box ``box``
     (``(lo, hi)``; default: everything drawn), the object stood up by the shape of the box ``shape``
     (default ``box``; ``natural_axes``: the frog lies flat, the mannequin stands).
 
     Returns False when nothing is visible (the camera is left alone)."""
-    from volanim_core.render.camera import named_view, natural_axes
+    from volanim_core.render.views import named_view, natural_axes
 
     if box is None:
         b = visible_bounds(renderer)  # the x-ray layer's posed bones too
