@@ -6,6 +6,7 @@
                       against larger, power plane against smaller), in its own frame, with the margin
     slice_lists       bucket spheres by the output z-slices they overlap, keeping file order
                       inside each slice (that order is the tie-break)
+    snapped_squares   the radii squared as the kernels compare them (radii.py)
 """
 
 from __future__ import annotations
@@ -120,3 +121,15 @@ def slice_lists(zlo, zhi, nz):
             ids[fill[z]] = i
             fill[z] += 1
     return offsets, ids
+
+
+@njit(cache=True)
+def snapped_squares(dt):
+    """``dt**2`` per sphere, snapped to the nearest integer within 1e-9 (relative): radii.py's kernel."""
+    # one pass: the NumPy expression made five temporaries the size of the frog's 137 k radii
+    out = np.empty(len(dt))
+    for i in range(len(dt)):
+        r2 = dt[i] * dt[i]
+        near = np.rint(r2)
+        out[i] = near if abs(r2 - near) <= 1e-9 * max(1.0, r2) else r2
+    return out
