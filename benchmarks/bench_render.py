@@ -24,11 +24,11 @@ from bench_sequence import frog_case, machine_scaling, mannequin_case  # noqa: E
 
 
 def make_sequence(case, folder: Path, mode: str) -> Path:
-    from volanim_core.sequence.run import run_sequence
+    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
 
     name, conn, frames, source = case
     out = folder / f"{name.split()[0]}.zarr"
-    run_sequence(conn, frames, out, mode=mode, source=source, workers=2)
+    run_sequence(conn, frames, out, SequenceSettings(mode=mode, source=source), on=RunOn(workers=2))
     return out
 
 

@@ -98,12 +98,13 @@ def steady_rate(records: list[dict]) -> float:
 
 
 def run(case, folder: Path, **where) -> dict:
-    from volanim_core.sequence.run import run_sequence
+    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
 
     name, conn, frames, source = case
     out = folder / "s.zarr"
     before = _helper_cpu()
-    rep = run_sequence(conn, frames, out, mode="sampled", source=source, force=True, **where)
+    rep = run_sequence(conn, frames, out, SequenceSettings(mode="sampled", source=source), on=RunOn(**where),
+                       existing="redo")
     helpers = _helper_cpu() - before
     size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
     shutil.rmtree(out)

@@ -164,13 +164,13 @@ def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Pat
     from volanim_core.parallel import default_workers
     from volanim_core.sequence.effects import crumble
     from volanim_core.sequence.frames import FrameSpec
-    from volanim_core.sequence.run import run_sequence
+    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
 
     numbers = range(retarget.motion.frames)[frames]
     specs = [FrameSpec(n, m) for n, m in zip(numbers, retarget.matrices(frames))]
     specs += crumble(specs, 10)
-    rep = run_sequence(conn, specs, out, mode="sampled", source=source, workers=min(default_workers(), 4),
-                       fps=20.0)
+    rep = run_sequence(conn, specs, out, SequenceSettings(mode="sampled", source=source, fps=20.0),
+                       on=RunOn(workers=min(default_workers(), 4)))
     grid = "x".join(map(str, rep.bounds.shape))
     _say(f"[7] sequence: {len(specs) - 10} frames of one walk cycle and 10 of crumbling, one {grid} grid "
          f"at origin {rep.bounds.lo}, {rep.workers}, {rep.seconds:.1f} s ({rep.computed} made, {rep.skipped} "

@@ -7,6 +7,7 @@ work; nothing here knows a window exists.
 
 from __future__ import annotations
 
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -20,8 +21,27 @@ from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 from volanim_core.volume import is_colour, isotropic_mask, resample, segment, to_grey
 
 
-def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: bool, metric: str = "euclid",
-                   min_thinness: float = DEFAULT_MIN_THINNESS, skeleton_path=None, grey=None, geometry=None,
+@dataclass(frozen=True)
+class Segmentation:
+    """How a scan is segmented and skeletonized: ``volanim skeletonize``'s ``--threshold LO[:HI]``,
+    ``--fill-cavities``, ``--metric`` and ``--min-thinness`` (a project saves them as a dict)."""
+
+    lo: float
+    hi: float | None = None
+    fill: bool = False
+    metric: str = "euclid"
+    min_thinness: float = DEFAULT_MIN_THINNESS
+
+    @classmethod
+    def of(cls, params: dict) -> Segmentation:
+        """The segmentation a dialog's or a project's parameters hold (other keys ignored)."""
+        return cls(**{f.name: params[f.name] for f in fields(cls) if f.name in params})
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def prepare_volume(volume: np.ndarray, segmentation: Segmentation, *, skeleton_path=None, grey=None, geometry=None,
                    progress=None, cancel=None) -> dict:
     """Segment, skeletonize and isosurface a loaded volume.
 
@@ -37,7 +57,8 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     report(0, 100)
     if grey is None:  # a colour scan is segmented on its luminance
         grey = to_grey(volume) if is_colour(volume) else volume
-    mask = segment(grey, lo, hi, fill=fill)  # the command line's own segmentation
+    lo, hi = segmentation.lo, segmentation.hi
+    mask = segment(grey, lo, hi, fill=segmentation.fill)  # the command line's own segmentation
     if not mask.any():
         raise ValueError(f"no voxel lies in the threshold range {lo}..{hi if hi is not None else 'max'}")
     report(5, 100)
@@ -50,14 +71,15 @@ def prepare_volume(volume: np.ndarray, *, lo: float, hi: float | None, fill: boo
     if skeleton_path:
         skel = read_skeleton(skeleton_path).one_level()
     else:
-        skel = skeletonize(mask, metric=metric, min_thinness=min_thinness, geometry=geometry or IDENTITY,
+        skel = skeletonize(mask, metric=segmentation.metric, min_thinness=segmentation.min_thinness,
+                           geometry=geometry or IDENTITY,
                            progress=stage(report, 10, 80), cancel=cancel)
     report(80, 100)
     hull, lod = display_hulls(mask)  # lod: drawn while a slider is held
     report(100, 100)
     return {"volume": volume, "mask": mask, "skeleton": skel, "hull": hull, "hull_lod": lod,
             "skeleton_path": skeleton_path, "geometry": geometry,
-            "segmentation": {"lo": lo, "hi": hi, "fill": fill, "metric": metric, "min_thinness": min_thinness}}
+            "segmentation": segmentation.as_dict()}
 
 
 def on_grid(volume: np.ndarray, geometry, target) -> np.ndarray:
@@ -94,26 +116,45 @@ def load_volume_file(path: str, dims=None, series: str | None = None) -> dict:
 def load_demo(name: str, *, skeleton_path=None, progress=None, cancel=None) -> dict:
     """A demo dataset, segmented, skeletonized (or its saved ``.mskel`` read) and with its hull."""
     s = samples.load(name)
-    out = prepare_volume(s.volume, lo=s.mask_level, hi=None, fill=False, skeleton_path=skeleton_path,
-                         progress=progress, cancel=cancel)
+    out = prepare_volume(s.volume, Segmentation(lo=s.mask_level), skeleton_path=skeleton_path, progress=progress,
+                         cancel=cancel)
     out.update(spacing=s.spacing, sample=s)
     return out
 
 
-def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, kernel: int = 1, spacing=(1.0, 1.0, 1.0),
-                 style: str = "surface", size=(640, 480), fps: float = 24.0, frame_numbers: bool = False,
-                 background: str = "#1e1f24", workers: int | None = None, follow: bool = False, transfer=None,
-                 progress=None, cancel=None) -> dict:
+@dataclass(frozen=True)
+class MovieSettings:
+    """How the studio's movie is made: the preview's mode (and the scan ``source`` it samples, with its
+    ``kernel``), the view's ``camera`` in a world of ``spacing`` units, the picture's ``style``, ``size``,
+    ``background`` and ``frame_numbers``, the ``fps``, ``follow`` (the camera moved with the body) and the
+    user's ``transfer`` function; ``workers``: processes (default: the machine's)."""
+
+    mode: str
+    camera: object  # a volanim_core.camera.Camera
+    source: np.ndarray | None = None
+    kernel: int = 1
+    spacing: tuple = (1.0, 1.0, 1.0)
+    style: str = "surface"
+    size: tuple = (640, 480)
+    fps: float = 24.0
+    frame_numbers: bool = False
+    background: str = "#1e1f24"
+    follow: bool = False
+    transfer: object = None  # a volanim_core.transfer_function.TransferFunction
+    workers: int | None = None
+
+
+def render_movie(conn, matrices, numbers, out, settings: MovieSettings, *, progress=None, cancel=None) -> dict:
     """The timeline's frames reconstructed (a sequence in one grid) and rendered to ``out`` with the
     studio's camera: the command line's ``volanim sequence`` + ``volanim render``, in worker processes.
 
-    ``follow``: each frame's camera is ``camera`` moved with the body (``RenderInputs.follow``: its
+    ``settings.follow``: each frame's camera is ``camera`` moved with the body (``RenderInputs.follow``: its
     direction and distance kept, centred on the frame's smoothed filled box), as the timeline follows it.
 
     A colour ``source`` gives a colour movie: the sequence holds its palette indices and the render draws
     them in the palette's colours (:mod:`volanim_core.colour.indexed`).
 
-    ``transfer``: the user's transfer function (the studio's editor) instead of the mode's colours; over a
+    ``settings.transfer``: the user's transfer function (the studio's editor) instead of the mode's colours; over a
     colour movie it reads each voxel's luminance, as the preview does (``through_palette``).
 
     The sequence is kept beside the movie (``.NAME.zarr``) until the movie is written, and the render's
@@ -130,9 +171,11 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, ker
     from volanim_core.render.scene import RenderSettings
     from volanim_core.sequence.checked import read_store
     from volanim_core.sequence.frames import FrameSpec
-    from volanim_core.sequence.run import run_sequence
+    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
 
     t0 = time.perf_counter()
+    mode, source, camera, spacing = settings.mode, settings.source, settings.camera, settings.spacing
+    size, fps, transfer = settings.size, settings.fps, settings.transfer
     report = Reporter(progress, cancel)
     out = Path(out)
     kind = output_kind(out)  # a bad name is refused before anything runs
@@ -144,20 +187,20 @@ def render_movie(conn, matrices, numbers, out, *, mode: str, source, camera, ker
     total = 2 * len(frames)
     report(0, total)
     cache = out.parent / f".{out.name}.zarr"  # the same frames resume; another pose replaces it
-    workers = workers or default_workers()
-    seq = run_sequence(conn, frames, cache, mode=mode, source=source if mode == "sampled" else None, kernel=kernel,
-                       fps=fps, workers=workers, replace_other=True,
+    workers = settings.workers or default_workers()
+    how = SequenceSettings(mode=mode, source=source if mode == "sampled" else None, kernel=settings.kernel, fps=fps)
+    seq = run_sequence(conn, frames, cache, how, on=RunOn(workers=workers), existing="replace-other",
                        on_frame=lambda rec, done, n: report(done, total))
     inputs = replace(open_inputs([cache]), spacing=tuple(float(s) for s in spacing))  # the studio's world
-    if follow:
+    if settings.follow:
         inputs = replace(inputs, frames=inputs.follow("front", size[0] / size[1], base=camera))
     palette = read_store(cache).palette if transfer is not None else None
     if palette is not None:
         transfer = through_palette(transfer, palette)  # the frames hold indices: the function of their colours
-    settings = RenderSettings(camera, style=style, preset=mode, vmax=inputs.vmax, size=tuple(size),
-                              background=background, frame_numbers=frame_numbers, transfer=transfer,
-                              spacing=tuple(float(s) for s in spacing))
-    rep = render(inputs, settings, out, fps=fps, workers=workers, isolate=True,
+    look = RenderSettings(camera, style=settings.style, preset=mode, vmax=inputs.vmax, size=tuple(size),
+                          background=settings.background, frame_numbers=settings.frame_numbers, transfer=transfer,
+                          spacing=tuple(float(s) for s in spacing))
+    rep = render(inputs, look, out, fps=fps, workers=workers, isolate=True,
                  on_frame=lambda number, done, n: report(len(frames) + done, total))
     shutil.rmtree(cache, ignore_errors=True)
     return {"out": out, "frames": len(frames), "seconds": time.perf_counter() - t0, "workers": rep.workers,

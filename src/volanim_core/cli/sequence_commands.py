@@ -40,7 +40,7 @@ def _sequence(args):
     from volanim_core.io.mapping_files import read_mapping
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
-    from volanim_core.sequence.run import run_sequence
+    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
 
     conn = joints_of(args, read_connect(args.connect))
     bones = read_bones(args.bones) if args.bones else None
@@ -59,10 +59,11 @@ def _sequence(args):
         frames += teleport(conn, frames, args.teleport, down=args.down)
     source, source_geometry = load_source(args, conn, colour=True)  # a colour scan: a colour sequence
     workers = local_workers(args)
-    rep = run_sequence(conn, frames, args.output, mode=args.mode, source=source, source_geometry=source_geometry,
-                       kernel=args.kernel, padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as,
-                       workers=workers, scheduler=args.scheduler, force=args.force,
-                       threads_per_worker=args.threads_per_worker, on_frame=FrameProgress())
+    settings = SequenceSettings(mode=args.mode, source=source, source_geometry=source_geometry, kernel=args.kernel,
+                                padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as)
+    on = RunOn(workers=workers, scheduler=args.scheduler, threads_per_worker=args.threads_per_worker)
+    rep = run_sequence(conn, frames, args.output, settings, on=on, existing="redo" if args.force else "resume",
+                       on_frame=FrameProgress())
     print(file=sys.stderr)
     print(format_report(rep))
     from volanim_core.sequence.store import ome_scale

@@ -138,26 +138,57 @@ def check_memory(bounds: Bounds, dtype: np.dtype, workers: int, source) -> int:
     return per_frame
 
 
-def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, *, mode: str = "binary", source=None,
-                 source_geometry=None, kernel: int = 1, padding: int = 2, fps: float = 24.0,
-                 every_frame_as: str | None = None, workers: int | None = None, scheduler=None,
-                 force: bool = False, replace_other: bool = False, threads_per_worker: int = 1,
-                 on_frame=None, frame_seconds=None) -> SequenceReport:
+@dataclass(frozen=True)
+class SequenceSettings:
+    """What every frame of a sequence is: reconstructed in ``mode`` (``sampled`` reads ``source``, whose voxels
+    lie where ``source_geometry`` says, through a ``kernel``), on one grid ``padding`` voxels round every
+    body, at ``fps``; ``every_frame_as``: each frame also written as a volume (``frame.%04d.vti``).
+    ``volanim sequence``'s options of the same names."""
+
+    mode: str = "binary"
+    source: np.ndarray | None = None
+    source_geometry: object = None  # a volanim_core.geometry.Geometry
+    kernel: int = 1
+    padding: int = 2
+    fps: float = 24.0
+    every_frame_as: str | None = None
+
+
+@dataclass(frozen=True)
+class RunOn:
+    """Where a sequence's frames are made: ``workers`` local processes (one: this process), or the Dask
+    ``scheduler`` at an address (``tcp://HOST:PORT``) or a ``distributed.Client``; numba threads per worker."""
+
+    workers: int | None = None
+    scheduler: object = None
+    threads_per_worker: int = 1
+
+
+EXISTING = ("resume", "replace-other", "redo")
+
+
+def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: SequenceSettings = SequenceSettings(),
+                 *, on: RunOn = RunOn(), existing: str = "resume", on_frame=None,
+                 frame_seconds=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
-    ``source_geometry``: where the source's voxels are (:func:`~volanim_core.reconstruct.reconstruct`); the store
-    records the
-    frames' geometry (``conn.geometry`` at the shared grid's origin) in physical units.
-    ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or a ``distributed.Client``.
+    The store records the frames' geometry (``conn.geometry`` at the shared grid's origin) in physical units.
+    ``existing``: what a store already at ``out`` gets. ``resume`` (default): the same sequence's finished
+    frames are kept and the rest made; another sequence there is refused. ``replace-other``: the same, but
+    another sequence is replaced (a cache, like the studio's movie). ``redo`` (``--force``): made again.
     ``on_frame(record, done, total)`` after each finished frame (progress).
-    ``replace_other``: a store of another sequence at ``out`` is replaced instead of refused (a
-    cache, like the studio's movie); the same sequence still resumes, and ``--force`` redoes it.
     ``frame_seconds(record) -> float``: what a finished frame cost, for sizing Dask's tasks
     (``frames_per_task``); default the ``seconds`` its worker measured. The frames never depend on
     it; a test passes a constant, so the tasks are known whatever the machine's load.
     """
     if not frames:
         raise ValueError("no frames to reconstruct")
+    if existing not in EXISTING:
+        raise ValueError(f"existing must be one of {', '.join(EXISTING)}, got {existing!r}")
+    mode, source, source_geometry, kernel = settings.mode, settings.source, settings.source_geometry, settings.kernel
+    padding, fps, every_frame_as = settings.padding, settings.fps, settings.every_frame_as
+    workers, scheduler, threads_per_worker = on.workers, on.scheduler, on.threads_per_worker
+    force, replace_other = existing == "redo", existing == "replace-other"
     for name, value in (("workers", workers), ("threads per worker", threads_per_worker)):
         if value is not None and value < 1:
             raise ValueError(f"{name} must be 1 or more, got {value}")

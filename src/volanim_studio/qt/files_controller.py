@@ -190,10 +190,10 @@ class FilesController(Controller):
     def _prepare(self, loaded: dict, params: dict, skeleton_path, progress, cancel) -> dict:
         """A volume just read, segmented by ``params`` (the dialog's, or a project's) and skeletonized
         (in a worker): :func:`tasks.prepare_volume` on the voxel size the user confirmed."""
-        args = {k: v for k, v in params.items() if k not in ("series", "spacing")}
-        return tasks.prepare_volume(loaded["volume"], skeleton_path=skeleton_path, progress=progress, cancel=cancel,
+        return tasks.prepare_volume(loaded["volume"], tasks.Segmentation.of(params), skeleton_path=skeleton_path,
                                     grey=loaded["grey"],
-                                    geometry=loaded["geometry"].with_spacing(self._spacing(loaded, params)), **args)
+                                    geometry=loaded["geometry"].with_spacing(self._spacing(loaded, params)),
+                                    progress=progress, cancel=cancel)
 
     def _apply_volume(self, r: dict, path, dims, spacing, series, then) -> None:
         r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none

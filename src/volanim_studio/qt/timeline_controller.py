@@ -95,10 +95,10 @@ class TimelineController(Controller):
         joints = self.doc.pose.posed_joints()
         if not joints:
             return
-        from volanim_studio.scene import camera
+        from volanim_studio.scene import camera_moves
 
         p = np.array(list(joints.values()), np.float64)
-        camera.follow(self.scene.plotter.renderer, self.scene.world(((p.min(0) + p.max(0)) / 2)[None])[0], blend)
+        camera_moves.follow(self.scene.plotter.renderer, self.scene.world(((p.min(0) + p.max(0)) / 2)[None])[0], blend)
         self.scene.render()
 
     def step(self, delta: int) -> None:
@@ -309,7 +309,7 @@ class TimelineController(Controller):
         """Reconstruct frames ``first..last`` (every ``step``) in the preview's mode and render them with
         the view's camera -- moved with the body when ``follow`` (default: the Follow the body setting) --
         and the user's transfer function when there is one, in the background with progress and cancel."""
-        from volanim_studio.tasks import render_movie
+        from volanim_studio.tasks import MovieSettings, render_movie
 
         tl, st = self.doc.timeline, self.doc.settings
         if self.jobs.busy:
@@ -341,10 +341,11 @@ class TimelineController(Controller):
         follow = st.follow_body if follow is None else follow
         fps = tl.frame_rate / step
         transfer = self.doc.transfer.function  # the editor's (None: the mode's colours)
+        settings = MovieSettings(mode, camera, source=source, kernel=kernel, spacing=spacing, style=style, size=size,
+                                 fps=fps, frame_numbers=frame_numbers, follow=follow, transfer=transfer,
+                                 workers=workers)
         return self.jobs.run(f"Rendering {len(frames)} frames", lambda progress, cancel: render_movie(
-            conn, mats, numbers, out, mode=mode, source=source, kernel=kernel, camera=camera, spacing=spacing,
-            style=style, size=size, fps=fps, frame_numbers=frame_numbers, workers=workers, follow=follow,
-            transfer=transfer, progress=progress, cancel=cancel),
+            conn, mats, numbers, out, settings, progress=progress, cancel=cancel),
             lambda r: self.doc.message(f"Rendered {r['frames']} frames to {r['out']} in {r['seconds']:.1f} s "
                                        f"({r['workers']}){'; ' + r['colours'] if r['colours'] else ''}."))
 

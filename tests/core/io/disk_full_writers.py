@@ -117,16 +117,16 @@ def sequence_store(full: Path, spare: Path) -> dict:
     from volanim_core.sequence import store
     from volanim_core.sequence.checked import read_store
     from volanim_core.sequence.frames import frames_from_files
-    from volanim_core.sequence.run import run_sequence
+    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
 
     conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
     walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))
-    run_sequence(conn, walk, spare / "roomy.zarr", mode="bone", workers=1)
+    run_sequence(conn, walk, spare / "roomy.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=1))
     size = sum(f.stat().st_size for f in (spare / "roomy.zarr").rglob("*") if f.is_file())
     ballast = fill(full, size // 2)
     result = {"writer": "sequence .zarr", "store_bytes": size}
     try:
-        run_sequence(conn, walk, full / "s.zarr", mode="bone", workers=1)
+        run_sequence(conn, walk, full / "s.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=1))
         result["raised"] = None
     except OSError as exc:
         result["raised"] = f"{type(exc).__name__}: {exc}"[:300]
@@ -137,7 +137,7 @@ def sequence_store(full: Path, spare: Path) -> dict:
     result["recorded_verify"] = all(np.array_equal(read_store(full / "s.zarr").read_frame(i),
                                                    read_store(spare / "roomy.zarr").read_frame(i)) for i in recorded)
     ballast.unlink()
-    again = run_sequence(conn, walk, full / "s.zarr", mode="bone", workers=1)
+    again = run_sequence(conn, walk, full / "s.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=1))
     result["skipped_on_resume"] = again.skipped
     got = store.open_frames(full / "s.zarr")
     result["resumed_equal"] = bool(np.array_equal(got[:], want[:]))

@@ -22,7 +22,7 @@ from volanim_core.render.views import named_view
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.frames import frames_from_files
-from volanim_core.sequence.run import run_sequence, shared_bounds
+from volanim_core.sequence.run import SequenceSettings, run_sequence, shared_bounds
 
 W, H = 240, 180
 
@@ -73,7 +73,7 @@ def test_each_colour_frame_is_the_colour_preview_placed_in_the_shared_grid(tmp_p
     few = index_colours(rgb)
     few_rgb = few.colour(few.indices)
     bounds = shared_bounds(conn, walk, 2)
-    rep = run_sequence(conn, walk, tmp_path / "few.zarr", mode="sampled", source=few_rgb)
+    rep = run_sequence(conn, walk, tmp_path / "few.zarr", SequenceSettings(mode="sampled", source=few_rgb))
     assert rep.colours == "colour: 255 palette colours, exact"
     seq = read_store(tmp_path / "few.zarr")
     assert seq.palette.shape == (256, 3) and seq.dtype == np.uint8
@@ -81,7 +81,7 @@ def test_each_colour_frame_is_the_colour_preview_placed_in_the_shared_grid(tmp_p
         alone = reconstruct(spec.tskel(conn), mode="sampled", source=few_rgb)
         assert np.array_equal(seq.read_colour(i), placed(alone.volume, alone.origin, bounds)), f"frame {i}"
 
-    rep = run_sequence(conn, walk, tmp_path / "many.zarr", mode="sampled", source=rgb)
+    rep = run_sequence(conn, walk, tmp_path / "many.zarr", SequenceSettings(mode="sampled", source=rgb))
     assert rep.colours.startswith("colour: 255 palette colours, quantised (CIEDE2000 mean 0.8")
     seq = read_store(tmp_path / "many.zarr")
     alone = reconstruct(walk[1].tskel(conn), mode="sampled", source=rgb)
@@ -95,7 +95,7 @@ def test_each_colour_frame_is_the_colour_preview_placed_in_the_shared_grid(tmp_p
 def test_the_movie_of_a_colour_sequence_is_the_preview_s_colours(tmp_path, conn, walk, rgb):
     few = index_colours(rgb)
     few_rgb = few.colour(few.indices)
-    run_sequence(conn, walk[:1], tmp_path / "s.zarr", mode="sampled", source=few_rgb)
+    run_sequence(conn, walk[:1], tmp_path / "s.zarr", SequenceSettings(mode="sampled", source=few_rgb))
     inputs = open_inputs([tmp_path / "s.zarr"])
     camera = named_view("front", inputs.lo, inputs.hi, aspect=W / H)
     settings = RenderSettings(camera, preset="sampled", size=(W, H))
@@ -138,7 +138,7 @@ def test_the_command_line_sequences_a_colour_scan_and_refuses_averaged_indices(t
 
 
 def test_a_store_whose_palette_is_not_256_colours_is_refused_naming_its_file(tmp_path, conn, walk, rgb):
-    run_sequence(conn, walk[:1], tmp_path / "s.zarr", mode="sampled", source=rgb)
+    run_sequence(conn, walk[:1], tmp_path / "s.zarr", SequenceSettings(mode="sampled", source=rgb))
     meta = tmp_path / "s.zarr" / "zarr.json"
     doc = json.loads(meta.read_text())
     doc["attributes"]["volanim"]["palette"] = doc["attributes"]["volanim"]["palette"][:3]

@@ -19,7 +19,7 @@ from volanim_core.sequence import store
 from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.effects import crumble, fall, melt, parse_axis, teleport
 from volanim_core.sequence.frames import frames_from_files
-from volanim_core.sequence.run import run_sequence, shared_bounds
+from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence, shared_bounds
 
 CONNECT = ASSETS / "mannequin.0.50.connect"
 
@@ -98,7 +98,7 @@ def test_teleport_vanishes_from_the_head_down_and_ends_empty(conn):
 def test_a_walk_then_a_crumble_runs_on_two_workers_and_keeps_every_voxel(tmp_path, conn):
     walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 60, 30))
     frames = walk + crumble(walk, 3)
-    rep = run_sequence(conn, frames, tmp_path / "c.zarr", mode="mottled", workers=2)
+    rep = run_sequence(conn, frames, tmp_path / "c.zarr", SequenceSettings(mode="mottled"), on=RunOn(workers=2))
     last = rep.records[1]["filled"]
     assert [r["filled"] for r in rep.records[2:]] == [last] * 3  # falling loses nothing
     standing = read_store(tmp_path / "c.zarr").read_frame(1)
@@ -169,7 +169,7 @@ def test_melt_and_crumble_at_once_shrink_the_falling_body_onto_the_standing_floo
     walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 1))
     frames = walk + crumble(walk, 3, melt=4, conn=conn)
     assert len(frames) == 5 and [f.dt_scale for f in frames[1:]] == [0.75, 0.5, 0.25, 0.0]
-    rep = run_sequence(conn, frames, tmp_path / "m.zarr", mode="mottled", workers=1)
+    rep = run_sequence(conn, frames, tmp_path / "m.zarr", SequenceSettings(mode="mottled"), on=RunOn(workers=1))
     filled = [r["filled"] for r in rep.records]
     assert filled[0] > filled[1] > filled[2] > filled[3] > 0 and filled[4] == 0  # melting while it falls
     floor = np.nonzero(read_store(tmp_path / "m.zarr").read_frame(0))[2].min()

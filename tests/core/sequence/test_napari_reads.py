@@ -18,7 +18,7 @@ from volanim_core import io
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.frames import frames_from_files
-from volanim_core.sequence.run import run_sequence
+from volanim_core.sequence.run import SequenceSettings, run_sequence
 
 OPEN_IN_NAPARI = """
 import json, sys
@@ -43,7 +43,7 @@ def test_napari_opens_a_sequence_as_a_4d_image_of_its_frames(tmp_path):
     conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
     frames = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 40, 10))
     out = tmp_path / "walk.zarr"
-    rep = run_sequence(conn, frames, out, mode="bone", fps=30)
+    rep = run_sequence(conn, frames, out, SequenceSettings(mode="bone", fps=30))
     done = subprocess.run([sys.executable, "-W", "ignore", "-c", OPEN_IN_NAPARI, str(out), "2"],
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]

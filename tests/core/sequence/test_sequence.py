@@ -26,6 +26,8 @@ from volanim_core.sequence.effects import melt
 from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import (
     DASK_TASK_SECONDS,
+    RunOn,
+    SequenceSettings,
     frame_boxes,
     frame_grids,
     frames_per_task,
@@ -61,13 +63,13 @@ def test_one_worker_two_workers_and_a_dask_cluster_make_identical_frames(tmp_pat
     from distributed import Client, LocalCluster, get_task_stream
 
     walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))
-    one = run_sequence(conn, walk, tmp_path / "one.zarr", mode="bone", workers=1)
-    two = run_sequence(conn, walk, tmp_path / "two.zarr", mode="bone", workers=2)
+    one = run_sequence(conn, walk, tmp_path / "one.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=1))
+    two = run_sequence(conn, walk, tmp_path / "two.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=2))
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address="127.0.0.1:0") as cluster, Client(cluster) as client:
         with get_task_stream(client) as tasks:
-            dask = run_sequence(conn, walk, tmp_path / "dask.zarr", mode="bone", scheduler=client,
-                                frame_seconds=lambda rec: 0.1)
+            dask = run_sequence(conn, walk, tmp_path / "dask.zarr", SequenceSettings(mode="bone"),
+                                on=RunOn(scheduler=client), frame_seconds=lambda rec: 0.1)
         ran_on = {w["host"] for w in client.scheduler_info()["workers"].values()}
     assert ran_on == {"127.0.0.1"} and dask.workers == "Dask, 2 workers"
     # 4 in flight (2 a worker), one frame each until one is timed; then 0.5 s / 0.1 s = 5 frames a task,
@@ -89,7 +91,8 @@ def test_one_worker_reports_each_frame_before_making_the_next(tmp_path, conn, wa
     def on_frame(rec, done, total):
         made_when_reported.append(sum(bool(np.any(f)) for f in frames_of(tmp_path / "s.zarr")))
 
-    run_sequence(conn, walk[:3], tmp_path / "s.zarr", mode="binary", workers=1, on_frame=on_frame)
+    run_sequence(conn, walk[:3], tmp_path / "s.zarr", SequenceSettings(mode="binary"), on=RunOn(workers=1),
+                 on_frame=on_frame)
     assert made_when_reported == [1, 2, 3]
 
 
@@ -104,7 +107,7 @@ def test_frames_per_task_makes_tasks_of_the_length_asked_from_the_frames_timed_s
 
 def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_grid(tmp_path, conn, walk):
     frames = walk + melt(walk, 2)
-    rep = run_sequence(conn, frames, tmp_path / "s.zarr", mode="mottled", padding=3)
+    rep = run_sequence(conn, frames, tmp_path / "s.zarr", SequenceSettings(mode="mottled", padding=3))
     bounds = shared_bounds(conn, frames, 3)
     assert rep.bounds == bounds and read_store(tmp_path / "s.zarr").origin_xyz == bounds.lo
     assert store.open_frames(tmp_path / "s.zarr").shape == (8, *bounds.shape[::-1])
@@ -134,7 +137,7 @@ def test_a_run_that_cannot_fit_says_how_large_its_largest_frame_is(tmp_path, con
     assert all(np.all(np.greater_equal(g.lo, bounds.lo)) and np.all(np.less_equal(g.hi, bounds.hi)) for g in grids)
     assert np.prod(largest.shape) < np.prod(bounds.shape)  # the body's box is smaller than the walk's grid
     with pytest.raises(ValueError, match=rf"each frame needs .* \(grid {'x'.join(map(str, largest.shape))} = "):
-        run_sequence(conn, walk, tmp_path / "s.zarr", mode="bone", workers=10**6)
+        run_sequence(conn, walk, tmp_path / "s.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=10**6))
     assert not (tmp_path / "s.zarr").exists()
 
 
@@ -148,7 +151,7 @@ def test_a_run_killed_while_making_its_store_is_run_again_by_the_same_command(tm
     (half / "0").mkdir(parents=True)
     (half / "zarr.json").write_text('{"zarr_format": 3, "node_type": "group"}')
     out = tmp_path / "walk.zarr"
-    rep = run_sequence(conn, walk[:2], out, mode="bone")
+    rep = run_sequence(conn, walk[:2], out, SequenceSettings(mode="bone"))
     assert rep.skipped == 0 and len(store.finished(out)) == 2
     assert not half.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["walk.zarr"]
 
@@ -173,11 +176,11 @@ def test_a_killed_run_resumes_and_redoes_nothing_complete(tmp_path):
     complete = store.finished(out)
     assert 5 <= len(complete) < 24, "the kill came half-way"
     made = []
-    rep = run_sequence(conn, frames_from_files(conn, sorted(frames.glob("*.trans"))), out, mode="bone",
-                       on_frame=lambda rec, done, total: made.append(rec["index"]))
+    rep = run_sequence(conn, frames_from_files(conn, sorted(frames.glob("*.trans"))), out,
+                       SequenceSettings(mode="bone"), on_frame=lambda rec, done, total: made.append(rec["index"]))
     assert rep.skipped == len(complete) and sorted(made) == sorted(set(range(24)) - set(complete))
     clean = run_sequence(conn, frames_from_files(conn, sorted(frames.glob("*.trans"))), tmp_path / "clean.zarr",
-                         mode="bone")
+                         SequenceSettings(mode="bone"))
     assert [r["sha256"] for r in rep.records] == [r["sha256"] for r in clean.records]
     assert all(np.array_equal(x, y) for x, y in zip(frames_of(out), frames_of(tmp_path / "clean.zarr")))
 
@@ -201,30 +204,35 @@ def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tm
     # a cache (the studio's movie): another sequence there is replaced, the same one resumes
     conn = io.read_connect(CONNECT)
     frames = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 20, 10))
-    rep = run_sequence(conn, frames, out, mode="bone", replace_other=True)
+    rep = run_sequence(conn, frames, out, SequenceSettings(mode="bone"), existing="replace-other")
     assert rep.computed == 2 and rep.skipped == 0
-    again = run_sequence(conn, frames, out, mode="bone", replace_other=True)
+    again = run_sequence(conn, frames, out, SequenceSettings(mode="bone"), existing="replace-other")
     assert again.computed == 0 and again.skipped == 2
 
 
 def test_refusals_name_what_is_wrong(tmp_path, conn, walk):
     with pytest.raises(ValueError, match="100000 workers need .* available"):
-        run_sequence(conn, walk, tmp_path / "m.zarr", mode="bone", workers=100_000)
+        run_sequence(conn, walk, tmp_path / "m.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=100_000))
     (tmp_path / "notes").mkdir()
     (tmp_path / "notes" / "a.txt").write_text("mine")
     with pytest.raises(ValueError, match="not a volanim sequence"):
-        run_sequence(conn, walk, tmp_path / "notes", mode="bone")
+        run_sequence(conn, walk, tmp_path / "notes", SequenceSettings(mode="bone"))
     with pytest.raises(ValueError, match="not a volanim sequence"):
-        run_sequence(conn, walk, tmp_path / "notes", mode="bone", force=True)  # --force never deletes it
+        run_sequence(conn, walk, tmp_path / "notes", SequenceSettings(mode="bone"), existing="redo")  # not even redo
     assert (tmp_path / "notes" / "a.txt").read_text() == "mine"
-    for bad, match in (({"every_frame_as": str(tmp_path / "f.vti")}, "one number field"),
-                       ({"every_frame_as": str(tmp_path / "f.%d.png")}, r"must end in \.vti"),
-                       ({"fps": 0.0}, "fps must be above 0"), ({"workers": 0}, "workers must be 1 or more")):
+    for settings, on, match in ((SequenceSettings("bone", every_frame_as=str(tmp_path / "f.vti")), RunOn(),
+                                 "one number field"),
+                                (SequenceSettings("bone", every_frame_as=str(tmp_path / "f.%d.png")), RunOn(),
+                                 r"must end in \.vti"),
+                                (SequenceSettings("bone", fps=0.0), RunOn(), "fps must be above 0"),
+                                (SequenceSettings("bone"), RunOn(workers=0), "workers must be 1 or more"),
+                                (SequenceSettings("bone"), RunOn(), "existing must be one of")):
         with pytest.raises(ValueError, match=match):
-            run_sequence(conn, walk, tmp_path / "bad.zarr", mode="bone", **bad)
+            run_sequence(conn, walk, tmp_path / "bad.zarr", settings, on=on,
+                         existing="overwrite" if match.startswith("existing") else "resume")
     assert not (tmp_path / "bad.zarr").exists()  # refused before anything was written
     with pytest.raises(ValueError, match="needs the source"):
-        run_sequence(conn, walk, tmp_path / "s.zarr", mode="sampled")
+        run_sequence(conn, walk, tmp_path / "s.zarr", SequenceSettings(mode="sampled"))
     from volanim_core.rig.tskel_tools import identity_tskel
 
     io.write_tskel(tmp_path / "x.0001.tskel", identity_tskel(conn.take(np.arange(100))))
