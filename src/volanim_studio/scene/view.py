@@ -36,7 +36,9 @@ PICK_RADIUS = 8.0  # logical pixels; scaled by the device pixel ratio
 
 
 class SceneView:
-    """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor``.
+    """Actors for hull, cloud, bones and joints over a pyvista ``QtInteractor`` (the studio's, whose renders
+    are gathered into one per pass of Qt's event loop) or an off-screen ``pyvista.Plotter`` (tests, scripts:
+    each render at once), as napari draws its layers on any vispy canvas.
 
     Composed of parts that each own their actors: ``hull``, ``bone_layer`` (rest bones, joints, the
     selected bones' halo), ``names``, ``cube`` and ``lasso`` (selection overlays), ``xray`` and
@@ -181,7 +183,8 @@ class SceneView:
         self.render()
 
     def pixel_ratio(self) -> float:
-        return float(self.plotter.devicePixelRatioF())
+        ratio = getattr(self.plotter, "devicePixelRatioF", None)  # (an off-screen Plotter has none: 1)
+        return float(ratio()) if ratio is not None else 1.0
 
     # ---------------------------------------------------------------- picks
     def pick(self, x: float, y: float) -> PickEvent:
@@ -415,6 +418,9 @@ class SceneView:
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once (software GL takes
         100-500 ms for a large cloud: drawing on every slider step would stall the drag)."""
+        if not hasattr(self.plotter, "isVisible"):  # an off-screen pyvista Plotter (tests, scripts): now
+            self._render_now()
+            return
         if self._render_pending:
             return
         self._render_pending = True
@@ -427,7 +433,7 @@ class SceneView:
         if getattr(self.plotter, "_closed", False):
             return
         reset_clipping(self.plotter.renderer)  # a preview where the walk took it, not cut by old planes
-        if self._drawn_once and self.plotter.isVisible():
+        if self._drawn_once and getattr(self.plotter, "isVisible", lambda: False)():
             # One frame: the widget's paint renders. plotter.render() would render and then
             # have the paint render the same frame again (2x the software-GL time).
             self.plotter.update()
