@@ -24,7 +24,8 @@ from bench_sequence import frog_case, machine_scaling, mannequin_case  # noqa: E
 
 
 def make_sequence(case, folder: Path, mode: str) -> Path:
-    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
+    from volanim_core.parallel import RunOn
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
 
     name, conn, frames, source = case
     out = folder / f"{name.split()[0]}.zarr"
@@ -60,6 +61,7 @@ def per_frame(seq: Path, style: str, mapper: str = "gpu") -> float:
 def whole_run(seq: Path, folder: Path, workers: int) -> tuple[float, float]:
     """(frames/s over the whole run, steady frames/s after each worker's first picture): worker start-up
     (a process, VTK, an OpenGL context) is paid once per run, not per frame."""
+    from volanim_core.parallel import RunOn
     from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings
     from volanim_core.render.views import named_view
@@ -68,7 +70,7 @@ def whole_run(seq: Path, folder: Path, workers: int) -> tuple[float, float]:
     settings = RenderSettings(named_view("three-quarter", inputs.lo, inputs.hi), preset=inputs.mode,
                               vmax=inputs.vmax, size=(640, 480))
     stamps = []
-    rep = render(inputs, settings, folder / f"pics-{workers}", workers=workers, force=True,
+    rep = render(inputs, settings, folder / f"pics-{workers}", on=RunOn(workers=workers), force=True,
                  on_frame=lambda *_: stamps.append(time.perf_counter()))
     steady = (len(stamps) - workers) / (stamps[-1] - stamps[workers - 1])
     return rep.frames / rep.seconds, steady

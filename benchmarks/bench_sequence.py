@@ -98,7 +98,8 @@ def steady_rate(records: list[dict]) -> float:
 
 
 def run(case, folder: Path, **where) -> dict:
-    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
+    from volanim_core.parallel import RunOn
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
 
     name, conn, frames, source = case
     out = folder / "s.zarr"

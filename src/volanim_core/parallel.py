@@ -21,7 +21,24 @@ import os
 import sys
 from concurrent.futures import Future
 from contextlib import contextmanager
+from dataclasses import dataclass
 from functools import cache
+
+
+@dataclass(frozen=True)
+class RunOn:
+    """Where a job's tasks run (a sequence's frames, a render's pictures): ``workers`` local processes
+    (1: this process), or the Dask ``scheduler`` at an address (``tcp://HOST:PORT``) or a
+    ``distributed.Client``; ``threads_per_worker`` numba threads in each (sequences); ``isolate``: never in
+    this process, even with one worker (see :func:`executor`)."""
+
+    workers: int | None = None
+    scheduler: object = None
+    threads_per_worker: int = 1
+    isolate: bool = False
+
+
+THIS_PROCESS = RunOn()  # one worker, this process: the default of every job
 
 
 @contextmanager

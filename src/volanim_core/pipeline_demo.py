@@ -161,10 +161,10 @@ def _walk(folder: Path, clip: Path, s, conn, frames=slice(0, None, 133)):
 def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Path:
     """One walk cycle (about 1.2 s of the clip), then the body crumbles into a heap: a sequence,
     every frame in one grid, all cores."""
-    from volanim_core.parallel import default_workers
+    from volanim_core.parallel import RunOn, default_workers
     from volanim_core.sequence.effects import crumble
     from volanim_core.sequence.frames import FrameSpec
-    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
 
     numbers = range(retarget.motion.frames)[frames]
     specs = [FrameSpec(n, m) for n, m in zip(numbers, retarget.matrices(frames))]
@@ -180,14 +180,14 @@ def _sequence(out: Path, retarget, conn, source, frames=slice(0, 144, 6)) -> Pat
 
 def _movie(sequence: Path, out: Path) -> Path:
     """The sequence as a small looping GIF, seen from the side (where a walk reads best), off-screen."""
-    from volanim_core.parallel import default_workers
+    from volanim_core.parallel import RunOn, default_workers
     from volanim_core.render.framing import place_camera
     from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings
 
     camera, inputs = place_camera(open_inputs([sequence]), "side", aspect=320 / 240)  # every frame's body in view
     settings = RenderSettings(camera, preset=inputs.mode, vmax=inputs.vmax, size=(320, 240), background="#1e1e24")
-    rep = render(inputs, settings, out, workers=min(default_workers(), 4))
+    rep = render(inputs, settings, out, on=RunOn(workers=min(default_workers(), 4)))
     _say(f"[8] render: {rep.frames} frames, 320x240, surface style from the side, {rep.workers}, "
          f"{rep.seconds:.1f} s -> {out.name}")
     return out

@@ -166,12 +166,12 @@ def render_movie(conn, matrices, numbers, out, settings: MovieSettings, *, progr
     from pathlib import Path
 
     from volanim_core.colour.indexed import through_palette
-    from volanim_core.parallel import default_workers
+    from volanim_core.parallel import RunOn, default_workers
     from volanim_core.render.movie import open_inputs, output_kind, render
     from volanim_core.render.scene import RenderSettings
     from volanim_core.sequence.checked import read_store
     from volanim_core.sequence.frames import FrameSpec
-    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
 
     t0 = time.perf_counter()
     mode, source, camera, spacing = settings.mode, settings.source, settings.camera, settings.spacing
@@ -200,7 +200,7 @@ def render_movie(conn, matrices, numbers, out, settings: MovieSettings, *, progr
     look = RenderSettings(camera, style=settings.style, preset=mode, vmax=inputs.vmax, size=tuple(size),
                           background=settings.background, frame_numbers=settings.frame_numbers, transfer=transfer,
                           spacing=tuple(float(s) for s in spacing))
-    rep = render(inputs, look, out, fps=fps, workers=workers, isolate=True,
+    rep = render(inputs, look, out, on=RunOn(workers=workers, isolate=True), fps=fps,
                  on_frame=lambda number, done, n: report(len(frames) + done, total))
     shutil.rmtree(cache, ignore_errors=True)
     return {"out": out, "frames": len(frames), "seconds": time.perf_counter() - t0, "workers": rep.workers,

@@ -50,6 +50,7 @@ def _render(args):
     import numpy as np
 
     from volanim_core import io
+    from volanim_core.parallel import RunOn
     from volanim_core.render.framing import place_camera
     from volanim_core.render.movie import open_inputs, render
     from volanim_core.render.scene import RenderSettings, transfer_of
@@ -80,7 +81,7 @@ def _render(args):
         io.write_transfer_function(args.save_tf, transfer_of(settings))
         print(f"wrote {args.save_tf} (the {'--tf' if args.tf else preset + ' preset'}'s transfer function)")
     workers = local_workers(args)
-    rep = render(inputs, settings, args.output, fps=args.fps, workers=workers or 1, scheduler=args.scheduler,
+    rep = render(inputs, settings, args.output, on=RunOn(workers=workers or 1, scheduler=args.scheduler), fps=args.fps,
                  force=args.force, keep_frames=args.keep_frames, dims=args.dims, on_frame=FrameProgress())
     print(file=sys.stderr)
     print(f"wrote {rep.out}: {rep.frames} frame{'s' if rep.frames != 1 else ''} of {w}x{h} ({args.style}, {preset} "

@@ -38,9 +38,10 @@ EXAMPLE = (
 def _sequence(args):
     from volanim_core.io import read_bones, read_connect
     from volanim_core.io.mapping_files import read_mapping
+    from volanim_core.parallel import RunOn
     from volanim_core.sequence.effects import crumble, melt, teleport
     from volanim_core.sequence.frames import frames_from_files
-    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
 
     conn = joints_of(args, read_connect(args.connect))
     bones = read_bones(args.bones) if args.bones else None

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from volanim_core.io.files import resolved
-from volanim_core.parallel import executor
+from volanim_core.parallel import THIS_PROCESS, RunOn, executor
 
 from .scene import Renderer, RenderSettings
 from .views import Camera, union_box
@@ -291,14 +291,14 @@ class RenderReport:
     mapper: str = ""
 
 
-def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | None = None, workers: int = 1,
-           scheduler=None, force: bool = False, keep_frames: bool = False, dims=None, on_frame=None,
-           isolate: bool = False) -> RenderReport:
+def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | None = None, on: RunOn = THIS_PROCESS,
+           force: bool = False, keep_frames: bool = False, dims=None, on_frame=None) -> RenderReport:
     """Render every frame of ``inputs`` to ``out``; see the module docstring.
 
+    ``on``: where the pictures are drawn; ``on.isolate``: in worker processes only, never in this one.
     ``on_frame(number, done, total)`` after each picture (progress; it may raise to stop the run).
-    ``isolate``: draw in worker processes only, never in this one (see ``parallel.executor``).
     """
+    workers, scheduler, isolate = on.workers or 1, on.scheduler, on.isolate
     t0 = time.perf_counter()
     out = Path(out)
     kind = output_kind(out)

@@ -25,7 +25,7 @@ from volanim_core.colour.indexed import index_colours
 from volanim_core.io.atomic import naming_the_output
 from volanim_core.io.files import resolved
 from volanim_core.limits import available_bytes, human_bytes
-from volanim_core.parallel import executor
+from volanim_core.parallel import THIS_PROCESS, RunOn, executor
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.volume import Bounds
@@ -154,21 +154,11 @@ class SequenceSettings:
     every_frame_as: str | None = None
 
 
-@dataclass(frozen=True)
-class RunOn:
-    """Where a sequence's frames are made: ``workers`` local processes (one: this process), or the Dask
-    ``scheduler`` at an address (``tcp://HOST:PORT``) or a ``distributed.Client``; numba threads per worker."""
-
-    workers: int | None = None
-    scheduler: object = None
-    threads_per_worker: int = 1
-
-
 EXISTING = ("resume", "replace-other", "redo")
 
 
 def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: SequenceSettings = SequenceSettings(),
-                 *, on: RunOn = RunOn(), existing: str = "resume", on_frame=None,
+                 *, on: RunOn = THIS_PROCESS, existing: str = "resume", on_frame=None,
                  frame_seconds=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
@@ -187,7 +177,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
         raise ValueError(f"existing must be one of {', '.join(EXISTING)}, got {existing!r}")
     mode, source, source_geometry, kernel = settings.mode, settings.source, settings.source_geometry, settings.kernel
     padding, fps, every_frame_as = settings.padding, settings.fps, settings.every_frame_as
-    workers, scheduler, threads_per_worker = on.workers, on.scheduler, on.threads_per_worker
+    workers, scheduler, threads_per_worker = on.workers, on.scheduler, on.threads_per_worker  # (not isolate:
+    # a sequence's frames draw nothing, so this process may make them)
     force, replace_other = existing == "redo", existing == "replace-other"
     for name, value in (("workers", workers), ("threads per worker", threads_per_worker)):
         if value is not None and value < 1:

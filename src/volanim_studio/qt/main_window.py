@@ -60,7 +60,11 @@ class MainWindow(QMainWindow):
         # No multisampling: 8x MSAA costs software GL ~30 % a frame. FXAA smooths edges instead (~16 ms
         # of a frame with the hull at 1200x800 on software GL; the scene drops it while a slider is held).
         self.plotter = QtInteractor(self, auto_update=False, multi_samples=0)
-        self.plotter.enable_anti_aliasing("fxaa")
+        # FXAA on the widget's own window (VTK's generic window in Qt's GL context), set directly: pyvista's
+        # enable_anti_aliasing("fxaa") asks a new window of VTK's default kind whether this is an EGL build,
+        # which says nothing of a window Qt made. Where that default is EGL (VTK_DEFAULT_OPENGL_WINDOW, or
+        # no X connection for a new window: seen in long test workers) it warned and drew SSAA, 4x the pixels.
+        self.plotter.renderer.SetUseFXAA(True)
         self.setCentralWidget(self.plotter.interactor if hasattr(self.plotter, "interactor") else self.plotter)
         self.scene = SceneView(self.plotter, self.doc, on_pick=self.handle_pick)
         self.handlers = {m: cls(self.doc) for m, cls in HANDLERS.items()}

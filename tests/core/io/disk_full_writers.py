@@ -113,11 +113,12 @@ def sequence_store(full: Path, spare: Path) -> dict:
     sys.path.insert(0, str(Path(__file__).parents[2]))  # tests/: run as a script, not under pytest
     from paths import ASSETS, WALK
     from volanim_core import io
+    from volanim_core.parallel import RunOn
     from volanim_core.samples import mannequin_bones
     from volanim_core.sequence import store
     from volanim_core.sequence.checked import read_store
     from volanim_core.sequence.frames import frames_from_files
-    from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
 
     conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
     walk = frames_from_files(conn, [WALK], bones=mannequin_bones(), frames=slice(0, 240, 10))

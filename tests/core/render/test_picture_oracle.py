@@ -17,6 +17,7 @@ from picture_oracle import compare, foreground, silhouette
 from volanim_core import io, samples
 from volanim_core.camera import Camera
 from volanim_core.geometry import Geometry
+from volanim_core.parallel import RunOn
 from volanim_core.render.framing import place_camera
 from volanim_core.render.movie import open_inputs, read_frame, render
 from volanim_core.render.scene import RenderSettings
@@ -149,7 +150,8 @@ def test_a_sequence_framed_whole_and_followed(tmp_path):
         assert inputs.boxes[0] == ((25, 25, 25), (55, 55, 55))
         assert (inputs.lo, inputs.hi) == ((25, 25, 25), (355, 55, 55))
         cam, inputs = place_camera(inputs, "front", camera, aspect=SIZE[0] / SIZE[1])
-        render(inputs, RenderSettings(cam, preset="binary", vmax=1, size=SIZE), tmp_path / f"pics-{camera}", workers=1)
+        render(inputs, RenderSettings(cam, preset="binary", vmax=1, size=SIZE), tmp_path / f"pics-{camera}",
+               on=RunOn(workers=1))
         sizes[camera] = []
         for ref in inputs.frames:
             image = iio.imread(tmp_path / f"pics-{camera}" / f"frame.{ref.number:04d}.png")[..., :3]

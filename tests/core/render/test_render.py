@@ -14,6 +14,7 @@ from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
 from volanim_core.geometry import Geometry
+from volanim_core.parallel import RunOn
 from volanim_core.render.movie import frame_path, open_inputs, render
 from volanim_core.render.scene import Renderer, RenderSettings
 from volanim_core.render.views import Camera, named_view
@@ -106,7 +107,7 @@ def test_the_camera_stays_fixed_across_frames_and_workers(tmp_path):
     assert [f.number for f in inputs.frames] == [100, 102, 104, 106]
     cam = named_view("front", inputs.lo, inputs.hi, aspect=W / H)
     rep = render(inputs, RenderSettings(cam, preset="bone", vmax=inputs.vmax, size=(W, H)), tmp_path / "pics",
-                 workers=2)
+                 on=RunOn(workers=2))
     assert rep.drawn == 4 and rep.workers == "2 local workers"
     pics = [iio.imread(frame_path(tmp_path / "pics", n)) for n in (100, 102, 104, 106)]
     assert all(p.shape == (H, W, 3) for p in pics)
@@ -258,10 +259,10 @@ def test_a_dask_cluster_draws_the_same_pictures(tmp_path):
     seq = make_sequence(tmp_path / "s.zarr", frames=3)
     inputs = open_inputs([seq])
     settings = RenderSettings(named_view("side", inputs.lo, inputs.hi), preset="bone", size=(160, 120))
-    render(inputs, settings, tmp_path / "local", workers=1)
+    render(inputs, settings, tmp_path / "local", on=RunOn(workers=1))
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address="127.0.0.1:0") as cluster, Client(cluster) as client:
-        rep = render(inputs, settings, tmp_path / "dask", scheduler=client)
+        rep = render(inputs, settings, tmp_path / "dask", on=RunOn(scheduler=client))
     assert rep.workers == "Dask, 2 workers" and rep.drawn == 3
     for n in (100, 102, 104):
         a, b = (iio.imread(frame_path(tmp_path / where, n)) for where in ("dask", "local"))
@@ -293,7 +294,7 @@ def test_auto_mapper_is_resolved_once_for_the_whole_sequence(tmp_path):
                               size=(160, 120))
     chosen = choose_mapper(inputs, settings)
     assert chosen.mapper in ("gpu", "cpu") and chosen.style == "volume"
-    rep = render(inputs, settings, tmp_path / "pics", workers=2)
+    rep = render(inputs, settings, tmp_path / "pics", on=RunOn(workers=2))
     assert rep.mapper in ("gpu", "cpu") and rep.drawn == 4
     surface = RenderSettings(settings.camera, preset="bone")
     assert choose_mapper(inputs, surface) is surface  # nothing to choose

@@ -15,6 +15,7 @@ from volanim_core.cli import main
 from volanim_core.colour.indexed import index_colours
 from volanim_core.colour.space import delta_e
 from volanim_core.errors import FormatError
+from volanim_core.parallel import RunOn
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.render.movie import open_inputs, read_frame, render
 from volanim_core.render.scene import Renderer, RenderSettings
@@ -99,7 +100,7 @@ def test_the_movie_of_a_colour_sequence_is_the_preview_s_colours(tmp_path, conn,
     inputs = open_inputs([tmp_path / "s.zarr"])
     camera = named_view("front", inputs.lo, inputs.hi, aspect=W / H)
     settings = RenderSettings(camera, preset="sampled", size=(W, H))
-    render(inputs, settings, tmp_path / "pics", workers=1)
+    render(inputs, settings, tmp_path / "pics", on=RunOn(workers=1))
     movie = iio.imread(next((tmp_path / "pics").glob("*.png")))
     bounds = shared_bounds(conn, walk[:1], 2)
     alone = reconstruct(walk[0].tskel(conn), mode="sampled", source=few_rgb)

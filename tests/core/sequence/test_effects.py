@@ -13,13 +13,14 @@ import pytest
 from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core import io
 from volanim_core.cli import main
+from volanim_core.parallel import RunOn
 from volanim_core.reconstruct.engine import posed_centres, reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
 from volanim_core.sequence.checked import read_store
 from volanim_core.sequence.effects import crumble, fall, melt, parse_axis, teleport
 from volanim_core.sequence.frames import frames_from_files
-from volanim_core.sequence.run import RunOn, SequenceSettings, run_sequence, shared_bounds
+from volanim_core.sequence.run import SequenceSettings, run_sequence, shared_bounds
 
 CONNECT = ASSETS / "mannequin.0.50.connect"
 

@@ -18,6 +18,7 @@ from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
 from volanim_core.io.frame_files import write_frames
+from volanim_core.parallel import RunOn
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.samples import mannequin_bones
 from volanim_core.sequence import store
@@ -26,7 +27,6 @@ from volanim_core.sequence.effects import melt
 from volanim_core.sequence.frames import frames_from_files
 from volanim_core.sequence.run import (
     DASK_TASK_SECONDS,
-    RunOn,
     SequenceSettings,
     frame_boxes,
     frame_grids,

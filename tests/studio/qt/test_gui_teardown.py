@@ -67,3 +67,14 @@ def test_a_closed_window_leaves_no_wrapper_of_its_gl_surface(qtbot):
     assert _surface_wrappers(), "the interactor wraps its surface once drawn (else this test tests nothing)"
     w.close()
     assert _surface_wrappers() == []
+
+
+def test_the_window_smooths_edges_with_fxaa_whatever_vtk_s_default_window_is(qtbot, monkeypatch):
+    """The studio draws in Qt's GL context, so FXAA holds even where a new VTK window would be EGL. pyvista's
+    check made such a window and warned (an error here), failing whole GUI workers now and then."""
+    from ..conftest import new_window
+
+    monkeypatch.setenv("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")  # what a new window would be
+    w = new_window(qtbot)
+    assert w.plotter.renderer.GetUseFXAA()
+    assert "Generic" in type(w.plotter.ren_win).__name__  # the Qt widget's window, not the factory's
