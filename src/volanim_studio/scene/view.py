@@ -50,6 +50,8 @@ class SceneView:
 
     def __init__(self, plotter, doc: Document, on_pick: Callable[[PickEvent], None] | None = None):
         self.plotter = plotter
+        # a Qt widget (the studio's QtInteractor) or an off-screen pyvista Plotter (tests, scripts): decided once
+        self.in_qt = hasattr(plotter, "isVisible")
         self.doc = doc
         self.on_pick = on_pick
         self.settings = doc.settings
@@ -183,8 +185,7 @@ class SceneView:
         self.render()
 
     def pixel_ratio(self) -> float:
-        ratio = getattr(self.plotter, "devicePixelRatioF", None)  # (an off-screen Plotter has none: 1)
-        return float(ratio()) if ratio is not None else 1.0
+        return float(self.plotter.devicePixelRatioF()) if self.in_qt else 1.0
 
     # ---------------------------------------------------------------- picks
     def pick(self, x: float, y: float) -> PickEvent:
@@ -418,7 +419,7 @@ class SceneView:
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once (software GL takes
         100-500 ms for a large cloud: drawing on every slider step would stall the drag)."""
-        if not hasattr(self.plotter, "isVisible"):  # an off-screen pyvista Plotter (tests, scripts): now
+        if not self.in_qt:  # an off-screen Plotter: no event loop to gather renders in, so now
             self._render_now()
             return
         if self._render_pending:
@@ -433,7 +434,7 @@ class SceneView:
         if getattr(self.plotter, "_closed", False):
             return
         reset_clipping(self.plotter.renderer)  # a preview where the walk took it, not cut by old planes
-        if self._drawn_once and getattr(self.plotter, "isVisible", lambda: False)():
+        if self._drawn_once and self.in_qt and self.plotter.isVisible():
             # One frame: the widget's paint renders. plotter.render() would render and then
             # have the paint render the same frame again (2x the software-GL time).
             self.plotter.update()
