@@ -6,12 +6,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from small_rigs import arms_down, posed_joints
 from volanim_core.motion.keyframes import interpolate
 from volanim_core.rig.key_pose import KeyPose
 from volanim_core.rig.pose import pose_matrices
 from volanim_core.samples import mannequin_bones
-
-from .test_retarget import arms_down, posed_joints
 
 ARM = ("L_SHOULDER", "L_ELBOW")
 

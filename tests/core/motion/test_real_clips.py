@@ -11,12 +11,11 @@ import numpy as np
 import pytest
 
 from real_clips import clip
+from small_rigs import posed_joints
 from volanim_core.io.bvh_files import read_bvh
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget
 from volanim_core.samples import mannequin_bones
-
-from .test_retarget import posed_joints
 
 # clip -> (scheme, units, what the clip names its parts: L_UPPERARM, L_CLAVICLE, L_THIGH, L_SHIN)
 EXPECTED = {

@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from paths import WALK
+from small_rigs import arms_down, posed_joints
 from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
@@ -16,21 +18,8 @@ from volanim_core.motion.retarget import Retarget, axes_matrix, suggest_mapping
 from volanim_core.rig.bones import Bone, BoneSkeleton
 from volanim_core.samples import mannequin_bones
 
-from .test_bvh import WALK
-
 ASSETS = Path(__file__).resolve().parents[3] / "assets"
 A = axes_matrix("y", "z")  # BVH (Y up, facing +Z) -> ours (z up, facing -y)
-
-
-def posed_joints(bones: BoneSkeleton, mats: np.ndarray) -> dict[str, np.ndarray]:
-    """Each joint moved by the matrix of a bone it starts or ends (all agree when the rig holds)."""
-    out = {}
-    for b, bone in enumerate(bones.bones):
-        for j in (bone.proximal, bone.distal):
-            out.setdefault(j, []).append(bones.joints[j] @ mats[b, :3, :3] + mats[b, 3, :3])
-    for j, ps in out.items():
-        assert np.allclose(ps, ps[0], atol=1e-6), f"joint {j} torn apart"
-    return {j: ps[0] for j, ps in out.items()}
 
 
 def arm_clip(tmp_path, frames: list[str]) -> Path:
@@ -43,13 +32,6 @@ def arm_clip(tmp_path, frames: list[str]) -> Path:
     p = tmp_path / "arm.bvh"
     p.write_text(text)
     return p
-
-
-def arms_down() -> BoneSkeleton:
-    """Our arm, hanging down (z up, facing -y): shoulder at the top, then elbow, wrist."""
-    joints = {"PELVIS": (0, 0, 0), "L_SHOULDER": (2, 0, 10), "L_ELBOW": (2, 0, 4), "L_WRIST": (2, 0, -1)}
-    return BoneSkeleton(joints, [Bone("PELVIS", "L_SHOULDER", "SPINE"), Bone("L_SHOULDER", "L_ELBOW", "L_UPPERARM"),
-                                 Bone("L_ELBOW", "L_WRIST", "L_FOREARM")])
 
 
 def test_axes_map_bvh_up_and_forward_onto_ours():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from small_rigs import arms_down
 from volanim_core import io
 from volanim_core.errors import Cancelled, FormatError
 from volanim_core.io.frame_files import frame_number, read_frames, write_frames
@@ -12,8 +13,6 @@ from volanim_core.motion.keyframes import interpolate
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.key_pose import KeyPose
 from volanim_core.rig.pose import root_bones
-
-from .test_retarget import arms_down
 
 
 def clip():
