@@ -298,7 +298,6 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     ``on``: where the pictures are drawn; ``on.isolate``: in worker processes only, never in this one.
     ``on_frame(number, done, total)`` after each picture (progress; it may raise to stop the run).
     """
-    workers, scheduler, isolate = on.workers or 1, on.scheduler, on.isolate
     t0 = time.perf_counter()
     out = Path(out)
     kind = output_kind(out)
@@ -308,14 +307,14 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     if not 0 < fps <= 1000:
         raise ValueError(f"fps must be above 0 and at most 1000, got {fps:g}")
     total = len(inputs.frames)
-    if not isolate:  # timing both mappers draws here
+    if not on.isolate:  # timing both mappers draws here
         settings = choose_mapper(inputs, settings, dims)
     if kind == "png" and total != 1:
         raise ValueError(f"{total} frames do not fit in one .png: render to a folder, an .mp4 or a .gif")
     job = RenderJob(settings, dims)
     if kind == "png":
         try:
-            with executor(render_task, job, install, workers=1, isolate=isolate) as (submit, label, _):
+            with executor(render_task, job, install, workers=1, isolate=on.isolate) as (submit, label, _):
                 number, image = submit(inputs.frames[0]).result()
         finally:
             release()
@@ -331,7 +330,7 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     try:
         if todo:
             try:
-                label = _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate)
+                label = _draw(todo, job, folder, on, on_frame, done, total)
             finally:
                 release()
         if kind in ("mp4", "gif"):
@@ -345,10 +344,10 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     return RenderReport(out, total, len(todo), skipped, time.perf_counter() - t0, label, fps, settings.mapper)
 
 
-def _draw(todo, job, folder, workers, scheduler, on_frame, done, total, isolate) -> str:
+def _draw(todo, job, folder, on: RunOn, on_frame, done, total) -> str:
     """Draw ``todo`` anywhere; the driver writes each picture as it arrives. Returns where it ran."""
-    with executor(render_task, job, install, workers=min(workers, len(todo)), scheduler=scheduler,
-                  isolate=isolate) as (submit, label, in_flight):
+    with executor(render_task, job, install, workers=min(on.workers or 1, len(todo)), scheduler=on.scheduler,
+                  isolate=on.isolate) as (submit, label, in_flight):
         pending, queue = set(), list(todo)
         while queue or pending:  # pictures arrive about in order
             while queue and len(pending) < in_flight:

@@ -177,8 +177,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
         raise ValueError(f"existing must be one of {', '.join(EXISTING)}, got {existing!r}")
     mode, source, source_geometry, kernel = settings.mode, settings.source, settings.source_geometry, settings.kernel
     padding, fps, every_frame_as = settings.padding, settings.fps, settings.every_frame_as
-    workers, scheduler, threads_per_worker = on.workers, on.scheduler, on.threads_per_worker  # (not isolate:
-    # a sequence's frames draw nothing, so this process may make them)
+    workers, scheduler, threads_per_worker = on.workers, on.scheduler, on.threads_per_worker
     force, replace_other = existing == "redo", existing == "replace-other"
     for name, value in (("workers", workers), ("threads per worker", threads_per_worker)):
         if value is not None and value < 1:
@@ -241,8 +240,8 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
     records = dict(done)
     total = len(frames)
     task_seconds = DASK_TASK_SECONDS if scheduler is not None else 0.0
-    with full_disk, executor(reconstruct_frames, payload, install, workers=n_workers,
-                             scheduler=scheduler) as (submit, label, in_flight):
+    with full_disk, executor(reconstruct_frames, payload, install, workers=n_workers, scheduler=scheduler,
+                             isolate=on.isolate) as (submit, label, in_flight):
         pending: set[Future] = set()
         queue = list(todo)
         seconds: list[float] = []  # finished frames' own seconds: how many make a task

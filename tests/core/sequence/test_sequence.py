@@ -96,6 +96,17 @@ def test_one_worker_reports_each_frame_before_making_the_next(tmp_path, conn, wa
     assert made_when_reported == [1, 2, 3]
 
 
+@pytest.mark.long("starts a spawned worker process (imports numba and the kernels)")
+def test_an_isolated_run_makes_its_frames_in_a_worker_process_and_the_same_frames(tmp_path, conn, walk):
+    """``RunOn(isolate=True)`` was kept by renders and dropped by sequences: one worker then ran in this
+    process, against what the caller asked."""
+    here = run_sequence(conn, walk[:2], tmp_path / "here.zarr", SequenceSettings(mode="binary"), on=RunOn(workers=1))
+    away = run_sequence(conn, walk[:2], tmp_path / "away.zarr", SequenceSettings(mode="binary"),
+                        on=RunOn(workers=1, isolate=True))
+    assert here.workers == "1 worker (this process)" and away.workers == "1 local worker"
+    assert [r["sha256"] for r in here.records] == [r["sha256"] for r in away.records]
+
+
 def test_frames_per_task_makes_tasks_of_the_length_asked_from_the_frames_timed_so_far():
     assert frames_per_task([], DASK_TASK_SECONDS) == 1  # nothing timed yet
     assert frames_per_task([0.03] * 5, 0.0) == 1  # a local pool: a task costs microseconds
