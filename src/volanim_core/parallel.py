@@ -13,6 +13,13 @@ and tasks get the future -- never once per task.
 
 Every worker process, local or Dask, first undoes ``MALLOC_TRIM_THRESHOLD_``
 (:func:`keep_freed_memory`).
+
+    finished, pending = wait_some(pending, cancel)   # cancel() is asked while waiting, not only between tasks
+
+A local worker that dies (killed, out of memory) fails the job at once with a
+ChildProcessError that says so; a job that is cancelled or fails ends its pool's
+processes after a short grace, so a hung worker never holds it (#83: a dead
+render worker left the studio at 0 % and Cancel did nothing for a minute).
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ from __future__ import annotations
 import os
 import sys
 from concurrent.futures import Future
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from functools import cache
 
@@ -68,15 +75,76 @@ def executor(task, payload, install, *, workers: int = 1, scheduler=None, isolat
         return
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
 
-    # spawn, not fork: zarr's I/O thread, numba's threads and an OpenGL context do not survive a fork
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"), initializer=_start_worker,
-                             initargs=(install, payload, os.getpid())) as pool:
+    # spawn, not fork: zarr's I/O thread, numba's threads and an OpenGL context do not survive a fork. The
+    # payload goes through a file, not the initializer's arguments: spawn writes those into a pipe whose
+    # reading end the parent itself holds open until the write ends, so a worker that died while starting
+    # (killed, out of memory) left a payload larger than the pipe's 64 KiB blocked there forever, and the
+    # job with it (#83: a render stuck at 0 %, deaf to Cancel).
+    with _payload_file(payload) as payload_path, ProcessPoolExecutor(
+            workers, mp_context=multiprocessing.get_context("spawn"), initializer=_start_worker,
+            initargs=(install, payload_path, os.getpid())) as pool:
+        submitted: list[Future] = []
+
+        def submit(*args) -> Future:
+            fut = pool.submit(task, None, *args)
+            submitted.append(fut)
+            return fut
+
+        label = f"{workers} local worker{'s' if workers > 1 else ''}"
         try:
-            label = f"{workers} local worker{'s' if workers > 1 else ''}"
-            yield (lambda *args: pool.submit(task, None, *args)), label, 2 * workers
+            yield submit, label, 2 * workers
+        except BrokenProcessPool:
+            _stop_workers(pool, [])
+            raise ChildProcessError(
+                f"a worker process ({label}) died while working: killed, or out of memory; what was finished "
+                "before is kept, so running it again goes on from there") from None
+        except BaseException:  # cancelled, or an error: the running tasks get a moment, then their processes go
+            _stop_workers(pool, submitted)
+            raise
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+#: How long a cancelled or failed job's running tasks may take to finish (a frame being written is kept)
+#: before their processes are ended: a hung or very slow worker must not hold the job (#83).
+STOP_GRACE_SECONDS = 2.0
+
+
+def _stop_workers(pool, submitted: list[Future]) -> None:
+    """Kill the pool's processes once the tasks under way finished or ``STOP_GRACE_SECONDS`` passed (what
+    has not started is cancelled by the pool's own shutdown: a future cancelled here, behind the pool's
+    back, made its manager thread fail with InvalidStateError once the pool broke)."""
+    from concurrent.futures import wait
+
+    running = [f for f in submitted if f.running()]
+    if running:
+        wait(running, timeout=STOP_GRACE_SECONDS)
+    kill = getattr(pool, "kill_workers", None)  # Python 3.14
+    if kill is not None:
+        kill()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):  # the same on 3.11-3.13
+        if proc.is_alive():
+            proc.kill()  # SIGKILL: a stopped (hung, swapped-out) process never acts on SIGTERM
+
+
+def wait_some(pending, cancel=None, *, poll_seconds: float = 0.25):
+    """``(finished, rest)`` of the futures ``pending``, at least one finished; ``cancel()`` is asked every
+    ``poll_seconds`` meanwhile (Cancelled when it says so), so a job waiting on one long or hung task still
+    stops when told. Without ``cancel``: concurrent.futures.wait(FIRST_COMPLETED)."""
+    from concurrent.futures import FIRST_COMPLETED, wait
+
+    from volanim_core.errors import Cancelled
+
+    while True:
+        finished, rest = wait(pending, timeout=None if cancel is None else poll_seconds,
+                              return_when=FIRST_COMPLETED)
+        if finished:
+            return finished, rest
+        if cancel():
+            raise Cancelled("cancelled by the user")
 
 
 def dask_client(address: str):
@@ -132,11 +200,30 @@ def end_with_parent(parent: int | None = None) -> None:
         os._exit(1)
 
 
-def _start_worker(install, payload, parent: int | None = None) -> None:
-    """A local pool worker's initializer."""
+@contextmanager
+def _payload_file(payload):
+    """``payload`` pickled once into a private temporary file (its path while the pool lives)."""
+    import pickle
+    import tempfile
+
+    fd, path = tempfile.mkstemp(prefix="volanim-payload-", suffix=".pickle")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump(payload, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        yield path
+    finally:
+        with suppress(OSError):
+            os.unlink(path)
+
+
+def _start_worker(install, payload_path: str, parent: int | None = None) -> None:
+    """A local pool worker's initializer: the payload read from its file (see :func:`executor`)."""
+    import pickle
+
     end_with_parent(parent)
     keep_freed_memory()
-    install(payload)
+    with open(payload_path, "rb") as fh:
+        install(pickle.load(fh))
 
 
 def _on_dask_worker(task, *args):

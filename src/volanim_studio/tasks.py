@@ -190,7 +190,7 @@ def render_movie(conn, matrices, numbers, out, settings: MovieSettings, *, progr
     workers = settings.workers or default_workers()
     how = SequenceSettings(mode=mode, source=source if mode == "sampled" else None, kernel=settings.kernel, fps=fps)
     seq = run_sequence(conn, frames, cache, how, on=RunOn(workers=workers), existing="replace-other",
-                       on_frame=lambda rec, done, n: report(done, total))
+                       on_frame=lambda rec, done, n: report(done, total), cancel=cancel)
     inputs = replace(open_inputs([cache]), spacing=tuple(float(s) for s in spacing))  # the studio's world
     if settings.follow:
         inputs = replace(inputs, frames=inputs.follow("front", size[0] / size[1], base=camera))
@@ -201,7 +201,7 @@ def render_movie(conn, matrices, numbers, out, settings: MovieSettings, *, progr
                           background=settings.background, frame_numbers=settings.frame_numbers, transfer=transfer,
                           spacing=tuple(float(s) for s in spacing))
     rep = render(inputs, look, out, on=RunOn(workers=workers, isolate=True), fps=fps,
-                 on_frame=lambda number, done, n: report(len(frames) + done, total))
+                 on_frame=lambda number, done, n: report(len(frames) + done, total), cancel=cancel)
     shutil.rmtree(cache, ignore_errors=True)
     return {"out": out, "frames": len(frames), "seconds": time.perf_counter() - t0, "workers": rep.workers,
             "colours": seq.colours}

@@ -21,7 +21,8 @@ def front_view(window) -> None:
 
 
 def rig_and_pose(qtbot, window):
-    """The mannequin's bones and attachments from assets/, the front view, then Pose mode (P)."""
+    """The mannequin's bones and attachments from assets/, the front view, then Pose mode (P) and the body's
+    preview it shows."""
     from paths import ASSETS
     from volanim_studio.model.interaction import Mode
 
@@ -30,6 +31,8 @@ def rig_and_pose(qtbot, window):
     front_view(window)
     qtbot.keyClick(window, Qt.Key_P)
     assert window.mode == Mode.POSE
+    # Pose mode shows the body (#83): its preview and report are made before the test goes on
+    qtbot.waitUntil(lambda: not window.jobs.running, timeout=JOB_TIMEOUT_MS)
     return window
 
 

@@ -71,6 +71,14 @@ class BreakageReport:
         return 100.0 * (self.rest_voxels - self.posed_voxels) / max(self.rest_voxels, 1)
 
     @property
+    def size_change(self) -> str:
+        """The loss in words: "0.44 % fewer voxels than the rest pose", or "more" (#83: "-0.44 % loss")."""
+        loss = self.loss_percent
+        if abs(loss) < 0.005:
+            return "as many voxels as the rest pose"
+        return f"{abs(loss):.2f} % {'fewer' if loss > 0 else 'more'} voxels than the rest pose"
+
+    @property
     def healthy(self) -> bool:
         """No piece torn off and no stump: measured against the rest pose, not against "one piece"."""
         return not self.pieces and not self.stumps
@@ -84,11 +92,14 @@ class BreakageReport:
         if self.stumps:
             s = self.stumps[0]
             return f"STUMP left behind near {s.joint}: {s.points} points of {s.attached} lie along {s.lies_along}"
-        first = self.lumps[0] if self.lumps else None
-        lump = f"; but a lump near {first.near}: {first.voxels} voxels carried off" if first else ""
-        if self.rest_pieces > 1:
-            return f"healthy: nothing torn off (the rest pose too is {self.rest_pieces:,} pieces), no stump{lump}"
-        return f"healthy: one piece, no stump{lump}"
+        whole = (f"nothing torn off (the rest pose too is {self.rest_pieces:,} pieces), no stump"
+                 if self.rest_pieces > 1 else "one piece, no stump")
+        if self.lumps:  # the finding first (#83: it came last, cut off as "...lump near L_SHOUL..." after "healthy")
+            first = self.lumps[0]
+            more = f" and {len(self.lumps) - 1} more" if len(self.lumps) > 1 else ""
+            moved = f" moved by {first.carrier}" if first.carrier else " carried off"
+            return f"lump near {first.near}: {first.voxels:,} voxels of {first.whose}{moved}{more}; {whole}"
+        return f"healthy: {whole}"
 
     def lines(self) -> list[str]:
         out = [f"{len(self.components)} connected component(s)"
@@ -98,8 +109,8 @@ class BreakageReport:
                *(f"piece of {n} voxels torn off near {j}" for n, j, _ in self.pieces[:5]),
                *(s.text() for s in self.stumps[:5]),
                *(lump.text() for lump in self.lumps[:5]),
-               f"{self.posed_voxels} voxels, {self.loss_percent:+.2f} % loss against the rest pose "
-               f"({self.lost_voxels} rest voxels not covered in the pose)",
+               f"{self.posed_voxels:,} voxels, {self.size_change} ({self.lost_voxels:,} rest voxels not "
+               "covered in the pose)",
                f"{self.cracks} cracks (sphere pairs of different bones that touched at rest and part in the pose)",
                f"hotspot: up to {self.hotspot_max} spheres on one voxel, mean {self.hotspot_mean:.1f}"]
         if self.source_coverage is not None:
@@ -426,4 +437,5 @@ def _lumps(tskel: Tskel, posed: Reconstruction, rest: RestParts, posed_joints: d
         rest.reach = bone_reach(segments, *rest.voxels), limb_voxels(segments, rest.voxels[1])
     reach, limbs = rest.reach
     return find_lumps(posed.volume, posed.origin, np.asarray(tskel.matrices, np.float64), segments, reach,
-                      rest.rest_bone.volume, rest.rest_bone.origin, posed_joints, limbs)
+                      rest.rest_bone.volume, rest.rest_bone.origin, posed_joints, limbs,
+                      labels=[b.label for b in tskel.bones])

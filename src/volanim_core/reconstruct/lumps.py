@@ -9,7 +9,8 @@
       nobody's own .. no bone k's own rest flesh lands on q ([q 1] M_k^-1 is owned by k at rest)
     --> opened by one voxel (a one-voxel rim is not a lump), 26-connected pieces, largest first
     --> kept when at least SHARE of the limb that carried it (its bone and the bones below, at rest)
-    --> Lump(voxels, the posed joint nearest its centre, centre)
+    --> Lump(voxels, the posed joint nearest its centre, centre, the bone that carried it, the bone c whose
+        flesh it is: the one to give those points to)
 
 Why: the nearest-bone connect gives a limb the torso's flesh next to its joint (the armpit, the groin).
 When the limb turns, that flesh turns with it and hangs beside the body: the lump a person sees under a
@@ -47,13 +48,28 @@ class Lump:
     centre: np.ndarray  # rest-grid voxels, posed frame
     lo: np.ndarray | None = None  # its box, the same voxels (the studio draws it)
     hi: np.ndarray | None = None
+    carrier: str = ""  # the bone that carried it off (its voxels' owner in the pose)
+    belongs_to: str = ""  # the bone whose reach its flesh lay in at rest: whom to give it to (#83)
 
     def __eq__(self, other) -> bool:  # two reports of one frame compare equal (the arrays element by element)
         return isinstance(other, Lump) and (self.voxels, self.near) == (other.voxels, other.near) and all(
             np.array_equal(a, b) for a, b in ((self.centre, other.centre), (self.lo, other.lo), (self.hi, other.hi)))
 
     def text(self) -> str:
-        return f"lump near {self.near}: {self.voxels} voxels of flesh carried off where no bone's own flesh is"
+        return f"lump near {self.near}: {self.voxels:,} voxels of {self.whose} carried off{self.by}{self.fix}"
+
+    @property
+    def whose(self) -> str:
+        return f"{self.belongs_to}'s flesh" if self.belongs_to else "flesh"
+
+    @property
+    def by(self) -> str:
+        return f" by {self.carrier}" if self.carrier else " where no bone's own flesh is"
+
+    @property
+    def fix(self) -> str:
+        """What to do about it, in words: give the points there to the bone the flesh belongs to."""
+        return f" (give the points there to {self.belongs_to})" if self.belongs_to else ""
 
 
 def bone_reach(segments: list[tuple[np.ndarray, np.ndarray]], voxels: np.ndarray, bone: np.ndarray) -> np.ndarray:
@@ -86,7 +102,7 @@ def limb_voxels(segments, bone: np.ndarray) -> np.ndarray:
 
 def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, reach: np.ndarray,
                rest_owner: np.ndarray, rest_origin, joints: dict[str, np.ndarray],
-               limbs: np.ndarray | None = None) -> list[Lump]:
+               limbs: np.ndarray | None = None, labels: list[str] | None = None) -> list[Lump]:
     """The lumps of a rigid frame (see the module docstring), largest first.
 
     Parameters
@@ -106,6 +122,8 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
     limbs : (B,), optional
         :func:`limb_voxels` of the connectivity: a lump is kept when it is SHARE of the limb that carried it
         (None: every piece of MIN_VOXELS or more).
+    labels : list of str, optional
+        The bones' names: each lump then says which bone carried it and which bone its flesh belongs to.
     """
     q = np.argwhere(posed_bone > 0)
     own = posed_bone[tuple(q.T)].astype(np.int64) - 1
@@ -126,13 +144,17 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
     d = segment_distances(rest[cand], np.array([[p0, p1] for p0, p1 in segments], np.float64))
     inside = d <= reach[None, :]
     host = np.argmin(np.where(inside, d, np.inf), axis=1)
+    # whose flesh it is, to name (not to find) a lump: the bone whose reach it lies deepest in, relative to
+    # that reach. The nearest segment named the clavicle for the armpit; the body part is the torso's (the
+    # mannequin's own parts, tests/core/reconstruct/test_lumps.py)
+    deepest = np.argmin(np.where(inside, d / reach[None, :], np.inf), axis=1)
     keep = inside.any(axis=1)  # within another bone's reach at rest: that bone's flesh, carried
     kept_at = np.empty((len(cand), 3))
     for c in np.unique(host):
         sel = host == c
         kept_at[sel] = rest[cand[sel]] @ matrices[c, :3, :3] + matrices[c, 3, :3]
     keep &= np.linalg.norm(kept_at - qf[cand], axis=1) > MOVED  # ... and moved away from it
-    cand = cand[keep]
+    cand, deepest = cand[keep], deepest[keep]
     rest_origin = np.asarray(rest_origin, np.int64)
     for k in range(len(segments)):  # a bone whose own rest flesh lands here: overlap, not a lump
         if not len(cand):
@@ -141,7 +163,8 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
         ok = np.all((at >= 0) & (at < rest_owner.shape), axis=1)
         theirs = np.zeros(len(cand), bool)
         theirs[ok] = rest_owner[tuple(at[ok].T)] == k + 1
-        cand = cand[~(theirs & (own[cand] != k))]
+        mine = ~(theirs & (own[cand] != k))
+        cand, deepest = cand[mine], deepest[mine]
     if not len(cand):
         return []
     # opened and labelled in the flagged voxels' box only (a margin of 1 for the opening), not the whole grid
@@ -150,24 +173,31 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
     box = tuple(slice(a, b) for a, b in zip(lo, hi))
     flagged = np.zeros(tuple(hi - lo), bool)
     flagged[tuple((q[cand] - lo).T)] = True
+    hosts = np.zeros(tuple(hi - lo), np.int64)  # each flagged voxel's owner at rest + 1: whom the flesh belongs to
+    hosts[tuple((q[cand] - lo).T)] = deepest + 1
     posed_bone = posed_bone[box]
     origin = np.asarray(origin, np.float64) + lo
-    labels, n = ndimage.label(ndimage.binary_opening(flagged, OPENING), PIECES)
+    pieces, n = ndimage.label(ndimage.binary_opening(flagged, OPENING), PIECES)
     if not n:
         return []
-    sizes = np.bincount(labels.ravel())[1:]
+    sizes = np.bincount(pieces.ravel())[1:]
     names = list(joints)
     at = np.array([joints[n] for n in names], np.float64) if names else None
     lumps = []
     for k in np.argsort(-sizes, kind="stable"):
         if sizes[k] < MIN_VOXELS:
             break
-        if limbs is not None:  # the limb that carried it: its voxels' most common owner's
-            carrier = np.bincount(posed_bone[labels == k + 1].astype(np.int64) - 1).argmax()
-            if sizes[k] < SHARE * limbs[carrier]:
-                continue
-        where = np.argwhere(labels == k + 1) + np.asarray(origin, np.float64)
+        piece = pieces == k + 1
+        carrier = np.bincount(posed_bone[piece].astype(np.int64) - 1).argmax()  # its voxels' most common owner
+        if limbs is not None and sizes[k] < SHARE * limbs[carrier]:  # under SHARE of the limb that carried it
+            continue
+        where = np.argwhere(piece) + np.asarray(origin, np.float64)
         centre = where.mean(axis=0)
         near = names[int(((at - centre) ** 2).sum(axis=1).argmin())] if names else ""
-        lumps.append(Lump(int(sizes[k]), near, centre, where.min(axis=0), where.max(axis=0)))
+        held = hosts[piece]
+        held = held[held > 0]
+        belongs = int(np.bincount(held).argmax()) - 1 if len(held) else -1
+        lumps.append(Lump(int(sizes[k]), near, centre, where.min(axis=0), where.max(axis=0),
+                          carrier=labels[carrier] if labels else "",
+                          belongs_to=labels[belongs] if labels and belongs >= 0 else ""))
     return lumps

@@ -17,14 +17,13 @@ import json
 import os
 import shutil
 import time
-from concurrent.futures import FIRST_COMPLETED, wait
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from volanim_core.io.files import resolved
-from volanim_core.parallel import THIS_PROCESS, RunOn, executor
+from volanim_core.parallel import THIS_PROCESS, RunOn, executor, wait_some
 
 from .scene import Renderer, RenderSettings
 from .views import Camera, union_box
@@ -292,11 +291,12 @@ class RenderReport:
 
 
 def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | None = None, on: RunOn = THIS_PROCESS,
-           force: bool = False, keep_frames: bool = False, dims=None, on_frame=None) -> RenderReport:
+           force: bool = False, keep_frames: bool = False, dims=None, on_frame=None, cancel=None) -> RenderReport:
     """Render every frame of ``inputs`` to ``out``; see the module docstring.
 
     ``on``: where the pictures are drawn; ``on.isolate``: in worker processes only, never in this one.
     ``on_frame(number, done, total)`` after each picture (progress; it may raise to stop the run).
+    ``cancel()``: asked while pictures are being drawn, not only when one arrives (Cancelled).
     """
     t0 = time.perf_counter()
     out = Path(out)
@@ -330,7 +330,7 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     try:
         if todo:
             try:
-                label = _draw(todo, job, folder, on, on_frame, done, total)
+                label = _draw(todo, job, folder, on, on_frame, done, total, cancel)
             finally:
                 release()
         if kind in ("mp4", "gif"):
@@ -344,7 +344,7 @@ def render(inputs: RenderInputs, settings: RenderSettings, out, *, fps: float | 
     return RenderReport(out, total, len(todo), skipped, time.perf_counter() - t0, label, fps, settings.mapper)
 
 
-def _draw(todo, job, folder, on: RunOn, on_frame, done, total) -> str:
+def _draw(todo, job, folder, on: RunOn, on_frame, done, total, cancel=None) -> str:
     """Draw ``todo`` anywhere; the driver writes each picture as it arrives. Returns where it ran."""
     with executor(render_task, job, install, workers=min(on.workers or 1, len(todo)), scheduler=on.scheduler,
                   isolate=on.isolate) as (submit, label, in_flight):
@@ -352,7 +352,7 @@ def _draw(todo, job, folder, on: RunOn, on_frame, done, total) -> str:
         while queue or pending:  # pictures arrive about in order
             while queue and len(pending) < in_flight:
                 pending.add(submit(queue.pop(0)))
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            finished, pending = wait_some(pending, cancel)
             for fut in finished:
                 number, image = fut.result()
                 write_png(frame_path(folder, number), image)

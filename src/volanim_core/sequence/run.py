@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import time
-from concurrent.futures import FIRST_COMPLETED, Future, wait
+from concurrent.futures import Future
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,7 +25,7 @@ from volanim_core.colour.indexed import index_colours
 from volanim_core.io.atomic import naming_the_output
 from volanim_core.io.files import resolved
 from volanim_core.limits import available_bytes, human_bytes
-from volanim_core.parallel import THIS_PROCESS, RunOn, executor
+from volanim_core.parallel import THIS_PROCESS, RunOn, executor, wait_some
 from volanim_core.reconstruct.engine import check_output_grid, grid_bounds, output_dtype
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.volume import Bounds
@@ -159,7 +159,7 @@ EXISTING = ("resume", "replace-other", "redo")
 
 def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: SequenceSettings = SequenceSettings(),
                  *, on: RunOn = THIS_PROCESS, existing: str = "resume", on_frame=None,
-                 frame_seconds=None) -> SequenceReport:
+                 frame_seconds=None, cancel=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
     The store records the frames' geometry (``conn.geometry`` at the shared grid's origin) in physical units.
@@ -167,6 +167,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
     frames are kept and the rest made; another sequence there is refused. ``replace-other``: the same, but
     another sequence is replaced (a cache, like the studio's movie). ``redo`` (``--force``): made again.
     ``on_frame(record, done, total)`` after each finished frame (progress).
+    ``cancel()``: asked while frames are being made, not only when one finishes (Cancelled when it says so).
     ``frame_seconds(record) -> float``: what a finished frame cost, for sizing Dask's tasks
     (``frames_per_task``); default the ``seconds`` its worker measured. The frames never depend on
     it; a test passes a constant, so the tasks are known whatever the machine's load.
@@ -251,7 +252,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
                 batch = queue[:min(frames_per_task(seconds, task_seconds), -(-len(queue) // in_flight))]
                 del queue[:len(batch)]
                 pending.add(submit([(i, frames[i], grids[i]) for i in batch]))
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            finished, pending = wait_some(pending, cancel)
             for fut in finished:
                 recs = fut.result()
                 store.record(out, *recs)  # one fsync a task, not one a frame

@@ -23,7 +23,22 @@ from volanim_core.skeleton.points import Skeleton
 
 from .undo import Command
 
+#: Auto-connect methods that decide every point from the whole rig (its fitted tubes): they take every shown
+#: point and may replace attachments, whatever Points and Overwrite say (a selection stays a selection).
+WHOLE_BODY_METHODS = ("fitted",)
 MATCH_TOLERANCE = 1e-3  # voxels: Root: joints must match the bone skeleton's to this
+
+
+def connectivity(skeleton: Skeleton, bones: BoneSkeleton, attached: np.ndarray, joints: Joints,
+                 thinness: float | None = None) -> Connectivity:
+    """The attached points of ``skeleton`` (``attached[i]``: point i's bone, -1 none) as a connectivity of
+    ``bones``: a function of its arguments alone, so an autosave can make it on its own thread from a
+    snapshot."""
+    keep = attached >= 0
+    roots = [BoneSegment(*bones.segment(i), b.label) for i, b in enumerate(bones.bones)]
+    conn = Connectivity(roots, skeleton.points[keep], skeleton.dt[keep], skeleton.thinness[keep], attached[keep],
+                        skeleton.metric, thinness, skeleton.geometry, joints)
+    return conn.grouped()
 
 
 class Attachments:
@@ -103,6 +118,10 @@ class Attachments:
             raise ValueError("auto-connect needs the segmented volume: open the volume (or project) first")
         n = doc.visible_count
         which = np.zeros(len(self.bone), bool)
+        if method in WHOLE_BODY_METHODS and scope != "selection":
+            # it decides each point from the whole rig's tubes, so it is asked of every shown point (#83:
+            # chosen alone, with the default "unconnected" points, it attached 0 of a connected body)
+            scope, overwrite = "all", True
         if scope == "selection":
             if selection is None or not len(selection):
                 raise ValueError("select points with the cube or lasso first")
@@ -150,11 +169,7 @@ class Attachments:
         s = doc.skeleton
         if s is None:  # an empty studio: F5, exports and saves end here, with words instead of a traceback
             raise ValueError("nothing loaded yet: open a volume, a demo or a project first (File menu)")
-        keep = self.bone >= 0
-        roots = [BoneSegment(*doc.bones.segment(i), b.label) for i, b in enumerate(doc.bones.bones)]
-        conn = Connectivity(roots, s.points[keep], s.dt[keep], s.thinness[keep], self.bone[keep], s.metric,
-                            thinness, s.geometry, Joints(doc.settings.joints, doc.settings.blend))
-        return conn.grouped()
+        return connectivity(s, doc.bones, self.bone, Joints(doc.settings.joints, doc.settings.blend), thinness)
 
     def save(self, path, thinness: float | None = None) -> int:
         """Write attached points with thinness >= ``thinness`` (default: the slider) atomically."""

@@ -1,16 +1,26 @@
-"""Autosave and crash recovery, Qt-free (the window drives it with a timer).
+"""Autosave and crash recovery, Qt-free (the window polls it with a timer).
 
     ROOT/<pid>-<start>/session.json        who owns this folder (pid)
     ROOT/<pid>-<start>/recovery.volanim    the last autosave, a project saved as one unit
     ROOT/<pid>-<start>/recovery.volanim.d/ its data files (this save's and the one before)
+    ROOT/<pid>-<start>/summary.json        what that autosave holds, for the recovery question
 
-A save happens after every ``every_edits`` edits and every ``every_seconds``
-while there are unsaved edits or the session's state (settings, thinness, the
-frame, the selection, the camera: ``document_state``) differs from the last save.
-A clean exit removes the folder; a folder whose pid is dead on the next start is a crashed session, offered for restore.
-Edits the user discards are first set aside (a declined folder, kept a week).
-A restored session's folder is removed only once the new session has
-autosaved what it restored, and never when the restore failed.
+    GUI thread, every POLL_SECONDS:  poll() --> changed since the last snapshot? --> project.snapshot (cheap)
+    the writer thread:                          project.write_snapshot --> summary.json
+
+Every change -- an edit, a step of a held drag, a slider, the frame, the camera --
+is on disk within one poll and one write (#83: a held drag used to hold back the
+autosave of finished edits, and a kill lost them). Taking a snapshot copies what
+a save needs, so the writing, which formats numbers, happens on a thread of its
+own while the user goes on; one write at a time, and the next snapshot is of the
+newest state, never a queue of old ones. An empty document is never autosaved,
+so a session killed before it loaded anything leaves nothing to offer.
+
+A clean exit removes the folder; a folder whose pid is dead on the next start is
+a crashed session, offered for restore with what it holds. Only the session the
+user restores is removed, once the new session has autosaved what it restored,
+and never when the restore failed; the others stay offered. Edits the user
+discards are first set aside (a declined folder, kept a week).
 ROOT is ``$VOLANIM_RECOVERY_DIR`` or ``~/.cache/volanim/recovery``.
 """
 
@@ -19,13 +29,17 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import threading
 import time
 from pathlib import Path
 
+from volanim_core.io import bundle
 from volanim_core.io.atomic import atomic_write_text
 
 RECOVERY_FILE = "recovery.volanim"
 DECLINED = "declined"
+SUMMARY = "summary.json"
+POLL_SECONDS = 0.25  # the window polls this often: a change is on disk within a poll and one write
 KEEP_DECLINED_SECONDS = 7 * 24 * 3600
 
 
@@ -70,13 +84,14 @@ def find_recoveries(root: Path | None = None) -> list[Path]:
     for folder in root.glob("*") if root.is_dir() else []:
         pid = _session_pid(folder)
         if (pid is not None and (folder / RECOVERY_FILE).is_file() and not (folder / DECLINED).exists()
-                and not _alive(pid)):
+                and not _alive(pid) and holds_work(folder / RECOVERY_FILE)):  # an empty one is never offered
             found.append(folder / RECOVERY_FILE)
     return sorted(found, key=lambda p: p.stat().st_mtime, reverse=True)
 
 
 def prune(root: Path | None = None, *, now: float | None = None) -> int:
-    """Remove folders of dead sessions with nothing to recover, and declined ones after a week.
+    """Remove folders of dead sessions with nothing to recover (no autosave, or one of an empty document),
+    and declined ones after a week.
 
     Returns how many folders went."""
     root = root or recovery_root()
@@ -87,7 +102,7 @@ def prune(root: Path | None = None, *, now: float | None = None) -> int:
         if pid is None or _alive(pid):
             continue
         declined = folder / DECLINED
-        if not (folder / RECOVERY_FILE).exists() or (
+        if not (folder / RECOVERY_FILE).exists() or not holds_work(folder / RECOVERY_FILE) or (
                 declined.exists() and now - declined.stat().st_mtime > KEEP_DECLINED_SECONDS):
             shutil.rmtree(folder, ignore_errors=True)
             removed += 1
@@ -99,33 +114,90 @@ def decline(recovery: Path) -> None:
     atomic_write_text(Path(recovery).parent / DECLINED, f"{time.time()}\n")
 
 
-def describe(recovery: Path) -> str:
-    """When an autosave was written and what it holds, for the recovery question: "Tue 24 Nov 2026
-    10:40: 18 bones, 4,380 attachments, a pose" (its folder's name is a process id and milliseconds)."""
+def summary_of(snap) -> dict:
+    """What an autosave holds, in numbers: written beside it, so the recovery question can say it
+    without reading the project."""
+    state = snap.fields
+    angles_shifts = state.get("pose") or {}
+    timeline = state.get("timeline") or {}
+    clip = timeline.get("clip") or {}
+    return {"saved": time.time(), "volume": Path(state["volume"]).name if state.get("volume") else state.get("demo"),
+            "points": 0 if snap.skeleton is None else len(snap.skeleton.points),
+            "bones": len(snap.bones), "attachments": int((snap.attached >= 0).sum()),
+            "pose": bool(angles_shifts.get("angles") or angles_shifts.get("shifts")),
+            "keys": len(timeline.get("keys") or []), "clip": Path(clip["path"]).name if clip.get("path") else None}
+
+
+def _summary(recovery: Path) -> dict | None:
+    """``summary.json`` beside an autosave (None: an older studio's autosave, or unreadable)."""
+    try:
+        data = json.loads((Path(recovery).parent / SUMMARY).read_text())
+    except (OSError, ValueError, RecursionError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _summary_from_project(recovery: Path) -> dict | None:
+    """The same numbers read from the project itself (an autosave without ``summary.json``); None when it
+    cannot be read (damaged: it is kept and offered all the same, never taken for empty)."""
     from volanim_core import io
 
     from .project import read_project
 
-    recovery = Path(recovery)
-    when = time.strftime("%a %d %b %Y %H:%M", time.localtime(recovery.stat().st_mtime))
-    parts = []
+    out = {"saved": Path(recovery).stat().st_mtime, "volume": None, "points": 0, "bones": 0, "attachments": 0,
+           "pose": False, "keys": 0, "clip": None}
     try:
         data = read_project(recovery)
-        if data.get("bones"):
-            parts.append(f"{len(io.read_bones(data['bones']))} bones")
-        if data.get("connect"):
-            parts.append(f"{len(io.read_connect(data['connect'])):,} attachments")
-        angles, shifts = data["state"].get("pose") or ({}, {})
-        if angles or shifts:
+    except (OSError, ValueError):  # FormatError is a ValueError
+        return None
+    out["volume"] = Path(data["volume"]).name if data.get("volume") else data.get("demo")
+    out["points"] = int(bool(data.get("mskel")))  # a skeleton is there (its size needs reading it)
+    if data.get("bones"):
+        out["bones"] = len(io.read_bones(data["bones"]))
+    if data.get("connect"):
+        out["attachments"] = len(io.read_connect(data["connect"]))
+    angles, shifts = data["state"].get("pose") or ({}, {})
+    out["pose"] = bool(angles or shifts)
+    timeline = data["state"].get("timeline") or {}
+    out["keys"] = len(timeline.get("keys") or [])
+    out["clip"] = Path(timeline["clip"]["path"]).name if timeline.get("clip") else None
+    return out
+
+
+def holds_work(recovery: Path) -> bool:
+    """Whether an autosave holds anything a user made: a volume or demo, a skeleton, bones, attachments, a
+    pose, keys."""
+    s = _summary(recovery) or _summary_from_project(recovery)
+    if s is None:
+        return True  # unreadable: what it holds is unknown, so it is kept
+    return bool(s.get("volume") or s.get("points") or s.get("bones") or s.get("attachments") or s.get("pose")
+                or s.get("keys"))
+
+
+def describe(recovery: Path) -> str:
+    """When an autosave was written and what it holds, for the recovery question: "Tue 24 Nov 2026
+    10:40: mannequin, 18 bones, 4,380 attachments, a pose, the clip walk.bvh" (its folder's name is a
+    process id and milliseconds)."""
+    recovery = Path(recovery)
+    s = _summary(recovery) or _summary_from_project(recovery)
+    if s is None:  # the question still names the time
+        return time.strftime("%a %d %b %Y %H:%M", time.localtime(recovery.stat().st_mtime)) + \
+            ": could not be read (restoring it says why)"
+    try:
+        saved = float(s.get("saved"))
+    except (TypeError, ValueError):
+        saved = recovery.stat().st_mtime
+    when = time.strftime("%a %d %b %Y %H:%M", time.localtime(saved))
+    parts = [str(s["volume"])] if s.get("volume") else []
+    for key, one in (("bones", "bone"), ("attachments", "attachment"), ("keys", "key")):
+        n = s.get(key)
+        if n:
+            parts.append(f"{n:,} {one if n == 1 else key}")
+        if key == "attachments" and s.get("pose"):
             parts.append("a pose")
-        timeline = data["state"].get("timeline") or {}
-        if timeline.get("keys"):
-            parts.append(f"{len(timeline['keys'])} keys")
-        if timeline.get("clip"):
-            parts.append(f"the clip {Path(timeline['clip']['path']).name}")
-    except (OSError, ValueError):  # FormatError is a ValueError: the question still names the time
-        pass
-    return when + (": " + ", ".join(parts) if parts else "")
+    if s.get("clip"):
+        parts.append(f"the clip {s['clip']}")
+    return when + (": " + ", ".join(parts) if parts else ": nothing")
 
 
 def discard(recovery: Path) -> None:
@@ -133,19 +205,26 @@ def discard(recovery: Path) -> None:
 
 
 class Autosaver:
-    def __init__(self, doc, root: Path | None = None, *, every_edits: int = 5, every_seconds: float = 60.0,
-                 clock=time.monotonic):
+    """One session's autosave (see the module docstring). ``background=False`` writes on the calling
+    thread (tests, scripts); ``clock`` is injectable."""
+
+    def __init__(self, doc, root: Path | None = None, *, background: bool = True, clock=time.monotonic):
         self.doc = doc
-        self.every_edits = every_edits
-        self.every_seconds = every_seconds
+        self.background = background
         self.clock = clock
         self.root = root or recovery_root()
         prune(self.root)
         self._new_folder()
-        self._saved_edits = doc.undo.edits
-        self._saved_state = self._state()
-        self._saved_at = clock()
-        self.saves = 0
+        self._taken = (doc.undo.edits, self._state_text())  # what the last snapshot was of
+        self._writer: threading.Thread | None = None
+        self._error: BaseException | None = None
+        self.saves = 0  # snapshots written (counted when taken)
+        self.written = 0  # writes finished
+        self.taken_at: float | None = None  # clock() when the last snapshot was taken
+        self.polls = 0
+        # a log of saves (the kill test's driver): on_taken(n) on the GUI thread as snapshot n is taken,
+        # on_written(n) on the writer thread once it is on disk
+        self.on_taken = self.on_written = None
 
     def _new_folder(self) -> None:
         self.folder = self.root / f"{os.getpid()}-{int(time.time() * 1000)}"
@@ -156,41 +235,103 @@ class Autosaver:
     def path(self) -> Path:
         return self.folder / RECOVERY_FILE
 
-    def _state(self) -> str:
-        """The session's state besides its edits (view state is not undoable, so no edit counts it)."""
+    def _state(self) -> dict:
         from .document_state import save_all
 
-        return json.dumps(save_all(self.doc, self.path), sort_keys=True, default=str)
+        return save_all(self.doc, self.path)
+
+    def _state_text(self, state: dict | None = None) -> str:
+        """The session's state besides its edits (view state is not undoable, so no edit counts it)."""
+        return json.dumps(self._state() if state is None else state, sort_keys=True, default=str)
 
     @property
     def dirty(self) -> bool:
-        """Edits, or a changed view (a slider, the frame, the camera), not autosaved yet."""
-        return self.doc.undo.edits != self._saved_edits or self._state() != self._saved_state
+        """Edits, or a changed view (a slider, the frame, the camera), not in the last snapshot."""
+        return self.doc.undo.edits != self._taken[0] or self._state_text() != self._taken[1]
 
-    def edited(self) -> bool:
-        """After an edit: save when ``every_edits`` edits are unsaved -- not while a slider or the timeline is
-        held: each step of a drag counts as an edit, and writing the project every fifth step cost a pose drag
-        45 ms a save (#65); the release's save follows once the window is idle (SessionController)."""
-        if self.doc.settings.dragging:
+    @property
+    def caught_up(self) -> bool:
+        """The session as it is now is on disk (an empty one: nothing to write): the last snapshot is of
+        it, and its write has finished without an error."""
+        return not self.writing and self._error is None and not self.dirty
+
+    @property
+    def writing(self) -> bool:
+        return self._writer is not None and self._writer.is_alive()
+
+    def poll(self) -> bool:
+        """From the window's timer: when the session changed since the last snapshot and no write is under
+        way, take one and write it (on the writer thread). Raises the last write's error once (the caller
+        says it); returns whether a write started."""
+        self.polls += 1
+        if self.writing:
             return False
-        if self.doc.undo.edits - self._saved_edits >= self.every_edits:
-            return self.save()
-        return False
+        self._raise_error()
+        state = self._state()
+        text = self._state_text(state)
+        if self.doc.undo.edits == self._taken[0] and text == self._taken[1]:
+            return False
+        return self._start(state, text)
 
-    def tick(self) -> bool:
-        """Periodically: save when there are unsaved edits older than ``every_seconds``."""
-        if self.dirty and self.clock() - self._saved_at >= self.every_seconds:
-            return self.save()
-        return False
+    def _start(self, state: dict, text: str) -> bool:
+        from .project import snapshot
+
+        snap = snapshot(self.doc, self.path, state=state)
+        self._taken = (self.doc.undo.edits, text)
+        if snap.is_empty:  # nothing a user made: never offered after a crash
+            return False
+        self.saves += 1
+        self.taken_at = self.clock()
+        if self.on_taken is not None:
+            self.on_taken(self.saves)
+        if not self.background:
+            self._write(snap, self.saves)
+            self._raise_error()
+            return True
+        self._writer = threading.Thread(target=self._write, args=(snap, self.saves), name="volanim autosave",
+                                        daemon=True)
+        self._writer.start()
+        return True
+
+    def _write(self, snap, number: int) -> None:
+        from .project import write_snapshot
+
+        try:
+            try:
+                write_snapshot(snap, self.path)
+            except BaseException:  # a full disk: the files this save stored, which no manifest names, go
+                bundle.collect_garbage(self.path)
+                raise
+            atomic_write_text(self.folder / SUMMARY, json.dumps(summary_of(snap)))
+            self.written += 1
+            if self.on_written is not None:
+                self.on_written(number)
+        except BaseException as exc:  # said on the GUI thread by the next poll
+            self._taken = (-1, "")  # try again at the next poll
+            self._error = exc
+
+    def _raise_error(self) -> None:
+        error, self._error = self._error, None
+        if error is not None:
+            raise error
+
+    def wait(self) -> None:
+        """Until the write under way (if any) has finished."""
+        if self._writer is not None:
+            self._writer.join()
+            self._writer = None
 
     def save(self) -> bool:
-        """Autosave now (the skeleton's file is written only when the skeleton changed)."""
+        """Autosave now, on this thread, after any write under way: the state at this moment is on disk
+        when it returns (Discard, a restore). Raises the write's error."""
+        self.wait()
+        self._error = None
         state = self._state()
-        self.doc.write_project(self.path)
-        self._saved_edits, self._saved_state = self.doc.undo.edits, state
-        self._saved_at = self.clock()
-        self.saves += 1
-        return True
+        background, self.background = self.background, False
+        try:
+            return self._start(state, self._state_text(state))
+        finally:
+            self.background = background
 
     def set_aside(self) -> Path:
         """Keep the document as it is now for a week, out of this session's way, and go on in a new folder.
@@ -205,8 +346,10 @@ class Autosaver:
         self.folder.rename(kept)
         decline(kept / RECOVERY_FILE)
         self._new_folder()
+        self._taken = (-1, "")  # the new folder holds nothing yet
         return kept / RECOVERY_FILE
 
     def close(self) -> None:
         """A clean exit: nothing to recover."""
+        self.wait()
         shutil.rmtree(self.folder, ignore_errors=True)

@@ -42,6 +42,13 @@ from .timeline import Timeline
 from .transfer import TransferState
 from .undo import UndoStack
 
+#: Changes that make the shown picture (and its verdict) old, with the words the verdict says them in.
+#: (A clip or keys matter through the pose they set: the timeline's own event is not one of these. Nor is the
+#: transfer function: the picture is drawn again in its colours at once, and no verdict depends on them.)
+STALE_AFTER = (("attachments", "the attachments"), ("bones", "the bones"), ("pose", "the pose"),
+               ("thinness", "the thinness"), ("skeleton", "the skeleton"))
+STALE_AFTER_SETTINGS = ("preview_mode", "preview_kernel", "preview_padding", "joints", "blend")
+
 
 class Document:
     """The Qt-free model of one studio session."""
@@ -50,7 +57,7 @@ class Document:
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
                                    "point_selection", "pose", "pose_settled", "preview", "timeline", "camera",
-                                   "transfer")
+                                   "transfer", "stale")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -85,6 +92,15 @@ class Document:
         self.point_selection = np.zeros(0, np.int64)  # the last cube / lasso selection
         self.camera: dict | None = None  # the last camera set or saved (the view's own when it lends it)
         self.view_camera = None  # () -> dict: the scene's camera now (a project saves what is on screen)
+        # what a picture is of (#83: after an auto-connect, a lasso or an undo the old picture and its green
+        # "healthy" stayed): every change that makes the shown preview old counts here; a preview carries the
+        # count it was made at, and the verdict and the scene say "old" until one of the count now is shown
+        self.picture_basis = 0
+        self.picture_change: str | None = None  # what changed last, in words ("the attachments")
+        for event, what in STALE_AFTER:
+            getattr(self.events, event).connect(lambda _what=what, **_: self._picture_changed(_what))
+        for name in STALE_AFTER_SETTINGS:
+            getattr(self.settings.events, name).connect(lambda **_: self._picture_changed("the preview settings"))
 
     # ------------------------------------------------------------------ data
     def set_volume(self, volume, mask=None, *, spacing=(1.0, 1.0, 1.0), path=None, segmentation=None, dims=None):
@@ -230,6 +246,17 @@ class Document:
     def set_preview(self, preview) -> None:
         self.preview = preview
         self.events.preview.emit()
+
+    def _picture_changed(self, what: str) -> None:
+        self.picture_basis += 1
+        self.picture_change = what
+        self.events.stale.emit(what=what)
+
+    @property
+    def preview_is_current(self) -> bool:
+        """A preview is shown and nothing it depends on changed since it was asked for."""
+        p = self.preview
+        return p is not None and getattr(p, "basis", None) == self.picture_basis
 
     def set_camera(self, camera: dict | None) -> None:
         """Look from ``camera`` (a saved view: position, focal_point, view_up); the scene follows."""

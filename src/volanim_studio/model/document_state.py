@@ -187,7 +187,10 @@ ATTRIBUTES = {
     "mskel_path": "the .mskel data file's place", "bones_path": "the .bones data file's place",
     "project_path": "where the project is", "demo_name": "saved as \"demo\"",
     "hull": "made again from the volume", "hull_lod": "made again from the volume",
-    "preview": "a reconstruction: made again with F5", "only_unconnected": "a filter of the Connect tab, per visit",
+    "preview": "a reconstruction: made again with F5",
+    "picture_basis": "counts changes since the preview: a new session has no preview",
+    "picture_change": "counts changes since the preview: a new session has no preview",
+    "only_unconnected": "a filter of the Connect tab, per visit",
     "only_working": "a filter of the Connect tab, per visit", "cube_centre": "placed again with a click in Cube mode",
     "point_selection": "the last cube or lasso, per visit", "transfer": "the transfer part",
 }

@@ -34,6 +34,7 @@ class Preview:
     joints: dict | None = None  # the posed joints it was made for: playing, the bones drawn are these
     frame: int | None = None  # the timeline frame it shows (None: not a frame of the timeline)
     live: bool = False  # made while a pose changes (LivePreviews): drawn as a surface, no report
+    basis: int | None = None  # Document.picture_basis when it was asked for: older than the document's is old
 
     @property
     def spacing(self) -> tuple[float, float, float]:

@@ -22,9 +22,12 @@ minimum thinness 0.5.
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import math
+import threading
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -34,9 +37,12 @@ from volanim_core.errors import FormatError
 from volanim_core.io import bundle
 from volanim_core.io.files import CHECKED_NUMBERS
 from volanim_core.limits import checked_grid
+from volanim_core.rig.bones import BoneSkeleton
+from volanim_core.rig.skinning import Joints
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
 
 from . import document_state
+from .attachments import connectivity
 from .document_state import relative_path
 
 PROJECT_FORMAT = "volanim project"
@@ -46,6 +52,44 @@ DEFAULT_SEGMENTATION = {"lo": 1, "hi": None, "fill": False, "metric": "euclid", 
                         "series": None}  # series: the DICOM series chosen from a folder of several
 DATA_FILES = ("mskel", "bones", "connect")
 _stored: dict = {}  # (store folder, kind) -> (fingerprint, skeleton, relative path, sha256): written once
+_stored_lock = threading.Lock()  # an autosave writes on its own thread while Save writes on the GUI's
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """What one project save writes, taken from the document at one moment.
+
+    Taking it is cheap (the bones deep-copied, the attachment array copied, the session's JSON parts;
+    the skeleton by reference, since the document replaces it and never changes it in place), so an
+    autosave takes one on the GUI thread and formats and writes the files on its own thread while the
+    user goes on editing (#83: a held drag once held back the autosave of finished edits).
+    """
+
+    bones: BoneSkeleton
+    grid: object
+    skeleton: object  # volanim_core Skeleton or None
+    attached: np.ndarray  # each skeleton point's bone (-1: none), a copy
+    joints: Joints
+    fields: dict  # the manifest's keys besides the data files: what to load, the segmentation, the state
+
+    @property
+    def is_empty(self) -> bool:
+        """Nothing a user made: no volume, no skeleton, no bones."""
+        return self.skeleton is None and not len(self.bones) and not (self.fields.get("volume")
+                                                                     or self.fields.get("demo"))
+
+
+def snapshot(doc, path, *, state: dict | None = None) -> Snapshot:
+    """The document as :func:`write_snapshot` writes it to ``path`` (see :class:`Snapshot`); ``state``:
+    ``document_state.save_all(doc, path)`` when the caller has it already."""
+    path = Path(path)
+    volume = relative_path(path, doc.volume_path) if doc.volume_path else None
+    fields = {"format": PROJECT_FORMAT, "version": PROJECT_VERSION, "demo": doc.demo_name, "volume": volume,
+              "volume_dims": list(doc.volume_dims) if doc.volume_dims else None,
+              "segmentation": copy.deepcopy(doc.segmentation),
+              **copy.deepcopy(document_state.save_all(doc, path) if state is None else state)}
+    return Snapshot(copy.deepcopy(doc.bones), doc.grid, doc.skeleton, doc.attachments.bone.copy(),
+                    Joints(doc.settings.joints, doc.settings.blend), fields)
 
 
 def _store_once(path: Path, kind: str, suffix: str, skeleton, fingerprint, write) -> tuple[str, str]:
@@ -53,46 +97,49 @@ def _store_once(path: Path, kind: str, suffix: str, skeleton, fingerprint, write
     ``fingerprint`` is not formatted and written again (an autosave after a pose change wrote the frog's
     .connect anew: 1 s of number formatting for nothing, #65)."""
     key = (str(bundle.store_folder(path).resolve()), kind)
-    hit = _stored.get(key)
+    with _stored_lock:
+        hit = _stored.get(key)
     if hit is not None and hit[0] == fingerprint and hit[1] is skeleton and (path.parent / hit[2]).is_file():
         return hit[2], hit[3]
     rel, digest = bundle.store_file(path, kind, suffix, write)
-    if len(_stored) > 16:
-        _stored.clear()
-    _stored[key] = (fingerprint, skeleton, rel, digest)
+    with _stored_lock:
+        if len(_stored) > 16:
+            _stored.clear()
+        _stored[key] = (fingerprint, skeleton, rel, digest)
     return rel, digest
 
 
-def _connect_fingerprint(doc) -> tuple:
+def _connect_fingerprint(snap: Snapshot) -> tuple:
     """What a .connect is made of besides the skeleton's own arrays: each point's bone, the bones, the joints."""
-    digest = hashlib.sha256(doc.attachments.bone.tobytes())
-    digest.update(np.ascontiguousarray(doc.bones.segments(), np.float64).tobytes())
-    return (id(doc.skeleton), digest.hexdigest(), tuple(b.label for b in doc.bones.bones),
-            doc.settings.joints, doc.settings.blend)
+    digest = hashlib.sha256(snap.attached.tobytes())
+    digest.update(np.ascontiguousarray(snap.bones.segments(), np.float64).tobytes())
+    return (id(snap.skeleton), digest.hexdigest(), tuple(b.label for b in snap.bones.bones),
+            snap.joints.kind, snap.joints.blend)
 
 
 def write_project(doc, path) -> dict:
     """Write ``doc`` as one project save (see the module docstring); returns the absolute paths written."""
+    return write_snapshot(snapshot(doc, path), path)
+
+
+def write_snapshot(snap: Snapshot, path) -> dict:
+    """Write one project save of ``snap`` (any thread: it reads nothing of the document); returns the
+    absolute paths written."""
     path = Path(path)
     stored = {}
-    if len(doc.bones):  # a .bones file with no bones is not a valid file: a project without bones has none
-        stored["bones"] = bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, doc.bones, doc.grid))
-    if doc.skeleton is not None:
-        stored["mskel"] = _store_once(path, "skeleton", ".mskel", doc.skeleton, id(doc.skeleton),
-                                      lambda p: io.write_mskel(p, doc.skeleton))
-    if len(doc.attachments.bone) and (doc.attachments.bone >= 0).any():
-        stored["connect"] = _store_once(path, "connect", ".connect", doc.skeleton, _connect_fingerprint(doc),
-                                        lambda p: io.write_connect(p, doc.attachments.to_connectivity()))
-
-    volume = relative_path(path, doc.volume_path) if doc.volume_path else None
-    data = {
-        "format": PROJECT_FORMAT, "version": PROJECT_VERSION, "demo": doc.demo_name,
-        "volume": volume, "volume_dims": list(doc.volume_dims) if doc.volume_dims else None,
-        "segmentation": doc.segmentation,
-        **{key: rel for key, (rel, _) in stored.items()},
-        "sha256": {key: digest for key, (_, digest) in stored.items()},
-        **document_state.save_all(doc, path),
-    }
+    if len(snap.bones):  # a .bones file with no bones is not a valid file: a project without bones has none
+        stored["bones"] = bundle.store_file(path, "bones", ".bones", lambda p: io.write_bones(p, snap.bones, snap.grid))
+    if snap.skeleton is not None:
+        stored["mskel"] = _store_once(path, "skeleton", ".mskel", snap.skeleton, id(snap.skeleton),
+                                      lambda p: io.write_mskel(p, snap.skeleton))
+    if len(snap.attached) and (snap.attached >= 0).any():
+        stored["connect"] = _store_once(
+            path, "connect", ".connect", snap.skeleton, _connect_fingerprint(snap),
+            lambda p: io.write_connect(p, connectivity(snap.skeleton, snap.bones, snap.attached, snap.joints)))
+    data = {**snap.fields, **{key: rel for key, (rel, _) in stored.items()},
+            "sha256": {key: digest for key, (_, digest) in stored.items()}}
+    keys = ["format", "version", "demo", "volume", "volume_dims", "segmentation", *stored, "sha256"]
+    data = {k: data[k] for k in keys} | {k: v for k, v in data.items() if k not in keys}  # the order it always had
     bundle.commit(path, numbers_as_values(data))
     written = {"project": str(path), "bones": None, "mskel": None, "connect": None}
     written.update({key: str((path.parent / rel).resolve()) for key, (rel, _) in stored.items()})

@@ -13,7 +13,7 @@ bindings.py ........... two-way widget <-> settings bindings (signals blocked on
 *_panel.py ............ one panel per file: bone_panel.py, connect_panel.py, display_panel.py,
                         pose_panel.py, reconstruct_panel.py, timeline_panel.py
 dialogs and windows ... threshold_dialog.py, mapping_dialog.py, movie_dialog.py, propose_dialog.py,
-                        scan_dialog.py, look_dialog.py, quicklook_window.py, slice_window.py,
+                        scan_dialog.py, look_dialog.py, recovery_dialog.py, quicklook_window.py, slice_window.py,
                         transfer_editor.py (the thesis's Icol)
 status_line.py ........ the status bar; verdict_label.py the last preview's verdict
 mode_keys.py .......... the mode letters work wherever the focus is

@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from ..model.attachments import WHOLE_BODY_METHODS
 from ..model.document import Document
 from ..model.interaction import CubeMode
 from ..model.settings import AUTO_METHODS, AUTO_SCOPES, DEPTH_MODES
@@ -97,6 +98,9 @@ class ConnectPanel(QWidget):
                              (self.overwrite, "auto_overwrite")):
             bind(widget, st, name, on_error=doc.message)
         st.events.cube_size.connect(self._on_cube_size_changed)
+        st.events.auto_method.connect(lambda **_: self._on_method())
+        st.events.auto_scope.connect(lambda **_: self._on_method())
+        self._on_method()
         st.events.cube_size.connect(self._count_cube)
         for event in (doc.events.cube, doc.events.thinness, doc.events.filter, doc.events.attachments,
                       doc.events.skeleton):
@@ -112,6 +116,18 @@ class ConnectPanel(QWidget):
         doc.events.thinness.connect(self._refresh)
         doc.events.filter.connect(self._on_filter_changed)
         self._refresh()
+
+    def _on_method(self) -> None:
+        """A whole-body method takes every shown point and may replace attachments: Overwrite is not asked
+        (greyed, with why), and Points offers the choice that matters, all or the selection."""
+        st = self.doc.settings
+        whole = st.auto_method in WHOLE_BODY_METHODS
+        self.overwrite.setEnabled(not whole)
+        self.overwrite.setToolTip(f"{st.auto_method} decides every shown point from the whole rig: it replaces "
+                                  "attachments whatever this says" if whole else
+                                  "auto-connect may replace existing attachments")
+        self.scope.setToolTip(f"{st.auto_method}: every shown point unless Points is the selection" if whole
+                              else "which points auto-connect considers")
 
     def _on_cube_size_changed(self, value: float, **_) -> None:
         self.cube_size_label.setText(f"{value:g}")

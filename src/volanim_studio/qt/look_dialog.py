@@ -37,9 +37,12 @@ class LookDialog(QFileDialog):
         if picked and is_sequence_folder(picked[0]):
             self._choose(picked[0])
             return
+        # chosen is set before QFileDialog.accept, which emits ``finished`` from inside itself: set after it,
+        # every listener of finished read None, and View of a plain file did nothing at all (#83)
+        self.chosen = picked[0] if picked else None
         super().accept()
-        if self.result() == QDialog.Accepted and self.selectedFiles():
-            self.chosen = self.selectedFiles()[0]
+        if self.result() != QDialog.Accepted:  # refused (no such file): the dialog stays open
+            self.chosen = None
 
     def _choose(self, path: str) -> None:
         self.chosen = path

@@ -15,9 +15,12 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractSpinBox,
+    QApplication,
     QDockWidget,
+    QLabel,
     QMainWindow,
     QMessageBox,
+    QSizePolicy,
     QTabWidget,
 )
 from pyvistaqt import QtInteractor
@@ -48,8 +51,7 @@ from .worker import JobRunner
 
 
 class MainWindow(QMainWindow):
-    def __init__(self, doc: Document | None = None, *, autosave_every_edits: int = 5,
-                 autosave_seconds: float = 60.0):
+    def __init__(self, doc: Document | None = None):
         super().__init__()
         collect_on_gui_thread()  # before any worker thread runs: garbage holding Qt/VTK objects dies here
         self.doc = doc or Document()
@@ -98,6 +100,11 @@ class MainWindow(QMainWindow):
         tabs.addTab(self.reconstruct_panel, "Reconstruct")
         tabs.addTab(self.display_panel, "Display")
         tabs.setMinimumWidth(420)
+        # text that grows with what it says wraps in the panel's width instead of widening the panel (#83: a
+        # long verdict took 223 px from the 3-D view after each release)
+        for label in tabs.findChildren(QLabel):
+            if label.wordWrap():
+                label.setSizePolicy(QSizePolicy.Ignored, label.sizePolicy().verticalPolicy())
         dock = QDockWidget("Panels", self)
         dock.setWidget(tabs)
         dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
@@ -118,7 +125,7 @@ class MainWindow(QMainWindow):
         self.doc.events.attachments.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.events.bones.connect(lambda **_: self._on_picked_changed(index=self.doc.picked_point))
         self.doc.undo.events.changed.connect(self._on_undo_changed)
-        self.session = SessionController(self, every_edits=autosave_every_edits, every_seconds=autosave_seconds)
+        self.session = SessionController(self)
         self.doc.settings.events.mode.connect(lambda value: self._enter_mode(value))
         self._enter_mode(self.doc.settings.mode)
         self._letters = LettersPastNumberFields(self)
@@ -296,13 +303,26 @@ class MainWindow(QMainWindow):
                                  f"   DT {i['dt']:.3f} ({i['dt_mm']:.2f} mm)   thinness {i['thinness']:.3f}   "
                                  f"bone {i['bone'] or '—'}")
 
-    def show_shortcuts(self) -> None:
+    def show_shortcuts(self):
+        """F1: every shortcut in a scrolling list that fits the screen (#83: a message box of them all was
+        taller than a 1000 px screen, its Close button out of reach)."""
+        from PySide6.QtWidgets import QDialog, QDialogButtonBox, QTextBrowser, QVBoxLayout
+
         rows = "".join(f"<tr><td><b>{k}</b></td><td>{v}</td></tr>" for k, v in SHORTCUTS)
-        box = QMessageBox(QMessageBox.Information, "Shortcuts", f"<table cellspacing=6>{rows}</table>",
-                          QMessageBox.Close, self)
-        box.setTextFormat(Qt.RichText)
+        box = QDialog(self)
+        box.setWindowTitle("Shortcuts")
+        text = QTextBrowser()
+        text.setHtml(f"<table cellspacing=6>{rows}</table>")
+        buttons = QDialogButtonBox(QDialogButtonBox.Close)
+        buttons.rejected.connect(box.reject)
+        layout = QVBoxLayout(box)
+        layout.addWidget(text)
+        layout.addWidget(buttons)
+        screen = (self.screen() or QApplication.primaryScreen()).availableGeometry()
+        box.resize(min(720, int(0.9 * screen.width())), min(900, int(0.8 * screen.height())))
         self._shortcut_box = box
         box.open()
+        return box
 
     def show_transfer_editor(self):
         """The transfer-function editor (one per window, not modal: the preview follows its edits)."""

@@ -3,7 +3,8 @@
     settings.dragging (a pose slider, the timeline held or playing) + doc.events.pose
         --> live_preview (full resolution on a small body, else half; GUI thread, coalesced) --> doc.set_preview
     settings.current_frame (a step) --> live_preview
-    dragging back to False in Pose mode, doc.events.pose_settled, F5
+    dragging back to False in Pose mode, doc.events.pose_settled, F5, Pose mode entered, a clip loaded
+        (show_body: unless the picture shown is current)
         --> preview() --> JobRunner(make_preview) --> doc.set_preview (the picture)
                       --> JobRunner(with_report, background) --> doc.set_preview (the same picture, with its report)
     doc.set_preview --> the scene's PoseLayer draws it (this controller draws nothing)
@@ -43,10 +44,17 @@ class PreviewController(Controller):
         st.dragging.connect(self._on_dragging)
         st.current_frame.connect(lambda **_: self.live_preview_soon() if self.doc.timeline.active else None)
         st.mode.connect(self._on_mode)
+        # a clip loaded (or keys changed) moves the body to its frame: drawn, not left under the new bones (#83);
+        # looked at once the event has been handled, since the timeline sets the frame's pose after telling
+        ev.timeline.connect(lambda **_: QTimer.singleShot(0, window, self._after_timeline))
         self._again = QTimer(window)  # a preview asked for while a job runs: made once it has ended
         self._again.setSingleShot(True)
         self._again.setInterval(50)
         self._again.timeout.connect(self._preview_when_idle)
+        self._body_again = QTimer(window)  # the same for show_body's preview
+        self._body_again.setSingleShot(True)
+        self._body_again.setInterval(50)
+        self._body_again.timeout.connect(self.show_body)
         st.joints.connect(lambda **_: self._joints_changed())
         st.blend.connect(lambda **_: self._joints_changed() if self.doc.settings.joints == "smooth" else None)
 
@@ -77,13 +85,24 @@ class PreviewController(Controller):
     def _on_mode(self, value) -> None:
         if value != Mode.POSE:
             self._live_timer.stop()
+        else:
+            self.show_body()
+
+    def _after_timeline(self) -> None:
+        st = self.doc.settings
+        if not (self.doc.preview_is_current or st.dragging or st.playing):
+            self.show_body()
 
     def show_body(self) -> None:
-        """A project or a recovered session opened in Pose mode: its full preview, once no job runs (#61: it
-        showed the bones alone until F5). Entering Pose mode by hand starts nothing: the rest pose is the
-        body the user sees, and the first pose change previews."""
-        if self.doc.preview is None:
-            self._preview_when_idle()
+        """Pose mode entered, or a project or a recovered session opened in it: the body's full preview,
+        once no job runs, unless the one shown is current (#61, #83: it showed the bones alone until the
+        first pose change or F5). A background job (no dialog): any job the user asks for next goes first."""
+        if self.doc.preview_is_current or not self._posing:
+            return
+        if self.jobs.running:  # any job, a background one too: never preempted from here (a preempt handles
+            self._body_again.start()  # events, and this could be called again inside it)
+        else:
+            self.preview(background=True)
 
     def _on_dragging(self, value: bool) -> None:
         """Held (a pose slider, the timeline scrubbed or playing): a running full preview is cancelled, a
@@ -142,21 +161,24 @@ class PreviewController(Controller):
         t0 = time.perf_counter()
         mode = self.doc.settings.preview_mode
         mode = mode if mode in ("binary", "bone") else "bone"
+        basis = self.doc.picture_basis
         try:
             tskel = self.doc.pose.tskel()
             p = self.live.make(tskel, mode=mode, padding=2)  # only what moved; full or half resolution
         except ValueError as exc:
             self.doc.message(str(exc))
             return
+        p.basis = basis
         # what it shows: playing, the scene draws these bones with it, never the newer pose's
         p.joints = self.doc.pose.posed_joints()
         p.frame = self.doc.settings.current_frame if self.doc.timeline.active else None
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
         self.live_timings.append(time.perf_counter() - t0)
 
-    def preview(self, *, report: bool = True) -> Worker | None:
+    def preview(self, *, report: bool = True, background: bool = False) -> Worker | None:
         """Full-resolution reconstruction in the background, shown as soon as it is made; then, as a second
-        job, its breakage report (mannequin-large: the picture in 0.2 s, the report 5 s later, #65)."""
+        job, its breakage report (mannequin-large: the picture in 0.2 s, the report 5 s later, #65).
+        ``background``: no dialog, and the next job asked for cancels it (the body shown on entering Pose)."""
         st = self.doc.settings
         settings = {"mode": st.preview_mode, "kernel": st.preview_kernel, "padding": st.preview_padding}
         if self.jobs.busy:
@@ -173,14 +195,16 @@ class PreviewController(Controller):
             self.show_error("Preview", str(exc))
             return None
         source = self.doc.volume if settings["mode"] == "sampled" else None
+        basis = self.doc.picture_basis
 
         def done(p) -> None:
+            p.basis = basis  # of the document as it was asked for: a change since leaves it marked old
             self.doc.set_preview(p)
             if report and not self.jobs.busy:  # (busy: what the picture set off started a job of its own)
                 self._report(p, tskel)
 
         worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
-            tskel, **settings, source=source, progress=progress, cancel=cancel), done)
+            tskel, **settings, source=source, progress=progress, cancel=cancel), done, background=background)
         worker.is_preview = True
         return worker
 
@@ -204,7 +228,21 @@ class PreviewController(Controller):
         posed = self.doc.pose.posed_joints()
         if name in posed:
             self.scene.jump_to(posed[name])
-            self.doc.message(f"Centred on {name}. Fix the points there (Lasso, L), then preview again (F5).")
+            self.doc.message(f"Centred on {name}. {self.fix_hint(name)}, then preview again (F5).")
+
+    def fix_hint(self, joint: str) -> str:
+        """What to do about the finding near ``joint``, naming the bone to give the points to (#83: "Fix the
+        points there" named none, and a guess turned a lump into a stump and 13 cracks)."""
+        report = self.doc.preview.report if self.doc.preview is not None else None
+        for lump in (report.lumps if report is not None else []):
+            if lump.near == joint and lump.belongs_to:
+                return (f"The flesh there is {lump.belongs_to}'s, carried off by {lump.carrier}: make "
+                        f"{lump.belongs_to} the working bone and give it the points there (Lasso, L)")
+        for stump in (report.stumps if report is not None else []):
+            if stump.joint == joint:
+                return (f"The points left behind lie along {stump.lies_along}: make it the working bone and "
+                        "give them to it (Lasso, L)")
+        return "Fix the points there (Lasso, L)"
 
     def export_preview(self, path) -> bool:
         p = self.doc.preview

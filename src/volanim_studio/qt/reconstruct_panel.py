@@ -110,7 +110,8 @@ class ReconstructPanel(QWidget):
             item.setData(Qt.UserRole, s.joint)
             self.joints.addItem(item)
         for lump in r.lumps:
-            item = QListWidgetItem(f"lump: {lump.voxels} voxels of flesh carried off near {lump.near}")
+            item = QListWidgetItem(f"lump: {lump.voxels:,} voxels of {lump.whose} carried off near {lump.near}"
+                                   f"{lump.by}{lump.fix}")
             item.setData(Qt.UserRole, lump.near)
             self.joints.addItem(item)
         total = max(sum(j.gap for j in r.joints), 1e-9)

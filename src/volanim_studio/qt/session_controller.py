@@ -1,7 +1,7 @@
 """The session's safety net: autosave, crash recovery, the unsaved-changes marker and "Save changes?".
 
-    undo stack changed / timer --> Autosaver (every N edits, every minute; a held drag's steps once the
-        window is idle after its release)
+    timer, every autosave.POLL_SECONDS --> Autosaver.poll: anything changed (an edit, a held drag's
+        latest step, the view) is snapshotted and written on the autosave's own thread
     doc project / skeleton / undo events --> window title "volanim studio — NAME[*]" (* = unsaved edits)
     close, open another volume or project --> when_saved_or_discarded(then): Save / Discard / Cancel
         Discard --> Autosaver.set_aside (kept a week, openable as a project) --> then()
@@ -21,24 +21,14 @@ from ..model import autosave
 from .controller import Controller
 from .worker import Worker
 
-RELEASE_POLL_MS = 300  # how often a released drag's save looks for an idle window
-
 
 class SessionController(Controller):
-    def __init__(self, window, *, every_edits: int = 5, every_seconds: float = 60.0):
+    def __init__(self, window, *, poll_seconds: float = autosave.POLL_SECONDS):
         super().__init__(window)
-        self.autosaver = autosave.Autosaver(self.doc, every_edits=every_edits, every_seconds=every_seconds)
-        self.doc.undo.events.changed.connect(self._after_edit)
-        # a drag's steps are saved after its release, once the window is idle: its preview first (the frog's
-        # first save formats 0.5 M numbers: 2 s on the GUI thread, which held the picture back, #65)
-        self._after_release = QTimer(window)
-        self._after_release.setInterval(RELEASE_POLL_MS)
-        self._after_release.timeout.connect(self._save_after_release)
-        self.doc.settings.events.dragging.connect(
-            lambda value, **_: self._after_release.stop() if value else self._after_release.start())
+        self.autosaver = autosave.Autosaver(self.doc)
         self.timer = QTimer(window)
-        self.timer.timeout.connect(self._tick)
-        self.timer.start(int(1000 * min(every_seconds, 60.0)))
+        self.timer.timeout.connect(self.poll)
+        self.timer.start(int(1000 * poll_seconds))
         self.save_box: QMessageBox | None = None  # the "Save changes?" question while it is open
         self.close_confirmed = False
         for event in (self.doc.events.project, self.doc.events.skeleton, self.doc.undo.events.changed):
@@ -46,54 +36,38 @@ class SessionController(Controller):
         self.update_title()
 
     # ------------------------------------------------------------ autosave
-    def _after_edit(self, **_) -> None:
+    def poll(self) -> None:
+        """Autosave what changed since the last snapshot, whatever else is going on (a held drag too: the
+        snapshot is cheap and the writing happens on the autosave's own thread)."""
         try:
-            self.autosaver.edited()
-        except (OSError, ValueError) as exc:
-            self.doc.message(f"Autosave failed: {exc}")
-
-    def _save_after_release(self) -> None:
-        if self.window.busy:  # the release's preview and report: the save waits for them
-            return
-        self._after_release.stop()
-        self._after_edit()
-
-    def _tick(self) -> None:
-        try:
-            self.autosaver.tick()
+            self.autosaver.poll()
         except (OSError, ValueError) as exc:
             self.doc.message(f"Autosave failed: {exc}")
 
     def close(self) -> None:
         """A clean exit (the edits were saved or set aside): nothing left to recover."""
         self.timer.stop()
-        self._after_release.stop()
         self.autosaver.close()
 
     def offer_recovery(self, ask=None) -> Worker | None:
-        """If an earlier session crashed, offer to restore its last autosave.
+        """If earlier sessions crashed, offer to restore one of their autosaves, each said with what it holds.
 
-        ``ask(path) -> bool`` replaces the question dialog (tests).
+        ``ask(recoveries) -> chosen path or None`` replaces the question dialog (tests). None declines them
+        all (kept a week, openable as projects, not asked again). The chosen one is removed only once this
+        session has autosaved what it restored; the others are untouched and offered next time.
         """
         found = autosave.find_recoveries()
         if not found:
             return None
-        latest = found[0]
-        if ask is None:
-            answer = QMessageBox.question(
-                self.window, "Restore unsaved work?", f"volanim studio did not close properly last time.\n"
-                f"Restore the session autosaved {autosave.describe(latest)}?", QMessageBox.Yes | QMessageBox.No)
-            restore = answer == QMessageBox.Yes
-        else:
-            restore = ask(latest)
-        if not restore:
+        chosen = (ask or self._ask_recovery)(found)
+        if chosen is None:
             for f in found:
                 autosave.decline(f)  # kept a week (the folder can still be opened as a project), not asked again
             return None
 
         def opened(ok: bool) -> None:
             if not ok:  # nothing is deleted: the next start offers it again
-                self.doc.message(f"The autosave in {latest.parent} was not restored; it is kept.")
+                self.doc.message(f"The autosave in {chosen.parent} was not restored; it is kept.")
                 return
             self.doc.project_path = None  # a restored session saves where the user says, not into the cache
             self.doc.undo.mark_modified()  # it is saved nowhere yet
@@ -102,11 +76,19 @@ class SessionController(Controller):
             except (OSError, ValueError) as exc:
                 self.doc.message(f"Restored, but the autosave of it failed ({exc}); the old autosave is kept.")
                 return
-            for f in found:  # ... before the crashed sessions' folders go
-                autosave.discard(f)
-            self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones).")
+            autosave.discard(chosen)  # ... before the restored session's folder goes (only that one)
+            others = len(found) - 1
+            self.doc.message(f"Restored the autosaved session ({len(self.doc.bones)} bones)."
+                             + (f" {others} other autosave{'s' if others > 1 else ''} kept for the next start."
+                                if others else ""))
 
-        return self.window.files.open_project(latest, on_opened=opened)
+        return self.window.files.open_project(chosen, on_opened=opened)
+
+    def _ask_recovery(self, found: list[Path]) -> Path | None:
+        from .recovery_dialog import RecoveryDialog
+
+        dialog = RecoveryDialog(found, [autosave.describe(f) for f in found], self.window)
+        return dialog.chosen if dialog.exec() else None
 
     # ------------------------------------------------------ unsaved changes
     def update_title(self, **_) -> None:

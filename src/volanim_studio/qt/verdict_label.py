@@ -2,7 +2,8 @@
 
     doc.events.preview (with a report) --> the verdict, coloured
     doc.events.preview (a full preview, its report still being made) --> "Checking for breakage…", greyed
-    doc.events.pose --> the same words, greyed: the pose changed since (F5 checks again)
+    doc.events.stale --> the same words, greyed, naming what changed since: the pose, the attachments, the
+                         bones, the clip or keys, the transfer function, ... (F5 checks again)
 """
 
 from __future__ import annotations
@@ -11,13 +12,17 @@ from ..model.document import Document
 from .status_line import ElidedLabel
 
 CHECKING = "Checking the pose for breakage…"
-COLOURS = {"healthy": "#2e9d4f", "broken": "#d33c3c", "stale": "#8a8a8a"}
+COLOURS = {"healthy": "#2e9d4f", "lump": "#d9861a", "broken": "#d33c3c", "stale": "#8a8a8a"}
+
+
+def verdict_colour(report) -> str:
+    """Green when healthy, amber for a lump (#83: a verdict with a lump was green), red for pieces or a stump."""
+    return COLOURS["broken" if not report.healthy else "lump" if report.lumps else "healthy"]
 
 
 def verdict_html(report) -> str:
-    """The report's verdict in colour: green when healthy, red for pieces or a stump."""
-    colour = COLOURS["healthy" if report.healthy else "broken"]
-    return f"<b style='color:{colour}'>{report.verdict}</b>"
+    """The report's verdict in its colour."""
+    return f"<b style='color:{verdict_colour(report)}'>{report.verdict}</b>"
 
 
 class VerdictLabel(ElidedLabel):
@@ -29,7 +34,7 @@ class VerdictLabel(ElidedLabel):
         self.base_tip = ("The breakage verdict of the last full preview (F5); the Reconstruct tab has the report.")
         self.setToolTip(self.base_tip)
         doc.events.preview.connect(self._on_preview)
-        doc.events.pose.connect(self._on_pose)
+        doc.events.stale.connect(self._on_stale)
 
     def _on_preview(self, **_) -> None:
         p = self.doc.preview
@@ -38,15 +43,21 @@ class VerdictLabel(ElidedLabel):
             self.setText("")
         elif p.report is not None:
             self._report, self._checking = p.report, False
-            self.set_styled(p.report.verdict, COLOURS["healthy" if p.report.healthy else "broken"], bold=True)
+            if self.doc.preview_is_current:
+                self.set_styled(p.report.verdict, verdict_colour(p.report), bold=True)
+            else:  # a job that ended after a change: its verdict is of what was
+                self._show_stale(self.doc.picture_change)
         elif not p.live:  # the picture is shown, its report follows (a background job): no old verdict meanwhile
             self._report, self._checking = None, True
             self.set_styled(CHECKING, COLOURS["stale"])
 
-    def _on_pose(self, **_) -> None:
-        if self._checking:  # that check is cancelled: the pose it was of is gone
+    def _on_stale(self, what: str, **_) -> None:
+        if self._checking:  # that check is of what was: cancelled or soon old
             self._checking = False
             self.setText("")
         elif self._report is not None:
-            self.set_styled(f"{self._report.verdict} (before the last pose change: F5 checks again)",
-                            COLOURS["stale"])
+            self._show_stale(what)
+
+    def _show_stale(self, what: str | None) -> None:
+        self.set_styled(f"{self._report.verdict} (before the last change of {what or 'the session'}: "
+                        "F5 checks again)", COLOURS["stale"])

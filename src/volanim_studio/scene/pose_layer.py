@@ -5,6 +5,9 @@
     doc.events.preview, settings.show_rest / slices --> draw(): the preview (or the rest pose's, to compare)
     doc.events.preview (with a report) --> the stumps' red boxes, the lumps' white ones
     doc.events.transfer --> the full preview's colours and opacities (the user's function, or the mode's own)
+    doc.events.stale / preview, settings.dragging / playing --> "Old picture: ... changed" in the view's top
+                        corner while the preview shown is of an earlier state (not during a drag or playback,
+                        whose live pictures follow at once)
 
 Owned by :class:`~volanim_studio.scene.view.SceneView`. Full previews are
 volumes with a transfer function per mode (``volanim_core.render``); live
@@ -37,6 +40,7 @@ from volanim_core.volume import to_grey
 
 STUMP_COLOUR = "#ff3030"  # over a black halo, seen on a red bone colour too
 LUMP_COLOUR = "#ffffff"  # flesh carried off (reconstruct/lumps.py): white over a black halo, seen on any bone colour
+STALE_NOTE = "stale_note"  # the view's "Old picture" text
 AXIS_COLOURS = ((230, 60, 60), (60, 200, 80), (70, 120, 255))  # x, y, z: the Pose tab names them so
 
 
@@ -76,6 +80,25 @@ class PoseLayer:
         view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
         # stopped: the bones follow the pose again (drawn now, not at the next pose change)
         view.doc.settings.events.playing.connect(lambda value: None if value else self.on_pose_changed())
+        for event in (view.doc.events.stale, view.doc.events.preview, view.doc.settings.events.dragging,
+                      view.doc.settings.events.playing, view.doc.settings.events.mode):
+            event.connect(lambda **_: self.draw_stale_note())
+
+    def draw_stale_note(self) -> None:
+        """Say in the view when the picture shown is of an earlier state (#83: an old body after an
+        auto-connect or an undo looked current)."""
+        view, doc = self.view, self.view.doc
+        st = doc.settings
+        old = (view.posing and doc.preview is not None and not doc.preview_is_current and not st.dragging
+               and not st.playing and not st.show_rest)
+        if old:
+            view.plotter.add_text(f"Old picture: {doc.picture_change or 'the session'} changed since. F5 redraws.",
+                                  position="upper_left", font_size=9, color="#d0d0d0", name=STALE_NOTE)
+        elif STALE_NOTE in view.plotter.actors:
+            view.plotter.remove_actor(STALE_NOTE, render=False)
+        else:
+            return
+        view.render()
 
     def on_pose_changed(self, **_) -> None:
         view = self.view

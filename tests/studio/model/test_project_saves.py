@@ -235,3 +235,83 @@ def test_bones_follow_the_skeletons_grid_in_and_out(tmp_path):
     assert np.allclose(doc.bones.joints["B"], (20, 10, 10))  # 10 mm from the origin: 20 cubes of 0.5 mm
     doc.bone_edits.save_bones(tmp_path / "saved.bones")
     assert io.read_bones(tmp_path / "saved.bones").geometry == cubes
+
+
+# ---------------------------------------------------------------- #83: autosave that never lags
+def test_a_held_drag_and_the_edits_before_it_are_on_disk_after_one_poll(tmp_path, doc):
+    """The old autosave skipped every save while a slider was held: six renames and a held drag were lost
+    to a kill. Now the poll after a change writes it (on the writer thread), drag or not."""
+    saver = autosave.Autosaver(doc, tmp_path / "recovery")
+    make_generation(doc, 5)
+    for i, joint in enumerate(["R_ELBOW", "L_KNEE", "R_KNEE", "R_WRIST", "L_ANKLE", "R_ANKLE"]):
+        doc.bone_edits.rename_joint(joint, f"RENAMED{i}")
+    doc.settings.dragging = True  # a slider is held ...
+    arm = doc.bones.index("L_UPPERARM")
+    doc.pose.set_angles(arm, (0, 30, 0))  # ... and has moved: a merged step of an unfinished drag
+    assert saver.poll() and saver.writing or saver.written == 1
+    saver.wait()
+    data = read_project(saver.path)
+    assert sum(j.startswith("RENAMED") for j in io.read_bones(data["bones"]).joints) == 6
+    assert np.allclose(data["state"]["pose"][0][("L_SHOULDER", "L_ELBOW")], (0, 30, 0))
+    doc.pose.set_angles(arm, (0, 45, 0))  # the drag goes on: the next poll has its latest value
+    assert saver.poll()
+    saver.wait()
+    assert np.allclose(read_project(saver.path)["state"]["pose"][0][("L_SHOULDER", "L_ELBOW")], (0, 45, 0))
+    assert saver.caught_up and not saver.poll()  # nothing changed: nothing written
+
+
+def test_a_snapshot_is_the_session_at_the_moment_it_was_taken(tmp_path, doc):
+    """The writer thread formats a snapshot while the user goes on editing: what it writes is the
+    moment the snapshot was taken, whatever the document became since."""
+    from volanim_studio.model.project import snapshot, write_snapshot
+
+    make_generation(doc, 9)
+    path = tmp_path / "p.volanim"
+    snap = snapshot(doc, path)
+    make_generation(doc, 3)  # bones replaced, attachments changed in place
+    doc.pose.set_angles(0, (10, 0, 0))
+    write_snapshot(snap, path)
+    assert generation_on_disk(path) == 9
+    assert read_project(path)["state"]["pose"] == ({}, {})
+
+
+def test_an_empty_session_is_never_autosaved_nor_offered(tmp_path):
+    """A session killed while the recovery question was up was offered at the next start, and restoring it
+    (0 bones) deleted the real one behind it."""
+    from volanim_studio.model import Document
+
+    root = tmp_path / "recovery"
+    empty = Document()
+    saver = autosave.Autosaver(empty, root, background=False)
+    empty.settings.colour_by = "dt"  # the view changed, nothing was made
+    assert not saver.poll() and not saver.path.exists() and saver.caught_up
+    # an older studio's autosave of an empty session: pruned, never offered
+    old = root / "4194304-1"
+    old.mkdir()
+    (old / "session.json").write_text(json.dumps({"pid": 2**22}))
+    Document().write_project(old / autosave.RECOVERY_FILE)
+    assert autosave.find_recoveries(root) == []
+    assert autosave.prune(root) == 1 and not old.exists()
+
+
+def test_an_unreadable_autosave_is_kept_and_offered_with_its_time(tmp_path):
+    root = tmp_path / "recovery"
+    damaged = root / "4194305-1"
+    damaged.mkdir(parents=True)
+    (damaged / "session.json").write_text(json.dumps({"pid": 2**22 + 1}))
+    (damaged / autosave.RECOVERY_FILE).write_text("{not json")
+    assert autosave.prune(root) == 0 and autosave.find_recoveries(root) == [damaged / autosave.RECOVERY_FILE]
+    assert "could not be read" in autosave.describe(damaged / autosave.RECOVERY_FILE)
+
+
+def test_the_recovery_question_says_what_each_autosave_holds(tmp_path, doc):
+    saver = autosave.Autosaver(doc, tmp_path / "recovery")
+    doc.demo_name = "mannequin"
+    make_generation(doc, 7)
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -30, 0))
+    doc.timeline.set_key(0)
+    saver.save()
+    text = autosave.describe(saver.path)
+    assert text.endswith(": mannequin, 18 bones, 8 attachments, a pose, 1 key"), text
+    (saver.folder / autosave.SUMMARY).unlink()  # an older studio's autosave: read from the project
+    assert autosave.describe(saver.path).endswith(": mannequin, 18 bones, 8 attachments, a pose, 1 key")

@@ -144,6 +144,8 @@ def test_autosave_file_appears(qtbot, window, recovery_dir):
     assert window.files.open_bones(ASSETS / "mannequin.bones")
     for i in range(5):
         window.doc.attachments.assign([i], 0)
+    saver = window.session.autosaver
+    qtbot.waitUntil(lambda: saver.caught_up, timeout=JOB_TIMEOUT_MS)  # the window's poll
     files = list(recovery_dir.glob("*/recovery.volanim"))
     assert len(files) == 1
     assert io.read_bones(read_project(files[0])["bones"]) == window.doc.bones
@@ -157,13 +159,16 @@ import os, sys
 from PySide6.QtWidgets import QApplication
 app = QApplication([])
 from volanim_studio.qt.main_window import MainWindow
-w = MainWindow(autosave_every_edits=1)
+w = MainWindow()
 w.show()
 w.files.load_demo("mannequin")
 while w.busy:
     app.processEvents()
 w.files.open_bones(sys.argv[1])
 w.doc.attachments.auto(scope="all")
+saver = w.session.autosaver
+while saver.written == 0 or not saver.caught_up:  # the window's poll saves it
+    app.processEvents()
 print("EDITED", int((w.doc.attachments.bone >= 0).sum()), flush=True)
 os._exit(3)  # a crash: no close, no cleanup
 """
@@ -182,7 +187,7 @@ def test_restore_after_a_crash(qtbot, tmp_path, recovery_dir):
     w = MainWindow()
     qtbot.addWidget(w)
     asked = []
-    w.session.offer_recovery(ask=lambda p: asked.append(p) or True)
+    w.session.offer_recovery(ask=lambda found: asked.extend(found) or found[0])
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert asked, listing
     assert len(w.doc.bones) == 18, (listing, w.last_error)
@@ -216,7 +221,7 @@ def test_a_restore_that_fails_deletes_nothing(qtbot, tmp_path, recovery_dir):
 
     w = MainWindow()
     qtbot.addWidget(w)
-    w.session.offer_recovery(ask=lambda p: True)
+    w.session.offer_recovery(ask=lambda found: found[0])
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
     assert "changed or damaged" in (w.last_error or "")
     assert sorted(p.name for p in saver.folder.rglob("*")) == before  # nothing deleted
@@ -320,3 +325,98 @@ def test_the_working_bone_stays_the_bone_after_a_drag_and_open_connections(qtbot
     qtbot.mouseClick(window.connect_panel.cube_connect, Qt.LeftButton)
     got = {doc.bones.bones[b].label for b in doc.attachments.bone[doc.attachments.bone >= 0]}
     assert got == {"HEAD"}
+
+
+def _crashed_autosave(root, doc, pid: int):
+    """``doc`` autosaved as a session that crashed (its pid dead)."""
+    import json
+
+    from volanim_studio.model import autosave
+
+    saver = autosave.Autosaver(doc, root)
+    saver.save()
+    (saver.folder / "session.json").write_text(json.dumps({"pid": pid}))
+    return saver.path
+
+
+def test_the_recovery_question_lists_every_autosave_and_only_the_restored_one_goes(qtbot, tmp_path, recovery_dir):
+    """A session killed while the question was up stood in front of the one with the work; Yes restored 0
+    bones and deleted the real autosave. Now: empty sessions are never offered, each autosave is listed
+    with what it holds, and only the chosen one is removed once restored."""
+    import os
+    import time
+
+    from volanim_studio.model import Document, autosave
+    from volanim_studio.qt.main_window import MainWindow
+    from volanim_studio.qt.recovery_dialog import RecoveryDialog
+
+    work = Document()
+    work.demo_name = "mannequin"
+    work.bone_edits.set_bones(samples.mannequin_bones())
+    older = _crashed_autosave(recovery_dir, work, 2**22 + 11)
+    os.utime(older, (time.time() - 60, time.time() - 60))
+    work.bone_edits.rename_joint("L_ELBOW", "L_KNUCKLE")
+    newer = _crashed_autosave(recovery_dir, work, 2**22 + 12)
+    empty = Document()
+    empty.settings.colour_by = "dt"
+    assert not autosave.Autosaver(empty, recovery_dir).save()  # nothing made: not written, never offered
+    assert autosave.find_recoveries(recovery_dir) == [newer, older]
+
+    # the real dialog: both listed, with what they hold; the older one chosen
+    dialog = RecoveryDialog([newer, older], [autosave.describe(newer), autosave.describe(older)])
+    qtbot.addWidget(dialog)
+    assert dialog.list.count() == 2 and dialog.list.isVisibleTo(dialog)
+    assert all("mannequin, 18 bones" in dialog.list.item(i).text() for i in range(2))
+    dialog.list.setCurrentRow(1)
+    dialog.restore_button.click()
+    assert dialog.result() and dialog.chosen == older
+
+    w = MainWindow()
+    qtbot.addWidget(w)
+    w.session.offer_recovery(ask=lambda found: older)
+    qtbot.waitUntil(lambda: not w.busy and "Restored" in w.statusBar().currentMessage(), timeout=JOB_TIMEOUT_MS)
+    assert "L_ELBOW" in w.doc.bones.joints  # the older one's bones
+    assert "1 other autosave kept" in w.statusBar().currentMessage()
+    assert not older.exists() and newer.exists()  # only the restored one went
+    assert autosave.find_recoveries(recovery_dir) == [newer]  # the other is offered next time
+    w.doc.undo.mark_clean()
+    w.close()
+
+
+def test_a_single_autosave_is_asked_about_in_a_sentence_that_says_what_it_holds(qtbot, tmp_path):
+    from volanim_studio.qt.recovery_dialog import RecoveryDialog
+
+    path = tmp_path / "recovery.volanim"
+    dialog = RecoveryDialog([path], ["Tue 01 Dec 2026 10:40: mannequin, 18 bones"])
+    qtbot.addWidget(dialog)
+    dialog.show()
+    assert not dialog.list.isVisible()
+    assert "Restore the session autosaved Tue 01 Dec 2026 10:40: mannequin, 18 bones?" in \
+        dialog.findChildren(type(dialog.layout().itemAt(0).widget()))[0].text()
+    dialog.skip_button.click()
+    assert not dialog.result() and dialog.chosen is None
+
+
+def test_fitted_auto_connect_works_when_chosen_alone(qtbot, window):
+    """#83 item 11: choosing *fitted* alone attached 0 points and kept 4,380 (the default Points,
+    "unconnected", left nothing to do on a connected body); it also needed Points = all and Overwrite."""
+    w = window
+    assert w.files.open_bones(ASSETS / "mannequin.bones")
+    assert w.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    panel = w.connect_panel
+    before = w.doc.attachments.bone.copy()
+    assert panel.scope.currentText() == "unconnected" and not panel.overwrite.isChecked()
+    panel.method.setCurrentText("fitted")
+    assert not panel.overwrite.isEnabled() and "fitted" in panel.overwrite.toolTip()
+    panel.auto_button.click()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    after = w.doc.attachments.bone
+    from volanim_core.rig.attach import auto_connect
+
+    shown = np.arange(len(before)) < w.doc.visible_count
+    expected, _ = auto_connect(w.doc.skeleton.points, w.doc.bones, w.doc.mask, method="fitted",
+                               current=before.copy(), overwrite=True, which=shown, radii=w.doc.skeleton.dt)
+    assert (after != before).sum() > 0, "fitted changed nothing"
+    assert np.array_equal(after, expected)  # what fitted decides over every shown point
+    w.undo()
+    assert np.array_equal(w.doc.attachments.bone, before)

@@ -216,3 +216,50 @@ def test_file_view_takes_a_sequence_folder_as_chosen(qtbot, window, tmp_path):
     qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
     for v in window.files.open_viewers():
         v.close()
+
+
+def test_file_view_opens_every_kind_it_offers_or_says_why(qtbot, window, tmp_path):
+    """#83 item 10: File → View on a .vti closed the dialog and nothing followed (the dialog set its
+    choice after Qt had already said it was finished). Every kind the dialog lists, chosen through the
+    dialog's own Open button: a window opens, or a message names the file."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtWidgets import QDialogButtonBox
+
+    from core.render.test_render import make_sequence
+    from volanim_core.io import write_volume
+    from volanim_core.io.mesh_files import write_mesh
+    from volanim_core.skeleton.hull import isosurface
+
+    vol = np.zeros((20, 16, 12), np.uint8, order="F")
+    vol[4:15, 3:12, 2:10] = 200
+    colour = np.zeros((*vol.shape, 3), np.uint8)
+    colour[vol > 0] = (200, 40, 30)
+    names = []
+    for suffix in (".vti", ".nrrd", ".nii.gz", ".mha", ".VOL", ".tif"):
+        write_volume(tmp_path / f"grey{suffix}", vol)
+        names.append(f"grey{suffix}")
+    write_volume(tmp_path / "colour.vti", colour)
+    names.append("colour.vti")
+    verts, faces = isosurface(vol > 0)
+    for suffix in (".ply", ".stl", ".obj", ".vtp"):
+        write_mesh(tmp_path / f"hull{suffix}", verts, faces)
+        names.append(f"hull{suffix}")
+    make_sequence(tmp_path / "walk.zarr", frames=2)
+    names.append("walk.zarr")
+    (tmp_path / "bad.nrrd").write_text("NRRD0004\nnot a header\n")
+    for name in [*names, "bad.nrrd"]:
+        before = window.files.open_viewers()
+        window.last_error = None
+        dialog = window.files.view_file_dialog()
+        dialog.setDirectory(str(tmp_path))
+        dialog.selectFile(name)
+        qtbot.mouseClick(dialog.findChild(QDialogButtonBox).button(QDialogButtonBox.Open), Qt.LeftButton)
+        assert not dialog.isVisible() and dialog.chosen == str(tmp_path / name), name
+        qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
+        new = [v for v in window.files.open_viewers() if v not in before]
+        if name == "bad.nrrd":
+            assert not new and "bad.nrrd" in (window.last_error or ""), window.last_error
+            continue
+        assert len(new) == 1 and new[0].isVisible() and name in new[0].windowTitle(), (name, window.last_error)
+        assert "body" in new[0].plotter.renderer.actors, name
+        new[0].close()

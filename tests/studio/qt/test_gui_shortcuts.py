@@ -8,9 +8,21 @@ from PySide6.QtCore import Qt
 pytestmark = pytest.mark.gui
 
 
-def test_shortcuts_dialog(qtbot, window):
+def test_shortcuts_dialog_lists_them_all_and_fits_the_screen(qtbot, window):
+    """#83 item 12: the F1 box was taller than a 1000 px screen (its Close button out of reach)."""
+    from PySide6.QtWidgets import QDialogButtonBox, QTextBrowser
+
+    from volanim_studio.qt.main_window import SHORTCUTS
+
     qtbot.keyClick(window, Qt.Key_F1)
-    assert window._shortcut_box.isVisible() and "Ctrl+Z" in window._shortcut_box.text()
+    box = window._shortcut_box
+    assert box.isVisible()
+    text = box.findChild(QTextBrowser).toPlainText()
+    assert "Ctrl+Z" in text and all(k in text for k, _ in SHORTCUTS)
+    screen = box.screen().availableGeometry()
+    assert box.frameGeometry().height() <= screen.height() and box.height() <= 900
+    box.findChild(QDialogButtonBox).button(QDialogButtonBox.Close).click()
+    assert not box.isVisible()
 
 
 def test_f1_lists_every_keyboard_shortcut_of_the_menus(window):
