@@ -76,10 +76,24 @@ def prepare_volume(volume: np.ndarray, segmentation: Segmentation, *, skeleton_p
                            progress=stage(report, 10, 80), cancel=cancel)
     report(80, 100)
     hull, lod = display_hulls(mask)  # lod: drawn while a slider is held
+    report(90, 100)
+    pieces = regrown_pieces(skel, mask)
     report(100, 100)
     return {"volume": volume, "mask": mask, "skeleton": skel, "hull": hull, "hull_lod": lod,
-            "skeleton_path": skeleton_path, "geometry": geometry,
+            "skeleton_path": skeleton_path, "geometry": geometry, "pieces": pieces,
             "segmentation": segmentation.as_dict()}
+
+
+def regrown_pieces(skeleton, mask: np.ndarray) -> tuple[int, int]:
+    """``(pieces the skeleton's balls re-grow, pieces of the segmented body)``, 26-connected. More of the
+    first: the minimum thinness kept no points in thin parts, and the rest pose is in pieces before any pose
+    (#83: the ant at 0.50 had legs of dashes, and the verdict called it healthy)."""
+    from scipy import ndimage
+
+    from volanim_core.reconstruct.shape import PIECES
+    from volanim_core.rig.curve_skeleton import balls
+
+    return int(ndimage.label(balls(skeleton), PIECES)[1]), int(ndimage.label(mask, PIECES)[1])
 
 
 def on_grid(volume: np.ndarray, geometry, target) -> np.ndarray:

@@ -62,6 +62,7 @@ class BreakageReport:
     pieces: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid) of torn-off parts
     stumps: list = field(default_factory=list)  # Stump, largest first
     rest_pieces: int = 1  # the body's pieces at rest: pieces the pose keeps apart are not breakage
+    body_pieces: int | None = None  # the segmented volume's pieces, when the caller knows them (the studio)
     lumps: list = field(default_factory=list)  # Lump (lumps.py), largest first: flesh carried off (rigid frames)
     source_coverage: tuple[int, int] | None = None  # (covered at rest, object voxels) of the scan, when given
 
@@ -79,6 +80,11 @@ class BreakageReport:
         return f"{abs(loss):.2f} % {'fewer' if loss > 0 else 'more'} voxels than the rest pose"
 
     @property
+    def shredded(self) -> bool:
+        """The skeleton re-grows the rest pose in more pieces than the volume has (thin parts lost)."""
+        return self.body_pieces is not None and self.rest_pieces > self.body_pieces
+
+    @property
     def healthy(self) -> bool:
         """No piece torn off and no stump: measured against the rest pose, not against "one piece"."""
         return not self.pieces and not self.stumps
@@ -94,6 +100,9 @@ class BreakageReport:
             return f"STUMP left behind near {s.joint}: {s.points} points of {s.attached} lie along {s.lies_along}"
         whole = (f"nothing torn off (the rest pose too is {self.rest_pieces:,} pieces), no stump"
                  if self.rest_pieces > 1 else "one piece, no stump")
+        if self.shredded:  # said first: every pose of this skeleton is in pieces, whatever the pose does
+            return (f"the rest pose is already {self.rest_pieces:,} pieces where the volume is "
+                    f"{self.body_pieces:,}: thin parts have no points (lower the thinness); {whole}")
         if self.lumps:  # the finding first (#83: it came last, cut off as "...lump near L_SHOUL..." after "healthy")
             first = self.lumps[0]
             more = f" and {len(self.lumps) - 1} more" if len(self.lumps) > 1 else ""

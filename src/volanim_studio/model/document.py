@@ -95,6 +95,7 @@ class Document:
         # what a picture is of (#83: after an auto-connect, a lasso or an undo the old picture and its green
         # "healthy" stayed): every change that makes the shown preview old counts here; a preview carries the
         # count it was made at, and the verdict and the scene say "old" until one of the count now is shown
+        self.body_pieces: int | None = None  # the segmented volume's pieces (a rest pose in more lost thin parts)
         self.picture_basis = 0
         self.picture_change: str | None = None  # what changed last, in words ("the attachments")
         for event, what in STALE_AFTER:
@@ -332,6 +333,7 @@ class Document:
         self.only_unconnected = self.only_working = False
         self.cube_centre = None
         self.point_selection = np.zeros(0, np.int64)
+        self.body_pieces = None
         self._symmetry_x = None
         self.camera = None
         self.transfer._write(None)

@@ -189,6 +189,7 @@ ATTRIBUTES = {
     "hull": "made again from the volume", "hull_lod": "made again from the volume",
     "preview": "a reconstruction: made again with F5",
     "picture_basis": "counts changes since the preview: a new session has no preview",
+    "body_pieces": "counted again when the volume is segmented",
     "picture_change": "counts changes since the preview: a new session has no preview",
     "only_unconnected": "a filter of the Connect tab, per visit",
     "only_working": "a filter of the Connect tab, per visit", "cube_centre": "placed again with a click in Cube mode",

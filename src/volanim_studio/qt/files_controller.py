@@ -116,6 +116,14 @@ class FilesController(Controller):
                             path=path, segmentation=result["segmentation"], dims=dims)
         self.doc.set_skeleton(result["skeleton"], result.get("skeleton_path"))
         self.doc.set_hull(*result["hull"], lod=result.get("hull_lod"))
+        regrown, body = result.get("pieces") or (None, None)
+        self.doc.body_pieces = body
+        if regrown is not None and regrown > body:
+            thinness = result["segmentation"].get("min_thinness")
+            self.doc.message(f"Thin parts are lost: the skeleton's {len(result['skeleton'])} points re-grow the body "
+                             f"in {regrown:,} pieces where the volume is {body:,} (minimum thinness {thinness:g}). "
+                             "Open it again with a lower minimum thinness to keep them.")
+            return
         self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
 
     def load_demo(self, name: str, *, skeleton_path=None, then: Callable[[], None] | None = None) -> Worker:

@@ -217,6 +217,7 @@ class PreviewController(Controller):
 
         def done(p) -> None:
             self.doc.pose.keep_rest_parts(tskel, p.rest_parts, version)
+            p.report.body_pieces = self.doc.body_pieces  # a rest pose in more pieces than the volume is said
             if self.doc.preview is shown:
                 self.doc.set_preview(p)
 

@@ -16,8 +16,9 @@ COLOURS = {"healthy": "#2e9d4f", "lump": "#d9861a", "broken": "#d33c3c", "stale"
 
 
 def verdict_colour(report) -> str:
-    """Green when healthy, amber for a lump (#83: a verdict with a lump was green), red for pieces or a stump."""
-    return COLOURS["broken" if not report.healthy else "lump" if report.lumps else "healthy"]
+    """Green when healthy; amber for a lump or a rest pose in more pieces than the volume (#83: both were
+    green); red for pieces or a stump."""
+    return COLOURS["broken" if not report.healthy else "lump" if report.lumps or report.shredded else "healthy"]
 
 
 def verdict_html(report) -> str:

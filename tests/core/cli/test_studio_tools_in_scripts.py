@@ -128,7 +128,10 @@ def test_report_exit_status_and_json_match_the_pose(made):
 
     assert main(["pose", str(d / "mannequin.bones"), "--rotate", "L_UPPERARM=0,-45,0", "-o", str(d / "arm.trans")]) == 0
     healthy = run("report", d / "m.connect", d / "arm.trans", "--source", d / "mannequin.VOL")
-    assert healthy.returncode == 0 and healthy.stdout.startswith("healthy"), healthy.stdout + healthy.stderr
+    # nothing torn, no stump: exit 0; the verdict leads with the armpit's lump (#83), which #84 will enter in
+    # the exit status once its precision is proven
+    first = healthy.stdout.splitlines()[0]
+    assert healthy.returncode == 0 and first.endswith("one piece, no stump"), healthy.stdout + healthy.stderr
     # the scan's object voxels at thinness 0.5, re-grown at rest: the skeleton's own loss, counted here
     body = io.read_volume(d / "mannequin.VOL") > 0
     rest = reconstruct(connect_to_tskel(io.read_connect(d / "m.connect"),

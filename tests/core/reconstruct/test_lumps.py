@@ -129,3 +129,18 @@ def test_the_report_says_a_grown_body_in_words_not_a_negative_loss():
     shrunk = BreakageReport(components=[1000], posed_voxels=990, rest_voxels=1000, lost_voxels=10, hotspot_max=1,
                             hotspot_mean=1.0)
     assert shrunk.size_change == "1.00 % fewer voxels than the rest pose"
+
+
+def test_a_rest_pose_in_more_pieces_than_the_volume_is_said_first():
+    """#83 item 9: the ant at thinness 0.50 had legs of dashes, and the verdict read "healthy: nothing torn
+    off (the rest pose too is 20 pieces)", in green."""
+    from volanim_core.reconstruct.breakage import BreakageReport
+
+    r = BreakageReport(components=[500] * 20, posed_voxels=10_000, rest_voxels=10_000, lost_voxels=0,
+                       hotspot_max=1, hotspot_mean=1.0, rest_pieces=20, body_pieces=1)
+    assert r.healthy and r.shredded
+    assert r.verdict.startswith("the rest pose is already 20 pieces where the volume is 1: thin parts have no "
+                                "points (lower the thinness)")
+    unknown = BreakageReport(components=[500] * 20, posed_voxels=10_000, rest_voxels=10_000, lost_voxels=0,
+                             hotspot_max=1, hotspot_mean=1.0, rest_pieces=20)
+    assert not unknown.shredded and unknown.verdict.startswith("healthy")  # the command line knows no volume

@@ -91,4 +91,6 @@ def test_propose_on_the_ant_accept_connect_and_pose_a_leg_healthy(qtbot, window,
     qtbot.waitUntil(lambda: not window.busy and doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
     assert not doc.pose.is_rest
     assert doc.preview.report.healthy, doc.preview.report.verdict
-    assert "healthy" in window.verdict_label.text()
+    # nothing torn off; the verdict also says the ant's rest pose is already in more pieces than its volume (#83:
+    # thin legs keep few points at the default thinness), in amber instead of a plain green "healthy"
+    assert "nothing torn off" in window.verdict_label.text()
