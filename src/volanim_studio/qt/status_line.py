@@ -22,7 +22,9 @@ GAP = 24  # pixels between the message and the labels (the bar's own margins and
 
 class ElidedLabel(QLabel):
     """A one-line label that may be given less width than its text: it draws the text cut with "…".
-    ``set_styled(text, colour, bold)``; ``text()`` stays the whole text (rich text when styled)."""
+    ``set_styled(text, colour, bold)``; ``text()`` stays the whole text (rich text when styled).
+    With ``setWordWrap(True)`` (the Pose tab's verdict, which has room below it) it draws the whole text
+    wrapped to its width instead (#83: the verdict was cut there too)."""
 
     def __init__(self, parent=None):
         super().__init__("", parent)
@@ -42,6 +44,8 @@ class ElidedLabel(QLabel):
     def _show(self, plain: str, colour: str | None, bold: bool, shown: str) -> None:
         self._plain, self._colour, self._bold = plain, colour, bold
         super().setText(shown)
+        if self.wordWrap():
+            self.updateGeometry()  # its height follows the text
         self.changed()
 
     @property
@@ -60,7 +64,16 @@ class ElidedLabel(QLabel):
         return QSize(0, super().minimumSizeHint().height())
 
     def sizeHint(self) -> QSize:  # noqa: N802
+        if self.wordWrap():
+            return QSize(0, self.heightForWidth(max(self.width(), 1)))
         return QSize(self.natural_width(), super().sizeHint().height())
+
+    def hasHeightForWidth(self) -> bool:  # noqa: N802
+        return self.wordWrap()
+
+    def heightForWidth(self, width: int) -> int:  # noqa: N802
+        rect = self._metrics().boundingRect(0, 0, max(width - 4, 1), 100_000, int(Qt.TextWordWrap), self._plain)
+        return rect.height() + 4
 
     def paintEvent(self, event) -> None:  # noqa: N802
         painter = QPainter(self)
@@ -68,11 +81,17 @@ class ElidedLabel(QLabel):
         font.setBold(self._bold)
         painter.setFont(font)
         painter.setPen(QColor(self._colour) if self._colour else self.palette().windowText().color())
+        if self.wordWrap():
+            painter.drawText(self.rect().adjusted(2, 0, -2, 0), int(Qt.TextWordWrap | Qt.AlignTop | Qt.AlignLeft),
+                             self._plain)
+            return
         shown = painter.fontMetrics().elidedText(self._plain, Qt.ElideRight, max(self.width() - 4, 0))
         painter.drawText(self.rect().adjusted(2, 0, -2, 0), Qt.AlignVCenter | Qt.AlignLeft, shown)
 
     def shown_text(self) -> str:
-        """What is drawn now (the text, cut to the width it has)."""
+        """What is drawn now (the text, cut to the width it has; all of it when wrapped)."""
+        if self.wordWrap():
+            return self._plain
         return self._metrics().elidedText(self._plain, Qt.ElideRight, max(self.width() - 4, 0))
 
 

@@ -233,8 +233,8 @@ class PoseLayer:
                 self.draw()  # the slices' colours too
             else:
                 self.view.render()
-        elif self.preview_actor is not None:
-            self.draw()
+        elif self.preview_actor is not None or (self.view.doc.preview is not None and self.view.doc.preview.live):
+            self.draw()  # a live preview's surface takes the function's colours when drawn
 
     def _apply_transfer(self, tf, mode: str) -> None:
         ctf, otf = vtk_functions(tf)
@@ -315,11 +315,20 @@ class PoseLayer:
 
     def show_surface(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
         """A live preview: the reconstruction's surface coloured by label (software GL draws a
-        surface far faster than it ray-casts a volume)."""
+        surface far faster than it ray-casts a volume). With the user's transfer function, its colours and
+        opacities by label: a label it makes clear is not drawn (#83: live previews ignored the function)."""
         view, plotter = self.view, self.view.plotter
         world_origin = view.world(origin_voxels)
         world_spacing = np.asarray(spacing_voxels, np.float64) * view.spacing
-        table = label_table(len(view.doc.bones)) if mode == "bone" else None
+        tf = view.doc.transfer.function
+        if tf is not None and volume.ndim == 3:
+            rgba = tf(np.arange(int(volume.max()) + 1, dtype=np.float64))
+            clear = rgba[:, 3] <= 0
+            if clear[1:].any():
+                volume = np.where(clear[volume], 0, volume)
+            table = np.round(np.clip(rgba, 0, 1) * 255).astype(np.uint8)  # RGBA: translucent where it says
+        else:
+            table = label_table(len(view.doc.bones)) if mode == "bone" else None
         surf = label_surface(volume, world_origin, world_spacing, table)  # colour: its voxels' colours
         self.clear(render=False)
         if surf.n_points and "rgb" in surf.point_data:

@@ -508,4 +508,7 @@ def test_the_panels_keep_their_width_whatever_the_verdict_says(qtbot, posed_wind
         w.panel_tabs.setCurrentWidget(w.pose_panel)
         qtbot.wait(50)
         assert (w.plotter.width(), w.panel_tabs.width()) == (view_width, panel_width), w.verdict_label.plain
-    assert len(w.pose_panel.verdict.plain) > 60  # a long verdict was shown
+    verdict = w.pose_panel.verdict
+    assert len(verdict.plain) > 60  # a long verdict was shown ...
+    assert verdict.shown_text() == verdict.plain and verdict.height() >= verdict.heightForWidth(verdict.width())
+    # ... whole, wrapped in the Pose tab's width (it was cut with "…" there too)

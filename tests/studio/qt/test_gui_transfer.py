@@ -181,3 +181,45 @@ def test_a_movie_draws_with_the_function(qtbot, window, tmp_path):
         pic = iio.imread(png)[..., :3].astype(int)
         body = pic[np.abs(pic - (0x1E, 0x1F, 0x24)).max(axis=2) > 12]
         assert len(body) > 300 and (body[:, 1] > body[:, 0] + 40).mean() > 0.9
+
+
+def test_a_live_preview_draws_with_the_function_too(qtbot, window):
+    """#83 item 8: live previews (a drag, playback) ignored the function: they kept the mode's bone colours
+    and drew bones the function made clear. One bone opaque red, every other clear: the live picture is the
+    silhouette of that bone's voxels alone (the oracle projects them without VTK), and red."""
+    from volanim_studio.model.transfer import starting_function
+
+    w = rig_and_pose(qtbot, window)
+    doc = w.doc
+    arm = doc.bones.index("L_UPPERARM")
+    tf = starting_function("bone", 1.0, len(doc.bones))
+    rgba = tf.rgba.copy()
+    rgba[:, 3] = 0.0
+    keep = (np.abs(tf.values - (arm + 1)) < 0.5)  # the arm's own points (two per label: a flat step)
+    rgba[keep] = [1.0, 0.0, 0.0, 1.0]
+    doc.transfer.set(TransferFunction(tf.values, rgba), "only the arm, red")
+    doc.select_bones([arm])
+    slider = w.pose_panel.sliders[1]
+    slider.setSliderDown(True)  # a drag: the live preview
+    slider.setValue(-40)
+    qtbot.waitUntil(lambda: doc.preview is not None and doc.preview.live and doc.preview_is_current,
+                    timeout=JOB_TIMEOUT_MS)
+    w.scene.xray.show(False)
+    w.plotter.render()
+    image = np.asarray(w.plotter.screenshot(return_img=True))[..., :3]
+    p = doc.preview
+    size = (image.shape[1], image.shape[0])
+    sil, outside = silhouette(p.reconstruction.volume == arm + 1, p.origin_voxels * w.scene.spacing,
+                              np.asarray(p.spacing) * w.scene.spacing, Camera.of(w.plotter.renderer.GetActiveCamera()),
+                              size)
+    fg = foreground(image, np.round(np.asarray(rgb(BACKGROUND)) * 255))
+    h, w_ = fg.shape
+    fg[int(h * 0.75):, : int(w_ * 0.25)] = sil[int(h * 0.75):, : int(w_ * 0.25)] = False  # the axes widget
+    fg[: int(h * 0.08), :] = sil[: int(h * 0.08), :] = False  # the view's top line (a note may stand there)
+    got = compare(fg, sil)
+    assert outside == 0.0 and got["iou_rim"] >= 0.9 and got["stray"] < 0.01, got
+    body = image[fg].astype(int)
+    assert (body[:, 0] > 2 * body[:, 1] + 20).mean() > 0.95  # red
+    slider.setSliderDown(False)
+    w.scene.xray.show(True)
+    qtbot.waitUntil(lambda: not w.jobs.running, timeout=JOB_TIMEOUT_MS)
