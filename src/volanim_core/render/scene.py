@@ -89,11 +89,13 @@ def preset_transfer(preset: str, vmax: float) -> TransferFunction:
 
 
 def colour_table(settings: RenderSettings, vmax: float | None = None) -> np.ndarray:
-    """``(L, 3)`` uint8: the surface colour of value v at row v (rounded), for every value up to vmax."""
+    """``(L, 3)`` uint8: the surface colour of value v at row v (rounded), for every value up to vmax. With
+    the user's transfer function ``(L, 4)``: its opacity too (#83: a movie's surfaces took the function's
+    colours, not its opacity), and a value it makes clear is not drawn (:func:`prepare_frame`)."""
     top = int(np.ceil(vmax if vmax is not None else settings.vmax))
     values = np.arange(max(top, 1) + 1, dtype=np.float64)
     if settings.transfer is not None:
-        rgb_ = settings.transfer(values)[:, :3]
+        return np.round(np.clip(settings.transfer(values), 0, 1) * 255).astype(np.uint8)
     elif settings.preset in LABEL_MODES:
         colours = label_colours(settings.preset, LABELS)
         rgb_ = np.vstack([[0, 0, 0], colours[(np.arange(1, len(values)) - 1) % len(colours)]])
@@ -225,8 +227,12 @@ def prepare_frame(settings: RenderSettings, volume: np.ndarray, origin, table=No
     part, at = crop(volume, origin)  # a sequence's shared grid is mostly empty
     values = part if np.issubdtype(part.dtype, np.integer) else np.rint(part)
     spacing = np.asarray(s.spacing, np.float64)  # world = voxel x spacing (the camera's units)
-    mesh = label_surface(values, np.asarray(at) * spacing, spacing,
-                         colour_table(s) if table is None else table)  # above the range: top colour
+    table = colour_table(s) if table is None else table
+    if table.shape[1] == 4 and values.ndim == 3:  # the user's function: what it makes clear is not there
+        clear = table[np.clip(values.astype(np.int64), 0, len(table) - 1), 3] == 0
+        if clear.any():
+            values = np.where(clear, 0, values)
+    mesh = label_surface(values, np.asarray(at) * spacing, spacing, table)  # above the range: top colour
     return PreparedFrame(volume, np.asarray(origin), mesh)
 
 

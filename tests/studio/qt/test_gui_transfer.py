@@ -223,3 +223,38 @@ def test_a_live_preview_draws_with_the_function_too(qtbot, window):
     slider.setSliderDown(False)
     w.scene.xray.show(True)
     qtbot.waitUntil(lambda: not w.jobs.running, timeout=JOB_TIMEOUT_MS)
+
+
+def test_a_movie_takes_the_function_s_opacity_too(qtbot, window, tmp_path):
+    """#83 item 8: movies took the function's colours but not its opacity: a bone made clear was drawn. The
+    arm opaque red, every other bone clear: the movie's picture is the arm alone, in red, a small part of
+    the body the same camera draws with every bone opaque."""
+    import imageio.v3 as iio
+
+    from volanim_studio.model.transfer import starting_function
+
+    w = rig_and_pose(qtbot, window)
+    doc = w.doc
+    doc.settings.preview_mode = "bone"
+    arm = doc.bones.index("L_UPPERARM")
+    tf = starting_function("bone", 1.0, len(doc.bones))
+    opaque = tf.rgba.copy()
+    opaque[:, 3] = np.where(tf.values > 0.5, 1.0, 0.0)
+    only_arm = opaque.copy()
+    only_arm[:, 3] = 0.0
+    keep = np.abs(tf.values - (arm + 1)) < 0.5
+    only_arm[keep] = [1.0, 0.0, 0.0, 1.0]
+    w.timeline_panel.length.setValue(2)
+    w.timeline_panel.length.editingFinished.emit()
+    qtbot.keyClick(w, Qt.Key_S)  # a key at frame 0: the movie's frames are the timeline's
+    bodies = {}
+    for name, rgba in (("all", opaque), ("arm", only_arm)):
+        doc.transfer.set(TransferFunction(tf.values, rgba), name)
+        assert w.timeline.render_movie(tmp_path / name, first=0, last=0, size=(320, 240), workers=1) is not None
+        qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+        pic = iio.imread(next((tmp_path / name).glob("*.png")))[..., :3].astype(int)
+        bodies[name] = pic[np.abs(pic - (0x1E, 0x1F, 0x24)).max(axis=2) > 12]
+    assert len(bodies["all"]) > 3000
+    assert 50 < len(bodies["arm"]) < 0.25 * len(bodies["all"])  # the clear bones are not drawn
+    arm_px = bodies["arm"]
+    assert (arm_px[:, 0] > 2 * arm_px[:, 1] + 20).mean() > 0.95  # and the arm is red
