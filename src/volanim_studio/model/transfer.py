@@ -8,7 +8,8 @@
 colours, the grey ramp, the heat map). The first edit starts from the look of the mode shown
 (:func:`starting_function`), so nothing changes on screen until the user moves something. Edits are pure
 functions on :class:`~volanim_core.transfer_function.TransferFunction` (``with_point``, ``moved``,
-``recoloured``, ``without``); each is one undo step, a drag of one point one step (merged).
+``recoloured``, ``without``); each is one undo step, a drag of one point one step (merged). The editor shows
+one handle per label (:func:`handles`: a label's flat step is two points) and edits both points at once.
 A project keeps the function (``document_state``'s ``transfer`` part); ``.tf`` files hold it alone.
 """
 
@@ -19,7 +20,7 @@ import numpy as np
 from volanim_core import io
 from volanim_core.errors import FormatError
 from volanim_core.render.scene import preset_transfer
-from volanim_core.render.volume_style import label_colours, label_steps
+from volanim_core.render.volume_style import LABEL_STEP, label_colours, label_steps
 from volanim_core.transfer_function import TransferFunction
 
 from .undo import Command
@@ -68,6 +69,59 @@ def without(tf: TransferFunction, i: int) -> TransferFunction:
     if len(tf.values) == 1:
         raise ValueError("a transfer function keeps at least one point")
     return TransferFunction(np.delete(tf.values, i), np.delete(tf.rgba, i, axis=0))
+
+
+def handles(tf: TransferFunction) -> list[tuple[int, ...]]:
+    """The points a user edits as one, in order: each label's flat step (two points ``2 * LABEL_STEP`` apart
+    in one colour, as :func:`~volanim_core.render.volume_style.label_steps` makes them) is one handle; every
+    other point is a handle of its own. (#83: in the bone look each bone was two points, and recolouring one
+    recoloured half a bone: the arm turned mauve; opacity 0.1 on one left the head solid.)"""
+    out, i, n = [], 0, len(tf.values)
+    while i < n:
+        if (i + 1 < n and abs(tf.values[i + 1] - tf.values[i] - 2 * LABEL_STEP) < 1e-6
+                and np.array_equal(tf.rgba[i], tf.rgba[i + 1])):
+            out.append((i, i + 1))
+            i += 2
+        else:
+            out.append((i,))
+            i += 1
+    return out
+
+
+def handle_value(tf: TransferFunction, handle: tuple[int, ...]) -> float:
+    """Where a handle stands: its point's value, or the middle of a label's step (the label's value)."""
+    return float(np.mean(tf.values[list(handle)]))
+
+
+def handle_of(tf: TransferFunction, i: int) -> int:
+    """The handle that holds point ``i``."""
+    return next(k for k, h in enumerate(handles(tf)) if i in h)
+
+
+def moved_handle(tf: TransferFunction, handle: tuple[int, ...], value: float, opacity: float) -> TransferFunction:
+    """A handle moved to ``value`` and ``opacity``: a step keeps its width and stays between its neighbours."""
+    if len(handle) == 1:
+        return moved(tf, handle[0], value, opacity)
+    a, b = handle
+    lo = tf.values[a - 1] + GAP + LABEL_STEP if a > 0 else -np.inf
+    hi = tf.values[b + 1] - GAP - LABEL_STEP if b + 1 < len(tf.values) else np.inf
+    centre = min(max(float(value), lo), hi)
+    values, rgba = tf.values.copy(), tf.rgba.copy()
+    values[a], values[b] = centre - LABEL_STEP, centre + LABEL_STEP
+    rgba[[a, b], 3] = float(np.clip(opacity, 0, 1))
+    return TransferFunction(values, rgba)
+
+
+def recoloured_handle(tf: TransferFunction, handle: tuple[int, ...], rgb) -> TransferFunction:
+    for i in handle:
+        tf = recoloured(tf, i, rgb)
+    return tf
+
+
+def without_handle(tf: TransferFunction, handle: tuple[int, ...]) -> TransferFunction:
+    if len(handle) == len(tf.values):
+        raise ValueError("a transfer function keeps at least one point")
+    return TransferFunction(np.delete(tf.values, list(handle)), np.delete(tf.rgba, list(handle), axis=0))
 
 
 def to_json(tf: TransferFunction | None):

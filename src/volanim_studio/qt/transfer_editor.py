@@ -1,9 +1,10 @@
 """*View → Transfer function…*: the thesis's Icol, points on a histogram, colour and opacity, saved as ``.tf``.
 
-    canvas (x: value over the histogram of what is shown, y: opacity; a dot per point in its colour)
-        drag a dot --> doc.transfer.set(moved(...), merge_key)   one undo step per drag (sealed on release)
-        double-click empty --> with_point          double-click a dot / Colour… --> recoloured
-        right-click a dot / Delete / Remove point --> without
+    canvas (x: value over the histogram of what is shown, y: opacity; a dot per handle in its colour: a
+            label's flat step, two points, is one dot -- model.transfer.handles)
+        drag a dot --> doc.transfer.set(moved_handle(...), merge_key)   one undo step per drag (sealed on release)
+        double-click empty --> with_point          double-click a dot / Colour… --> recoloured_handle
+        right-click a dot / Delete / Remove point --> without_handle
         Open .tf… / Save .tf… / Mode's look (None: each mode draws as it did)
     doc.events.transfer --> redrawn (an undo from the main window shows here too)
     doc.events.preview --> the histogram of the new preview
@@ -30,7 +31,15 @@ from PySide6.QtWidgets import (
 )
 
 from volanim_core.volume import to_grey
-from volanim_studio.model.transfer import moved, recoloured, with_point, without
+from volanim_studio.model.transfer import (
+    handle_of,
+    handle_value,
+    handles,
+    moved_handle,
+    recoloured_handle,
+    with_point,
+    without_handle,
+)
 
 MARGIN = 10  # pixels around the plot, so a dot at either end is whole
 HIT = 8  # pixels: how near a click must be to take a dot
@@ -76,9 +85,14 @@ class TransferCanvas(QWidget):
         w, h = self.width() - 2 * MARGIN, self.height() - 2 * MARGIN
         return lo + (x - MARGIN) / max(w, 1) * (hi - lo), float(np.clip(1 - (y - MARGIN) / max(h, 1), 0, 1))
 
-    def point_at(self, x: float, y: float) -> int | None:
+    def dots(self) -> list[QPointF]:
+        """Where each handle (:func:`~volanim_studio.model.transfer.handles`) is drawn: a label's step as one."""
         tf = self.editor.function()
-        d = [np.hypot(p.x() - x, p.y() - y) for p in (self.to_pixel(v, a) for v, a in zip(tf.values, tf.rgba[:, 3]))]
+        return [self.to_pixel(handle_value(tf, h), tf.rgba[h[0], 3]) for h in handles(tf)]
+
+    def point_at(self, x: float, y: float) -> int | None:
+        """The handle under the pixel (x, y), or None."""
+        d = [np.hypot(p.x() - x, p.y() - y) for p in self.dots()]
         i = int(np.argmin(d))
         return i if d[i] <= HIT else None
 
@@ -104,11 +118,11 @@ class TransferCanvas(QWidget):
             p.setPen(QColor.fromRgbF(c[0], c[1], c[2], max(c[3], 0.15)))
             px = MARGIN + k
             p.drawLine(QPointF(px, MARGIN + h + 2), QPointF(px, MARGIN + h + MARGIN - 1))
-        dots = [self.to_pixel(v, a) for v, a in zip(tf.values, tf.rgba[:, 3])]
+        line = [self.to_pixel(v, a) for v, a in zip(tf.values, tf.rgba[:, 3])]
         p.setPen(QPen(QColor(230, 230, 230), 1.5))
-        p.drawPolyline(QPolygonF([self.to_pixel(lo, tf.rgba[0, 3])] + dots + [self.to_pixel(hi, tf.rgba[-1, 3])]))
-        for k, dot in enumerate(dots):
-            r, g, b = tf.rgba[k, :3]
+        p.drawPolyline(QPolygonF([self.to_pixel(lo, tf.rgba[0, 3])] + line + [self.to_pixel(hi, tf.rgba[-1, 3])]))
+        for k, (dot, h) in enumerate(zip(self.dots(), handles(tf))):
+            r, g, b = tf.rgba[h[0], :3]
             selected = k == self.editor.selected
             p.setPen(QPen(QColor(255, 210, 80) if selected else QColor(240, 240, 240), 2.5 if selected else 1.2))
             p.setBrush(QBrush(QColor.fromRgbF(r, g, b)))
@@ -200,17 +214,23 @@ class TransferEditor(QDialog):
         super().showEvent(event)
         self._on_preview()
 
+    def _handle(self) -> tuple[int, ...] | None:
+        """The selected handle's points (a label's step: both), or None."""
+        hs = handles(self.function())
+        return hs[self.selected] if self.selected is not None and self.selected < len(hs) else None
+
     def _on_changed(self, **_) -> None:
         tf = self.function()
-        if self.selected is not None and self.selected >= len(tf.values):
+        h = self._handle()
+        if h is None:
             self.selected = None
-        if self.selected is None:
             mine = ("yours" if self.doc.transfer.function is not None
                     else f"the {self.mode} look; edit it to make it yours")
-            self.info.setText(f"{len(tf.values)} points ({mine}); values 0..{self.top:g} shown")
+            self.info.setText(f"{len(handles(tf))} points ({mine}); values 0..{self.top:g} shown")
         else:
-            v, (r, g, b, a) = tf.values[self.selected], tf.rgba[self.selected]
-            self.info.setText(f"point {self.selected + 1}: value {v:.4g}, opacity {a:.2f}, "
+            v, (r, g, b, a) = handle_value(tf, h), tf.rgba[h[0]]
+            what = f"label {v:.4g}" if len(h) == 2 else f"value {v:.4g}"
+            self.info.setText(f"point {self.selected + 1}: {what}, opacity {a:.2f}, "
                               f"colour {QColor.fromRgbF(r, g, b).name()}")
         self.canvas.update()
 
@@ -224,21 +244,26 @@ class TransferEditor(QDialog):
 
     def add(self, value: float, opacity: float) -> None:
         try:
-            tf, self.selected = with_point(self.function(), value, opacity)
+            tf, i = with_point(self.function(), value, opacity)
         except ValueError as exc:
             self.doc.message(str(exc))
             return
+        self.selected = handle_of(tf, i)
         self._set(tf, "Add a transfer function point")
 
-    def move(self, i: int, value: float, opacity: float) -> None:
-        self.selected = i
-        self._set(moved(self.function(), i, value, opacity), "Move a transfer function point", f"transfer:{i}")
+    def move(self, k: int, value: float, opacity: float) -> None:
+        """Handle ``k`` to ``value`` and ``opacity`` (a label's step: both its points)."""
+        self.selected = k
+        h = self._handle()
+        self._set(moved_handle(self.function(), h, value, opacity), "Move a transfer function point",
+                  f"transfer:{k}")
 
     def remove(self) -> None:
-        if self.selected is None:
+        h = self._handle()
+        if h is None:
             return
         try:
-            tf = without(self.function(), self.selected)
+            tf = without_handle(self.function(), h)
         except ValueError as exc:
             self.doc.message(str(exc))
             return
@@ -246,15 +271,17 @@ class TransferEditor(QDialog):
         self._set(tf, "Remove a transfer function point")
 
     def colour(self, rgb) -> None:
-        """Colour the selected point ``rgb`` (0..1)."""
-        if self.selected is not None:
-            self._set(recoloured(self.function(), self.selected, rgb), "Colour a transfer function point")
+        """Colour the selected handle ``rgb`` (0..1): a label's step, both its points."""
+        h = self._handle()
+        if h is not None:
+            self._set(recoloured_handle(self.function(), h, rgb), "Colour a transfer function point")
 
     def choose_colour(self) -> None:
-        if self.selected is None:
+        h = self._handle()
+        if h is None:
             self.doc.message("Click a point first, then choose its colour.")
             return
-        r, g, b = self.function().rgba[self.selected, :3]
+        r, g, b = self.function().rgba[h[0], :3]
         dialog = QColorDialog(QColor.fromRgbF(r, g, b), self)
         dialog.setOption(QColorDialog.DontUseNativeDialog, True)
         dialog.colorSelected.connect(lambda c: self.colour((c.redF(), c.greenF(), c.blueF())))

@@ -106,3 +106,24 @@ def test_through_palette_is_the_function_of_each_colour_s_luminance():
     by_index = through_palette(tf, palette)
     for k, colour in enumerate(palette):
         assert np.allclose(by_index(float(k)), tf(float(to_grey(colour[None])[0])))
+
+
+def test_a_label_step_is_one_handle_and_moves_whole_between_its_neighbours():
+    """#83 item 8: each label of the bone look is two points (a flat step); edited one at a time, half a bone
+    changed. Handles group them; a step moves with its width kept and never past its neighbours."""
+    import numpy as np
+
+    from volanim_core.render.volume_style import LABEL_STEP, label_steps
+    from volanim_studio.model.transfer import handle_value, handles, moved_handle, recoloured_handle, without_handle
+
+    tf = label_steps(np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1]], np.float64))
+    hs = handles(tf)
+    assert hs == [(0,), (1,), (2, 3), (4, 5), (6, 7)]
+    assert [handle_value(tf, h) for h in hs[2:]] == [1.0, 2.0, 3.0]
+    red = recoloured_handle(tf, hs[3], (1, 1, 0))
+    assert np.allclose(red(np.linspace(1.55, 2.45, 5))[:, :3], (1, 1, 0)) and np.allclose(red(1.0), tf(1.0))
+    far = moved_handle(tf, hs[3], 99.0, 0.2)  # dragged far right: stopped before label 3's step
+    a, b = hs[3]
+    assert np.isclose(far.values[b] - far.values[a], 2 * LABEL_STEP) and far.values[b] < tf.values[6]
+    assert np.allclose(far.rgba[[a, b], 3], 0.2)
+    assert handles(without_handle(tf, hs[2])) == [(0,), (1,), (2, 3), (4, 5)]

@@ -258,3 +258,43 @@ def test_a_movie_takes_the_function_s_opacity_too(qtbot, window, tmp_path):
     assert 50 < len(bodies["arm"]) < 0.25 * len(bodies["all"])  # the clear bones are not drawn
     arm_px = bodies["arm"]
     assert (arm_px[:, 0] > 2 * arm_px[:, 1] + 20).mean() > 0.95  # and the arm is red
+
+
+def test_in_the_bone_look_each_bone_is_one_point_recoloured_and_made_faint_whole(qtbot, window):
+    """#83 item 8: in the bone look each bone was two points; recolouring one recoloured half the bone (the arm
+    turned mauve) and opacity 0.1 on one left the head solid. Each bone is now one dot on the canvas, and
+    a click, a colour and a drag through the real canvas change the whole bone, and it alone."""
+    w = rig_and_pose(qtbot, window)
+    doc = w.doc
+    doc.settings.preview_mode = "bone"
+    w.previews.preview()
+    qtbot.waitUntil(lambda: not w.jobs.running and doc.preview is not None and doc.preview.mode == "bone",
+                    timeout=JOB_TIMEOUT_MS)
+    qtbot.keyClick(w, Qt.Key_T, Qt.ControlModifier)
+    editor = w.transfer_editor
+    qtbot.waitExposed(editor)
+    canvas = editor.canvas
+    n = len(doc.bones)
+    assert len(canvas.dots()) == 2 + n  # the background's two points, then one per bone
+    arm, head = doc.bones.index("L_UPPERARM"), doc.bones.index("HEAD")
+    before = editor.function()
+    at = pixel(canvas, arm + 1, before(arm + 1)[3])
+    qtbot.mouseClick(canvas, Qt.LeftButton, pos=at)
+    assert f"label {arm + 1}" in editor.info.text()
+    editor.colour((1.0, 0.0, 0.0))  # what the colour dialog's OK does
+    tf = doc.transfer.function
+    inside = np.linspace(arm + 1 - 0.45, arm + 1 + 0.45, 7)
+    assert np.allclose(tf(inside)[:, :3], (1.0, 0.0, 0.0))  # the whole arm, not half of it
+    others = np.array([v for v in range(1, n + 1) if v != arm + 1], np.float64)
+    assert np.allclose(tf(others), before(others))  # and no other bone
+    at = pixel(canvas, head + 1, tf(head + 1)[3])
+    qtbot.mousePress(canvas, Qt.LeftButton, pos=at)  # the head's dot dragged down to opacity ~0.1
+    target = pixel(canvas, head + 1, 0.1)
+    qtbot.mouseMove(canvas, target)
+    qtbot.mouseRelease(canvas, Qt.LeftButton, pos=target)
+    tf = doc.transfer.function
+    whole_head = tf(np.linspace(head + 1 - 0.45, head + 1 + 0.45, 7))
+    assert np.allclose(whole_head[:, 3], whole_head[0, 3]) and whole_head[0, 3] < 0.2  # the whole head faint
+    assert np.allclose(tf(head + 1)[:3], before(head + 1)[:3])  # in its colour
+    assert np.allclose(actor_function(w, [head + 1 - 0.3, head + 1 + 0.3])[:, 3], whole_head[0, 3], atol=1e-6)
+    editor.close()
