@@ -62,7 +62,8 @@ class FilesController(Controller):
 
         tf = self.doc.transfer.function  # the editor's, as the preview draws with it
         return self._read_then_view(path, "View", lambda: read_look(path, size=SIZE, transfer=tf),
-                                    lambda look: QuickLookWindow(path, look, self.window), f"Viewing {Path(path).name}")
+                                    lambda look: QuickLookWindow(path, look, self.window, self.doc),
+                                    f"Viewing {Path(path).name}")
 
     def view_file_dialog(self) -> LookDialog:
         """Ask for a volume, a mesh or a sequence (its ``NAME.zarr`` folder, or the ``zarr.json`` in it), then

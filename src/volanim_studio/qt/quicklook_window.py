@@ -6,6 +6,7 @@ reconstruction written by ``volanim reconstruct``, a hull ``.ply``, a frame of a
 It does not touch the document.
 
     file --read_look (the main window's reader thread)--> Look --draw_look (here, the GUI thread)--> window
+    doc.events.transfer --> the volume drawn again through the edited function, the user's camera kept
 """
 
 from __future__ import annotations
@@ -21,11 +22,14 @@ SIZE = (800, 600)
 
 
 class QuickLookWindow(QMainWindow):
-    def __init__(self, path, look, parent=None):
-        """``look``: the file as :func:`~volanim_core.render.quicklook.read_look` read it (at ``SIZE``)."""
+    def __init__(self, path, look, parent=None, doc=None):
+        """``look``: the file as :func:`~volanim_core.render.quicklook.read_look` read it (at ``SIZE``).
+        ``doc``: the studio's document, whose transfer function the window follows (#83: an open View window
+        kept the function it was opened with)."""
         from volanim_core.render.quicklook import draw_look
 
         super().__init__(parent)
+        self.look, self.doc = look, doc
         self.setWindowTitle(f"View — {Path(path).name}")
         self.resize(*SIZE)
         self.plotter = QtInteractor(self)
@@ -36,7 +40,26 @@ class QuickLookWindow(QMainWindow):
             close_interactor(self.plotter)
             raise
         self.statusBar().showMessage(f"{path}: {self.what}. Drag to turn, wheel to zoom.")
+        if doc is not None and look.volume is not None:  # a mesh has no values for a function to colour
+            doc.events.transfer.connect(self._on_transfer)
+
+    def _on_transfer(self, function, **_) -> None:
+        """Draw the volume again through the edited function, from the camera the user has now."""
+        from dataclasses import replace
+
+        from volanim_core.render.quicklook import draw_look
+        from volanim_core.render.scene import prepare_frame
+        from volanim_core.render.views import Camera
+
+        camera = Camera.of(self.plotter.renderer.GetActiveCamera())
+        settings = replace(self.look.settings, transfer=function, camera=camera)
+        look = replace(self.look, settings=settings, frame=prepare_frame(settings, self.look.volume, self.look.origin))
+        self.plotter.remove_actor("body", render=False)
+        self.renderer = draw_look(look, plotter=self.plotter)
+        self.plotter.render()
 
     def closeEvent(self, event) -> None:
+        if self.doc is not None and self._on_transfer in self.doc.events.transfer._callbacks:
+            self.doc.events.transfer.disconnect(self._on_transfer)
         close_interactor(self.plotter)
         super().closeEvent(event)

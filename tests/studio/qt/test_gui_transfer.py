@@ -298,3 +298,29 @@ def test_in_the_bone_look_each_bone_is_one_point_recoloured_and_made_faint_whole
     assert np.allclose(tf(head + 1)[:3], before(head + 1)[:3])  # in its colour
     assert np.allclose(actor_function(w, [head + 1 - 0.3, head + 1 + 0.3])[:, 3], whole_head[0, 3], atol=1e-6)
     editor.close()
+
+
+def test_an_open_view_window_follows_an_edit_of_the_function(qtbot, window, tmp_path):
+    """#83 item 8: an open View window kept the function it was opened with. Opened green, then the function
+    edited to red: the same window redraws red, from the camera the user had turned it to; closed, it
+    follows no more."""
+    from volanim_core.render.views import Camera
+
+    w = window
+    w.doc.transfer.set(GREEN, "green")
+    path = tmp_path / "mannequin.VOL"
+    io.write_volume(path, samples.mannequin().volume)
+    viewer = viewer_opened(w, qtbot, w.files.view_file, path)
+    cam = viewer.plotter.renderer.GetActiveCamera()
+    cam.Azimuth(30)  # the user turns the view
+    turned = Camera.of(cam)
+    red = TransferFunction(GREEN.values, np.where(np.arange(4)[None, :] == 3, GREEN.rgba, [1.0, 0.0, 0.0, 0.0]))
+    w.doc.transfer.set(red, "red")
+    assert viewer.renderer.settings.transfer == red
+    pic = np.asarray(viewer.plotter.screenshot(return_img=True))[..., :3].astype(int)
+    body = pic[np.abs(pic - pic[0, 0]).max(axis=2) > 12]
+    assert len(body) > 1000 and (body[:, 0] > body[:, 1] + 40).mean() > 0.9  # red now
+    now = Camera.of(viewer.plotter.renderer.GetActiveCamera())
+    assert np.allclose(now.position, turned.position) and np.allclose(now.focal_point, turned.focal_point)
+    viewer.close()
+    w.doc.transfer.set(GREEN, "green again")  # a closed window is no longer told (nor crashes the studio)
