@@ -89,23 +89,32 @@ class JobRunner(QObject):
         self._on_idle = on_idle or (lambda: None)
         self.worker: Worker | None = None
         self.dialog: QProgressDialog | None = None
+        self._preempting = False  # run() is ending a background job (and handling events while it waits)
 
     @property
     def busy(self) -> bool:
         """A job the user waits for runs: another is refused. A background job does not count (``run``
         cancels it first)."""
-        return self.worker is not None and not self.worker.background
+        return self._preempting or (self.worker is not None and not self.worker.background)
 
     @property
     def running(self) -> bool:
-        """Any job's thread is running, a background one too."""
-        return self.worker is not None
+        """Any job's thread is running, a background one too (or one is being started)."""
+        return self._preempting or self.worker is not None
 
     def run(self, label: str, task: Callable, on_done: Callable, *, background: bool = False) -> Worker:
         """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel (``background``: with
         neither, cancelled by the next job asked for)."""
-        if self.worker is not None and self.worker.background:
-            self._preempt()
+        # Ending a background job handles events while its thread winds down; a timer firing then (a preview
+        # asked for "when idle") must see a busy runner and wait, not start a job inside this one (#83: F5 just
+        # after entering Pose mode raised "another job is running"); and a background job its last signals
+        # started (a picture's report) is ended in turn.
+        self._preempting = True
+        try:
+            while self.worker is not None and self.worker.background:
+                self._preempt()
+        finally:
+            self._preempting = False
         if self.worker is not None:
             raise RuntimeError("another job is running")
         worker = Worker(task, self._window)

@@ -157,3 +157,33 @@ def test_a_background_job_has_no_dialog_and_the_next_job_cancels_it(qtbot, windo
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
     assert applied == ["fresh"]
     assert not any("Checking" in m for m in messages)
+
+
+def test_a_preview_asked_for_while_a_background_job_is_being_ended_waits_its_turn(qtbot, window):
+    """#83: ending a background job handles events while its thread winds down. A "preview when idle" timer
+    that fired then saw a free runner, started a preview inside the first job's start, and that job then
+    raised "another job is running" (seen once in make test: F5 just after entering Pose mode)."""
+    from PySide6.QtCore import QTimer
+
+    from paths import ASSETS
+
+    assert window.files.open_bones(ASSETS / "mannequin.bones")
+    assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
+    from volanim_studio.model.interaction import Mode
+
+    window.set_mode(Mode.POSE)
+    qtbot.waitUntil(lambda: not window.jobs.running, timeout=JOB_TIMEOUT_MS)
+    released = threading.Event()
+
+    def wait_for_cancel(progress, cancel):
+        while not cancel():
+            released.wait(0.01)
+        return None
+
+    window.jobs.run("Checking", wait_for_cancel, lambda _: None, background=True)
+    QTimer.singleShot(0, window.previews._preview_when_idle)  # fires while the next run() ends that job
+    applied = []
+    worker = window.jobs.run("Next", lambda progress, cancel: "fresh", applied.append)
+    assert worker is not None  # no "another job is running"
+    qtbot.waitUntil(lambda: not window.jobs.running and applied == ["fresh"], timeout=JOB_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: window.doc.preview_is_current and not window.jobs.running, timeout=JOB_TIMEOUT_MS)
