@@ -147,6 +147,56 @@ def add_volume_uncopied(plotter, grid, scalars: str, **kwargs):
     return actor
 
 
+#: Ray samples a still frame of the CPU ray caster may take with one ray per pixel (~50 ms of the GUI thread
+#: here, on software GL). The mannequin's posed preview in the studio's view takes ~6e7 (drawn with every ray,
+#: as the picture tests compare it with its voxels); mannequin-large's ~2.5e8.
+RAY_SAMPLES_BUDGET = 1.2e8
+
+
+def ray_spacing(rays: float, samples_per_ray: float) -> float:
+    """Pixels between two rays of the CPU ray caster so that a still frame takes about
+    :data:`RAY_SAMPLES_BUDGET` samples (#83: mannequin-large's posed preview held the GUI thread 0.17 s a
+    frame, every frame, on software GL). Rays fall as the square of their spacing. Decided by the picture's
+    size on screen and the volume's depth alone, never by a timing, so a picture is the same on a busy
+    machine (VTK's own auto-adjust, by timing, is left to interaction)."""
+    return float(max(1.0, min(4.0, np.sqrt(rays * samples_per_ray / RAY_SAMPLES_BUDGET))))
+
+
+def limit_ray_cost(actor, renderer, step: float = 1.0) -> float:
+    """Bound the cost of a still frame of ``actor``'s CPU ray-cast mapper (a GPU mapper is left as it is):
+    one sample per ``step`` world units along a ray (``step`` > 1: a coarser copy of the volume, sampled at
+    its own resolution) and rays spaced by :func:`ray_spacing` for the pixels its box covers in
+    ``renderer``'s view now. Returns the spacing."""
+    mapper = actor.GetMapper()
+    if not hasattr(mapper, "SetMinimumImageSampleDistance"):
+        return 1.0
+    mapper.SetSampleDistance(float(step))
+    b = np.asarray(mapper.GetInput().GetBounds(), np.float64)
+    diagonal = float(np.linalg.norm(b[1::2] - b[::2]))
+    d = ray_spacing(_covered_pixels(renderer, b), diagonal / step)
+    mapper.SetImageSampleDistance(d)
+    mapper.SetMinimumImageSampleDistance(d)  # auto-adjust (interaction) may go coarser, never finer
+    mapper.SetMaximumImageSampleDistance(max(d, mapper.GetMaximumImageSampleDistance()))
+    return d
+
+
+def _covered_pixels(renderer, bounds) -> float:
+    """The pixels of ``renderer``'s viewport inside the screen rectangle of a box's eight corners."""
+    xs, ys = [], []
+    for x in bounds[0:2]:
+        for y in bounds[2:4]:
+            for z in bounds[4:6]:
+                renderer.SetWorldPoint(float(x), float(y), float(z), 1.0)
+                renderer.WorldToDisplay()
+                px, py, _ = renderer.GetDisplayPoint()
+                xs.append(px)
+                ys.append(py)
+    width, height = renderer.GetSize()
+    w = min(max(xs), width) - max(min(xs), 0)
+    h = min(max(ys), height) - max(min(ys), 0)
+    return float(max(w, 0) * max(h, 0))
+
+
 def binary_view(volume: np.ndarray) -> np.ndarray:
     """A binary-mode volume as labels 0/1 (one colour for every filled voxel)."""
     return (volume > 0).astype(np.uint8)

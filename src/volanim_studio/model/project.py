@@ -241,26 +241,81 @@ def _checked_segmentation(path, seg: dict) -> dict:
     return seg
 
 
-def apply_project(doc, data: dict, path, *, reset: bool = False) -> list[str]:
+@dataclass(frozen=True)
+class ProjectFiles:
+    """A project's data files, read (in a worker: a large skeleton or a clip of a thousand ``.trans``
+    frames took seconds on the GUI thread, #83), ready for :func:`apply_project`."""
+    skeleton: object = None  # the MultiSkeleton, when it is to be read (a document without one)
+    bones: object = None
+    connect: object = None
+    clip: dict | None = None  # the timeline clip's content: {"motion": Motion} or {"frames": (mats, files)}
+    # or {"error": text} (a clip that cannot be read is a warning when applied, never a failure)
+
+
+def read_project_files(data: dict, path, *, skeleton: bool, grid=None) -> ProjectFiles:
+    """Read the data files ``data`` (:func:`read_project`'s) names, and its timeline clip, without touching
+    any document; ``skeleton``: the ``.mskel`` too (a document that has none yet); ``grid``: the Geometry
+    the bones will be put on (the loaded skeleton's; else the ``.mskel``'s). A bad data file raises
+    FormatError naming the project, then the file."""
+    sk = _data_file(data, path, "mskel", io.read_mskel) if data.get("mskel") and skeleton else None
+    bones = _data_file(data, path, "bones", io.read_bones) if data.get("bones") else None
+    conn = _data_file(data, path, "connect", io.read_connect) if data.get("connect") else None
+    clip = (data["state"].get("timeline") or {}).get("clip")
+    grid = grid if grid is not None else (sk.geometry if sk is not None else None)
+    content = None
+    if clip and bones is not None:  # frames are read against the bones as the document will hold them
+        content = _read_clip(clip, bones if grid is None else bones.on_grid(grid))
+        content["grid"] = grid
+    return ProjectFiles(sk, bones, conn, content)
+
+
+def _data_file(data: dict, path, key: str, read):
+    try:
+        return read(data[key])
+    except FormatError as exc:  # the project is what the user opened: name it, then the file
+        raise FormatError(path, f"its {key} file: {exc}") from None
+
+
+def _read_clip(clip: dict, bones) -> dict:
+    """A timeline clip's file(s), read as :meth:`Timeline.restore` takes them."""
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.frame_files import read_frames
+
+    from .timeline import retarget_clip
+
+    try:
+        if clip["kind"] == "bvh":
+            motion = read_bvh(clip["path"])
+            return {"motion": motion, "built": retarget_clip(clip["path"], bones, motion, clip.get("mapping"),
+                                                              clip.get("up", "auto"), clip.get("forward", "auto"))}
+        return {"frames": read_frames(clip["path"], bones)}
+    except (OSError, ValueError) as exc:  # FormatError is a ValueError
+        return {"error": str(exc)}
+
+
+def apply_project(doc, data: dict, path, *, reset: bool = False, files: ProjectFiles | None = None) -> list[str]:
     """Load a read project's files and state into ``doc`` (after its volume, if any, is loaded).
 
-    Every data file is read before the document is touched, so a bad file
-    (FormatError, naming it) leaves the document as it was; ``reset`` empties it
-    first (a project without a volume or demo is a new document too). Returns warnings
-    for the user (the previous save was used, settings refused, points added).
+    ``files``: :func:`read_project_files`' result, read in a worker (read here when None). Every
+    data file is read before the document is touched, so a bad file (FormatError, naming it) leaves
+    the document as it was; ``reset`` empties it first (a project without a volume or demo is a new
+    document too). Returns warnings for the user (the previous save was used, settings refused,
+    points added).
     """
     warnings = list(data.get("warnings") or [])
     fresh = reset or doc.skeleton is None
-
-    def data_file(key, read):
-        try:
-            return read(data[key])
-        except FormatError as exc:  # the project is what the user opened: name it, then the file
-            raise FormatError(path, f"its {key} file: {exc}") from None
-
-    skeleton = data_file("mskel", io.read_mskel) if data.get("mskel") and fresh else None
-    bones = data_file("bones", io.read_bones) if data.get("bones") else None
-    conn = data_file("connect", io.read_connect) if data.get("connect") else None
+    if files is None:
+        files = read_project_files(data, path, skeleton=fresh)
+    skeleton = files.skeleton if fresh else None
+    if skeleton is None and fresh and data.get("mskel"):  # read without it: the document had one then
+        skeleton = _data_file(data, path, "mskel", io.read_mskel)
+    bones, conn = files.bones, files.connect
+    state = data["state"]
+    held = skeleton if skeleton is not None else None if reset else doc.skeleton  # load_bones puts bones on it
+    grid = held.geometry if held is not None else None
+    if (files.clip is not None and files.clip["grid"] == grid and state.get("timeline")
+            and state["timeline"].get("clip")):  # else read again, on the grid the bones are put on
+        state = {**state, "timeline": {**state["timeline"], "clip": {**state["timeline"]["clip"], "read": files.clip}}}
     if reset:  # a new document, once every file has been read
         doc.reset()
     if skeleton is not None:
@@ -271,7 +326,7 @@ def apply_project(doc, data: dict, path, *, reset: bool = False) -> list[str]:
         doc.bone_edits.load_bones(data["bones"], bones)
     if conn is not None:
         warnings += doc.attachments.apply_connectivity(conn, Path(data["connect"]).name)
-    warnings += document_state.apply_all(doc, data["state"], path)
+    warnings += document_state.apply_all(doc, state, path)
     doc.project_path = str(path)
     # opening is not an edit: Ctrl+Z right after it undid "Load connect", then the bones (issue #37)
     doc.undo.clear()

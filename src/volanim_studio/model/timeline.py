@@ -55,6 +55,17 @@ class Clip:
         return "bvh" if self.motion is not None else "trans"
 
 
+def retarget_clip(path, bones, motion: Motion, mapping=None, up: str = "auto", forward: str = "auto"):
+    """``(bones, Retarget, matrices)``: ``motion`` (read from ``path``) retargeted onto ``bones`` -- pure
+    arrays, so a worker can make it (#83: a project's clip was retargeted on the GUI thread)."""
+    if mapping is not None:
+        check_mapping_file(path, mapping, bones, motion)
+    r = Retarget.build(bones, motion, mapping, up=up, forward=forward)
+    if not r.mapping:
+        raise ValueError(f"{Path(path).name}: no bone is mapped to a joint of the clip; map them by hand")
+    return bones, r, r.matrices()
+
+
 class Timeline:
     def __init__(self, doc):
         self.doc = doc
@@ -167,23 +178,24 @@ class Timeline:
 
     # ---------------------------------------------------------------- clips
     def load_bvh(self, path, mapping: dict[str, str] | None = None, up: str = "auto", forward: str = "auto",
-                 motion: Motion | None = None) -> Retarget:
+                 motion: Motion | None = None, built=None) -> Retarget:
         """Retarget a BVH clip onto the bones and put it on the timeline (FormatError names the file).
-        A load, not an edit: the history starts after it."""
-        return self.doc.loading(lambda: self._retarget(path, mapping, up, forward, motion))
+        A load, not an edit: the history starts after it. ``built``: see :meth:`_retarget`."""
+        return self.doc.loading(lambda: self._retarget(path, mapping, up, forward, motion, built))
 
-    def _retarget(self, path, mapping, up, forward, motion) -> Retarget:
-        """:meth:`load_bvh` without touching the history (the bones changed: the clip follows them)."""
+    def _retarget(self, path, mapping, up, forward, motion, built=None) -> Retarget:
+        """:meth:`load_bvh` without touching the history (the bones changed: the clip follows them).
+        ``built``: :func:`retarget_clip`'s ``(bones, Retarget, matrices)`` made in a worker, used when
+        its bones are the document's."""
         if not len(self.doc.bones):
             raise ValueError("build or open the bone skeleton first: the clip drives its bones")
-        motion = read_bvh(path) if motion is None else motion
-        if mapping is not None:
-            check_mapping_file(path, mapping, self.doc.bones, motion)
-        r = Retarget.build(self.doc.bones, motion, mapping, up=up, forward=forward)
-        if not r.mapping:
-            raise ValueError(f"{Path(path).name}: no bone is mapped to a joint of the clip; map them by hand")
+        if built is None or built[0] != self.doc.bones:
+            motion = read_bvh(path) if motion is None else motion
+            built = retarget_clip(path, self.doc.bones, motion, mapping, up, forward)
+        _, r, matrices = built
+        motion = r.motion
         used = {self.doc.bones.bones[b].label: motion.names[k] for b, k in r.mapping.items()}
-        self._put_clip(Clip(Path(path).stem, r.matrices(), motion.fps, str(path), list(range(motion.frames)),
+        self._put_clip(Clip(Path(path).stem, matrices, motion.fps, str(path), list(range(motion.frames)),
                             motion, used, r.up, r.forward))
         return r
 
@@ -296,11 +308,15 @@ class Timeline:
         clip = parsed["clip"]
         if not clip:
             return []
+        read = clip.get("read") or {}  # the file(s) already read in a worker (project.read_project_files)
         try:
+            if "error" in read:
+                raise ValueError(read["error"])
             if clip["kind"] == "bvh":
-                self.load_bvh(clip["path"], clip.get("mapping"), clip.get("up", "auto"), clip.get("forward", "auto"))
+                self.load_bvh(clip["path"], clip.get("mapping"), clip.get("up", "auto"), clip.get("forward", "auto"),
+                              motion=read.get("motion"), built=read.get("built"))
             else:
-                self.load_trans(clip["path"])
+                self.load_trans(clip["path"], frames=read.get("frames"))
         except (OSError, ValueError) as exc:
             return [f"{where}: the timeline's clip was not loaded ({exc})"]
         return []

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from PySide6.QtWidgets import QFileDialog
 
@@ -22,7 +23,7 @@ from volanim_core import io
 
 from .. import tasks
 from ..model import autosave
-from ..model.project import apply_project, read_project
+from ..model.project import apply_project, read_project, read_project_files
 from .controller import FAILED, Controller
 from .look_dialog import LookDialog
 from .threshold_dialog import ThresholdDialog
@@ -127,23 +128,30 @@ class FilesController(Controller):
             return
         self.doc.message(f"{len(result['skeleton'])} skeleton points; thinness slider shows the prefix ≥ t.")
 
-    def load_demo(self, name: str, *, skeleton_path=None, then: Callable[[], None] | None = None) -> Worker:
-        """Prepare a demo dataset in a worker; ``then()`` runs right after it is applied (see :meth:`open_project`)."""
+    def load_demo(self, name: str, *, skeleton_path=None, then: Callable[[Any], None] | None = None,
+                  also: Callable[[Any], Any] | None = None) -> Worker:
+        """Prepare a demo dataset in a worker; ``then(also(grid))`` runs right after it is applied (see
+        :meth:`open_project`: ``also`` reads more in the same worker, given the prepared skeleton's grid)."""
+        def task(progress, cancel):
+            r = tasks.load_demo(name, skeleton_path=skeleton_path, progress=progress, cancel=cancel)
+            r["also"] = also(r["skeleton"].geometry) if also is not None else None
+            return r
+
         def done(r):
             self._apply_prepared(r, spacing=r["spacing"])
             self.doc.demo_name = name
-            if then is not None:
-                then()
+            if then is not None:  # the next pass: the window draws the volume in between
+                self.jobs.later(lambda: then(r["also"]))
 
-        return self.jobs.run(f"Preparing the {name} demo", lambda progress, cancel: tasks.load_demo(
-            name, skeleton_path=skeleton_path, progress=progress, cancel=cancel), done)
+        return self.jobs.run(f"Preparing the {name} demo", task, done)
 
     def open_volume(self, path, *, dims=None, params: dict | None = None, skeleton_path=None,
-                    then: Callable[[], None] | None = None, otherwise: Callable[[], None] | None = None,
-                    series: str | None = None) -> Worker | None:
+                    then: Callable[[Any], None] | None = None, otherwise: Callable[[], None] | None = None,
+                    series: str | None = None, also: Callable[[Any], Any] | None = None) -> Worker | None:
         """Read a volume and segment it, both in workers (#61: a large scan's read froze the window): a
         DICOM folder of several series asks which; without ``params`` the threshold dialog asks between
-        the read and the segmentation. ``then()`` runs right after the result is applied; ``otherwise()``
+        the read and the segmentation. ``then(also(grid))`` runs right after the result is applied (``also``:
+        more to read in the same worker, given the prepared skeleton's grid; None without it); ``otherwise()``
         when the read or the segmentation failed or was cancelled, or the user declined a dialog (the
         error is shown). Returns the first job's worker (None while another job runs: said)."""
         otherwise = otherwise or (lambda: None)
@@ -162,7 +170,8 @@ class FilesController(Controller):
             loaded = tasks.load_volume_file(str(path), dims, series)
             if params is None:
                 return {"loaded": loaded}
-            return {"loaded": loaded, "prepared": self._prepare(loaded, params, skeleton_path, progress, cancel)}
+            return {"loaded": loaded, "prepared": self._prepare(loaded, params, skeleton_path, progress, cancel,
+                                                                also)}
 
         def read(r):
             if "choices" in r:
@@ -171,15 +180,15 @@ class FilesController(Controller):
                     otherwise()
                 else:
                     self.open_volume(path, dims=dims, params=params, skeleton_path=skeleton_path, then=then,
-                                     otherwise=otherwise, series=chosen)
+                                     otherwise=otherwise, series=chosen, also=also)
             elif "prepared" in r:
                 self._apply_volume(r["prepared"], path, dims, self._spacing(r["loaded"], params), series, then)
             else:
-                self._ask_threshold(path, r["loaded"], dims, skeleton_path, series, then, otherwise)
+                self._ask_threshold(path, r["loaded"], dims, skeleton_path, series, then, otherwise, also)
 
         return _or_else(self.jobs.run(f"Opening {name}" if params else f"Reading {name}", task, read), otherwise)
 
-    def _ask_threshold(self, path, loaded, dims, skeleton_path, series, then, otherwise) -> None:
+    def _ask_threshold(self, path, loaded, dims, skeleton_path, series, then, otherwise, also=None) -> None:
         """The threshold dialog over a volume just read, then its segmentation in a worker."""
         dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"],
                                  segments=loaded["segments"])
@@ -188,7 +197,7 @@ class FilesController(Controller):
             return
         params = dialog.parameters()
         _or_else(self.jobs.run(f"Skeletonizing {Path(path).name}", lambda progress, cancel: self._prepare(
-            loaded, params, skeleton_path, progress, cancel),
+            loaded, params, skeleton_path, progress, cancel, also),
             lambda r: self._apply_volume(r, path, dims, self._spacing(loaded, params), series, then)), otherwise)
 
     @staticmethod
@@ -196,20 +205,22 @@ class FilesController(Controller):
         """The voxel size the user confirmed (the dialog's, a project's), else the file's."""
         return tuple(float(v) for v in params.get("spacing") or loaded["spacing"])
 
-    def _prepare(self, loaded: dict, params: dict, skeleton_path, progress, cancel) -> dict:
+    def _prepare(self, loaded: dict, params: dict, skeleton_path, progress, cancel, also=None) -> dict:
         """A volume just read, segmented by ``params`` (the dialog's, or a project's) and skeletonized
-        (in a worker): :func:`tasks.prepare_volume` on the voxel size the user confirmed."""
-        return tasks.prepare_volume(loaded["volume"], tasks.Segmentation.of(params), skeleton_path=skeleton_path,
-                                    grey=loaded["grey"],
-                                    geometry=loaded["geometry"].with_spacing(self._spacing(loaded, params)),
-                                    progress=progress, cancel=cancel)
+        (in a worker): :func:`tasks.prepare_volume` on the voxel size the user confirmed; then ``also``."""
+        r = tasks.prepare_volume(loaded["volume"], tasks.Segmentation.of(params), skeleton_path=skeleton_path,
+                                 grey=loaded["grey"],
+                                 geometry=loaded["geometry"].with_spacing(self._spacing(loaded, params)),
+                                 progress=progress, cancel=cancel)
+        r["also"] = also(r["skeleton"].geometry) if also is not None else None
+        return r
 
     def _apply_volume(self, r: dict, path, dims, spacing, series, then) -> None:
         r["segmentation"]["spacing"] = list(spacing)  # saved with the project: a raw .vol has none
         r["segmentation"]["series"] = series  # and which series of a DICOM folder
         self._apply_prepared(r, path=path, spacing=r["geometry"].spacing, dims=dims)
-        if then is not None:
-            then()
+        if then is not None:  # the next pass: the window draws the volume in between
+            self.jobs.later(lambda: then(r["also"]))
 
     def open_volume_dialog(self) -> None:
         self.window.session.when_saved_or_discarded(self._ask_volume, "opening another volume")
@@ -267,38 +278,58 @@ class FilesController(Controller):
     def open_project(self, path, on_opened: Callable[[bool], None] | None = None) -> Worker | None:
         """Open a ``.volanim``: its volume segmented as saved (its ``.mskel`` read, not recomputed), then its files.
 
-        ``on_opened(ok)`` is called once it is all applied (True) or has failed
-        or been cancelled (False; the error was shown).
+        Everything is read in workers (the project and its hashes, then the volume, its skeleton, bones,
+        attachments and clip, #83: a ``.trans`` clip read on the GUI thread froze the window 1.4 s); what
+        is left for the GUI thread is putting them in the document. ``on_opened(ok)`` is called once it
+        is all applied (True) or has failed or been cancelled (False; the error was shown).
         """
         done = on_opened or (lambda ok: None)
-        data = self.attempt("Open project", lambda: read_project(path))
-        if data is FAILED:
+        name = Path(path).name
+        if self.jobs.busy:
+            self.doc.message(f"A job is running; open {name} when it ends.")
             done(False)
             return None
 
-        def rest(reset=False):
-            warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path, reset=reset))
+        def read(progress, cancel):
+            data = read_project(path)
+            if data.get("volume") or data.get("demo"):
+                return data, None  # its files are read after the volume, on its skeleton's grid
+            return data, read_project_files(data, path, skeleton=True)
+
+        def rest(data, files, reset=False):
+            warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path, reset=reset,
+                                                                          files=files))
             if warnings is FAILED:
                 done(False)
                 return
             if warnings:
                 self.show_error("Open project", "\n".join(warnings))
             self.doc.undo.mark_clean()  # as saved: loading its bones is not an edit to save
-            self.doc.message(f"Opened {Path(path).name}.")
+            self.doc.message(f"Opened {name}.")
             done(True)
             self.window.previews.show_body()  # opened in Pose mode: its body, not its bones alone
 
         # the rest is applied by the job's own completion handler, not by a second connection to
         # `succeeded`: that would run as a separate event after the job reads as done ("not busy"),
         # and anything acting in between (a key press, a test) would see a half-opened project
-        if data.get("volume"):
-            return self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
-                                    skeleton_path=data.get("mskel"), then=rest, otherwise=lambda: done(False))
-        if data.get("demo"):
-            return _or_else(self.load_demo(data["demo"], skeleton_path=data.get("mskel"), then=rest),
-                            lambda: done(False))
-        rest(reset=True)  # a project of bones alone: still a new document
-        return None
+        def opened(r):
+            data, files = r
+            def also(grid):
+                return read_project_files(data, path, skeleton=False, grid=grid)
+            if data.get("volume"):
+                self.open_volume(data["volume"], dims=data.get("volume_dims"), params=data["segmentation"],
+                                 skeleton_path=data.get("mskel"), then=lambda f: rest(data, f), also=also,
+                                 otherwise=lambda: done(False))
+            elif data.get("demo"):
+                _or_else(self.load_demo(data["demo"], skeleton_path=data.get("mskel"),
+                                        then=lambda f: rest(data, f), also=also), lambda: done(False))
+            else:
+                rest(data, files, reset=True)  # a project of bones alone: still a new document
+
+        worker = self.jobs.run(f"Opening {name}", read, opened)
+        worker.failed.connect(lambda _: done(False))
+        worker.was_cancelled.connect(lambda: done(False))
+        return worker
 
     def open_connect(self, path) -> bool:
         warnings = self.attempt("Open connectivity", lambda: self.doc.attachments.load(path),

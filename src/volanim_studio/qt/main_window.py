@@ -356,8 +356,8 @@ class MainWindow(QMainWindow):
 
     @property
     def busy(self) -> bool:
-        """A background job or a read for a viewer is running (its thread has not ended yet)."""
-        return self.jobs.running or self.readers.busy
+        """A background job, a read for a viewer or a live picture is running (its thread has not ended yet)."""
+        return self.jobs.running or self.readers.busy or not self.previews.live_worker.idle
 
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
@@ -368,6 +368,7 @@ class MainWindow(QMainWindow):
             return
         self.timeline.stop()
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
+        self.previews.live_worker.close()  # and for the live picture being made
         self.readers.shutdown()
         self.session.close()
         close_interactor(self.plotter)

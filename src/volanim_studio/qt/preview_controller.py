@@ -1,7 +1,8 @@
 """Posing and previews: live and full previews, compare, slices, export, poses in and out.
 
     settings.dragging (a pose slider, the timeline held or playing) + doc.events.pose
-        --> live_preview (full resolution on a small body, else half; GUI thread, coalesced) --> doc.set_preview
+        --> live_preview (coalesced) --> LiveWorker (its thread, newest pose first: full resolution on a
+            small body, else half; the surface too) --> _live_made --> doc.set_preview
     settings.current_frame (a step) --> live_preview
     dragging back to False in Pose mode, doc.events.pose_settled, F5, Pose mode entered, a clip loaded
         (show_body: unless the picture shown is current)
@@ -23,9 +24,10 @@ from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
 
-from ..model.preview import LivePreviews, make_preview, with_report
+from ..model.preview import LivePreviews, live_surface, make_preview, with_report
 from ..model.settings import Mode
 from .controller import FAILED, Controller
+from .live_worker import LiveWorker
 from .worker import Worker
 
 
@@ -33,7 +35,10 @@ class PreviewController(Controller):
     def __init__(self, window):
         super().__init__(window)
         self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
-        self.live = LivePreviews()  # redoes only the slices the moved spheres reach
+        self.live = LivePreviews()  # redoes only the slices the moved spheres reach; used by the live thread only
+        self.live_worker = LiveWorker(window)  # makes them off the GUI thread, the newest pose first
+        self.live_worker.made.connect(self._live_made)
+        self._full_asked = 0  # full previews asked for: a live picture asked for before the last is dropped
         self._live_timer = QTimer(window)
         self._live_timer.setSingleShot(True)
         self._live_timer.setInterval(0)
@@ -156,24 +161,43 @@ class PreviewController(Controller):
             self._live_timer.start()
 
     def live_preview(self) -> None:
-        """Binary or bone preview on the GUI thread: full resolution on a small body (the mannequin: ~10 ms),
-        half on a larger one (:func:`live_factor`)."""
-        t0 = time.perf_counter()
+        """Ask the live thread for a binary or bone preview of the pose now: full resolution on a small
+        body, half on a larger one (:func:`live_factor`), only what moved redone, its surface made there
+        too; the GUI thread only draws what comes back (:meth:`_live_made`)."""
         mode = self.doc.settings.preview_mode
         mode = mode if mode in ("binary", "bone") else "bone"
-        basis = self.doc.picture_basis
         try:
             tskel = self.doc.pose.tskel()
-            p = self.live.make(tskel, mode=mode, padding=2)  # only what moved; full or half resolution
         except ValueError as exc:
             self.doc.message(str(exc))
             return
-        p.basis = basis
+        t0 = time.perf_counter()
+        basis, full = self.doc.picture_basis, self._full_asked
         # what it shows: playing, the scene draws these bones with it, never the newer pose's
-        p.joints = self.doc.pose.posed_joints()
-        p.frame = self.doc.settings.current_frame if self.doc.timeline.active else None
+        joints = self.doc.pose.posed_joints()
+        frame = self.doc.settings.current_frame if self.doc.timeline.active else None
+        function, n_bones, live = self.doc.transfer.function, len(self.doc.bones), self.live
+
+        def make():
+            p = live.make(tskel, mode=mode, padding=2)  # only what moved; full or half resolution
+            p.basis, p.joints, p.frame = basis, joints, frame
+            p.surface = live_surface(p, function, n_bones)
+            return p, full, t0
+
+        self.live_worker.ask(make)
+
+    def _live_made(self, result) -> None:
+        """A live picture made: drawn, unless a full preview was asked for since (it would hide it)."""
+        if isinstance(result, ValueError):
+            self.doc.message(str(result))
+            return
+        if isinstance(result, Exception):
+            raise result  # a bug: seen, as on the GUI thread
+        p, full, t0 = result
+        self.live_timings.append(time.perf_counter() - t0)  # asked -> made (drawn at the next render)
+        if full != self._full_asked or self.doc.settings.mode != Mode.POSE:
+            return
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
-        self.live_timings.append(time.perf_counter() - t0)
 
     def preview(self, *, report: bool = True, background: bool = False) -> Worker | None:
         """Full-resolution reconstruction in the background, shown as soon as it is made; then, as a second
@@ -196,6 +220,9 @@ class PreviewController(Controller):
             return None
         source = self.doc.volume if settings["mode"] == "sampled" else None
         basis = self.doc.picture_basis
+        self._full_asked += 1  # a live picture asked for before this one is not drawn over it,
+        self._live_timer.stop()  # nor one about to be asked (playback's last frame, stopped just now)
+        self.live_worker.forget()
 
         def done(p) -> None:
             p.basis = basis  # of the document as it was asked for: a change since leaves it marked old

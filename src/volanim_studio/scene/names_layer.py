@@ -73,6 +73,10 @@ class NamesLayer:
         if self._labels is None:
             return
         view, plotter = self.view, self.view.plotter
+        if view.posing and self.label_actors:  # hidden in Pose mode: no layout (20 ms a render on 30 bones)
+            for actor in self.label_actors:
+                actor.SetVisibility(False)
+            return
         joints, names, mids, bone_names = self._labels
         xy, _ = view.project_world(joints)
         groups = label_layout.merge_coincident(xy, names)

@@ -21,7 +21,6 @@ import pyvista as pv
 from matplotlib.colors import ListedColormap
 
 from volanim_core.render.bone_colours import SKIN, label_table
-from volanim_core.render.surfaces import label_surface
 from volanim_core.render.volume_style import (
     LABEL_MODES,
     add_volume_uncopied,
@@ -29,6 +28,7 @@ from volanim_core.render.volume_style import (
     apply_rgba,
     binary_view,
     gl_renderer,
+    limit_ray_cost,
     rgba_points,
     software_gl,
     volume_mapper,
@@ -37,6 +37,8 @@ from volanim_core.render.volume_style import (
 )
 from volanim_core.rig.pose import apply_matrices
 from volanim_core.volume import to_grey
+
+from ..model.preview import live_surface
 
 STUMP_COLOUR = "#ff3030"  # over a black halo, seen on a red bone colour too
 LUMP_COLOUR = "#ffffff"  # flesh carried off (reconstruct/lumps.py): white over a black halo, seen on any bone colour
@@ -71,6 +73,7 @@ class PoseLayer:
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
         self._mapper = None  # the volume mapper for full previews, chosen once the GL context exists
         self._bone_lines = None  # the posed bones' lines as drawn: a drag's step moves their points
+        self._note = None  # the "Old picture" text actor, once made
         view.doc.events.pose.connect(self.on_pose_changed)
         view.doc.events.preview.connect(lambda **_: self.draw())
         view.doc.events.preview.connect(self.on_report)
@@ -92,8 +95,14 @@ class PoseLayer:
         old = (view.posing and doc.preview is not None and not doc.preview_is_current and not st.dragging
                and not st.playing and not st.show_rest)
         if old:
-            view.plotter.add_text(f"Old picture: {doc.picture_change or 'the session'} changed since. F5 redraws.",
-                                  position="upper_left", font_size=9, color="#d0d0d0", name=STALE_NOTE)
+            text = f"Old picture: {doc.picture_change or 'the session'} changed since. F5 redraws."
+            if self._note is None:  # made once: pyvista's add_text took 45-65 ms of the GUI thread each time
+                self._note = view.plotter.add_text(text, position="upper_left", font_size=9, color="#d0d0d0",
+                                                   name=STALE_NOTE)
+            else:
+                self._note.SetText(2, text)  # a corner annotation: corner 2 is upper left
+                if STALE_NOTE not in view.plotter.actors:
+                    view.plotter.add_actor(self._note, name=STALE_NOTE, reset_camera=False, render=False)
         elif STALE_NOTE in view.plotter.actors:
             view.plotter.remove_actor(STALE_NOTE, render=False)
         else:
@@ -177,7 +186,9 @@ class PoseLayer:
         if p is None:
             self.clear()
         elif p.live and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest
-            self.show_surface(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
+            self.show_surface(p)
+        elif p.view is not None:  # made by the worker: every second voxel of a large one (Preview.view_volume)
+            self.show_volume(p.view, p.origin_voxels, np.multiply(p.spacing, p.view_step), p.mode)
         else:
             self.show_volume(p.reconstruction.volume, p.origin_voxels, p.spacing, p.mode)
 
@@ -278,6 +289,8 @@ class PoseLayer:
             if volume.ndim == 4:
                 apply_rgba(self.preview_actor)
             self.preview_key = key
+        # a coarser copy (a large preview's every second voxel, a half-resolution one) is sampled as coarsely
+        limit_ray_cost(self.preview_actor, plotter.renderer, float(np.max(spacing_voxels)))
         if tf is not None:
             self._apply_transfer(tf, mode)
         self.preview_actor.SetVisibility(view.posing)
@@ -313,23 +326,15 @@ class PoseLayer:
             self._mapper = "fixed_point" if software_gl(renderer) else "smart"
         return volume_mapper(self._mapper, components)
 
-    def show_surface(self, volume: np.ndarray, origin_voxels, spacing_voxels, mode: str) -> None:
-        """A live preview: the reconstruction's surface coloured by label (software GL draws a
-        surface far faster than it ray-casts a volume). With the user's transfer function, its colours and
-        opacities by label: a label it makes clear is not drawn (#83: live previews ignored the function)."""
+    def show_surface(self, p) -> None:
+        """A live preview: its surface (:func:`live_surface`, made by the live worker; made here for a preview
+        that has none), put in world units and drawn."""
         view, plotter = self.view, self.view.plotter
-        world_origin = view.world(origin_voxels)
-        world_spacing = np.asarray(spacing_voxels, np.float64) * view.spacing
-        tf = view.doc.transfer.function
-        if tf is not None and volume.ndim == 3:
-            rgba = tf(np.arange(int(volume.max()) + 1, dtype=np.float64))
-            clear = rgba[:, 3] <= 0
-            if clear[1:].any():
-                volume = np.where(clear[volume], 0, volume)
-            table = np.round(np.clip(rgba, 0, 1) * 255).astype(np.uint8)  # RGBA: translucent where it says
-        else:
-            table = label_table(len(view.doc.bones)) if mode == "bone" else None
-        surf = label_surface(volume, world_origin, world_spacing, table)  # colour: its voxels' colours
+        surf = p.surface
+        if surf is None:
+            surf = live_surface(p, view.doc.transfer.function, len(view.doc.bones))
+        surf = surf.copy(deep=False)
+        surf.points = np.asarray(surf.points) * view.spacing  # voxels -> world (view.world)
         self.clear(render=False)
         if surf.n_points and "rgb" in surf.point_data:
             plotter.add_mesh(surf, scalars="rgb", rgb=True, name="preview", render=False, reset_camera=False)

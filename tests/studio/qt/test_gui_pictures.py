@@ -42,6 +42,10 @@ def full_preview(qtbot, w, mode: str) -> None:
     w.previews.preview(report=False)
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.mode == mode
                     and not w.doc.preview.live, timeout=JOB_TIMEOUT_MS)
+    # the mannequin is drawn whole: every voxel, a ray a pixel (only a far larger body's are spaced, #83)
+    mapper = w.scene.pose_layer.preview_actor.GetMapper()
+    assert w.doc.preview.view_step == 1
+    assert not hasattr(mapper, "GetImageSampleDistance") or mapper.GetImageSampleDistance() == 1.0
 
 
 @pytest.fixture
