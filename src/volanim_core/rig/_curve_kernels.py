@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)  # run by the studio's worker: the window draws meanwhile
 def paint_balls(centres, radii, out):
     """Set every voxel of ``out`` whose centre lies in a ball (``centres`` and ``radii`` in ``out``'s voxels)."""
     nx, ny, nz = out.shape

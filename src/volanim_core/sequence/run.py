@@ -159,14 +159,15 @@ EXISTING = ("resume", "replace-other", "redo")
 
 def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: SequenceSettings = SequenceSettings(),
                  *, on: RunOn = THIS_PROCESS, existing: str = "resume", on_frame=None,
-                 frame_seconds=None, cancel=None) -> SequenceReport:
+                 frame_seconds=None, cancel=None, on_palette=None) -> SequenceReport:
     """Reconstruct ``frames`` into the OME-Zarr store ``out``; see the module docstring.
 
     The store records the frames' geometry (``conn.geometry`` at the shared grid's origin) in physical units.
     ``existing``: what a store already at ``out`` gets. ``resume`` (default): the same sequence's finished
     frames are kept and the rest made; another sequence there is refused. ``replace-other``: the same, but
     another sequence is replaced (a cache, like the studio's movie). ``redo`` (``--force``): made again.
-    ``on_frame(record, done, total)`` after each finished frame (progress).
+    ``on_frame(record, done, total)`` after each finished frame (progress); ``on_palette(done, total)`` while
+    a colour source is indexed, before any frame (a second on a colour mannequin: a bar that moves).
     ``cancel()``: asked while frames are being made, not only when one finishes (Cancelled when it says so).
     ``frame_seconds(record) -> float``: what a finished frame cost, for sizing Dask's tasks
     (``frames_per_task``); default the ``seconds`` its worker measured. The frames never depend on
@@ -194,7 +195,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
         if kernel != 1:
             raise ValueError(f"a colour source is sequenced as palette indices, read at the nearest voxel "
                              f"(kernel 1): indices cannot be averaged, got kernel {kernel}")
-        indexed = index_colours(source)
+        indexed = index_colours(source, progress=on_palette, cancel=cancel)
         colours = describe_palette(indexed)
         source, palette = indexed.indices, indexed.palette
     elif source is not None and np.ndim(source) != 3:

@@ -191,7 +191,7 @@ class FilesController(Controller):
     def _ask_threshold(self, path, loaded, dims, skeleton_path, series, then, otherwise, also=None) -> None:
         """The threshold dialog over a volume just read, then its segmentation in a worker."""
         dialog = ThresholdDialog(loaded["grey"], Path(path).name, self.window, spacing=loaded["spacing"],
-                                 segments=loaded["segments"])
+                                 segments=loaded["segments"], histogram=loaded.get("histogram"))
         if dialog.exec() != ThresholdDialog.Accepted:
             otherwise()
             return

@@ -19,7 +19,8 @@ from PySide6.QtWidgets import (
 )
 
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS
-from volanim_core.volume import finite_range
+
+from ..tasks import value_histogram
 
 
 class HistogramWidget(QWidget):
@@ -52,13 +53,12 @@ class HistogramWidget(QWidget):
 class ThresholdDialog(QDialog):
     """Choose the object's value range, cavity filling and the skeleton's settings."""
 
-    def __init__(self, volume: np.ndarray, name: str, parent=None, spacing=(1.0, 1.0, 1.0), segments=None):
+    def __init__(self, volume: np.ndarray, name: str, parent=None, spacing=(1.0, 1.0, 1.0), segments=None,
+                 histogram=None):
         super().__init__(parent)
         self.setWindowTitle(f"Segment {name}")
-        vmin, vmax = finite_range(volume) or (0.0, 0.0)  # NaN (resampled MRI) is background, not a value
-        sample = volume.ravel()[:: max(1, volume.size // 2_000_000)]
-        sample = sample[np.isfinite(sample)] if sample.dtype.kind == "f" else sample
-        counts, edges = np.histogram(sample, bins=256, range=(vmin, vmax if vmax > vmin else vmin + 1))
+        # made by the reader's worker (#83: the range and histogram of a large scan took the GUI thread)
+        vmin, vmax, counts, edges = histogram if histogram is not None else value_histogram(volume)
         self.histogram = HistogramWidget(counts, edges)
         self.lo = QDoubleSpinBox(decimals=2, minimum=vmin, maximum=vmax)
         self.hi = QDoubleSpinBox(decimals=2, minimum=vmin, maximum=vmax)

@@ -44,6 +44,7 @@ class TimelineController(Controller):
         self._play.timeout.connect(self._tick)
         self._start = (0.0, 0)
         self.doc.settings.events.current_frame.connect(lambda **_: self._frame_changed())
+        self.doc.events.preview.connect(lambda **_: self._picture_changed())
 
     # ------------------------------------------------------------ wiring
     def fill_menu(self, menu, action) -> None:
@@ -85,14 +86,23 @@ class TimelineController(Controller):
 
     # ------------------------------------------------------------ frames
     def _frame_changed(self) -> None:
-        if self.doc.timeline.active:
+        if self.doc.timeline.active and not self.playing:
             if self.doc.settings.follow_body and self.scene.posing:  # the posed body is what the view shows
-                self.follow_body(blend=0.35 if self.playing else 1.0)
+                self.follow_body()
 
-    def follow_body(self, blend: float = 1.0) -> None:
-        """Centre the view on the posed body (the middle of its posed joints' box): a walk's figure, which
-        travels metres through the clip, stays in the picture instead of walking out of it."""
-        joints = self.doc.pose.posed_joints()
+    def _picture_changed(self) -> None:
+        """Playing, the view follows the body drawn -- the frame of the picture, not the newest frame asked
+        for (#83: the camera ran ahead of a loaded machine's pictures, and the body left the view's middle)."""
+        p = self.doc.preview
+        if (self.playing and self.doc.settings.follow_body and self.scene.posing and p is not None
+                and p.joints is not None):
+            self.follow_body(blend=0.35, joints=p.joints)
+
+    def follow_body(self, blend: float = 1.0, joints: dict | None = None) -> None:
+        """Centre the view on the posed body (the middle of its posed joints' box; ``joints``: those of the
+        picture drawn, else the pose's): a walk's figure, which travels metres through the clip, stays in the
+        picture instead of walking out of it."""
+        joints = self.doc.pose.posed_joints() if joints is None else joints
         if not joints:
             return
         from volanim_studio.scene import camera_moves

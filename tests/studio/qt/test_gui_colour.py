@@ -83,9 +83,14 @@ def test_the_colour_body_s_movie_is_in_colour(qtbot, window, colour_file, tmp_pa
     w.timeline_panel.set_key.click()
     w.doc.settings.preview_mode = "sampled"
     w.doc.settings.preview_kernel = 3  # the preview averages colours; the movie's indices cannot be
-    assert w.timeline.render_movie(tmp_path / "pics", first=0, last=1, size=(160, 120), workers=1) is not None
+    worker = w.timeline.render_movie(tmp_path / "pics", first=0, last=1, size=(160, 120), workers=1)
+    assert worker is not None
+    steps = []
+    worker.progressed.connect(lambda done, total: steps.append((done, total)))
     assert "samples the nearest voxel (kernel 1)" in w.statusBar().currentMessage()
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    # #83: indexing the colours (a second) moved the bar before any frame: 3 steps of 3 + 2 x 2 frames
+    assert {(1, 7), (2, 7), (3, 7)} <= set(steps) and steps[-1] == (7, 7)
     message = w.statusBar().currentMessage()
     assert "Rendered 2 frames" in message and "colour: 255 palette colours, quantised" in message
     pngs = sorted((tmp_path / "pics").glob("*.png"))

@@ -187,3 +187,38 @@ def test_a_preview_asked_for_while_a_background_job_is_being_ended_waits_its_tur
     assert worker is not None  # no "another job is running"
     qtbot.waitUntil(lambda: not window.jobs.running and applied == ["fresh"], timeout=JOB_TIMEOUT_MS)
     qtbot.waitUntil(lambda: window.doc.preview_is_current and not window.jobs.running, timeout=JOB_TIMEOUT_MS)
+
+
+def test_the_threshold_dialog_s_range_and_histogram_are_made_by_the_reader(qtbot, window, tmp_path, monkeypatch):
+    """#83 item 13: the threshold dialog took the value range and histogram of a scan on the GUI thread. They
+    are made in the worker that read it; the dialog only draws them."""
+    import numpy as np
+
+    from volanim_studio import tasks
+    from volanim_studio.qt import threshold_dialog
+    from volanim_studio.qt.threshold_dialog import ThresholdDialog
+
+    real = tasks.value_histogram
+    where = []
+
+    def watched(volume):
+        where.append(threading.current_thread() is threading.main_thread())
+        return real(volume)
+
+    monkeypatch.setattr(tasks, "value_histogram", watched)
+    monkeypatch.setattr(threshold_dialog, "value_histogram", watched)
+    shown = []
+
+    def exec_(dialog):
+        shown.append((dialog.lo.minimum(), dialog.hi.maximum()))
+        return ThresholdDialog.Rejected
+
+    monkeypatch.setattr(ThresholdDialog, "exec", exec_)
+    volume = np.zeros((30, 20, 10), np.uint8)
+    volume[5:25, 5:15, 2:8] = 180
+    volume[0, 0, 0] = 7
+    io.write_volume(tmp_path / "box.VOL", volume)
+    window.files.open_volume(tmp_path / "box.VOL")
+    qtbot.waitUntil(lambda: bool(shown) and not window.busy, timeout=JOB_TIMEOUT_MS)
+    assert where == [False]  # once, in the worker
+    assert shown == [(0.0, 180.0)]  # the scan's own range, from the worker's figures

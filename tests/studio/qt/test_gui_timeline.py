@@ -80,9 +80,10 @@ def test_play_draws_live_previews_dropping_frames_then_previews_in_full(qtbot, r
     # forward in clip time (frames skipped when the preview is slower than the clip; the clip loops once
     # every 8.9 s, which a very busy machine may reach)
     assert sum(b <= a for a, b in zip(shown, shown[1:])) <= 1
-    assert w.previews.live_timings and w.doc.preview is not None
     # pausing previews the frame stopped on at full resolution, with its report
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    assert w.previews.live_timings  # live pictures were made while it played (their thread may end after the
+    # pause: a loaded machine made the first one after the last frame was shown)
     assert w.doc.preview.factor == 1 and not w.doc.preview.live
     assert np.allclose(w.doc.pose.matrices(), w.doc.timeline.matrices([w.doc.settings.current_frame])[0], atol=1e-6)
 
@@ -494,13 +495,15 @@ def test_cancel_ends_a_movie_whose_worker_hangs(qtbot, rigged, tmp_path):
     qtbot.waitUntil(lambda: not _pool_workers(), timeout=ENDS_WITHIN_MS)
 
 
-def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtbot, rigged):
+def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtbot, rigged, tmp_path):
     """#83 item 5: a picture grabbed while the walk played on a loaded machine showed a forearm and a leg
     apart, no torso or head: 19 % of the drawn bones lay on the body. Now a live picture is made whole in
     its own thread, for the newest frame asked, and drawn with the bones of *its* frame (frames in between
     are dropped, never half drawn). Checked on every picture drawn while playing: the bones drawn are its
     frame's, and >= 90 % of points along them lie in its voxels (read from the reconstruction, not the
-    screen); and at three moments the picture on screen covers >= 80 % of what the paused frame's does."""
+    screen); and at three moments the picture on screen covers >= 80 % of what the same frame's does paused
+    (the camera follows the body drawn, not the newest frame: on a loaded machine it ran ahead of it)."""
+    import imageio.v3 as iio
     from scipy import ndimage
 
     w = rigged
@@ -508,24 +511,35 @@ def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtb
     seen, grabs = [], []
     background = np.array(w.plotter.background_color.int_rgb)
 
-    def foreground() -> int:
-        img = np.asarray(w.plotter.screenshot(return_img=True))[..., :3].astype(int)
-        return int((np.abs(img - background).max(axis=-1) > 30).sum())
+    def foreground(name) -> int:
+        img = np.asarray(w.plotter.screenshot(return_img=True))[..., :3]
+        iio.imwrite(tmp_path / f"{name}.png", img)  # to look at
+        return int((np.abs(img.astype(int) - background).max(axis=-1) > 30).sum())
 
     def on_preview(**_):
         p = w.doc.preview
         if p is not None and p.live and w.doc.settings.playing:
             drawn = np.asarray(w.scene.pose_layer._bone_lines.points, np.float64).reshape(-1, 2, 3)
             seen.append((p, drawn))
+            body = np.reshape(w.plotter.renderer.actors["preview"].GetBounds(), (3, 2))
+            filled = np.argwhere(p.reconstruction.volume > 0) * p.factor + p.origin_voxels
+            want = w.scene.world(np.array([filled.min(0), filled.max(0)])).T
+            assert np.abs(body - want).max() <= 1.0 * p.factor, "the body drawn is not the picture's"
 
     w.doc.events.preview.connect(on_preview)
     qtbot.keyClick(w, Qt.Key_Space)
     for moment in (6, 12, 18):  # three moments of the walk, each a picture drawn by the scene
         qtbot.waitUntil(lambda m=moment: len(seen) >= m, timeout=JOB_TIMEOUT_MS)
-        grabs.append(foreground())
+        grabs.append((seen[-1][0].frame, foreground(f"playing-{seen[-1][0].frame}")))
     qtbot.keyClick(w, Qt.Key_Space)
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
-    paused = foreground()
+    paused = []  # each moment's frame, paused on: its full picture
+    for frame, _ in grabs:
+        w.timeline.go(frame)
+        w.previews.preview()
+        qtbot.waitUntil(lambda: not w.busy and w.doc.preview_is_current and not w.doc.preview.live
+                        and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)  # this frame's, not the last
+        paused.append(foreground(f"paused-{frame}"))
 
     bones = w.doc.bones
     on_body = []
@@ -541,7 +555,8 @@ def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtb
         hits = np.zeros(len(at), bool)
         hits[inside] = filled[tuple(at[inside].T)]
         on_body.append(hits.mean())
+    ratios = [g / p for (_, g), p in zip(grabs, paused)]
     print(f"pictures while playing: {len(seen)}, bones on the body: min {min(on_body):.0%}; foreground "
-          f"{[round(g / paused, 2) for g in grabs]} of the paused picture's")
+          f"{[round(r, 2) for r in ratios]} of the same frame's paused picture")
     assert min(on_body) >= 0.9
-    assert all(g >= 0.8 * paused for g in grabs)
+    assert min(ratios) >= 0.8
