@@ -21,8 +21,13 @@ class Event:
         self._callbacks.append(callback)
         return callback
 
-    def disconnect(self, callback: Callable) -> None:
-        self._callbacks.remove(callback)
+    def disconnect(self, callback: Callable) -> bool:
+        """Stop calling ``callback``; whether it was connected (a listener that may already have gone --
+        a closed window's -- can ask without knowing)."""
+        if callback in self._callbacks:
+            self._callbacks.remove(callback)
+            return True
+        return False
 
     def emit(self, **kwargs) -> None:
         if self.blocked:

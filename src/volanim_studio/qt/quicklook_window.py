@@ -59,7 +59,7 @@ class QuickLookWindow(QMainWindow):
         self.plotter.render()
 
     def closeEvent(self, event) -> None:
-        if self.doc is not None and self._on_transfer in self.doc.events.transfer._callbacks:
-            self.doc.events.transfer.disconnect(self._on_transfer)
+        if self.doc is not None:
+            self.doc.events.transfer.disconnect(self._on_transfer)  # a second close finds it gone
         close_interactor(self.plotter)
         super().closeEvent(event)
