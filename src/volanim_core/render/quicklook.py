@@ -58,11 +58,33 @@ def read_look(path, *, style: str = "surface", preset: str | None = None, view: 
     volume, origin = read_frame(ref, dims)  # a colour sequence's frame in colours: the function reads luminance
     shown = "RGB" if volume.ndim == 4 else settings.preset
     what = f"{volume.shape[0]}x{volume.shape[1]}x{volume.shape[2]} voxels, {shown} colours"
+    level = _object_level(volume) if style == "surface" and settings.preset == "sampled" and transfer is None \
+        else None
+    if level is not None:  # a scan's surface: the object's, not the box of its noisy background
+        volume = np.where(volume >= level, volume, 0).astype(volume.dtype)
+        what += f", surface at {level:g} and above (Otsu's level: the scan's background is not empty)"
     if ref.index >= 0:
         what = f"frame {ref.number}: {what}"
     # the surface (or the volume's point values) made here, off the GUI thread: only actors are left to draw
     return Look(settings, what, volume=volume, origin=origin, number=ref.number,
                 frame=prepare_frame(settings, volume, origin))
+
+
+def _object_level(volume: np.ndarray) -> float | None:
+    """The value a grey scan's object starts at, when the scan has no empty background (over half its voxels
+    non-zero: an MRI's noise, a CT's air at -1000): Otsu's threshold of (up to 2 M of) its values. None for a
+    volume with an empty background (a reconstruction, a segmented scan): its surface is its non-zero voxels.
+    #83: nibabel's anatomical.nii, viewed, showed a few specks -- the inside of the box its noise filled."""
+    if volume.ndim != 3 or volume.size == 0:
+        return None
+    sample = volume.ravel()[:: max(1, volume.size // 2_000_000)]
+    sample = sample[np.isfinite(sample)] if sample.dtype.kind == "f" else sample
+    if sample.size == 0 or (sample != 0).mean() <= 0.5 or sample.min() == sample.max():
+        return None
+    from skimage.filters import threshold_otsu
+
+    level = float(threshold_otsu(sample))
+    return float(np.ceil(level)) if volume.dtype.kind in "ui" else level
 
 
 def draw_look(look: Look, *, plotter=None, off_screen: bool | None = True) -> Renderer:

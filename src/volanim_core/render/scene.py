@@ -116,6 +116,12 @@ def transfer_of(settings: RenderSettings) -> TransferFunction:
     return label_steps(colour_table(settings)[1:].astype(np.float64) / 255)  # row 0: the background
 
 
+def _touches_edge(part: np.ndarray) -> bool:
+    """Whether any filled voxel lies on a face of ``part`` (colour: black is empty)."""
+    filled = part.any(axis=3) if part.ndim == 4 else part != 0
+    return bool(filled[[0, -1]].any() or filled[:, [0, -1]].any() or filled[:, :, [0, -1]].any())
+
+
 def crop(volume: np.ndarray, origin, pad: int = 1):
     """The smallest box holding every filled voxel (and ``pad`` empty ones around it), and its origin."""
     from volanim_core.volume import tight_bounds
@@ -225,6 +231,11 @@ def prepare_frame(settings: RenderSettings, volume: np.ndarray, origin, table=No
             data = data.ravel(order="F")
         return PreparedFrame(volume, np.asarray(origin), data=data)
     part, at = crop(volume, origin)  # a sequence's shared grid is mostly empty
+    if _touches_edge(part):
+        # an object up to the grid's edge (a scan's body, a single DICOM slice): closed there, not left open
+        # or, one voxel thick, drawn as nothing (#83: pydicom's CT_small.dcm viewed as an empty window)
+        part = np.pad(part, [(1, 1)] * 3 + [(0, 0)] * (part.ndim - 3))
+        at = np.asarray(at, np.float64) - 1
     values = part if np.issubdtype(part.dtype, np.integer) else np.rint(part)
     spacing = np.asarray(s.spacing, np.float64)  # world = voxel x spacing (the camera's units)
     table = colour_table(s) if table is None else table

@@ -3,6 +3,8 @@ spacing kept, the connected skeleton given back, another volume viewed in its ow
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -297,3 +299,35 @@ def test_a_thinness_that_leaves_the_body_in_pieces_is_said_on_opening_and_in_the
     assert w.verdict_label._colour == "#d9861a"
     w.doc.undo.mark_clean()
     w.close()
+
+
+def test_file_view_opens_other_projects_files_or_says_why(qtbot, window, tmp_path):
+    """File → View on files other projects ship (nibabel's NIfTI and MGH, pydicom's CT and MR slices,
+    pyvista's volumes and meshes): each opens a window that draws it, or a message names the file and why
+    (a 4-D series is not a volume). The pictures are written for a person to look at."""
+    import imageio.v3 as iio
+    import nibabel as nib
+    import pydicom
+    import pyvista as pv
+
+    nibabel_data = Path(nib.__file__).parent / "tests" / "data"
+    pydicom_data = Path(pydicom.__file__).parent / "data" / "test_files"
+    pyvista_data = Path(pv.__file__).parent / "examples"
+    opens = [nibabel_data / "anatomical.nii", nibabel_data / "standard.nii.gz",
+             pydicom_data / "CT_small.dcm", pydicom_data / "MR_small.dcm", pyvista_data / "frog_tissues.vti",
+             pyvista_data / "ant.ply", pyvista_data / "nut.ply"]
+    refused = [nibabel_data / "example4d.nii.gz", nibabel_data / "test.mgz"]  # 4-D: said, and how to go on
+    for path in opens + refused:
+        window.last_error = None
+        viewer = viewer_opened(window, qtbot, window.files.view_file, path)
+        if path in refused:
+            assert viewer is None and path.name in (window.last_error or ""), (path.name, window.last_error)
+            continue
+        assert viewer is not None and "body" in viewer.plotter.renderer.actors, (path.name, window.last_error)
+        picture = np.asarray(viewer.plotter.screenshot(return_img=True))[..., :3]
+        background = picture[0, 0].astype(int)
+        drawn = (np.abs(picture.astype(int) - background).max(axis=-1) > 30).mean()
+        iio.imwrite(tmp_path / f"view-{path.name}.png", picture)
+        assert drawn > 0.01, (path.name, drawn)  # the body is on screen, not an empty window
+        iio.imwrite(tmp_path / f"view-{path.name}.png", picture)
+        viewer.close()
