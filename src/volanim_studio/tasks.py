@@ -88,7 +88,7 @@ def regrown_pieces(skeleton, mask: np.ndarray) -> tuple[int, int]:
     """``(pieces the skeleton's balls re-grow, pieces of the segmented body)``, 26-connected. More of the
     first: the minimum thinness kept no points in thin parts, and the rest pose is in pieces before any pose
     (#83: the ant at 0.50 had legs of dashes, and the verdict called it healthy)."""
-    from volanim_core.reconstruct.breakage import piece_count
+    from volanim_core.reconstruct.shape import piece_count
     from volanim_core.rig.curve_skeleton import balls
 
     # counted without holding the GIL (the window draws meanwhile): 1.2 s of a frozen window on mannequin-large

@@ -235,16 +235,6 @@ def stumps(tskel: Tskel, joints: dict[str, np.ndarray], misplaced=None) -> list[
     return sorted(out, key=lambda s: -s.weight)
 
 
-def piece_count(volume: np.ndarray) -> int:
-    """How many 26-connected pieces the non-zero voxels of ``volume`` (``[x, y, z]``) make, as
-    ``scipy.ndimage.label`` counts them -- on its runs, without holding Python's GIL (scipy's label held it
-    0.5 s on mannequin-large, and the studio's window with it, #83)."""
-    zyx = np.asarray(volume).T
-    if zyx.dtype == bool:
-        zyx = zyx.view(np.uint8)  # the labelling kernels' own type: no copy, no second compilation
-    return int(L.label_runs(np.ascontiguousarray(zyx))[4])
-
-
 def components(volume: np.ndarray) -> list[int]:
     """Sizes of the 26-connected components of the non-zero voxels, largest first."""
     return [n for n, _, _ in _components(volume)[0]]

@@ -23,11 +23,22 @@ import numpy as np
 from scipy import ndimage
 
 from volanim_core.progress import Reporter
+from volanim_core.reconstruct._label_kernels import label_runs
 
 STEPS = 5  # grid and parts, the extra blob, the missing blob, the surface distance, the joints' regions
 
 OPENING = ndimage.generate_binary_structure(3, 1)  # a one-voxel ball: what a one-voxel rim does not survive
 PIECES = ndimage.generate_binary_structure(3, 3)  # 26-connected blobs
+
+
+def piece_count(volume: np.ndarray) -> int:
+    """How many 26-connected pieces the non-zero voxels of ``volume`` (``[x, y, z]``) make, as
+    ``scipy.ndimage.label`` counts them -- on its runs, without holding Python's GIL (scipy's label held it
+    0.5 s on mannequin-large, and the studio's window with it, #83)."""
+    zyx = np.asarray(volume).T
+    if zyx.dtype == bool:
+        zyx = zyx.view(np.uint8)  # the labelling kernels' own type: no copy, no second compilation
+    return int(label_runs(np.ascontiguousarray(zyx))[4])
 
 
 @dataclass

@@ -9,6 +9,7 @@ timeline_controller.py  load clips, play, step, key, scan for breakage, export f
 naming_controller.py .. F2 names a joint, Ctrl+F2 a whole chain
 session_controller.py . autosave, crash recovery, the unsaved marker and "Save changes?"
 worker.py ............. JobRunner/Worker: background jobs with progress, Cancel, clean shutdown
+live_worker.py ........ LiveWorker: the live pictures' own thread, the newest pose first
 bindings.py ........... two-way widget <-> settings bindings (signals blocked on write-back)
 *_panel.py ............ one panel per file: bone_panel.py, connect_panel.py, display_panel.py,
                         pose_panel.py, reconstruct_panel.py, timeline_panel.py

@@ -8,6 +8,7 @@ from scipy import ndimage
 
 from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct import breakage
+from volanim_core.reconstruct.shape import piece_count
 
 SHAPES = [(1, 1, 1), (1, 1, 6), (3, 1, 7), (1, 9, 1), (5, 6, 7), (20, 20, 20), (7, 30, 2), (33, 17, 29)]
 
@@ -46,7 +47,7 @@ def test_piece_count_is_scipys_for_any_layout_of_mask(shape, density):
     mask = noise(shape, density, seed=3 + sum(shape)) > 0
     want = ndimage.label(mask, structure=np.ones((3, 3, 3), bool))[1]
     for m in (mask, np.asfortranarray(mask), mask.astype(np.uint8), np.asfortranarray(mask.astype(np.uint8))):
-        assert breakage.piece_count(m) == want
+        assert piece_count(m) == want
 
 
 def test_runs_that_touch_only_by_a_corner_or_an_edge_join():
