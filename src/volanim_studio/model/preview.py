@@ -38,7 +38,7 @@ class Preview:
     frame: int | None = None  # the timeline frame it shows (None: not a frame of the timeline)
     live: bool = False  # made while a pose changes (LivePreviews): drawn as a surface, no report
     basis: int | None = None  # Document.picture_basis when it was asked for: older than the document's is old
-    surface: object = None  # a live preview's surface (pyvista PolyData in voxel units), made off the GUI thread
+    surface: object = None  # a live preview's surface (pyvista PolyData in world units), made off the GUI thread
     view: np.ndarray | None = None  # what the view draws of a full preview ([x, y, z] in Fortran order, every
     view_step: int = 1  # ``view_step``-th voxel of the reconstruction), made off the GUI thread (view_volume)
 
@@ -62,8 +62,8 @@ class Preview:
         return np.asarray(self.reconstruction.origin, np.float64) * self.factor
 
 
-def live_surface(preview: Preview, function=None, n_bones: int = 0):
-    """The surface a live preview is drawn as (pyvista PolyData, in full-resolution voxel units): the
+def live_surface(preview: Preview, function=None, n_bones: int = 0, spacing=(1.0, 1.0, 1.0)):
+    """The surface a live preview is drawn as (pyvista PolyData in world units: voxels x ``spacing``): the
     boundary of its filled voxels coloured by label -- software GL draws a surface far faster than it
     ray-casts a volume. With the user's transfer ``function``, its colours and opacities by label (a label it
     makes clear is not drawn, #83); else the bone colours (``n_bones``) in bone mode, none in binary.
@@ -80,7 +80,8 @@ def live_surface(preview: Preview, function=None, n_bones: int = 0):
         table = np.round(np.clip(rgba, 0, 1) * 255).astype(np.uint8)  # RGBA: translucent where it says
     else:
         table = label_table(n_bones) if preview.mode == "bone" else None
-    return label_surface(volume, preview.origin_voxels, preview.spacing, table)  # colour: its voxels' colours
+    world = np.asarray(spacing, np.float64)
+    return label_surface(volume, preview.origin_voxels * world, np.asarray(preview.spacing) * world, table)
 
 
 def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,

@@ -177,11 +177,12 @@ class PreviewController(Controller):
         joints = self.doc.pose.posed_joints()
         frame = self.doc.settings.current_frame if self.doc.timeline.active else None
         function, n_bones, live = self.doc.transfer.function, len(self.doc.bones), self.live
+        spacing = tuple(self.scene.spacing)  # the view's world units
 
         def make():
             p = live.make(tskel, mode=mode, padding=2)  # only what moved; full or half resolution
             p.basis, p.joints, p.frame = basis, joints, frame
-            p.surface = live_surface(p, function, n_bones)
+            p.surface = live_surface(p, function, n_bones, spacing)
             return p, full, t0
 
         self.live_worker.ask(make)

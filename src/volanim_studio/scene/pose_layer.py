@@ -338,14 +338,13 @@ class PoseLayer:
         return volume_mapper(self._mapper, components)
 
     def show_surface(self, p) -> None:
-        """A live preview: its surface (:func:`live_surface`, made by the live worker; made here for a preview
-        that has none), put in world units and drawn."""
+        """A live preview: its surface (:func:`live_surface`, made by the live worker in world units; made
+        here for a preview that has none), drawn."""
         view, plotter = self.view, self.view.plotter
-        surf = p.surface
+        surf = p.surface  # drawn as it is: never scaled here (a shallow copy's new points were the picture's
+        # own, and each redraw of a body with 1.5 mm voxels grew it 1.5 times)
         if surf is None:
-            surf = live_surface(p, view.doc.transfer.function, len(view.doc.bones))
-        surf = surf.copy(deep=False)
-        surf.points = np.asarray(surf.points) * view.spacing  # voxels -> world (view.world)
+            surf = live_surface(p, view.doc.transfer.function, len(view.doc.bones), view.spacing)
         self.clear(render=False)
         if surf.n_points and "rgb" in surf.point_data:
             plotter.add_mesh(surf, scalars="rgb", rgb=True, name="preview", render=False, reset_camera=False)

@@ -512,3 +512,34 @@ def test_the_panels_keep_their_width_whatever_the_verdict_says(qtbot, posed_wind
     assert len(verdict.plain) > 60  # a long verdict was shown ...
     assert verdict.shown_text() == verdict.plain and verdict.height() >= verdict.heightForWidth(verdict.width())
     # ... whole, wrapped in the Pose tab's width (it was cut with "…" there too)
+
+
+def test_a_live_picture_drawn_again_stays_where_its_voxels_are(qtbot, window, tmp_path):
+    """Review of #83: the live picture's surface was put in world units on each draw through a shallow copy
+    whose new points were the picture's own, so every redraw (a transfer-function edit, Compare off) of a
+    body with 1.5 mm voxels grew it 1.5 times more. Drawn three times, it stays on its voxels' box."""
+    from volanim_core import io as vio
+    from volanim_core import samples as vsamples
+
+    path = tmp_path / "mannequin.nrrd"
+    vio.write_volume(path, vsamples.mannequin().volume)
+    window.files.open_volume(path, params={"lo": 1, "hi": None, "fill": False, "spacing": [1.5, 1.5, 1.5]})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    w = rig_and_pose(qtbot, window)
+    doc = w.doc
+    assert np.allclose(w.scene.spacing, 1.5)
+    doc.select_bones([doc.bones.index("L_UPPERARM")])
+    slider = w.pose_panel.sliders[1]
+    slider.setSliderDown(True)
+    slider.setValue(-30)
+    qtbot.waitUntil(lambda: doc.preview is not None and doc.preview.live and doc.preview_is_current
+                    and w.previews.live_worker.idle, timeout=JOB_TIMEOUT_MS)
+    p = doc.preview
+    filled = np.argwhere(p.reconstruction.volume > 0) * p.factor + p.origin_voxels
+    want = w.scene.world(np.array([filled.min(0), filled.max(0)])).T
+    for _ in range(3):
+        w.scene.pose_layer.draw()
+        body = np.reshape(w.plotter.renderer.actors["preview"].GetBounds(), (3, 2))
+        assert np.abs(body - want).max() <= 1.5 * p.factor, (body, want)
+    slider.setSliderDown(False)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
