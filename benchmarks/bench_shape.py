@@ -35,9 +35,10 @@ JOINTS = {
     "spine twist": ("SPINE", 60, lambda a, u: (0, 0, a)),
     "forearm twist": ("L_FOREARM", 90, lambda a, u: Rotation.from_rotvec(u * np.radians(a)).as_matrix()),
 }
+#: owned: the default since #84 (each rest voxel moved by its owner, balls at the joints; rig/ownership.py);
 #: rigid and smooth joints over the default (nearest) connectivity; fitted: rigid joints over the fitted one;
 #: the peers (benchmarks/_peers.py) over the default connectivity: linear-blend skinning, Bender's heat weights
-METHODS = ("rigid", "smooth", "fitted", "lbs", "bender")
+METHODS = ("owned", "rigid", "smooth", "fitted", "lbs", "bender")
 GOALS = {"dice": 0.995, "blob": 0.5, "p95": 1.5}
 
 
@@ -97,7 +98,7 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
                 rep = compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin,
                                      joints=at, segments=segments)
                 lumps = find_lumps(r.volume, r.origin, m, rest_segments, reach, rest.rest_bone.volume,
-                                   rest.rest_bone.origin, at, limbs) if method == "rigid" else []
+                                   rest.rest_bone.origin, at, limbs) if method in ("rigid", "owned") else []
                 if lumps:  # once a frame, whatever the number of lumps
                     extra, lo = extra_flesh(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin)
                 real = [lump_is_real(lump, extra, lo) for lump in lumps]
@@ -118,11 +119,13 @@ def frames_of(sample, conn) -> dict:
     """method -> (matrices -> the frame it reconstructs), every method over the same skeleton."""
     from _peers import bender_frame, bender_skin, lbs_frame
 
+    from volanim_core.rig.ownership import ownership
     from volanim_core.rig.skinning import Joints
 
     smooth, fitted = conn.with_joints(Joints("smooth")), default_connectivity(sample, "fitted")
     bender = bender_skin(conn, sample.volume)
-    return {"rigid": conn.posed, "smooth": smooth.posed, "fitted": fitted.posed,
+    owned = conn.with_ownership(ownership(sample.mask, conn))
+    return {"owned": owned.posed, "rigid": conn.posed, "smooth": smooth.posed, "fitted": fitted.posed,
             "lbs": lambda m: lbs_frame(conn, m), "bender": lambda m: bender_frame(conn, m, bender)}
 
 
@@ -162,12 +165,12 @@ def print_lumps(rows: list[dict]) -> None:
     """The report's lumps (no truth) against the truth's, over the rigid rows: recall, the share of rows with a
     true lump (largest extra blob >= 0.5 % of the moved limb) that the report flags; precision, the share of
     flags that are real (mostly voxels the true shape does not have, :func:`lump_is_real`)."""
-    for body in dict.fromkeys(r["body"] for r in rows):
-        mine = [r for r in rows if r["method"] == "rigid" and r["body"] == body]
+    for body, method in [(b, m) for b in dict.fromkeys(r["body"] for r in rows) for m in ("owned", "rigid")]:
+        mine = [r for r in rows if r["method"] == method and r["body"] == body]
         true = [r for r in mine if r["true lump"]]
         hit = [r for r in true if r["flagged"]]
         flags, real = sum(r["flags"] for r in mine), sum(r["real flags"] for r in mine)
-        print(f"{body}, rigid: {len(true)} of {len(mine)} rows have a true lump (an extra blob >= 0.5 % of the "
+        print(f"{body}, {method}: {len(true)} of {len(mine)} rows have a true lump (an extra blob >= 0.5 % of the "
               f"moved limb); the report flags {len(hit)} of them (recall {len(hit) / max(len(true), 1):.2f}); "
               f"of its {flags} flags {real} are real (precision {real / max(flags, 1):.2f})")
         for r in mine:

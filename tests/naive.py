@@ -197,3 +197,29 @@ def thinned_radii(rest, posed, dt, sheet, pairs, floor):
         if mean > 1 + 1e-6:
             out[p] = dt[p] * min(1.0, max(floor, 1.0 / mean))
     return out
+
+
+def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
+    """The ownership warp (reconstruct/owned.py) voxel by voxel: each output voxel q of ``bounds`` is bone b's
+    (first in order) when ``round([q 1] @ inv(M_b))`` is a rest voxel owned by b; then each empty voxel strictly
+    inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. Returns 1 + bone per voxel
+    ``[x, y, z]``."""
+    import math
+
+    lo, hi = np.asarray(bounds[0]), np.asarray(bounds[1])
+    out = np.zeros(tuple(hi - lo + 1), np.int64)
+    for b, m in enumerate(matrices):
+        inv = np.linalg.inv(m)
+        for idx in np.ndindex(*out.shape):
+            if out[idx]:
+                continue
+            q = np.asarray(idx) + lo
+            k = np.array([int(math.floor(v + 0.5)) for v in (q @ inv[:3, :3] + inv[3, :3])]) - rest_lo
+            if (k >= 0).all() and (k < labels.shape).all() and labels[tuple(k)] == b + 1:
+                out[idx] = b + 1
+    for centre, radius, bone in balls:
+        for idx in np.ndindex(*out.shape):
+            q = np.asarray(idx) + lo
+            if out[idx] == 0 and ((q - centre) ** 2).sum() < radius ** 2:
+                out[idx] = bone + 1
+    return out

@@ -52,18 +52,19 @@ def _reconstruct(args):
     bounds = bounds_arg(args.bounds) if args.bounds else None
     bar = TextProgress("reconstruct")
     r = reconstruct(t, mode=args.mode, source=source, source_geometry=source_geometry, kernel=args.kernel,
-                    bounds=bounds, padding=args.padding, threads=args.threads, progress=bar)
+                    bounds=bounds, padding=args.padding, threads=args.threads, progress=bar, method=args.method)
     output, note = write_output(args.output, r.volume, r.geometry, args.mode)
     if note:
         print(f"note: {note}")
     s = r.stats
-    print(f"{s['spheres']} spheres -> {s['filled']} voxels filled in {s['seconds']:.3f} s "
+    made = f"{s['bones']} bones moved their owned voxels" if s.get("method") == "owned" else f"{s['spheres']} spheres"
+    print(f"{made} -> {s['filled']} voxels filled in {s['seconds']:.3f} s "
           f"(overdraw {s['overdraw']:.1f}); grid {r.volume.shape[0]}x{r.volume.shape[1]}x{r.volume.shape[2]}, "
           f"origin {r.origin[0]} {r.origin[1]} {r.origin[2]} -> {output}")
     if s["clipped"]:
         # what the user loses is body voxels, not sphere coverage (overlapping spheres count many times)
         try:
-            whole = reconstruct(t, mode="binary", padding=args.padding, threads=args.threads)
+            whole = reconstruct(t, mode="binary", padding=args.padding, threads=args.threads, method=args.method)
         except ValueError:  # the unbounded grid is too large to make: say what is known
             print(f"clipped: the spheres reach outside the given bounds ({s['clipped']:,} sphere voxels, "
                   "overlaps counted; the whole body's grid is too large to count the voxels lost)")
@@ -72,9 +73,10 @@ def _reconstruct(args):
             print(f"clipped: {lost:,} voxels of the body lie outside the given bounds and were not written "
                   f"({100 * lost / max(whole.stats['filled'], 1):.2f} % of {whole.stats['filled']:,})")
     if args.mode == "hotspot":
-        print(f"hotspot: max {s['hotspot_max']} spheres on one voxel, mean {s['hotspot_mean']:.2f}")
+        what = "bones" if s.get("method") == "owned" else "spheres"
+        print(f"hotspot: max {s['hotspot_max']} {what} on one voxel, mean {s['hotspot_mean']:.2f}")
     if args.loss:
-        rest = reconstruct(identity_tskel(t.connectivity), mode="binary", threads=args.threads)
+        rest = reconstruct(identity_tskel(t.connectivity), mode="binary", threads=args.threads, method=args.method)
         lost = rest.stats["filled"] - s["filled"]
         print(f"voxel loss against the identity frame: {lost} of {rest.stats['filled']} "
               f"({100 * lost / max(rest.stats['filled'], 1):.2f} %)")
@@ -188,6 +190,10 @@ def register(sub) -> None:
     p.add_argument("--source", help="rest-pose volume (needed for --mode sampled)")
     add_dims(p)  # --dims for a headerless .vol source, --series for a DICOM folder of several
     p.add_argument("--mode", choices=MODES, default="binary", help="default binary")
+    p.add_argument("--method", choices=("auto", "owned", "spheres"), default="auto",
+                   help="auto (default): move each rest voxel with the bone that owns it when the frame names its "
+                        "rig's ownership (# ownership:, written by connect2tskel), else re-grow spheres; spheres: "
+                        "the thesis's re-growth")
     p.add_argument("--kernel", type=ascii_int, choices=(1, 3, 5), default=1, help="sampled: Gaussian kernel size")
     group = p.add_mutually_exclusive_group()
     group.add_argument("--bounds", nargs=6, type=ascii_int, metavar="N", help="inclusive bounds x0 y0 z0 x1 y1 z1")

@@ -82,6 +82,24 @@ def _connect(args):
     write_connect(args.output, conn, thinness=args.thinness)
     counts = np.bincount(conn.bone, minlength=len(conn.bones))
     print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")
+    if args.ownership:
+        _write_ownership(args, skel, conn, mask)
+
+
+def _write_ownership(args, skel, conn, mask) -> None:
+    """The rig's ownership beside the .connect (rig/ownership.py): of the scan's object with --volume (the
+    rest pose is then the segmentation voxel for voxel), else of the body the skeleton's balls make."""
+    from volanim_core.io.ownership_files import ownership_path, write_ownership
+    from volanim_core.rig.curve_skeleton import balls
+    from volanim_core.rig.ownership import ownership
+
+    t0 = time.perf_counter()
+    body = mask if mask is not None else balls(skel)
+    own = ownership(body, conn)
+    path = ownership_path(args.output)
+    write_ownership(path, own)
+    of = "the scan's object" if mask is not None else "the skeleton's balls (give --volume for the scan's own)"
+    print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
 
 
 def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:
@@ -195,7 +213,10 @@ def register(sub) -> None:
     p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
                    help="object = LO <= v <= HI (default: every non-zero voxel)")
     p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background first")
-    p.add_argument("-o", "--output", required=True)
+    p.add_argument("--no-ownership", dest="ownership", action="store_false",
+                   help="write no NAME.owners.nrrd (frames then re-grow the thesis's spheres)")
+    p.add_argument("-o", "--output", required=True,
+                   help="the .connect; NAME.owners.nrrd beside it holds which bone owns each rest voxel")
 
     p = add_command(sub, "pose", "Write a .trans frame: rotate bones about their proximal joints (FK).",
                     "volanim pose mannequin.bones --rotate L_UPPERARM=0,-45,0 -o arm.trans", _pose)

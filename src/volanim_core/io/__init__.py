@@ -13,6 +13,7 @@ for a bad file; all writers are atomic.
       skeleton_files.py ... .skel and .mskel
       bones_files.py ...... .bones and .connections
       connect_files.py .... .connect, .trans and .tskel (and the smooth-joints line)
+      ownership_files.py .. NAME.owners.nrrd beside a .connect: the rig's ownership as a label NRRD
     motion
       frame_files.py ...... an animation on disk: one .trans (and .tskel) per frame, NAME.0000.trans
       keys_files.py ....... .keys (keyframes)

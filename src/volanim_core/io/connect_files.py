@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -143,14 +144,18 @@ def _read_rooted(path, *, matrices: bool, points: bool):
     return rec, bones, np.array(mats).reshape(-1, 4, 4), arr, np.array(owner, dtype=np.int32)
 
 
-def read_connect(path: str | Path) -> Connectivity:
-    """Read a ``.connect`` file (docs/formats.md)."""
+def read_connect(path: str | Path, *, ownership: bool = True) -> Connectivity:
+    """Read a ``.connect`` file (docs/formats.md), with the ownership beside it (``NAME.owners.nrrd``) when
+    there is one and ``ownership``."""
     rec, bones, _, arr, owner = _read_rooted(path, matrices=False, points=True)
     threshold = rec.header.get("thinness")
     if threshold is not None:
         threshold = parse_float(rec, None, threshold, "'# thinness:' header")
-    return Connectivity(bones, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), threshold,
+    conn = Connectivity(bones, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), threshold,
                         parse_geometry(rec), _parse_joints(rec))
+    from volanim_core.io.ownership_files import attach_ownership
+
+    return attach_ownership(conn, path) if ownership else conn
 
 
 def read_trans(path: str | Path) -> Trans:
@@ -162,8 +167,18 @@ def read_trans(path: str | Path) -> Trans:
 def read_tskel(path: str | Path) -> Tskel:
     """Read a ``.tskel`` file: per bone ``Root:``, 4 matrix rows, then points."""
     rec, bones, mats, arr, owner = _read_rooted(path, matrices=True, points=True)
-    return Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), parse_geometry(rec),
-                 joints=_parse_joints(rec))
+    t = Tskel(bones, mats, arr[:, :3], arr[:, 3], arr[:, 4], owner, parse_metric(rec), parse_geometry(rec),
+              joints=_parse_joints(rec))
+    named = rec.header.get("ownership")
+    if named:
+        from volanim_core.io.ownership_files import read_ownership
+
+        own_path = Path(path).parent / named.strip()
+        if not own_path.exists():
+            raise rec.error(None, f"its '# ownership:' file {own_path} is missing: put it back beside the "
+                                  "frame, or delete that line to re-grow the thesis's spheres")
+        t.ownership = read_ownership(own_path, t)
+    return t
 
 
 def _parse_joints(rec: TextRecords) -> Joints:
@@ -229,9 +244,18 @@ def write_trans(path: str | Path, trans: Trans) -> None:
 def write_tskel(path: str | Path, tskel: Tskel) -> None:
     """Write a ``.tskel`` file atomically, points grouped under their bone."""
     lines = ["# volanim tskel 1", f"# points: {len(tskel.points)}", f"# metric: {tskel.metric}",
-             *_geometry_header(tskel.geometry), *_joints_header(tskel.joints)]
+             *_geometry_header(tskel.geometry), *_joints_header(tskel.joints), *_ownership_header(path, tskel)]
     lines += _bone_blocks(tskel.bones, tskel.bone, tskel.points, tskel.dt, tskel.thinness, tskel.matrices)
     atomic_write_text(path, "\n".join(lines) + "\n")
+
+
+def _ownership_header(path, tskel: Tskel) -> list[str]:
+    """``# ownership: FILE`` (relative to the frame) when the frame's rig has an ownership on disk."""
+    own = getattr(tskel, "ownership", None)
+    if own is None or own.path is None or tskel.joints.smooth:
+        return []
+    target, here = Path(own.path).resolve(), Path(path).resolve().parent
+    return [f"# ownership: {os.path.relpath(target, here)}"]
 
 
 def connect_filename(stem: str, thinness: float) -> str:

@@ -1,7 +1,9 @@
 """Re-growing a volume from a posed frame, and finding where a pose breaks it.
 
 plan.py ............ a frame checked and made ready: FramePlan (grid, centres, values, cut, slice lists)
-engine.py .......... reconstruct(): runs the plan, five modes, two metrics
+engine.py .......... reconstruct(): runs the plan, five modes, two metrics; result.py what it returns
+owned.py ........... the default when the rig has an ownership: each rest voxel moved by the bone that
+                     owns it, joints closed by balls (_owned_kernels.py, tested against tests/naive.py)
 live.py ............ LiveFrame: frame after frame on one grid, redoing only the slices moved spheres reach
 _plan_kernels.py ... the plan's numba kernels; _kernels.py the fill and sample kernels (tested
                      against tests/naive.py); _clip_kernels.py what falls outside the grid

@@ -22,12 +22,11 @@ as float32 (squared Euclidean, or integer 3-4-5 chamfer).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 
 import numba
 import numpy as np
 
-from volanim_core.geometry import IDENTITY, Geometry
+from volanim_core.geometry import Geometry
 from volanim_core.progress import CancelFn, Clock, Pacer, ProgressFn, Reporter
 from volanim_core.reconstruct import _kernels as K
 from volanim_core.reconstruct._clip_kernels import count_outside
@@ -48,7 +47,8 @@ from volanim_core.reconstruct.plan import (  # noqa: F401
     plan_frame,
     posed_centres,
 )
-from volanim_core.reconstruct.sampling import sample_source
+from volanim_core.reconstruct.result import Reconstruction  # noqa: F401  (this module's API too)
+from volanim_core.reconstruct.sampling import grid_to_source, sample_source
 from volanim_core.reconstruct.speedups import ALL, Speedups
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.volume import Bounds
@@ -57,38 +57,6 @@ _MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled
               OWNER: K.BONE}
 LAUNCH_SECONDS = 0.25  # aimed length of one parallel launch: the progress and cancel granularity
 CLIP_ROW_BUDGET = 4_000_000  # rows counted exactly per clipped sphere (radius ~1000); beyond, estimated
-
-
-@dataclass
-class Reconstruction:
-    """A reconstructed volume and what it took.
-
-    Attributes
-    ----------
-    volume : (X, Y, Z) ndarray indexed ``[x, y, z]``
-        uint8 (binary, mottled, bone with < 256 bones), uint16 (hotspot, bone
-        with more bones) or the source's dtype (sampled).
-    origin : (3,) ints
-        Voxel ``[0, 0, 0]`` of ``volume`` is voxel ``origin`` of the rest frame.
-    geometry : Geometry
-        Where ``volume``'s voxels are in physical space: the frame's geometry shifted to ``origin``
-        (what a writer records, so the posed frame overlays the scan it came from).
-    stats : dict
-        ``spheres``, ``filled`` (voxels), ``visits`` (voxels the spheres
-        examined: the kernel's work), ``overdraw`` (visits / filled), ``clipped`` (sphere voxels outside
-        given bounds), ``seconds``; hotspot adds ``hotspot_max`` and
-        ``hotspot_mean`` (over covered voxels).
-    """
-
-    volume: np.ndarray
-    origin: tuple[int, int, int]
-    stats: dict = field(default_factory=dict)
-    geometry: Geometry = IDENTITY
-
-    @property
-    def bounds(self) -> Bounds:
-        lo = tuple(int(v) for v in self.origin)
-        return Bounds(lo, tuple(lo[i] + self.volume.shape[i] - 1 for i in range(3)))
 
 
 def reconstruct(
@@ -108,8 +76,14 @@ def reconstruct(
     cancel: CancelFn | None = None,
     speedups: Speedups = ALL,
     clock: Clock = time.perf_counter,
+    method: str = "auto",
 ) -> Reconstruction:
-    """Re-grow a volume from the spheres of a ``.tskel`` frame.
+    """Re-grow a volume from the spheres of a ``.tskel`` frame, or move the rig's owned voxels.
+
+    A rigid frame posed from a connectivity with an ownership (``tskel.ownership``, rig/ownership.py) is
+    made by :func:`~volanim_core.reconstruct.owned.reconstruct_owned` unless ``method='spheres'``: every
+    rest voxel moved by the bone that owns it, joints closed by balls (the default, #84). Smooth joints
+    and frames without an ownership re-grow the thesis's spheres.
 
     Parameters
     ----------
@@ -149,6 +123,8 @@ def reconstruct(
     clock : callable
         Seconds (``time.perf_counter``): sizes the launches (:class:`~volanim_core.progress.Pacer`) and
         times the call (``stats['seconds']``). The result does not depend on it; a test passes a fake one.
+    method : {'auto', 'owned', 'spheres'}
+        'auto': owned when the frame carries an ownership and its joints are rigid, else spheres.
 
     Returns
     -------
@@ -163,6 +139,13 @@ def reconstruct(
     >>> int((r.volume > 0).sum()), r.origin   # voxels strictly within 2 of the centre: 3x3x3
     (27, (3, 3, 3))
     """
+    if _owned(tskel, method):
+        from volanim_core.reconstruct.owned import reconstruct_owned
+
+        return reconstruct_owned(tskel.ownership, tskel.matrices, mode="bone" if mode == OWNER else mode,
+                                 source=source, source_geometry=source_geometry, kernel=kernel, bounds=bounds,
+                                 padding=padding, value=value, threads=threads, progress=progress, cancel=cancel,
+                                 clock=clock)
     t0 = clock()
     report = Reporter(progress, cancel)
     plan = plan_frame(tskel, mode, source=source, kernel=kernel, value=value, bounds=bounds, padding=padding,
@@ -209,6 +192,17 @@ def reconstruct(
     return Reconstruction(volume, tuple(int(v) for v in lo), stats, plan.tskel.geometry.shifted(lo))
 
 
+def _owned(tskel: Tskel, method: str) -> bool:
+    """Whether this frame is made from its rig's ownership (see :func:`reconstruct`)."""
+    if method not in ("auto", "owned", "spheres"):
+        raise ValueError(f"method must be 'auto', 'owned' or 'spheres', got {method!r}")
+    own = getattr(tskel, "ownership", None)
+    if method == "owned" and (own is None or tskel.joints.smooth):
+        raise ValueError("method 'owned' needs a rigid frame of a rig with an ownership (volanim connect makes "
+                         "NAME.owners.nrrd beside the .connect)")
+    return method != "spheres" and own is not None and not tskel.joints.smooth
+
+
 def _output_array(out, shape_zyx, out_dtype, final_dtype) -> np.ndarray:
     """A zeroed ``[z, y, x]`` array: the caller's previous result when it fits (no first-touch cost)."""
     if out is not None and out.shape == shape_zyx[::-1] and out.dtype == final_dtype == out_dtype \
@@ -225,15 +219,7 @@ def source_maps(plan, source_geometry: Geometry | None, z0: int = 0) -> np.ndarr
     rigid map)."""
     to_source = np.eye(4) if source_geometry is None else plan.tskel.geometry.index_map(source_geometry)
     minv = np.concatenate([plan.minv_rest, np.linalg.inv(plan.table[len(plan.minv_rest):])])
-    return _grid_to_source(minv, plan.origin + np.array([0.0, 0.0, z0]), to_source)
-
-
-def _grid_to_source(minv_rest: np.ndarray, origin: np.ndarray, to_source: np.ndarray) -> np.ndarray:
-    """Per bone: output-grid coordinates -> source-array coordinates (shift in, invert, then the
-    frame's grid -> the source's grid, :meth:`Geometry.index_map`)."""
-    shift_in = np.eye(4)
-    shift_in[3, :3] = origin
-    return np.ascontiguousarray(shift_in @ minv_rest @ to_source)
+    return grid_to_source(minv, plan.origin + np.array([0.0, 0.0, z0]), to_source)
 
 
 def _stats(spheres: int, filled: np.ndarray, visits: np.ndarray, clipped: int, hotspot=None) -> dict:

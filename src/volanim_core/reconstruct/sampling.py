@@ -63,3 +63,11 @@ def _sample(owner, out, src, minv, kernel, spans, nthreads, chunk, report) -> np
         K.sample_rows(owner, out, z0, z1, nthreads, *spans, minv, src, weights, kernel // 2)
         report(z1)
     return out
+
+
+def grid_to_source(minv_rest: np.ndarray, origin: np.ndarray, to_source: np.ndarray) -> np.ndarray:
+    """Per bone: output-grid coordinates -> source-array coordinates (shift in, invert, then the
+    frame's grid -> the source's grid, :meth:`Geometry.index_map`)."""
+    shift_in = np.eye(4)
+    shift_in[3, :3] = origin
+    return np.ascontiguousarray(shift_in @ minv_rest @ to_source)

@@ -88,6 +88,9 @@ class Connectivity:
     thinness_threshold: float | None = None
     geometry: Geometry = IDENTITY  # the voxel grid of the coordinates (volanim_core.geometry)
     joints: Joints = RIGID  # how bones meet: rigid, or smooth with a blend width (rig/skinning.py)
+    #: which bone owns each rest voxel (rig/ownership.py), when the rig has one: rigid frames posed from this
+    #: connectivity carry it, and reconstruct() then moves the voxels themselves (reconstruct/owned.py)
+    ownership = None
 
     def __post_init__(self):
         self.points, self.dt, self.thinness, self.bone = _points_fields(
@@ -130,13 +133,25 @@ class Connectivity:
         """A frame of these points: one matrix per bone, the joints of the connectivity (or ``joints``)."""
         joints = self.joints if joints is None else joints
         skin = self.skin if joints == self.joints and joints.smooth else None
-        return Tskel(self.bones, matrices, self.points, self.dt, self.thinness, self.bone, self.metric,
-                     self.geometry, joints=joints, skin=skin)
+        t = Tskel(self.bones, matrices, self.points, self.dt, self.thinness, self.bone, self.metric,
+                  self.geometry, joints=joints, skin=skin)
+        t.ownership = self.ownership
+        return t
+
+    def with_ownership(self, ownership) -> Connectivity:
+        """The same points with a rig's ownership (None: without; its bones must be these)."""
+        if ownership is not None and len(ownership.bones) != len(self.bones):
+            raise ValueError(f"the ownership has {len(ownership.bones)} bones, the connectivity {len(self.bones)}")
+        c = self.take(np.arange(len(self)))
+        c.ownership = ownership
+        return c
 
     def with_joints(self, joints: Joints) -> Connectivity:
         """The same points with other joints."""
-        return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
-                            self.thinness_threshold, self.geometry, joints)
+        c = Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
+                         self.thinness_threshold, self.geometry, joints)
+        c.ownership = self.ownership
+        return c
 
     def is_grouped(self) -> bool:
         """Whether points are grouped by bone in root order, as files list them."""
@@ -234,5 +249,7 @@ class Tskel(Connectivity):
 
     @property
     def connectivity(self) -> Connectivity:
-        return Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
-                            geometry=self.geometry, joints=self.joints)
+        c = Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
+                         geometry=self.geometry, joints=self.joints)
+        c.ownership = self.ownership
+        return c
