@@ -21,12 +21,34 @@ import numpy as np
 from numba import njit
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _row_span(bx, by, bz, sx, sy, sz, box, x_lo):
+    """The output x range (one voxel wider, exactness is kept by the read itself) whose rest point
+    ``(b + (x + x_lo) s)`` rounds into ``box`` (``x0 y0 z0 x1 y1 z1``); (1, 0) when none."""
+    t0, t1 = -1e30, 1e30
+    for base, step, lo, hi in ((bx, sx, box[0], box[3]), (by, sy, box[1], box[4]), (bz, sz, box[2], box[5])):
+        a, c = lo - 0.5 - base, hi + 0.5 - base
+        if abs(step) < 1e-12:
+            if a > 0 or c < 0:
+                return 1, 0
+            continue
+        u, w = a / step, c / step
+        if u > w:
+            u, w = w, u
+        t0, t1 = max(t0, u), min(t1, w)
+    if t1 < t0:
+        return 1, 0
+    return int(math.floor(max(t0, -1e9))) - x_lo - 1, int(math.ceil(min(t1, 1e9))) - x_lo + 1
+
+
 @njit(cache=True, nogil=True, parallel=True)
-def warp_owners(labels, rest_lo, inv, boxes, out_lo, out, row_lo, row_hi, claims, count):
+def warp_owners(labels, rest_lo, inv, boxes, rest_boxes, out_lo, out, row_lo, row_hi, claims, count):
     """``out`` ``[z, y, x]`` (zeroed): each voxel's owning bone + 1. ``labels`` ``[x, y, z]``: the rest owners,
-    voxel ``[0, 0, 0]`` at rest voxel ``rest_lo``. ``boxes[b]``: bone b's posed box ``x0 y0 z0 x1 y1 z1`` in output
-    indices (empty when x1 < x0). ``row_lo/row_hi[z, y]``: each row's span of written voxels. ``count``: also count
-    every bone reaching a voxel in ``claims`` (hotspot), else stop at the first. Returns the voxel-bone reads."""
+    voxel ``[0, 0, 0]`` at rest voxel ``rest_lo``. ``boxes[b]``: bone b's posed box ``x0 y0 z0 x1 y1 z1`` in
+    output indices (empty when x1 < x0); ``rest_boxes[b]`` its owned voxels' box in ``labels``' indices: each
+    row reads only where its straight line through the rest frame crosses that box. ``row_lo/row_hi[z, y]``:
+    each row's span of written voxels. ``count``: also count every bone reaching a voxel in ``claims``
+    (hotspot), else stop at the first. Returns the voxel-bone reads."""
     nz, ny, nx = out.shape
     lx, ly, lz = labels.shape
     nb = inv.shape[0]
@@ -45,7 +67,8 @@ def warp_owners(labels, rest_lo, inv, boxes, out_lo, out, row_lo, row_hi, claims
                 bx = qy * m[1, 0] + qz * m[2, 0] + m[3, 0] - rest_lo[0]
                 by = qy * m[1, 1] + qz * m[2, 1] + m[3, 1] - rest_lo[1]
                 bz = qy * m[1, 2] + qz * m[2, 2] + m[3, 2] - rest_lo[2]
-                for x in range(boxes[b, 0], boxes[b, 3] + 1):
+                x0, x1 = _row_span(bx, by, bz, m[0, 0], m[0, 1], m[0, 2], rest_boxes[b], out_lo[0])
+                for x in range(max(x0, boxes[b, 0]), min(x1, boxes[b, 3]) + 1):
                     qx = x + out_lo[0]
                     n += 1
                     if not count and out[z, y, x] != 0:

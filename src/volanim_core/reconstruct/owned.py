@@ -125,6 +125,7 @@ def reconstruct_owned(
     local[:, 3:] = np.minimum(local[:, 3:], np.array([nx, ny, nz]) - 1)
     inv = np.ascontiguousarray(np.linalg.inv(matrices))
     rest_lo = np.asarray(own.origin, np.int64)
+    rest_boxes = own.boxes() - np.tile(rest_lo, 2)
     nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
@@ -137,7 +138,8 @@ def reconstruct_owned(
             slab = local.copy()
             slab[:, 2] = np.maximum(slab[:, 2] - z0, 0)
             slab[:, 5] = np.minimum(slab[:, 5] - z0, z1 - z0 - 1)
-            reads += K.warp_owners(own.labels, rest_lo, inv, slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1],
+            reads += K.warp_owners(own.labels, rest_lo, inv, slab, rest_boxes, lo + (0, 0, z0), owner[z0:z1],
+                                   row_lo[z0:z1],
                                    row_hi[z0:z1], claims[z0:z1] if count else claims, count)
             report(z1, total)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
