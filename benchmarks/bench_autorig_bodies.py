@@ -1,7 +1,8 @@
 """Auto-rig on every body we have, each proposal posed leaf by leaf and judged (#62's proof table).
 
     body --skeletonize--> .mskel --autorig--> bones --connect (pieces, autorig --connect's default)-->
-    every leaf bone bent 45 and 90 degrees (about an axis across it), rigid and smooth joints
+    every leaf bone bent 45 and 90 degrees (about an axis across it): owned (the body's voxels moved by their
+    owners, the default since #84), rigid and smooth spheres
       --report--> healthy or not
 
 Bodies: the mannequin and mannequin-large (hand-made rigs: the proposal's mean joint error), the frog,
@@ -24,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 BODIES = ("mannequin", "mannequin-large", "frog", "ant", "rabbit", "spot", "bob")
+JOINTS = ("owned", "rigid", "smooth")
 
 
 def body_mask(name: str, folder: Path):
@@ -43,19 +45,22 @@ def leaves(bones) -> list[str]:
     return [bones.bones[i].label for i in bones.leaves()]
 
 
-def leaf_poses(skel, bones, angles) -> dict:
-    """{(joints, angle): (healthy, of, first broken verdict)} with the pieces connect."""
+def leaf_poses(skel, bones, angles, mask=None) -> dict:
+    """{(joints, angle): (healthy, of, first broken verdict)} with the pieces connect: owned (the default since
+    #84: the body's voxels moved by the bones that own them, ``mask`` the body), rigid and smooth spheres."""
     from volanim_core.reconstruct.checks import report
     from volanim_core.rig.attach import connect
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.curve_skeleton import balls
+    from volanim_core.rig.ownership import ownership
     from volanim_core.rig.pose import bend_across, pose_matrices, root_bones
     from volanim_core.rig.skinning import Joints
 
     conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
     out = {}
-    for joints in ("rigid", "smooth"):
-        c = conn.with_joints(Joints(joints))
+    for joints in JOINTS:
+        c = conn.with_ownership(ownership(mask if mask is not None else balls(skel), conn)) if joints == "owned" \
+            else conn.with_joints(Joints(joints))
         for angle in angles:
             bad = []
             for leaf in leaves(bones):
@@ -76,7 +81,7 @@ def main(argv=None) -> int:
     p.add_argument("--angles", default="45,90")
     args = p.parse_args(argv)
     angles = [int(a) for a in args.angles.split(",")]
-    cols = [f"{j} {a}°" for j in ("rigid", "smooth") for a in angles]
+    cols = [f"{j} {a}°" for j in JOINTS for a in angles]
     print("| body | bones (template) | mean joint error | " + " | ".join(cols) + " | autorig s | / skeletonize |")
     print("|---|---|---|" + "---|" * len(cols) + "---|---|")
     broken = []
@@ -92,7 +97,7 @@ def main(argv=None) -> int:
             error = ""
             if truth is not None and proposal.template == "humanoid":
                 error = f"{np.mean([np.linalg.norm(bones.joints[k] - v) for k, v in truth.joints.items()]):.1f}"
-            poses = leaf_poses(skel, bones, angles)
+            poses = leaf_poses(skel, bones, angles, mask)
             cells = [f"{ok}/{of}" for ok, of, _ in poses.values()]
             broken += [f"{name} {j} {a}°: {bad[0]}" for (j, a), (_, _, bad) in poses.items() if bad]
             print(f"| {name} | {len(bones.bones)} ({proposal.template}) | {error} | " + " | ".join(cells)

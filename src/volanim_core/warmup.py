@@ -5,7 +5,7 @@
         (every mode x metric, sampled with kernel 1 and 3, and a colour source) --> palette
         orderings --> breakage report (+ detached pieces; a clip's scan uses the same kernels, and its
         proof of one piece)
-        --> a crumble's heap --> a proposed rig's balls
+        --> a crumble's heap --> a proposed rig's balls --> the rig's ownership and a frame from it
 
 Every kernel a user's command or the studio calls is in that list (a test holds it to that): a fresh
 install that skipped this compiles on first use instead -- the walk's first `volanim scan` took 22 s
@@ -89,6 +89,12 @@ def compile_kernels(progress=None) -> float:
                 np.zeros(1, np.int8))
     fall(np.pad(source, ((8, 8), (8, 8), (0, 8))), 1.0)  # a crumble's heap (room for it around the bar)
     balls(skel)  # a proposed rig's body of balls (auto-rig)
+    # the ownership default (#84): the rig's ownership, then a frame in every mode from it, uint8 labels
+    from volanim_core.rig.ownership import ownership
+
+    owned = conn.with_ownership(ownership(mask, conn)).posed(matrices)
+    for mode in MODES:
+        reconstruct(owned, mode=mode, source=source if mode == "sampled" else None)
     _report(progress, total, total)
     return time.perf_counter() - t0
 

@@ -88,18 +88,34 @@ def _connect(args):
 
 def _write_ownership(args, skel, conn, mask) -> None:
     """The rig's ownership beside the .connect (rig/ownership.py): of the scan's object with --volume (the
-    rest pose is then the segmentation voxel for voxel), else of the body the skeleton's balls make."""
+    rest pose is then the segmentation voxel for voxel), else of the body the skeleton's spheres re-grow at
+    rest (the thesis's rest pose, which the identity frame then gives back unchanged)."""
     from volanim_core.io.ownership_files import ownership_path, write_ownership
-    from volanim_core.rig.curve_skeleton import balls
     from volanim_core.rig.ownership import ownership
 
     t0 = time.perf_counter()
-    body = mask if mask is not None else balls(skel)
+    body = mask if mask is not None else _sphere_body(conn)
     own = ownership(body, conn)
     path = ownership_path(args.output)
     write_ownership(path, own)
     of = "the scan's object" if mask is not None else "the skeleton's balls (give --volume for the scan's own)"
     print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
+
+
+def _sphere_body(conn) -> np.ndarray:
+    """The body the connectivity's spheres re-grow at rest, on the skeleton's grid from voxel 0."""
+    from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.volume import Bounds
+
+    rest = reconstruct(identity_tskel(conn), mode="binary", method="spheres", padding=1)
+    lo = np.asarray(rest.origin)
+    if (lo < 0).any():  # spheres reaching below voxel 0: the grid starts there, the body is cut at it
+        rest = reconstruct(identity_tskel(conn), mode="binary", method="spheres",
+                           bounds=Bounds((0, 0, 0), tuple(int(v) for v in rest.bounds.hi)))
+        lo = np.asarray(rest.origin)
+    body = np.zeros(tuple(lo + rest.volume.shape), bool)
+    body[lo[0]:, lo[1]:, lo[2]:] = rest.volume > 0
+    return body
 
 
 def parse_rotation(text: str) -> tuple[str, tuple[float, float, float]]:

@@ -16,6 +16,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.io.nrrd_files import read_nrrd, write_nrrd
+from volanim_core.rig._ownership_kernels import TUBE_COLUMNS
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.ownership import Ownership, label_dtype
 
@@ -80,7 +81,7 @@ def read_ownership(path: str | Path, conn: Connectivity) -> Ownership:
     del geometry  # the connect's grid is the rig's: the labels' place on it is volanim_origin
     return Ownership(labels.astype(label_dtype(n), copy=False), tuple(origin), list(conn.bones),
                      _vector(path, pairs, "volanim_ball_radii", n), conn.geometry,
-                     _vector(path, pairs, "volanim_tubes", 18 * n).reshape(n, 18), path)
+                     _vector(path, pairs, "volanim_tubes", TUBE_COLUMNS * n).reshape(n, TUBE_COLUMNS), path)
 
 
 def attach_ownership(conn: Connectivity, connect_path: str | Path) -> Connectivity:

@@ -21,34 +21,17 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _row_span(bx, by, bz, sx, sy, sz, box, x_lo):
-    """The output x range (one voxel wider, exactness is kept by the read itself) whose rest point
-    ``(b + (x + x_lo) s)`` rounds into ``box`` (``x0 y0 z0 x1 y1 z1``); (1, 0) when none."""
-    t0, t1 = -1e30, 1e30
-    for base, step, lo, hi in ((bx, sx, box[0], box[3]), (by, sy, box[1], box[4]), (bz, sz, box[2], box[5])):
-        a, c = lo - 0.5 - base, hi + 0.5 - base
-        if abs(step) < 1e-12:
-            if a > 0 or c < 0:
-                return 1, 0
-            continue
-        u, w = a / step, c / step
-        if u > w:
-            u, w = w, u
-        t0, t1 = max(t0, u), min(t1, w)
-    if t1 < t0:
-        return 1, 0
-    return int(math.floor(max(t0, -1e9))) - x_lo - 1, int(math.ceil(min(t1, 1e9))) - x_lo + 1
-
-
 @njit(cache=True, nogil=True, parallel=True)
-def warp_owners(labels, rest_lo, inv, boxes, rest_boxes, out_lo, out, row_lo, row_hi, claims, count):
+def warp_owners(labels, spans, rest_lo, inv, shifts, turned, turned_spans, boxes, out_lo, out, row_lo, row_hi, claims,
+                count):
     """``out`` ``[z, y, x]`` (zeroed): each voxel's owning bone + 1. ``labels`` ``[x, y, z]``: the rest owners,
     voxel ``[0, 0, 0]`` at rest voxel ``rest_lo``. ``boxes[b]``: bone b's posed box ``x0 y0 z0 x1 y1 z1`` in
-    output indices (empty when x1 < x0); ``rest_boxes[b]`` its owned voxels' box in ``labels``' indices: each
-    row reads only where its straight line through the rest frame crosses that box. ``row_lo/row_hi[z, y]``:
+    output indices (empty when x1 < x0). A turned bone b reads only where ``turned_spans[turned[b], z, y]`` says its
+    voxels land on the row (:func:`posed_row_spans`, made for this slab's rows). ``row_lo/row_hi[z, y]``:
     each row's span of written voxels. ``count``: also count every bone reaching a voxel in ``claims``
-    (hotspot), else stop at the first. Returns the voxel-bone reads."""
+    (hotspot), else stop at the first. ``spans[b, y, z]``: bone b's first and last x on rest row (y, z) of
+    ``labels``. ``shifts[b]``: ``dx dy dz 1`` when bone b moves by whole voxels only (its
+    voxels are read without rounding), else ``0 0 0 0``. Returns the voxel-bone reads."""
     nz, ny, nx = out.shape
     lx, ly, lz = labels.shape
     nb = inv.shape[0]
@@ -67,8 +50,28 @@ def warp_owners(labels, rest_lo, inv, boxes, rest_boxes, out_lo, out, row_lo, ro
                 bx = qy * m[1, 0] + qz * m[2, 0] + m[3, 0] - rest_lo[0]
                 by = qy * m[1, 1] + qz * m[2, 1] + m[3, 1] - rest_lo[1]
                 bz = qy * m[1, 2] + qz * m[2, 2] + m[3, 2] - rest_lo[2]
-                x0, x1 = _row_span(bx, by, bz, m[0, 0], m[0, 1], m[0, 2], rest_boxes[b], out_lo[0])
-                for x in range(max(x0, boxes[b, 0]), min(x1, boxes[b, 3]) + 1):
+                if shifts[b, 3] == 1:
+                    x0, x1 = boxes[b, 0], boxes[b, 3]
+                else:  # where the turned bone's voxels land on this row (posed_row_spans)
+                    x0 = max(boxes[b, 0], turned_spans[turned[b], z, y, 0])
+                    x1 = min(boxes[b, 3], turned_spans[turned[b], z, y, 1])
+                if shifts[b, 3] == 1:  # moved by whole voxels only (most bones of a pose: not at all): no rounding
+                    iy, iz = qy - shifts[b, 1] - rest_lo[1], qz - shifts[b, 2] - rest_lo[2]
+                    if iy < 0 or iz < 0 or iy >= ly or iz >= lz or x1 < x0:
+                        continue
+                    dx = out_lo[0] - shifts[b, 0] - rest_lo[0]
+                    x0, x1 = max(x0, spans[b, iy, iz, 0] - dx), min(x1, spans[b, iy, iz, 1] - dx)
+                    n += max(0, x1 - x0 + 1)
+                    for x in range(x0, x1 + 1):
+                        if labels[x + dx, iy, iz] == b + 1 and (count or out[z, y, x] == 0):
+                            if out[z, y, x] == 0:
+                                out[z, y, x] = b + 1
+                                lo_x = min(lo_x, x)
+                                hi_x = max(hi_x, x)
+                            if count:
+                                claims[z, y, x] += 1
+                    continue
+                for x in range(x0, x1 + 1):
                     qx = x + out_lo[0]
                     n += 1
                     if not count and out[z, y, x] != 0:
@@ -119,3 +122,32 @@ def close_joints(out, out_lo, centres, r2s, bones, row_lo, row_hi, claims, count
                         out[z, y, x] = bones[k] + 1
                         row_lo[z, y] = min(row_lo[z, y], x)
                         row_hi[z, y] = max(row_hi[z, y], x)
+
+
+@njit(cache=True, nogil=True)
+def posed_row_spans(spans, rest_lo, m, out_lo, out):
+    """Where one turned bone's voxels land, row by row: ``out[z, y]`` (filled with ``(nx, -1)`` beforehand) widened
+    to hold every output voxel within ``REACH`` of a rest voxel of the bone moved by ``m`` (``[p 1] @ m``). A read
+    ``round(inv(m) q)`` can only find the bone's voxel there. ``spans[y, z]``: the bone's first and last x on
+    each row of its rest labels (voxel ``[0, 0, 0]`` at ``rest_lo``)."""
+    ly, lz = spans.shape[0], spans.shape[1]
+    nz, ny = out.shape[0], out.shape[1]
+    reach = 0.8661  # half a voxel's diagonal, and a hair: the farthest a rounded read lands from its voxel
+    for iz in range(lz):
+        for iy in range(ly):
+            x0, x1 = spans[iy, iz, 0], spans[iy, iz, 1]
+            if x1 < x0:
+                continue
+            py, pz = iy + rest_lo[1], iz + rest_lo[2]
+            for ix in range(x0, x1 + 1):
+                px = ix + rest_lo[0]
+                qx = px * m[0, 0] + py * m[1, 0] + pz * m[2, 0] + m[3, 0] - out_lo[0]
+                qy = px * m[0, 1] + py * m[1, 1] + pz * m[2, 1] + m[3, 1] - out_lo[1]
+                qz = px * m[0, 2] + py * m[1, 2] + pz * m[2, 2] + m[3, 2] - out_lo[2]
+                lo_x, hi_x = int(math.floor(qx - reach)), int(math.ceil(qx + reach))
+                for z in range(max(0, int(math.ceil(qz - reach))), min(nz - 1, int(math.floor(qz + reach))) + 1):
+                    for y in range(max(0, int(math.ceil(qy - reach))), min(ny - 1, int(math.floor(qy + reach))) + 1):
+                        if lo_x < out[z, y, 0]:
+                            out[z, y, 0] = lo_x
+                        if hi_x > out[z, y, 1]:
+                            out[z, y, 1] = hi_x

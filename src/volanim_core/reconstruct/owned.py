@@ -15,10 +15,11 @@ voxel for voxel and moves exactly what each bone owns. Where a joint bends, the 
 voxels part on the outside of the bend and a wedge opens; the ball of the body's depth at the joint, which
 both bones carry to the same place, closes it.
 
-Each voxel moves with its owner alone. Carrying also the body inside a bone's tube where two tubes overlap
-(a limb's end inside the torso, as the mannequin's capsules do) was measured and left out: it closed part of
-the hip's gap (4.6 % -> 2.2 % of the leg) but swung the chin with a nodding head's spine (8.7 % of the head)
-and left single voxels behind a torn limb. A lump is what the animator sees first; a gap the ball narrows.
+Each voxel moves with its owner alone. Also carrying, as a copy, another bone's voxel where the two bones'
+tubes overlap (the mannequin's capsules do: a limb's end inside the torso) was measured and left out
+(benchmarks/bench_shape.py, #84's note): it narrowed the hip's gap (4.6 % -> 2.2-2.8 % of the leg) but every
+variant swung flesh that is not there (a nodding head's neck: 3-9 % of the head), and a lump is what the
+animator sees first.
 
 Same output as :func:`~volanim_core.reconstruct.engine.reconstruct` (a :class:`Reconstruction`), so every
 caller can take either: ``volanim reconstruct --method spheres`` is the thesis's, still exact against its oracle.
@@ -44,18 +45,16 @@ SLAB = 32  # output slices per launch: the progress and cancel granularity
 
 
 def posed_boxes(own: Ownership, matrices: np.ndarray) -> np.ndarray:
-    """``(B, 6)`` each bone's owned voxels' box moved by its matrix, in rest-grid voxels (x1 < x0: owns none)."""
-    rest = own.boxes()
-    out = np.zeros_like(rest)
+    """``(B, 6)`` each bone's owned voxels' box once moved by its matrix, in rest-grid voxels (x1 < x0: owns
+    none): its hull's vertices moved (own.hulls()), one voxel wider for the rounding of a read."""
+    out = np.zeros((len(own.bones), 6), np.int64)
     out[:, :3] = 1
-    for b, box in enumerate(rest):
-        if box[3] < box[0]:
+    for b, hull in enumerate(own.hulls()):
+        if not len(hull):
             continue
-        corners = np.array([[box[3 * (c >> i & 1) + i] + (0.5 if c >> i & 1 else -0.5) for i in range(3)]
-                            for c in range(8)])
-        moved = corners @ matrices[b, :3, :3] + matrices[b, 3, :3]
-        out[b, :3] = np.floor(moved.min(0))
-        out[b, 3:] = np.ceil(moved.max(0))
+        moved = hull @ matrices[b, :3, :3] + matrices[b, 3, :3]
+        out[b, :3] = np.floor(moved.min(0)) - 1
+        out[b, 3:] = np.ceil(moved.max(0)) + 1
     return out
 
 
@@ -125,7 +124,8 @@ def reconstruct_owned(
     local[:, 3:] = np.minimum(local[:, 3:], np.array([nx, ny, nz]) - 1)
     inv = np.ascontiguousarray(np.linalg.inv(matrices))
     rest_lo = np.asarray(own.origin, np.int64)
-    rest_boxes = own.boxes() - np.tile(rest_lo, 2)
+    shifts = whole_voxel_shifts(matrices)
+    turned, turned_spans = _turned_spans(own, matrices, shifts, lo, (nz, ny))
     nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
@@ -138,9 +138,9 @@ def reconstruct_owned(
             slab = local.copy()
             slab[:, 2] = np.maximum(slab[:, 2] - z0, 0)
             slab[:, 5] = np.minimum(slab[:, 5] - z0, z1 - z0 - 1)
-            reads += K.warp_owners(own.labels, rest_lo, inv, slab, rest_boxes, lo + (0, 0, z0), owner[z0:z1],
-                                   row_lo[z0:z1],
-                                   row_hi[z0:z1], claims[z0:z1] if count else claims, count)
+            reads += K.warp_owners(own.labels, own.spans(), rest_lo, inv, shifts, turned, turned_spans[:, z0:z1],
+                                   slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
+                                   claims[z0:z1] if count else claims, count)
             report(z1, total)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
@@ -163,6 +163,31 @@ def reconstruct_owned(
     stats["seconds"] = clock() - t0
     xyz = volume.transpose(2, 1, 0, 3) if volume.ndim == 4 else volume.T
     return Reconstruction(xyz, tuple(int(v) for v in lo), stats, own.geometry.shifted(lo))
+
+
+def _turned_spans(own: Ownership, matrices: np.ndarray, shifts: np.ndarray, lo: np.ndarray, shape_zy):
+    """For each turned bone (not moved by whole voxels), where its voxels land on each output row: ``turned[b]``
+    its index in ``spans (T, nz, ny, 2)`` (0 for the others, whose entry is never read)."""
+    turned = np.zeros(len(matrices), np.int64)
+    which = [b for b in range(len(matrices)) if shifts[b, 3] == 0]
+    spans = np.empty((max(1, len(which)), *shape_zy, 2), np.int32)
+    spans[..., 0], spans[..., 1] = shape_zy[1] * 0 + 2**30, -(2**30)
+    rest_spans = own.spans()
+    rest_lo = np.asarray(own.origin, np.int64)
+    for k, b in enumerate(which):
+        turned[b] = k
+        K.posed_row_spans(rest_spans[b], rest_lo, matrices[b], lo, spans[k])
+    return turned, spans
+
+
+def whole_voxel_shifts(matrices: np.ndarray) -> np.ndarray:
+    """``(B, 4)``: ``dx dy dz 1`` for each bone its matrix moves by whole voxels only (no turn), else zeros."""
+    out = np.zeros((len(matrices), 4), np.int64)
+    for b, m in enumerate(matrices):
+        t = m[3, :3]
+        if np.array_equal(m[:3, :3], np.eye(3)) and np.array_equal(t, np.round(t)) and np.all(np.abs(t) < 2**30):
+            out[b] = (*np.round(t).astype(np.int64), 1)
+    return out
 
 
 def _checked(own: Ownership, matrices, mode, source, kernel) -> np.ndarray:

@@ -8,40 +8,67 @@ import numba
 import numpy as np
 from numba import njit
 
+#: a tube's row: a(3) ab(3) 1/|ab|^2 s0 ds w1(3) w2(3) u(3) cap0 cap1
+TUBE_COLUMNS = 20
+
 
 @njit(cache=True, nogil=True, inline="always")
 def tube_distance(tube, px, py, pz):
-    """Point p's distance from the tube ``a(3) ab(3) 1/|ab|^2 s0 ds w1(3) w2(3) w3(3)`` relative to its size:
-    < 1 inside. The offset v from the segment's nearest point (t clamped to 0..1) is measured along three
-    axes scaled by the tube's semi-axes (``w_i = e_i / a_i``: an elliptic cross-section, round end caps
-    stretched alike) and tapered by ``s0 + t ds``."""
+    """Point p's distance from a tube relative to its size: < 1 inside, inf for a tube that holds nothing.
+
+    The tube (:data:`TUBE_COLUMNS` numbers): the segment ``a + t ab``; p's offset v from its nearest point
+    (t clamped to 0..1) is measured across the bone along ``w1``, ``w2`` (the cross-section's axes divided by
+    its semi-axes: an ellipse), tapered by ``s0 + t ds``, and along the bone's unit axis ``u`` past a joint
+    against how far the body reaches beyond it there (``cap0`` behind the proximal joint, ``cap1`` past the
+    distal one)."""
     dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
-    t = min(1.0, max(0.0, (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]))
+    raw = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
+    t = min(1.0, max(0.0, raw))
     vx, vy, vz = dx - t * tube[3], dy - t * tube[4], dz - t * tube[5]
     s = tube[7] + t * tube[8]
-    q = 0.0
-    for i in range(3):
-        c = vx * tube[9 + 3 * i] + vy * tube[10 + 3 * i] + vz * tube[11 + 3 * i]
-        q += c * c
-    return math.sqrt(q) / s
+    if s <= 0.0:
+        return np.inf
+    c1 = vx * tube[9] + vy * tube[10] + vz * tube[11]
+    c2 = vx * tube[12] + vy * tube[13] + vz * tube[14]
+    c3 = vx * tube[15] + vy * tube[16] + vz * tube[17]
+    q = (c1 * c1 + c2 * c2) / (s * s)
+    if c3 != 0.0:
+        cap = tube[18] if raw < 0.5 else tube[19]
+        if cap <= 0.0:
+            return np.inf
+        q += (c3 / cap) ** 2
+    return math.sqrt(q)
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def own_by_tubes(mask, lo, tubes, out):
+def own_by_tubes(mask, lo, tubes, z_reach, out):
     """``out[x, y, z]`` = 1 + the bone whose tube holds mask voxel ``(x, y, z) + lo`` deepest relative to its
-    size (the least :func:`tube_distance`); 0 outside the mask."""
+    size (the least :func:`tube_distance`); 0 outside the mask. ``z_reach[b]``: the slices (of ``mask``) bone b's
+    tube can hold a voxel in; a voxel no tube holds is measured against every bone."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
     for z in numba.prange(nz):
+        near = np.empty(nb, np.int64)
+        m = 0
+        for b in range(nb):
+            if z_reach[b, 0] <= z <= z_reach[b, 1]:
+                near[m] = b
+                m += 1
         for y in range(ny):
             for x in range(nx):
                 if not mask[x, y, z]:
                     continue
+                px, py, pz = x + lo[0], y + lo[1], z + lo[2]
                 best, who = np.inf, 0
-                for b in range(nb):
-                    d = tube_distance(tubes[b], x + lo[0], y + lo[1], z + lo[2])
+                for i in range(m):
+                    d = tube_distance(tubes[near[i]], px, py, pz)
                     if d < best:
-                        best, who = d, b + 1
+                        best, who = d, near[i] + 1
+                if best >= 1.0:  # held by no tube near: the relatively nearest of all
+                    for b in range(nb):
+                        d = tube_distance(tubes[b], px, py, pz)
+                        if d < best:
+                            best, who = d, b + 1
                 out[x, y, z] = who
 
 
@@ -66,3 +93,106 @@ def label_boxes(labels, boxes):
                     boxes[k, 1], boxes[k, 4] = min(boxes[k, 1], y), max(boxes[k, 4], y)
                     boxes[k, 5] = z
                     boxes[k, 2] = min(boxes[k, 2], z)
+
+
+@njit(cache=True, nogil=True)
+def section_moments(mask, lo, tubes, step, sums):
+    """For the mask voxels on a lattice of ``step`` voxels: the bone whose tube holds each deepest (as
+    :func:`own_by_tubes`) and, where it lies in the middle of that bone (0.3 < t < 0.7), its offset v from
+    the bone's segment into ``sums[b]``: count, the sums of v (3) and of v v^T (xx xy xz yy yz zz)."""
+    nx, ny, nz = mask.shape
+    nb = tubes.shape[0]
+    for z in range(0, nz, step):
+        for y in range(0, ny, step):
+            for x in range(0, nx, step):
+                if not mask[x, y, z]:
+                    continue
+                px, py, pz = x + lo[0], y + lo[1], z + lo[2]
+                best, who = np.inf, -1
+                for b in range(nb):
+                    d = tube_distance(tubes[b], px, py, pz)
+                    if d < best:
+                        best, who = d, b
+                if who < 0:
+                    continue
+                tube = tubes[who]
+                dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
+                t = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
+                if t <= 0.3 or t >= 0.7:
+                    continue
+                vx, vy, vz = dx - t * tube[3], dy - t * tube[4], dz - t * tube[5]
+                s = sums[who]
+                s[0] += 1.0
+                s[1] += vx
+                s[2] += vy
+                s[3] += vz
+                s[4] += vx * vx
+                s[5] += vx * vy
+                s[6] += vx * vz
+                s[7] += vy * vy
+                s[8] += vy * vz
+                s[9] += vz * vz
+
+
+@njit(cache=True, nogil=True)
+def row_ends(labels, n_bones):
+    """Each label's first and last voxel on every row ``(y, z)`` of ``labels`` ``[x, y, z]``: ``(points (N, 3),
+    label (N,))``, every vertex of each label's convex hull among them."""
+    nx, ny, nz = labels.shape
+    first = np.full(n_bones + 1, -1, np.int64)
+    last = np.full(n_bones + 1, -1, np.int64)
+    cap = 2 * ny * nz * 4
+    pts = np.empty((cap, 3), np.int64)
+    lab = np.empty(cap, np.int64)
+    n = 0
+    for z in range(nz):
+        for y in range(ny):
+            first[:] = -1
+            for x in range(nx):
+                v = labels[x, y, z]
+                if v == 0 or v > n_bones:
+                    continue
+                if first[v] < 0:
+                    first[v] = x
+                last[v] = x
+            for v in range(1, n_bones + 1):
+                if first[v] < 0:
+                    continue
+                for x in (first[v], last[v]):
+                    if n == cap:  # grow: more labels on a row than four
+                        cap *= 2
+                        p2 = np.empty((cap, 3), np.int64)
+                        p2[:n] = pts[:n]
+                        l2 = np.empty(cap, np.int64)
+                        l2[:n] = lab[:n]
+                        pts, lab = p2, l2
+                    pts[n, 0], pts[n, 1], pts[n, 2] = x, y, z
+                    lab[n] = v - 1
+                    n += 1
+    return pts[:n], lab[:n]
+
+
+@njit(cache=True, nogil=True)
+def row_spans(labels, spans):
+    """``spans[l - 1, y, z]`` = the first and last x of label l on row ``(y, z)`` of ``labels`` ``[x, y, z]``
+    (``spans`` filled with ``(1, 0)`` beforehand: none)."""
+    nx, ny, nz = labels.shape
+    nb = spans.shape[0]
+    for z in range(nz):
+        for y in range(ny):
+            for x in range(nx):
+                v = labels[x, y, z]
+                if v == 0 or v > nb:
+                    continue
+                s = spans[v - 1, y, z]
+                if s[1] < s[0]:
+                    s[0] = x
+                s[1] = x
+
+
+@njit(cache=True, nogil=True)
+def piece_labels(pieces, labels, out):
+    """``out[p]`` = the label of piece ``p`` (pieces of a label volume hold one label each)."""
+    fp, fl = pieces.ravel(), labels.ravel()
+    for i in range(fp.size):
+        out[fp[i]] = fl[i]

@@ -28,9 +28,19 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
-from volanim_core.rig._ownership_kernels import label_boxes, own_by_tubes
+from volanim_core.rig._ownership_kernels import (
+    TUBE_COLUMNS,
+    label_boxes,
+    own_by_tubes,
+    piece_labels,
+    row_ends,
+    row_spans,
+    section_moments,
+)
 from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.volume import tight_bounds
+
+SECTION_VOXELS = 1_000_000  # the lattice the cross-sections' moments are gathered on
 
 
 def label_dtype(n_bones: int):
@@ -52,9 +62,11 @@ class Ownership:
     bones: list[BoneSegment]
     ball_radii: np.ndarray
     geometry: Geometry = IDENTITY
-    tubes: np.ndarray | None = None  # (B, 18): the tubes the rule used (_ownership_kernels.tube_distance)
+    tubes: np.ndarray | None = None  # (B, TUBE_COLUMNS): the tubes the rule used (_ownership_kernels.tube_distance)
     path: object = None  # the file it was read from or saved to (a .tskel names it)
     _boxes: np.ndarray | None = field(default=None, repr=False)
+    _hulls: list | None = field(default=None, repr=False)
+    _spans: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.origin = tuple(int(v) for v in self.origin)
@@ -64,8 +76,8 @@ class Ownership:
         if self.labels.dtype.kind != "u":
             raise ValueError(f"ownership labels must be unsigned integers, got {self.labels.dtype}")
         if self.tubes is None:  # no tubes (all zero: a tube that holds nothing): a bone carries what it owns
-            self.tubes = np.zeros((len(self.bones), 18))
-        self.tubes = np.ascontiguousarray(self.tubes, np.float64).reshape(len(self.bones), 18)
+            self.tubes = np.zeros((len(self.bones), TUBE_COLUMNS))
+        self.tubes = np.ascontiguousarray(self.tubes, np.float64).reshape(len(self.bones), TUBE_COLUMNS)
 
     @property
     def mask(self) -> np.ndarray:
@@ -76,6 +88,36 @@ class Ownership:
         if self._boxes is None:
             self._boxes = owned_boxes(self.labels, len(self.bones), self.origin)
         return self._boxes
+
+    def hulls(self) -> list[np.ndarray]:
+        """Each bone's owned voxels' convex hull vertices ``(K, 3)`` in rest voxels (empty: owns none): a posed
+        bone's voxels lie within its hull's vertices moved, so its posed box is tight whatever the turn."""
+        if self._hulls is None:
+            from scipy.spatial import ConvexHull, QhullError
+
+            pts, lab = row_ends(self.labels, len(self.bones))
+            pts = pts + np.asarray(self.origin)
+            order = np.argsort(lab, kind="stable")
+            starts = np.searchsorted(lab[order], np.arange(len(self.bones) + 1))
+            hulls = []
+            for b in range(len(self.bones)):
+                mine = pts[order[starts[b]:starts[b + 1]]].astype(np.float64)
+                try:
+                    hulls.append(mine[ConvexHull(mine).vertices] if len(mine) > 8 else mine)
+                except QhullError:  # flat or a line: its row ends bound it as well
+                    hulls.append(mine)
+            self._hulls = hulls
+        return self._hulls
+
+    def spans(self) -> np.ndarray:
+        """``(B, Y, Z, 2)`` int32: each bone's first and last x on each row of :attr:`labels` (x1 < x0: none),
+        so a bone moved by whole voxels reads only its own stretch of each row."""
+        if self._spans is None:
+            spans = np.empty((len(self.bones), *self.labels.shape[1:], 2), np.int32)
+            spans[..., 0], spans[..., 1] = 1, 0
+            row_spans(self.labels, spans)
+            self._spans = spans
+        return self._spans
 
     def counts(self) -> np.ndarray:
         """Each bone's owned voxels."""
@@ -96,6 +138,16 @@ class Ownership:
         return out
 
 
+def tube_reach(tube: np.ndarray) -> float:
+    """How far a tube (a row :func:`~volanim_core.rig._ownership_kernels.tube_distance` reads) reaches from its
+    segment: its largest semi-axis at its thicker end, or a cap (0: a tube that holds nothing)."""
+    scale = max(tube[7], tube[7] + tube[8])
+    norms = [float(np.linalg.norm(tube[9 + 3 * i:12 + 3 * i])) for i in range(2)]
+    if scale <= 0 or min(norms) <= 0:
+        return 0.0
+    return float(max(scale / min(norms), tube[18], tube[19]))
+
+
 def owned_boxes(labels: np.ndarray, n_bones: int, origin=(0, 0, 0)) -> np.ndarray:
     """``(n_bones, 6)`` inclusive boxes of each label's voxels, shifted by ``origin`` (x1 < x0 for none)."""
     boxes = np.zeros((n_bones, 6), np.int64)
@@ -106,7 +158,7 @@ def owned_boxes(labels: np.ndarray, n_bones: int, origin=(0, 0, 0)) -> np.ndarra
     return boxes
 
 
-def tube_radii(conn: Connectivity, depth: np.ndarray, lo: np.ndarray) -> np.ndarray:
+def tube_radii(conn: Connectivity, box: np.ndarray, lo: np.ndarray) -> np.ndarray:
     """``(B, 2)``: each bone's tube radius at its proximal and distal joint, from its own points' fit
     (:func:`~volanim_core.rig.limb_tubes.tube_profiles`); a bone too short or too bare for a fit takes the
     median depth of its points, else the body's depth at its middle, else one voxel."""
@@ -125,8 +177,7 @@ def tube_radii(conn: Connectivity, depth: np.ndarray, lo: np.ndarray) -> np.ndar
             r = float(np.median(mine))
         else:
             mid = np.round((segments[k, :3] + segments[k, 3:]) / 2 - lo).astype(int)
-            inside = (mid >= 0).all() and (mid < depth.shape).all()
-            r = float(depth[tuple(mid)]) if inside else 0.0
+            r = body_depth(box, mid)
         tubes[k] = max(r, 1.0)
     return np.maximum(tubes, 0.5)
 
@@ -149,8 +200,6 @@ def _bone_skeleton(segments: list[BoneSegment]):
 def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None = None) -> Ownership:
     """Each voxel of ``mask`` (the rest body, ``[x, y, z]`` on the skeleton's grid) given to one bone of
     ``conn`` (module docstring). ``geometry``: the grid's (default: the connectivity's)."""
-    import edt
-
     mask = np.asarray(mask) != 0
     if not len(conn.bones):
         raise ValueError("ownership needs at least one bone")
@@ -159,39 +208,43 @@ def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None
         raise ValueError("ownership needs a body: the mask is empty")
     lo = np.asarray(b.lo)
     box = np.asfortranarray(mask[b.slices()])
-    depth = edt.edt(np.pad(box, 1), black_border=True, parallel=0)[1:-1, 1:-1, 1:-1]
-    radii = tube_radii(conn, depth, lo)
+    radii = tube_radii(conn, box, lo)
     a = np.array([s.proximal for s in conn.bones], np.float64)
     ab = np.array([s.distal - s.proximal for s in conn.bones], np.float64)
     labels = np.zeros(box.shape, label_dtype(len(conn.bones)), order="F")
-    round_tubes = tube_rows(a, ab, radii, [None] * len(a))
-    own_by_tubes(box, lo.astype(np.float64), round_tubes, labels)
-    tubes = tube_rows(a, ab, radii, [cross_section(labels, lo, k, a[k], ab[k]) for k in range(len(a))])
-    own_by_tubes(box, lo.astype(np.float64), tubes, labels)
+    tubes = tube_rows(a, ab, radii, cross_sections(box, lo, tube_rows(a, ab, radii, [None] * len(a))))
+    own_by_tubes(box, lo.astype(np.float64), tubes, _z_reach(tubes, lo[2]), labels)
     join_specks(labels, len(a))
-    balls = np.array([_depth_at(depth, s.proximal - lo) for s in conn.bones])
+    balls = np.array([_ball_inside(box, s.proximal - lo) for s in conn.bones])
     return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes)
 
 
+def _z_reach(tubes: np.ndarray, z0: int) -> np.ndarray:
+    """``(B, 2)`` the slices (counted from ``z0``) each tube can hold a voxel in."""
+    out = np.zeros((len(tubes), 2), np.int64)
+    for b, tube in enumerate(tubes):
+        r = tube_reach(tube)
+        zs = (tube[2], tube[2] + tube[5])
+        out[b] = (np.floor(min(zs) - r) - z0 - 1, np.ceil(max(zs) + r) - z0 + 1) if r > 0 else (1, 0)
+    return out
+
+
 def tube_rows(a: np.ndarray, ab: np.ndarray, radii: np.ndarray, sections: list) -> np.ndarray:
-    """``(B, 18)`` tubes as :func:`~volanim_core.rig._ownership_kernels.tube_distance` reads them: each bone's
-    segment, its taper (``radii`` at both joints, relative to the middle) and its cross-section (``sections[k]``:
-    ``(axes (2, 3), semi-axes (2,))`` from :func:`cross_section`, None: round, of the middle's radius)."""
-    rows = np.zeros((len(a), 18))
+    """``(B, TUBE_COLUMNS)`` tubes as :func:`~volanim_core.rig._ownership_kernels.tube_distance` reads them: each
+    bone's segment, its taper (``radii`` at both joints, relative to the middle), its cross-section
+    (``sections[k]``: ``(axes (2, 3), semi-axes (2,))`` from :func:`cross_section`, None: round, of the middle's
+    radius), ending round past both joints."""
+    rows = np.zeros((len(a), TUBE_COLUMNS))
     for k in range(len(a)):
         length2 = float(ab[k] @ ab[k])
         mid = max(0.5 * (radii[k, 0] + radii[k, 1]), 0.5)
         u = ab[k] / np.sqrt(length2) if length2 > 0 else np.array([0.0, 0.0, 1.0])
-        if sections[k] is None:
-            e = _perpendiculars(u)
-            semi = (mid, mid)
-        else:
-            e, semi = sections[k]
+        e, semi = (_perpendiculars(u), (mid, mid)) if sections[k] is None else sections[k]
         rows[k, :3], rows[k, 3:6], rows[k, 6] = a[k], ab[k], 1.0 / length2 if length2 > 0 else 0.0
         rows[k, 7], rows[k, 8] = radii[k, 0] / mid, (radii[k, 1] - radii[k, 0]) / mid
-        # the end caps: stretched along the axis as far as the section's larger semi-axis
-        for i, (axis, r) in enumerate(((e[0], semi[0]), (e[1], semi[1]), (u, max(semi)))):
-            rows[k, 9 + 3 * i:12 + 3 * i] = axis / r
+        rows[k, 9:12], rows[k, 12:15], rows[k, 15:18] = e[0] / semi[0], e[1] / semi[1], u
+        # past a joint the tube ends round, as far as its larger semi-axis reaches at that end
+        rows[k, 18:20] = max(semi) * np.array([radii[k, 0], radii[k, 1]]) / mid
     return rows
 
 
@@ -201,71 +254,84 @@ def _perpendiculars(u: np.ndarray) -> np.ndarray:
     return np.array([e1, np.cross(u, e1)])
 
 
-def cross_section(labels: np.ndarray, lo: np.ndarray, k: int, a: np.ndarray, ab: np.ndarray):
-    """Bone k's cross-section in the middle of its own voxels (0.3 < t < 0.7): the principal axes of their
-    offsets from the segment and the semi-axes of the filled ellipse with those moments (2 sigma); None for
-    a bone with too few voxels there or a flat one."""
-    length2 = float(ab @ ab)
-    if length2 <= 0:
-        return None
-    v = np.argwhere(labels == k + 1)
-    if len(v) < 50:
-        return None
-    if len(v) > 200_000:
-        v = v[:: len(v) // 200_000]
-    p = v + lo - a
-    t = p @ ab / length2
-    p = p[(t > 0.3) & (t < 0.7)]
-    t = t[(t > 0.3) & (t < 0.7)]
-    if len(p) < 50:
-        return None
-    perp = p - np.outer(t, ab)
-    w, e = np.linalg.eigh(np.cov(perp.T))
-    axes = e[:, ::-1][:, :2].T  # the two largest
-    semi = 2.0 * np.sqrt(np.maximum(w[::-1][:2], 0.0))
-    if semi.min() < 0.5:
-        return None
-    return axes, semi
+def cross_sections(box: np.ndarray, lo: np.ndarray, round_tubes: np.ndarray) -> list:
+    """Each bone's cross-section in its middle (0.3 < t < 0.7), from the voxels its round tube holds deepest:
+    the principal axes of their offsets from the segment and the semi-axes of the filled ellipse with those
+    moments (2 sigma); None for a bone with too few voxels there, or a flat one. Moments are gathered on a
+    lattice of about 1 M voxels (SECTION_VOXELS): an ellipse's moments need no more."""
+    step = max(1, int(np.ceil((box.size / SECTION_VOXELS) ** (1 / 3))))
+    sums = np.zeros((len(round_tubes), 10))
+    section_moments(box, lo.astype(np.float64), round_tubes, step, sums)
+    out = []
+    for s in sums:
+        if s[0] < 30:
+            out.append(None)
+            continue
+        mean = s[1:4] / s[0]
+        xx, xy, xz, yy, yz, zz = s[4:] / s[0]
+        cov = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]) - np.outer(mean, mean)
+        w, e = np.linalg.eigh(cov)
+        semi = 2.0 * np.sqrt(np.maximum(w[::-1][:2], 0.0))
+        out.append(None if semi.min() < 0.5 else (e[:, ::-1][:, :2].T, semi))
+    return out
 
 
 def join_specks(labels: np.ndarray, n_bones: int) -> int:
     """Give each piece of a bone's voxels cut off from its largest piece (26-connected) to the bone its
     neighbours mostly belong to, in place; returns the voxels moved. Why: the tube rule can leave a speck
     of one bone inside another's flesh (a voxel of spine in the shoulder), which then stays behind, alone,
-    when the limb around it moves."""
+    when the limb around it moves. cc3d labels every bone's pieces in one pass over the label volume."""
+    import cc3d
     from scipy import ndimage
 
-    moved = 0
-    boxes = owned_boxes(labels, n_bones)
+    pieces = cc3d.connected_components(labels, connectivity=26)
+    stats = cc3d.statistics(pieces)
+    sizes = np.asarray(stats["voxel_counts"])
+    owner = np.zeros(len(sizes), np.int64)
+    piece_labels(np.asfortranarray(pieces).T, labels.T, owner)  # the same F-ordered voxels, C views
+    largest = np.zeros(n_bones + 1, np.int64)
+    for piece in np.argsort(sizes)[::-1]:  # each bone's first piece seen is its largest
+        if piece and owner[piece] and largest[owner[piece]] == 0:
+            largest[owner[piece]] = piece
     ball = np.ones((3, 3, 3), bool)
-    for k in range(n_bones):
-        if boxes[k, 3] < boxes[k, 0]:
+    moved = 0
+    for piece in np.flatnonzero((owner > 0) & (np.arange(len(sizes)) > 0)):
+        if largest[owner[piece]] == piece:
             continue
-        sl = tuple(slice(max(0, int(boxes[k, i]) - 1), int(boxes[k, 3 + i]) + 2) for i in range(3))
-        region = labels[sl]
-        pieces, n = ndimage.label(region == k + 1, ball)
-        if n < 2:
-            continue
-        sizes = np.bincount(pieces.ravel())
-        sizes[0] = 0
-        keep = int(sizes.argmax())
-        for piece, where in enumerate(ndimage.find_objects(pieces), start=1):
-            if piece == keep or where is None:
-                continue
-            grown = tuple(slice(max(0, w.start - 1), w.stop + 1) for w in where)
-            mine = pieces[grown] == piece
-            ring = ndimage.binary_dilation(mine, ball) & ~mine
-            around = region[grown][ring]
-            around = around[(around != 0) & (around != k + 1)]
-            if len(around):
-                region[grown][mine] = np.bincount(around).argmax()
-                moved += int(mine.sum())
+        box = stats["bounding_boxes"][piece]
+        grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in box)
+        mine = pieces[grown] == piece
+        ring = ndimage.binary_dilation(mine, ball) & ~mine
+        around = labels[grown][ring]
+        around = around[(around != 0) & (around != owner[piece])]
+        if len(around):
+            labels[grown][mine] = np.bincount(around).argmax()
+            moved += int(mine.sum())
     return moved
 
 
-def _depth_at(depth: np.ndarray, p: np.ndarray) -> float:
+def body_depth(box: np.ndarray, p) -> float:
+    """The distance from voxel ``p`` of ``box`` (the body) to the nearest voxel outside it (0 outside the body;
+    beyond the box is outside). A window around p, doubled until it holds an outside voxel: the few joints
+    asked about need no distance transform of the whole body."""
+    p = np.asarray(p, int)
+    if (p < 0).any() or (p >= box.shape).any() or not box[tuple(p)]:
+        return 0.0
+    r = 4
+    while True:
+        lo, hi = p - r, p + r + 1
+        inner = box[tuple(slice(max(0, a), min(n, b)) for a, b, n in zip(lo, hi, box.shape))]
+        edge = ((lo < 0) | (hi > np.array(box.shape))).any()
+        outside = np.argwhere(~inner) + np.maximum(lo, 0)
+        best = float(np.sqrt(((outside - p) ** 2).sum(1).min())) if len(outside) else np.inf
+        if edge:  # beyond the box is outside: the nearest face of the box counts
+            best = min(best, float(np.min(np.concatenate([p + 1, np.array(box.shape) - p]))))
+        if best <= r:
+            return best
+        r *= 2
+
+
+def _ball_inside(box: np.ndarray, p: np.ndarray) -> float:
     """A radius whose ball around ``p`` lies inside the body: the depth at the nearest voxel less the way to it."""
     v = np.round(p).astype(int)
-    if (v < 0).any() or (v >= depth.shape).any():
-        return 0.0
-    return max(0.0, float(depth[tuple(v)]) - float(np.linalg.norm(p - v)))
+    return max(0.0, body_depth(box, v) - float(np.linalg.norm(p - v)))
