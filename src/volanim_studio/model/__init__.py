@@ -8,6 +8,7 @@
     selection.py ........ cube and lasso selection of skeleton points (pure NumPy)
     interaction.py ...... the cube, lasso, pose and bone modes: pick events in, model calls out
     attachments.py ...... which bone each skeleton point is attached to
+    ownership_state.py .. which bone moves each voxel of the body (the default body), and the animator's repaints
     bone_edits.py ....... edits of the bone skeleton, attachments following renumbered bones
     proposal.py ......... auto-rig's proposal, previewed before the user accepts it
     posing.py ........... the pose being previewed: per-bone rotations and shifts driving FK

@@ -35,6 +35,7 @@ from volanim_core.skeleton.points import Skeleton
 from .attachments import Attachments
 from .bone_edits import BoneEdits
 from .events import EventEmitter
+from .ownership_state import OwnershipState
 from .posing import PoseState
 from .proposal import BoneProposal
 from .settings import Settings
@@ -46,8 +47,8 @@ from .undo import UndoStack
 #: (A clip or keys matter through the pose they set: the timeline's own event is not one of these. Nor is the
 #: transfer function: the picture is drawn again in its colours at once, and no verdict depends on them.)
 STALE_AFTER = (("attachments", "the attachments"), ("bones", "the bones"), ("pose", "the pose"),
-               ("thinness", "the thinness"), ("skeleton", "the skeleton"))
-STALE_AFTER_SETTINGS = ("preview_mode", "preview_kernel", "preview_padding", "joints", "blend")
+               ("thinness", "the thinness"), ("skeleton", "the skeleton"), ("ownership", "the ownership"))
+STALE_AFTER_SETTINGS = ("preview_mode", "preview_kernel", "preview_padding", "joints", "blend", "body")
 
 
 class Document:
@@ -57,7 +58,7 @@ class Document:
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
                                    "point_selection", "pose", "pose_settled", "preview", "timeline", "camera",
-                                   "transfer", "stale")
+                                   "transfer", "stale", "ownership")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
@@ -82,6 +83,7 @@ class Document:
         self.bone_edits = BoneEdits(self)
         self.proposal = BoneProposal(self)
         self.attachments = Attachments(self)
+        self.ownership = OwnershipState(self)
         self.pose = PoseState(self)
         self.timeline = Timeline(self)
         self.transfer = TransferState(self)

@@ -9,6 +9,7 @@
         selection  the selected bones (by joints), the clicked joint and point
         camera     the view's camera (the scene lends doc.view_camera; doc.set_camera puts one back)
         transfer   the user's transfer function (None: each mode's own look)
+        ownership  the animator's repaints of which bone owns which voxels (None: none)
 
     write_project --> part.save(doc, path)          one JSON value per part
     read_project  --> part.parse(value, path)       checked before anything is applied (FormatError names the file)
@@ -34,6 +35,7 @@ import numpy as np
 from volanim_core.errors import FormatError
 
 from . import transfer
+from .ownership_state import OwnershipState
 from .posing import PoseState
 from .timeline import Timeline
 
@@ -169,6 +171,8 @@ PARTS: tuple[Part, ...] = (
     Part("camera", lambda doc, _: doc.camera_now(), _object("camera", check_camera), _apply_camera),
     Part("transfer", lambda doc, _: transfer.to_json(doc.transfer.function), transfer.parse,
          lambda doc, tf, _: doc.transfer._write(tf) or []),
+    Part("ownership", lambda doc, _: doc.ownership.to_json(), OwnershipState.parse,
+         lambda doc, paints, _: doc.ownership.restore(paints)),
 )
 
 #: Where each Document attribute is kept by a project (a part, a data file, a key of the manifest), or why
@@ -194,6 +198,7 @@ ATTRIBUTES = {
     "only_unconnected": "a filter of the Connect tab, per visit",
     "only_working": "a filter of the Connect tab, per visit", "cube_centre": "placed again with a click in Cube mode",
     "point_selection": "the last cube or lasso, per visit", "transfer": "the transfer part",
+    "ownership": "the ownership part (the repaints; the ownership itself is made again from the volume)",
 }
 
 

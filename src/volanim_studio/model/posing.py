@@ -42,17 +42,18 @@ class PoseState:
 
         from .preview import make_preview
 
-        key = (self.rest_version, self.doc.thinness, mode)
+        key = (self.rest_version, self.doc.thinness, mode, self.doc.settings.body, self.doc.ownership.version)
         if self._rest_preview is None or self._rest_preview[0] != key:
             tskel = self.tskel()
             if not len(tskel):
                 return None
-            self._rest_preview = (key, make_preview(identity_tskel(tskel.connectivity), mode=mode,
-                                                    source=self.doc.volume))
+            rest = self.doc.ownership.attach(identity_tskel(tskel.connectivity))  # owned: the ownership itself
+            self._rest_preview = (key, make_preview(rest, mode=mode, source=self.doc.volume))
         return self._rest_preview[1]
 
     def _rest_key(self, tskel: Tskel) -> tuple:
-        return (self.doc.thinness, len(tskel), tskel.joints)  # smooth joints label the rest voxels by blend
+        # smooth joints label the rest voxels by blend; the owned body's rest is its ownership, repaints and all
+        return (self.doc.thinness, len(tskel), tskel.joints, self.doc.settings.body, self.doc.ownership.version)
 
     def rest_parts(self, tskel: Tskel):
         """The kept :class:`~volanim_core.reconstruct.breakage.RestParts` of this frame's attachments, or None."""

@@ -107,6 +107,8 @@ SETTINGS: dict[str, Setting] = {
     "preview_padding": Setting(2, number(0, 64, int), "voxels around the posed spheres"),
     "joints": Setting("rigid", one_of("rigid", "smooth"), "how bones meet: rigid, or smooth (blended near joints)"),
     "blend": Setting(1.0, number(0.1, 10), "smooth joints' blend width, times the bones' thickness"),
+    "body": Setting("owned", one_of("owned", "spheres"), "how a full preview moves the body: each voxel by the "
+                    "bone that owns it (needs the volume), or the thesis's spheres"),
     "live_preview": Setting(True, flag, "a preview while a pose slider moves (half resolution on a large body)"),
     "show_rest": Setting(False, flag, "show the rest pose's reconstruction instead (compare)"),
     # connect tools

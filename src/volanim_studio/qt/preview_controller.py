@@ -19,6 +19,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QFileDialog
 
@@ -71,6 +72,7 @@ class PreviewController(Controller):
         action("Save pose (.trans)…", lambda: self.save_dialog("trans"), menu=menu)
         action("Save frame (.tskel)…", lambda: self.save_dialog("tskel"), menu=menu)
         action("Export reconstruction…", lambda: self.save_dialog("volume"), menu=menu)
+        action("Give the cube's voxels to the working bone", lambda: self.own_cube(), menu=menu)
 
     def wire(self, pose_panel, reconstruct_panel) -> None:
         """Connect the Pose and Reconstruct tabs' buttons to this controller."""
@@ -79,6 +81,7 @@ class PreviewController(Controller):
         pose_panel.save_tskel.clicked.connect(lambda: self.save_dialog("tskel"))
         reconstruct_panel.preview_button.clicked.connect(lambda: self.preview())
         reconstruct_panel.export_button.clicked.connect(lambda: self.save_dialog("volume"))
+        reconstruct_panel.fix_lump.connect(self.fix_lump)
         reconstruct_panel.joint_clicked.connect(self.jump_to_joint)
 
     @property
@@ -231,8 +234,11 @@ class PreviewController(Controller):
             if report and not self.jobs.busy:  # (busy: what the picture set off started a job of its own)
                 self._report(p, tskel)
 
+        owned = self.doc.ownership  # the rig's ownership is made in the worker (once per rig), with the repaints
+
         worker = self.jobs.run("Reconstructing", lambda progress, cancel: make_preview(
-            tskel, **settings, source=source, progress=progress, cancel=cancel), done, background=background)
+            owned.attach(tskel), **settings, source=source, progress=progress, cancel=cancel), done,
+            background=background)
         worker.is_preview = True
         return worker
 
@@ -249,8 +255,10 @@ class PreviewController(Controller):
             if self.doc.preview is shown:
                 self.doc.set_preview(p)
 
+        owned = self.doc.ownership
         worker = self.jobs.run("Checking the pose for breakage", lambda progress, cancel: with_report(
-            shown, tskel, joints=joints, posed_joints=posed, rest_parts=rest, cancel=cancel), done, background=True)
+            shown, owned.attach(tskel), joints=joints, posed_joints=posed, rest_parts=rest, cancel=cancel), done,
+            background=True)
         worker.is_preview = True
 
     def jump_to_joint(self, name: str) -> None:
@@ -258,6 +266,48 @@ class PreviewController(Controller):
         if name in posed:
             self.scene.jump_to(posed[name])
             self.doc.message(f"Centred on {name}. {self.fix_hint(name)}, then preview again (F5).")
+
+    def fix_lump(self, k: int) -> None:
+        """The shown report's lump ``k`` fixed: the rest voxels it was made of given to the bone it belongs to
+        (a repaint of the ownership, one undo step), then the preview made again. The ownership is the one the
+        preview moved (made in its worker and kept), so this is quick."""
+        p = self.doc.preview
+        report = p.report if p is not None else None
+        if report is None or not 0 <= k < len(report.lumps):
+            return
+        lump = report.lumps[k]
+        names = [b.label for b in self.doc.bones.bones]
+        if self.doc.settings.body != "owned" or not self.doc.ownership.available:
+            self.show_error("Fix lump", "a lump is fixed by repainting ownership: choose Body: owned and open the "
+                                        "volume, or give the points there to another bone (Lasso, L)")
+            return
+        if lump.belongs_to not in names:
+            self.show_error("Fix lump", f"the lump near {lump.near} names no bone to give its flesh to")
+            return
+        tskel, matrices = self.doc.pose.tskel(), self.doc.pose.matrices()
+        owned = self.doc.ownership
+
+        def done(own) -> None:
+            if own is None:
+                self.show_error("Fix lump", "nothing attached: connect points to bones first")
+                return
+            n = owned.fix_lump(own, matrices, lump, names.index(lump.belongs_to))
+            self.doc.message(f"Gave {n:,} voxels near {lump.near} to {lump.belongs_to}; previewing again.")
+            self.preview()
+
+        self.jobs.run("Ownership", lambda progress, cancel: owned.of(tskel.connectivity), done)
+
+    def own_cube(self) -> None:
+        """Repaint ownership: the body's voxels inside the cube (Cube mode places it) go to the working bone."""
+        bone, centre = self.doc.working_bone, self.doc.cube_centre
+        if bone is None or centre is None:
+            self.show_error("Ownership", "place the cube (Cube mode) and choose the working bone first")
+            return
+        half = self.doc.settings.cube_size / 2
+        lo, hi = np.ceil(np.asarray(centre) - half), np.floor(np.asarray(centre) + half)
+        self.attempt("Ownership", lambda: self.doc.ownership.paint_box(lo, hi, bone),
+                     f"The body inside the cube now moves with {self.doc.bones.bones[bone].label} (Ctrl+Z undoes); "
+                     "preview again (F5).")
 
     def fix_hint(self, joint: str) -> str:
         """What to do about the finding near ``joint``, naming the bone to give the points to (#83: "Fix the

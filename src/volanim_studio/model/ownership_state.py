@@ -1,0 +1,214 @@
+"""The rig's ownership in the studio: which bone moves each voxel of the body, and the animator's repaints. Qt-free.
+
+    doc.mask (the segmented volume) + the attachments (at the thinness) --rig/ownership.py, in the preview's
+    worker, once per rig--> Ownership --the repaints, in order--> what full previews move (the default body)
+    paint_box / paint_voxels / fix_lump --> one undo step each --> the repaints (saved as the project's
+        "ownership" part: each as its bone and a box, or runs of voxel indices) --> events.ownership
+
+Why here and not in the attachments: the thesis's points choose which spheres grow; ownership chooses which
+bone each voxel of the scan follows (#84). Repaints are kept as edits on top of the made ownership, so a
+changed attachment makes it again and the animator's fixes still hold where they were painted.
+"""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+from volanim_core.errors import FormatError
+from volanim_core.rig.connectivity import Tskel
+from volanim_core.rig.ownership import Ownership, ownership
+
+
+class OwnershipState:
+    def __init__(self, doc):
+        self.doc = doc
+        # ((bone, ("box", lo, hi) | ("voxels", flat indices, Fortran order)), ...): replaced whole, never changed
+        self.paints: tuple = ()
+        self._made = None  # (key, Ownership before the paints)
+        self._lock = threading.Lock()  # the preview's worker makes it while the GUI thread may ask again
+        self.version = 0  # counts repaints: a preview made before one is old
+        for event in ("attachments", "bones", "volume", "skeleton", "thinness"):
+            getattr(doc.events, event).connect(lambda **_: self._forget())
+
+    def _forget(self) -> None:
+        self._made = None
+
+    @property
+    def available(self) -> bool:
+        """Whether the body can be moved by ownership: a segmented volume on the skeleton's grid."""
+        return self.doc.mask is not None and self.doc.skeleton is not None and len(self.doc.bones) > 0
+
+    # ------------------------------------------------------------------ making
+    def of(self, conn) -> Ownership | None:
+        """The ownership of ``conn`` (the attachments at the thinness) over the document's mask, with the
+        repaints; None when it cannot be made (no volume, nothing attached). Made once per rig, in the caller's
+        thread: call it from a worker."""
+        if not self.available or not len(conn):
+            return None
+        key = (id(self.doc.mask), len(conn), conn.points.tobytes().__hash__(), conn.bone.tobytes().__hash__(),
+               tuple(b.label for b in conn.bones))
+        with self._lock:
+            made = self._made
+        if made is None or made[0] != key:
+            made = (key, ownership(self.doc.mask, conn))
+            with self._lock:
+                self._made = made
+        return self._painted(made[1], self.paints)
+
+    def _painted(self, own: Ownership, paints) -> Ownership:
+        if not paints:
+            return own
+        full = own.volume(self.doc.mask.shape)
+        flat = full.reshape(-1, order="F")  # a view: full is Fortran-ordered
+        for bone, (kind, *where) in paints:
+            if bone >= len(own.bones):
+                continue  # a bone removed since: its repaint has nothing to give to
+            idx = _box_indices(where[0], where[1], full.shape) if kind == "box" else where[0]
+            idx = idx[flat[idx] != 0]  # only the body: a repaint moves flesh, never makes it
+            flat[idx] = bone + 1
+        lo = np.asarray(own.origin)
+        labels = np.asfortranarray(full[tuple(slice(o, o + n) for o, n in zip(lo, own.labels.shape))])
+        return own.with_labels(labels)
+
+    def attach(self, tskel: Tskel) -> Tskel:
+        """``tskel`` with its rig's ownership when the preview moves the body by it (the default body, rigid
+        joints, a volume loaded); as it is otherwise. Runs in the preview's worker."""
+        if self.doc.settings.body != "owned" or tskel.joints.smooth:
+            return tskel
+        own = self.of(tskel.connectivity)
+        if own is None:
+            return tskel
+        conn = tskel.connectivity.with_ownership(own)
+        return conn.posed(tskel.matrices)
+
+    # ------------------------------------------------------------------ repainting
+    def _set(self, paints: tuple) -> None:
+        self.paints = paints
+        self.version += 1
+        self.doc.events.ownership.emit()
+
+    def _push(self, label: str, paint) -> None:
+        from .undo import Command
+
+        old, new = self.paints, (*self.paints, paint)
+        self.doc.undo.push(Command(label, lambda: self._set(new), lambda: self._set(old)))
+
+    def paint_box(self, lo, hi, bone: int) -> None:
+        """The body's voxels in the box ``lo..hi`` (inclusive, rest voxels) to ``bone``: one undo step."""
+        self._check(bone)
+        lo, hi = np.asarray(lo, int), np.asarray(hi, int)
+        self._push(f"Own box by {self.doc.bones.bones[bone].label}", (bone, ("box", lo, hi)))
+
+    def paint_voxels(self, indices, bone: int, label: str | None = None) -> None:
+        """The body's voxels at flat ``indices`` (Fortran order over the volume's grid) to ``bone``."""
+        self._check(bone)
+        indices = np.unique(np.asarray(indices, np.int64))
+        if not len(indices):
+            return
+        self._push(label or f"Own {len(indices)} voxels by {self.doc.bones.bones[bone].label}",
+                   (bone, ("voxels", indices)))
+
+    def _check(self, bone: int) -> None:
+        if not 0 <= bone < len(self.doc.bones):
+            raise ValueError(f"no bone {bone}")
+        if not self.available:
+            raise ValueError("ownership needs the volume: open it (File → Open volume)")
+
+    def fix_lump(self, own: Ownership, matrices: np.ndarray, lump, to_bone: int) -> int:
+        """Give the rest voxels a lump was made of to ``to_bone``: each owned voxel whose posed place lies in
+        the lump's box (``lump.lo..hi``) and whose bone is not ``to_bone``. One undo step; returns the voxels."""
+        full = own.volume(self.doc.mask.shape)
+        idx = np.flatnonzero(full.reshape(-1, order="F"))
+        xyz = np.column_stack(np.unravel_index(idx, full.shape, order="F")).astype(np.float64)
+        bone = full.reshape(-1, order="F")[idx].astype(np.int64) - 1
+        posed = np.empty_like(xyz)
+        for b in np.unique(bone):
+            at = bone == b
+            posed[at] = xyz[at] @ matrices[b, :3, :3] + matrices[b, 3, :3]
+        lo, hi = np.asarray(lump.lo, float) - 0.5, np.asarray(lump.hi, float) + 0.5
+        inside = ((posed >= lo) & (posed <= hi)).all(1) & (bone != to_bone)
+        taken = idx[inside]
+        if len(taken):
+            near = getattr(lump, "near", "") or "the joint"
+            self.paint_voxels(taken, to_bone, f"Fix lump near {near}: {len(taken)} voxels to "
+                                              f"{self.doc.bones.bones[to_bone].label}")
+        return len(taken)
+
+    # ------------------------------------------------------------------ the project's part
+    def to_json(self) -> list | None:
+        if not self.paints:
+            return None
+        out = []
+        for bone, (kind, *where) in self.paints:
+            item = {"bone": self.doc.bones.bones[bone].label if bone < len(self.doc.bones) else int(bone)}
+            if kind == "box":
+                item["box"] = [int(v) for v in (*where[0], *where[1])]
+            else:
+                item["runs"] = _runs(where[0])
+            out.append(item)
+        return out
+
+    @staticmethod
+    def parse(value, path) -> list:
+        if not isinstance(value, list):
+            raise FormatError(path, "'ownership' must be a list of repaints")
+        out = []
+        for k, item in enumerate(value):
+            if not isinstance(item, dict) or "bone" not in item or ("box" in item) == ("runs" in item):
+                raise FormatError(path, f"ownership repaint {k}: a 'bone' and either a 'box' or 'runs'")
+            if "box" in item:
+                box = item["box"]
+                if not (isinstance(box, list) and len(box) == 6 and all(isinstance(v, int) for v in box)):
+                    raise FormatError(path, f"ownership repaint {k}: 'box' must be six integers x0 y0 z0 x1 y1 z1")
+                out.append((item["bone"], ("box", np.array(box[:3]), np.array(box[3:]))))
+            else:
+                runs = item["runs"]
+                if not (isinstance(runs, list) and all(isinstance(r, list) and len(r) == 2
+                                                       and all(isinstance(v, int) and v >= 0 for v in r)
+                                                       for r in runs)):
+                    raise FormatError(path, f"ownership repaint {k}: 'runs' must be [start, length] pairs")
+                out.append((item["bone"], ("voxels", _from_runs(runs))))
+        return out
+
+    def restore(self, parsed: list) -> list[str]:
+        """Put a project's repaints back (no undo step); bones named but missing are left out, with a warning."""
+        names = [b.label for b in self.doc.bones.bones]
+        paints, warnings = [], []
+        for bone, where in parsed:
+            if isinstance(bone, str):
+                if bone not in names:
+                    warnings.append(f"an ownership repaint names bone {bone!r}, which the bones no longer have: "
+                                    "left out")
+                    continue
+                bone = names.index(bone)
+            paints.append((int(bone), where))
+        self._set(tuple(paints))
+        return warnings
+
+
+def _box_indices(lo, hi, shape) -> np.ndarray:
+    lo = np.maximum(np.asarray(lo, int), 0)
+    hi = np.minimum(np.asarray(hi, int), np.asarray(shape) - 1)
+    if (hi < lo).any():
+        return np.zeros(0, np.int64)
+    axes = [np.arange(a, b + 1) for a, b in zip(lo, hi)]
+    x, y, z = np.meshgrid(*axes, indexing="ij")
+    return np.ravel_multi_index((x.ravel(), y.ravel(), z.ravel()), shape, order="F")
+
+
+def _runs(indices: np.ndarray) -> list:
+    """Sorted indices as ``[start, length]`` runs (a painted region is mostly rows of voxels)."""
+    if not len(indices):
+        return []
+    breaks = np.flatnonzero(np.diff(indices) != 1) + 1
+    starts = np.concatenate([[0], breaks])
+    ends = np.concatenate([breaks, [len(indices)]])
+    return [[int(indices[s]), int(e - s)] for s, e in zip(starts, ends)]
+
+
+def _from_runs(runs: list) -> np.ndarray:
+    if not runs:
+        return np.zeros(0, np.int64)
+    return np.concatenate([np.arange(s, s + n, dtype=np.int64) for s, n in runs])
