@@ -201,7 +201,8 @@ def thinned_radii(rest, posed, dt, sheet, pairs, floor):
 
 def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     """The ownership warp (reconstruct/owned.py) voxel by voxel: each output voxel q of ``bounds`` is bone b's
-    (first in order) when ``round([q 1] @ inv(M_b))`` is a rest voxel owned by b; then each empty voxel strictly
+    (first in order) when ``round([q 1] @ inv(M_b))`` is a rest voxel owned by b; then each rest voxel of a turned
+    bone is written where it lands, rounded, if that is empty; then each empty voxel strictly
     inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. Returns 1 + bone per voxel
     ``[x, y, z]``."""
     import math
@@ -217,6 +218,15 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
             k = np.array([int(math.floor(v + 0.5)) for v in (q @ inv[:3, :3] + inv[3, :3])]) - rest_lo
             if (k >= 0).all() and (k < labels.shape).all() and labels[tuple(k)] == b + 1:
                 out[idx] = b + 1
+    for b, m in enumerate(matrices):  # each turned bone's rest voxels pushed to where they land, if empty
+        if np.array_equal(m[:3, :3], np.eye(3)) and np.array_equal(m[3, :3], np.round(m[3, :3])):
+            continue
+        for k in np.argwhere(labels == b + 1):
+            p = k + rest_lo
+            v = [p[0] * m[0, i] + p[1] * m[1, i] + p[2] * m[2, i] + m[3, i] for i in range(3)]  # the kernel's sums
+            q = np.array([int(math.floor(x + 0.5)) for x in v]) - lo
+            if (q >= 0).all() and (q < out.shape).all() and out[tuple(q)] == 0:
+                out[tuple(q)] = b + 1
     for centre, radius, bone in balls:
         for idx in np.ndindex(*out.shape):
             q = np.asarray(idx) + lo

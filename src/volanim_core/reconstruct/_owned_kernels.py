@@ -151,3 +151,37 @@ def posed_row_spans(spans, rest_lo, m, out_lo, out):
                             out[z, y, 0] = lo_x
                         if hi_x > out[z, y, 1]:
                             out[z, y, 1] = hi_x
+
+
+@njit(cache=True, nogil=True)
+def splat_turned(labels, spans, rest_lo, m, bone, out_lo, out, row_lo, row_hi, claims, count):
+    """Each rest voxel of a turned bone written at its posed place rounded, where no bone wrote yet. The
+    inverse read alone can step over a limb one voxel thin that a turn lays across the grid (the ant's legs
+    came apart in single voxels); every rest voxel pushed to where it lands keeps such a limb in one piece
+    (two face neighbours land at most one voxel apart on each axis). Returns the voxels written."""
+    ly, lz = spans.shape[0], spans.shape[1]
+    nz, ny, nx = out.shape
+    n = 0
+    for iz in range(lz):
+        for iy in range(ly):
+            x0, x1 = spans[iy, iz, 0], spans[iy, iz, 1]
+            if x1 < x0:
+                continue
+            py, pz = iy + rest_lo[1], iz + rest_lo[2]
+            for ix in range(x0, x1 + 1):
+                if labels[ix, iy, iz] != bone + 1:  # a row's span holds other bones' voxels and holes too
+                    continue
+                px = ix + rest_lo[0]
+                # rounded on the rest grid first, then made an index: the same voxel whatever the output's box
+                x = int(math.floor(px * m[0, 0] + py * m[1, 0] + pz * m[2, 0] + m[3, 0] + 0.5)) - out_lo[0]
+                y = int(math.floor(px * m[0, 1] + py * m[1, 1] + pz * m[2, 1] + m[3, 1] + 0.5)) - out_lo[1]
+                z = int(math.floor(px * m[0, 2] + py * m[1, 2] + pz * m[2, 2] + m[3, 2] + 0.5)) - out_lo[2]
+                if x < 0 or y < 0 or z < 0 or x >= nx or y >= ny or z >= nz or out[z, y, x] != 0:
+                    continue
+                out[z, y, x] = bone + 1
+                row_lo[z, y] = min(row_lo[z, y], x)
+                row_hi[z, y] = max(row_hi[z, y], x)
+                if count:
+                    claims[z, y, x] += 1
+                n += 1
+    return n

@@ -3,6 +3,8 @@
     Ownership (rig/ownership.py: rest labels, ball radii), matrices (B, 4, 4)
         --each bone's owned box moved by its matrix--> posed boxes; output grid (their union + padding, or bounds)
         --K.warp_owners (each output voxel read from the rest voxel its bone brings it from)--> owner [z, y, x]
+        --K.splat_turned (each turned bone's rest voxels pushed to where they land, where still empty: a limb
+                          one voxel thin that the read steps over stays in one piece)-->
         --K.close_joints (the ball at each bone's proximal joint, moved by the bone: empty voxels to the bone)-->
         --by mode--> binary (value), bone (owner), mottled (a colour per bone), hotspot (bones reaching a voxel),
                      sampled (the source at each voxel's rest point: reconstruct/sampling.py, as the spheres do)
@@ -142,6 +144,10 @@ def reconstruct_owned(
                                    slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
                                    claims[z0:z1] if count else claims, count)
             report(z1, total)
+        # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
+        spans = own.spans()
+        for b in np.flatnonzero(shifts[:, 3] == 0):
+            K.splat_turned(own.labels, spans[b], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi, claims, count)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
         volume = _by_mode(owner, claims, mode, n_bones, value)

@@ -73,29 +73,6 @@ def own_by_tubes(mask, lo, tubes, z_reach, out):
 
 
 @njit(cache=True, nogil=True)
-def label_boxes(labels, boxes):
-    """``boxes[l - 1]`` = ``x0 y0 z0 x1 y1 z1`` of label l's voxels in ``labels`` ``[x, y, z]`` (left as given,
-    ``x1 < x0``, for a label with none)."""
-    nx, ny, nz = labels.shape
-    nb = boxes.shape[0]
-    for z in range(nz):
-        for y in range(ny):
-            for x in range(nx):
-                v = labels[x, y, z]
-                if v == 0 or v > nb:
-                    continue
-                k = v - 1
-                if boxes[k, 3] < boxes[k, 0]:
-                    boxes[k, 0], boxes[k, 1], boxes[k, 2] = x, y, z
-                    boxes[k, 3], boxes[k, 4], boxes[k, 5] = x, y, z
-                else:
-                    boxes[k, 0], boxes[k, 3] = min(boxes[k, 0], x), max(boxes[k, 3], x)
-                    boxes[k, 1], boxes[k, 4] = min(boxes[k, 1], y), max(boxes[k, 4], y)
-                    boxes[k, 5] = z
-                    boxes[k, 2] = min(boxes[k, 2], z)
-
-
-@njit(cache=True, nogil=True)
 def section_moments(mask, lo, tubes, step, sums):
     """For the mask voxels on a lattice of ``step`` voxels: the bone whose tube holds each deepest (as
     :func:`own_by_tubes`) and, where it lies in the middle of that bone (0.3 < t < 0.7), its offset v from

@@ -30,7 +30,6 @@ import numpy as np
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
-    label_boxes,
     own_by_tubes,
     piece_labels,
     row_ends,
@@ -64,7 +63,6 @@ class Ownership:
     geometry: Geometry = IDENTITY
     tubes: np.ndarray | None = None  # (B, TUBE_COLUMNS): the tubes the rule used (_ownership_kernels.tube_distance)
     path: object = None  # the file it was read from or saved to (a .tskel names it)
-    _boxes: np.ndarray | None = field(default=None, repr=False)
     _hulls: list | None = field(default=None, repr=False)
     _spans: np.ndarray | None = field(default=None, repr=False)
 
@@ -82,12 +80,6 @@ class Ownership:
     @property
     def mask(self) -> np.ndarray:
         return self.labels != 0
-
-    def boxes(self) -> np.ndarray:
-        """``(B, 6)`` each bone's owned voxels' box ``x0 y0 z0 x1 y1 z1`` in rest voxels (x1 < x0: owns none)."""
-        if self._boxes is None:
-            self._boxes = owned_boxes(self.labels, len(self.bones), self.origin)
-        return self._boxes
 
     def hulls(self) -> list[np.ndarray]:
         """Each bone's owned voxels' convex hull vertices ``(K, 3)`` in rest voxels (empty: owns none): a posed
@@ -146,16 +138,6 @@ def tube_reach(tube: np.ndarray) -> float:
     if scale <= 0 or min(norms) <= 0:
         return 0.0
     return float(max(scale / min(norms), tube[18], tube[19]))
-
-
-def owned_boxes(labels: np.ndarray, n_bones: int, origin=(0, 0, 0)) -> np.ndarray:
-    """``(n_bones, 6)`` inclusive boxes of each label's voxels, shifted by ``origin`` (x1 < x0 for none)."""
-    boxes = np.zeros((n_bones, 6), np.int64)
-    boxes[:, :3] = 1
-    label_boxes(labels, boxes)
-    has = boxes[:, 3] >= boxes[:, 0]
-    boxes[has] += np.tile(np.asarray(origin, np.int64), 2)
-    return boxes
 
 
 def tube_radii(conn: Connectivity, box: np.ndarray, lo: np.ndarray) -> np.ndarray:
