@@ -97,9 +97,27 @@ def _write_ownership(args, skel, conn, mask) -> None:
     body = mask if mask is not None else _sphere_body(conn)
     own = ownership(body, conn)
     path = ownership_path(args.output)
+    of = "the scan's object" if mask is not None else "the body its spheres re-grow (give --volume for the scan's own)"
+    if args.fix_lumps:
+        own = _fixed(args, conn.with_ownership(own))
     write_ownership(path, own)
-    of = "the scan's object" if mask is not None else "the skeleton's balls (give --volume for the scan's own)"
     print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
+
+
+def _fixed(args, conn):
+    """The ownership with the lumps of the ``--fix-lumps`` poses given back to the bones they belong to."""
+    from volanim_core.rig.ownership import fix_lumps
+
+    bones = read_bones(args.bones)
+    frames = [read_trans(p).on_grid(conn.geometry) for p in args.fix_lumps]
+    own, fixes = fix_lumps(conn, frames, bones.on_grid(conn.geometry),
+                           progress=TextProgress(f"fixing lumps over {len(frames)} poses"))
+    for k, lump, n in fixes:
+        print(f"  {args.fix_lumps[k]}: lump of {lump.voxels:,} voxels near {lump.near}: {n:,} rest voxels of "
+              f"{lump.carrier} given to {lump.belongs_to}")
+    print(f"{len(fixes)} lump(s) fixed over {len(frames)} pose(s)" if fixes else
+          f"no lump in {len(frames)} pose(s): the ownership is as made")
+    return own
 
 
 def _sphere_body(conn) -> np.ndarray:
@@ -229,6 +247,9 @@ def register(sub) -> None:
     p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]",
                    help="object = LO <= v <= HI (default: every non-zero voxel)")
     p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background first")
+    p.add_argument("--fix-lumps", nargs="+", metavar="TRANS",
+                   help="test poses (.trans): each lump their report finds is given back to the bone it belongs to "
+                        "in the ownership (the studio's Fix, headless)")
     p.add_argument("--no-ownership", dest="ownership", action="store_false",
                    help="write no NAME.owners.nrrd (frames then re-grow the thesis's spheres)")
     p.add_argument("-o", "--output", required=True,

@@ -117,23 +117,17 @@ class OwnershipState:
             raise ValueError("ownership needs the volume: open it (File → Open volume)")
 
     def fix_lump(self, own: Ownership, matrices: np.ndarray, lump, to_bone: int) -> int:
-        """Give the rest voxels a lump was made of to ``to_bone``: each owned voxel whose posed place lies in
-        the lump's box (``lump.lo..hi``) and whose bone is not ``to_bone``. One undo step; returns the voxels."""
-        full = own.volume(self.doc.mask.shape)
-        idx = np.flatnonzero(full.reshape(-1, order="F"))
-        xyz = np.column_stack(np.unravel_index(idx, full.shape, order="F")).astype(np.float64)
-        bone = full.reshape(-1, order="F")[idx].astype(np.int64) - 1
-        posed = np.empty_like(xyz)
-        for b in np.unique(bone):
-            at = bone == b
-            posed[at] = xyz[at] @ matrices[b, :3, :3] + matrices[b, 3, :3]
-        lo, hi = np.asarray(lump.lo, float) - 0.5, np.asarray(lump.hi, float) + 0.5
-        inside = ((posed >= lo) & (posed <= hi)).all(1) & (bone != to_bone)
-        taken = idx[inside]
-        if len(taken):
-            near = getattr(lump, "near", "") or "the joint"
-            self.paint_voxels(taken, to_bone, f"Fix lump near {near}: {len(taken)} voxels to "
-                                              f"{self.doc.bones.bones[to_bone].label}")
+        """Give the rest voxels a lump was made of to ``to_bone``: each voxel of another bone whose posed place
+        lies in the lump's box (:meth:`Ownership.carried_into`). One undo step; returns the voxels."""
+        taken = own.carried_into(matrices, lump.lo, lump.hi, but=to_bone)
+        if not len(taken):
+            return 0
+        # indices of the labels' box -> of the volume's grid, as repaints are kept
+        xyz = np.column_stack(np.unravel_index(taken, own.labels.shape, order="F")) + np.asarray(own.origin)
+        flat = np.ravel_multi_index(tuple(xyz.T), self.doc.mask.shape, order="F")
+        near = getattr(lump, "near", "") or "the joint"
+        self.paint_voxels(flat, to_bone, f"Fix lump near {near}: {len(taken)} voxels to "
+                                         f"{self.doc.bones.bones[to_bone].label}")
         return len(taken)
 
     # ------------------------------------------------------------------ the project's part
