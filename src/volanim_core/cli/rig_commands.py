@@ -106,7 +106,7 @@ def _write_ownership(args, skel, conn, mask) -> None:
 
 def _fixed(args, conn):
     """The ownership with the lumps of the ``--fix-lumps`` poses given back to the bones they belong to."""
-    from volanim_core.rig.ownership import fix_lumps
+    from volanim_core.reconstruct.checks import fix_lumps
 
     bones = read_bones(args.bones)
     frames = [read_trans(p).on_grid(conn.geometry) for p in args.fix_lumps]

@@ -118,3 +118,34 @@ def scan(conn: Connectivity, frames: list[Trans], *, bones: BoneSkeleton | None 
 
 def scan_json(verdicts: list[FrameVerdict]) -> list[dict]:
     return [{**asdict(v), "gap": round(v.gap, 3), "healthy": v.healthy, "broken": v.broken} for v in verdicts]
+
+
+def fix_lumps(conn: Connectivity, frames: list, bones, *, rounds: int = 3, progress=None) -> tuple:
+    """The ownership of ``conn`` (which carries one) with every lump its ``frames`` (Trans) show given back: the
+    flesh each lump was made of goes to the bone it belongs to (``Lump.belongs_to``), frame after frame, the
+    frames looked at again until none shows a lump or ``rounds`` passes are done (a fix can uncover another).
+    Returns the fixed ownership and ``[(frame index, lump, voxels given)]``. The headless *Fix* of the studio
+    (``volanim connect --fix-lumps``)."""
+    own = conn.ownership
+    if own is None:
+        raise ValueError("fixing lumps repaints ownership: the connectivity has none (volanim connect makes it)")
+    names = [b.name for b in conn.bones]
+    fixes = []
+    for _ in range(rounds):
+        found = False
+        for k, trans in enumerate(frames):
+            rep = report(conn.with_ownership(own), trans, bones=bones)
+            for lump in rep.lumps:
+                if lump.belongs_to not in names:
+                    continue
+                to = names.index(lump.belongs_to)
+                taken = own.carried_into(trans.matrices, lump.lo, lump.hi, but=to)
+                if len(taken):
+                    own = own.relabelled(taken, to)
+                    fixes.append((k, lump, len(taken)))
+                    found = True
+            if progress is not None:
+                progress(k + 1, len(frames))
+        if not found:
+            break
+    return own, fixes

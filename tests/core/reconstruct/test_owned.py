@@ -143,8 +143,8 @@ def test_fix_lumps_gives_a_painted_lump_back_and_the_pose_comes_closer_to_the_tr
     """The headless Fix (rig/ownership.fix_lumps, `volanim connect --fix-lumps`): the armpit's torso flesh painted
     to the arm makes a lump when the arm is raised; fixed over that pose, the flesh goes back to the spine and
     the raised arm matches the capsules posed by the same matrices again."""
+    from volanim_core.reconstruct.checks import fix_lumps
     from volanim_core.rig.connectivity import Trans
-    from volanim_core.rig.ownership import fix_lumps
     from volanim_core.rig.pose import root_bones
 
     s, conn = mannequin_rig
