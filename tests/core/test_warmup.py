@@ -25,7 +25,7 @@ INLINED = {
     "volanim_core.reconstruct._label_kernels.group_starts",
     "volanim_core.rig._attach_kernels._path_inside",
     "volanim_core.skeleton._kernels._relax",
-    "volanim_core.reconstruct._owned_kernels._row_span",
+    "volanim_core.reconstruct._owned_kernels._moved",
     "volanim_core.rig._ownership_kernels.tube_distance",
 }
 

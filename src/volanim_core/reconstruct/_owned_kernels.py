@@ -124,6 +124,14 @@ def close_joints(out, out_lo, centres, r2s, bones, row_lo, row_hi, claims, count
                         row_hi[z, y] = max(row_hi[z, y], x)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _moved(m, px, py, pz):
+    """Rest point p moved by the row-vector matrix ``m``: ``[p 1] @ m``, the same sums in every kernel (a
+    rounding at .5 then lands alike everywhere)."""
+    return (px * m[0, 0] + py * m[1, 0] + pz * m[2, 0] + m[3, 0], px * m[0, 1] + py * m[1, 1] + pz * m[2, 1] + m[3, 1],
+            px * m[0, 2] + py * m[1, 2] + pz * m[2, 2] + m[3, 2])
+
+
 @njit(cache=True, nogil=True)
 def posed_row_spans(spans, rest_lo, m, out_lo, out):
     """Where one turned bone's voxels land, row by row: ``out[z, y]`` (filled with ``(nx, -1)`` beforehand) widened
@@ -141,9 +149,8 @@ def posed_row_spans(spans, rest_lo, m, out_lo, out):
             py, pz = iy + rest_lo[1], iz + rest_lo[2]
             for ix in range(x0, x1 + 1):
                 px = ix + rest_lo[0]
-                qx = px * m[0, 0] + py * m[1, 0] + pz * m[2, 0] + m[3, 0] - out_lo[0]
-                qy = px * m[0, 1] + py * m[1, 1] + pz * m[2, 1] + m[3, 1] - out_lo[1]
-                qz = px * m[0, 2] + py * m[1, 2] + pz * m[2, 2] + m[3, 2] - out_lo[2]
+                vx, vy, vz = _moved(m, px, py, pz)
+                qx, qy, qz = vx - out_lo[0], vy - out_lo[1], vz - out_lo[2]
                 lo_x, hi_x = int(math.floor(qx - reach)), int(math.ceil(qx + reach))
                 for z in range(max(0, int(math.ceil(qz - reach))), min(nz - 1, int(math.floor(qz + reach))) + 1):
                     for y in range(max(0, int(math.ceil(qy - reach))), min(ny - 1, int(math.floor(qy + reach))) + 1):
@@ -173,9 +180,10 @@ def splat_turned(labels, spans, rest_lo, m, bone, out_lo, out, row_lo, row_hi, c
                     continue
                 px = ix + rest_lo[0]
                 # rounded on the rest grid first, then made an index: the same voxel whatever the output's box
-                x = int(math.floor(px * m[0, 0] + py * m[1, 0] + pz * m[2, 0] + m[3, 0] + 0.5)) - out_lo[0]
-                y = int(math.floor(px * m[0, 1] + py * m[1, 1] + pz * m[2, 1] + m[3, 1] + 0.5)) - out_lo[1]
-                z = int(math.floor(px * m[0, 2] + py * m[1, 2] + pz * m[2, 2] + m[3, 2] + 0.5)) - out_lo[2]
+                vx, vy, vz = _moved(m, px, py, pz)
+                x = int(math.floor(vx + 0.5)) - out_lo[0]
+                y = int(math.floor(vy + 0.5)) - out_lo[1]
+                z = int(math.floor(vz + 0.5)) - out_lo[2]
                 if x < 0 or y < 0 or z < 0 or x >= nx or y >= ny or z >= nz or out[z, y, x] != 0:
                     continue
                 out[z, y, x] = bone + 1

@@ -162,7 +162,8 @@ def reconstruct_owned(
     outside = 0 if bounds is None else int(((boxes[:, 3] >= boxes[:, 0]) & ((boxes[:, :3] < lo).any(1) | (
         boxes[:, 3:] > np.asarray(grid.hi)).any(1))).sum())
     stats = {"method": "owned", "bones": n_bones, "balls": len(r2s), "filled": filled, "visits": int(reads),
-             "overdraw": float(reads / filled) if filled else 0.0, "clipped": outside, "clipped_estimated": True}
+             "overdraw": float(reads / filled) if filled else 0.0, "clipped": outside,
+             "clipped_estimated": bool(outside)}
     if count:
         stats["hotspot_max"] = int(claims.max()) if claims.size else 0
         stats["hotspot_mean"] = float(claims.sum() / filled) if filled else 0.0
