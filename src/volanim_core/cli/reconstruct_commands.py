@@ -170,7 +170,9 @@ def _scan(args):
         for v in verdicts[:args.top]:
             print(f"  frame {v.frame}: {v.pieces} piece(s) ({v.rest_pieces} at rest), {v.detached} voxels "
                   f"detached, {v.stump} stump points, {v.cracks} cracks"
-                  + (f" near {v.worst_joint}" if v.worst_joint else "") + (": BROKEN" if v.broken else ""))
+                  + (f" near {v.worst_joint}" if v.worst_joint else "")
+                  + (f", a lump of {v.lump:,} voxels near {v.lump_near}" if v.lump else "")
+                  + (": BROKEN" if v.broken else ""))
     return 1 if bad else 0
 
 

@@ -15,7 +15,9 @@ breakage.py ........ cracks, stumps and torn-off pieces of a posed frame (_label
                      found on x-runs, nogil); cracks.py the sphere pairs that part; lumps.py flesh a
                      bone cannot carry, found without the true shape
 scan.py ............ many frames, worst first; whole.py one piece proved from the spheres alone
-                     (_whole_kernels.py); bend.py how a bent joint keeps shape
+                     (_whole_kernels.py); lump_watch.py the frames that can carry a lump, found
+                     from the rest pose's foreign voxels, then the report's own test on those
+                     (bend.py: how a bent joint keeps shape)
 checks.py .......... report() and scan(): the studio's verdicts for scripts
 shape.py ........... a posed volume against its true shape: Dice, the largest wrong blobs, surface distance
 displacement.py .... a frame's bones in physical space, for 3D Slicer and ITK: affines, a dense field

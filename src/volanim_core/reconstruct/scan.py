@@ -6,6 +6,8 @@
     per frame:  cracks and stumps from the posed sphere centres             (no voxels: cheap)
                 one piece proved from the spheres (whole.py), or else
                 connected components of a ``factor``-times coarser bone reconstruction
+                lumps: the report's own, at full resolution, only in the frames the rest
+                pose's foreign voxels say can carry one (lump_watch.py; rigid joints)
 
 The "once" part and the per-frame verdict are a :class:`Scanner`.
 
@@ -26,6 +28,7 @@ from volanim_core.progress import Reporter
 from volanim_core.reconstruct.breakage import components, misplaced_points, stumps
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import reconstruct
+from volanim_core.reconstruct.lump_watch import LumpWatch
 from volanim_core.reconstruct.whole import WholeProof
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.rig.tskel_tools import coarse_tskel, identity_tskel
@@ -41,6 +44,8 @@ class FrameVerdict:
     worst_joint: str  # the joint nearest the widest cracks ('' when none)
     stump: int = 0  # points left behind along another bone (breakage.stumps), summed
     rest_pieces: int = 1  # pieces of the rest pose on the same coarse grid: only more than these is breakage
+    lump: int = 0  # voxels of the largest lump (lumps.py, at full resolution: the report's), 0 when none
+    lump_near: str = ""  # the posed joint nearest it
 
     @property
     def healthy(self) -> bool:
@@ -55,9 +60,10 @@ class FrameVerdict:
         return self.pieces > self.rest_pieces or self.stump > 0
 
     def badness(self) -> tuple:
-        """Sort key, worst first: detached pieces outrank stumps, stumps outrank cracks, then how much."""
+        """Sort key, worst first: detached pieces outrank stumps, stumps outrank lumps, lumps outrank cracks,
+        then how much."""
         return (-min(max(self.pieces - self.rest_pieces, 0), 1), -self.detached, -min(self.stump, 1), -self.stump,
-                -self.gap)
+                -min(self.lump, 1), -self.lump, -self.gap)
 
 
 class Scanner:
@@ -79,6 +85,9 @@ class Scanner:
         self.misplaced = misplaced_points(rest)
         self.names = list(self.joints)
         self.near = cKDTree(np.array([self.joints[n] for n in self.names], np.float64)) if self.names else None
+        # lumps as the report finds them, at full resolution, in the frames that can carry one (lump_watch.py)
+        self.watch = None if conn.joints.smooth else LumpWatch(conn)
+        self.moved_by = [_joint_bone(conn, self.joints[n]) for n in self.names]
 
     def verdict(self, frame: int, mats: np.ndarray) -> FrameVerdict:
         posed = self.conn.posed(np.asarray(mats))
@@ -93,9 +102,26 @@ class Scanner:
         else:
             sizes = components(reconstruct(coarse, mode="bone", padding=1).volume)
         behind = stumps(posed, self.joints, self.misplaced)
+        lumps = [] if self.watch is None else self.watch.lumps(mats, self.posed_joints(mats))
         return FrameVerdict(frame, len(sizes), int(sum(sizes[self.rest_pieces:])) * self.factor ** 3, len(gaps),
                             float(gaps.sum()), worst or (behind[0].joint if behind else ""),
-                            sum(b.points for b in behind), self.rest_pieces)
+                            sum(b.points for b in behind), self.rest_pieces,
+                            lumps[0].voxels if lumps else 0, lumps[0].near if lumps else "")
+
+    def posed_joints(self, mats: np.ndarray) -> dict:
+        """Each named joint moved by the bone it belongs to (to name a lump's place)."""
+        m = np.asarray(mats, np.float64)
+        return {n: (np.asarray(self.joints[n], np.float64) @ m[b, :3, :3] + m[b, 3, :3]) if b >= 0 else
+                np.asarray(self.joints[n], np.float64) for n, b in zip(self.names, self.moved_by)}
+
+
+def _joint_bone(conn: Connectivity, p) -> int:
+    """The first bone (root order) that starts at joint ``p``, else one that ends there, else -1."""
+    for end in ("proximal", "distal"):
+        for b, seg in enumerate(conn.bones):
+            if np.allclose(getattr(seg, end), p, atol=1e-6):
+                return b
+    return -1
 
 
 def scan_frames(conn: Connectivity, matrices: np.ndarray, frames=None, *, joints: dict | None = None,
@@ -116,7 +142,7 @@ def scan_summary(verdicts: list[FrameVerdict]) -> str:
     """The one sentence ``volanim scan`` and the studio's scan both open with."""
     broken = sum(v.broken for v in verdicts)
     return (f"{len(verdicts)} frames scanned: {broken} broken (a piece torn off or a stump left behind), "
-            f"{sum(v.cracks > 0 for v in verdicts)} with cracks")
+            f"{sum(v.lump > 0 for v in verdicts)} with lumps, {sum(v.cracks > 0 for v in verdicts)} with cracks")
 
 
 def worst_first(verdicts: list[FrameVerdict]) -> list[FrameVerdict]:

@@ -2,19 +2,21 @@
 
     mask (the segmentation), connectivity (points on bones)
         --tube_profiles (limb_tubes.py), else the points' depth--> each bone's tube: radius at both joints
-        --own_by_tubes (numba)--> labels [x, y, z]: 1 + the bone whose tube holds the voxel deepest
-                                  relative to its radius (distance to the segment / the radius there)
+        --own_by_tubes (numba)--> labels [x, y, z]: 1 + the bone whose tube holds the voxel deepest, in voxels
+                                  below its surface (tube_depth: the tube's elliptic, tapered section)
         --DT of the mask at each bone's proximal joint--> ball radii (the body's depth at the joint)
         --> Ownership (labels cropped to the body, its origin, the bones, the balls)
 
 Why tubes and not the points' attachments: the nearest-bone attachment gives the armpit to the arm
 (its skeleton points lie a few voxels from the arm's segment and twenty from the spine's), and any rule
 built on points inherits that. A voxel in the armpit lies outside the arm's own round tube and well
-inside the torso's, so relative to each tube's radius the torso holds it deeper; the tube's radius is
-measured from the limb's own middle (limb_tubes.tube_profiles), where no other limb touches it. A
-voxel inside two tubes (a limb's end inside the torso) goes to the thinner one, which holds it
-relatively deeper: the limb's own flesh moves with the limb, and the ball at the joint keeps the torso
-whole where it leaves.
+inside the torso's, so the torso holds it deeper; the tube's radius is measured from the limb's own middle
+(limb_tubes.tube_profiles), where no other limb touches it. Where two tubes overlap (a limb's end inside
+the torso) the voxel goes to the one whose surface is farther, as the mannequin's true parts are made: a
+rule relative to each tube's size gave the thin thigh a third of the pelvis it overlaps, which it then
+carried off at every step of the walk clip as a lump of 2,200 voxels (#84; the absolute rule: none, and
+the frog's leaf poses 4/6 and 3/6 healthy where they were 2/6 and 1/6). The ball at the joint keeps the
+torso whole where a limb leaves it.
 
 Every voxel of the mask gets an owner, so at the identity pose the posed body is the mask voxel for
 voxel. The animator repaints ownership where the rule is wrong (the studio, ``volanim connect
@@ -218,10 +220,18 @@ def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None
     ab = np.array([s.distal - s.proximal for s in conn.bones], np.float64)
     labels = np.zeros(box.shape, label_dtype(len(conn.bones)), order="F")
     tubes = tube_rows(a, ab, radii, cross_sections(box, lo, tube_rows(a, ab, radii, [None] * len(a))))
-    own_by_tubes(box, lo.astype(np.float64), tubes, _z_reach(tubes, lo[2]), labels)
+    own_by_tubes(box, lo.astype(np.float64), tubes, _limb_goes_on(conn.bones), _z_reach(tubes, lo[2]), labels)
     join_specks(labels, len(a))
     balls = np.array([_ball_inside(box, s.proximal - lo) for s in conn.bones])
     return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes)
+
+
+def _limb_goes_on(bones: list[BoneSegment]) -> np.ndarray:
+    """``(B,)`` whether exactly one bone goes on from each bone's distal joint: a limb's segment, whose round end
+    there is the next segment's flesh and yields to it (a branching joint's, the shoulders' above the spine, is
+    body)."""
+    starts = np.array([b.proximal for b in bones], np.float64)
+    return np.array([int(np.all(np.abs(starts - b.distal) < 1e-6, axis=1).sum()) == 1 for b in bones])
 
 
 def _z_reach(tubes: np.ndarray, z0: int) -> np.ndarray:

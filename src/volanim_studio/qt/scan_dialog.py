@@ -7,7 +7,8 @@ from PySide6.QtWidgets import QDialog, QLabel, QTableWidget, QTableWidgetItem, Q
 
 from volanim_core.reconstruct.scan import scan_summary
 
-COLUMNS = ("frame", "pieces", "detached voxels", "stump points", "cracks", "gap (voxels)", "worst joint")
+COLUMNS = ("frame", "pieces", "detached voxels", "stump points", "lump voxels", "cracks", "gap (voxels)",
+           "worst joint")
 
 
 class ScanDialog(QDialog):
@@ -32,12 +33,13 @@ class ScanDialog(QDialog):
     def show_verdicts(self, verdicts, label=str) -> None:
         """``verdicts`` worst first; ``label(frame)`` is the number shown (the clip's own numbering)."""
         self.frames = [v.frame for v in verdicts]
-        self.summary.setText(f"{scan_summary(verdicts)} (half-resolution pieces, exact cracks). Double-click a "
-                             "frame to show it, then F5 for its full report.")
+        self.summary.setText(f"{scan_summary(verdicts)} (half-resolution pieces, exact cracks, lumps as the report "
+                             "finds them). Double-click a frame to show it, then F5 for its full report.")
         self.table.setRowCount(len(verdicts))
         for row, v in enumerate(verdicts):
-            cells = (label(v.frame), v.pieces, v.detached, v.stump, v.cracks, f"{v.gap:.1f}", v.worst_joint or "—")
+            near = v.worst_joint or v.lump_near or "—"
+            cells = (label(v.frame), v.pieces, v.detached, v.stump, v.lump, v.cracks, f"{v.gap:.1f}", near)
             for col, value in enumerate(cells):
                 item = QTableWidgetItem(str(value))
-                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter if col < 6 else Qt.AlignLeft | Qt.AlignVCenter)
+                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter if col < 7 else Qt.AlignLeft | Qt.AlignVCenter)
                 self.table.setItem(row, col, item)

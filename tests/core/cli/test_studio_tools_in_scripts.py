@@ -176,6 +176,8 @@ def test_keys_write_the_timeline_frames_and_scan_finds_the_torn_one(made, tmp_pa
     assert verdicts[0]["frame"] == 7  # torn.trans has no frame number: its place on the line
     clean = run("scan", d / "m.connect", *frames[::6])
     assert clean.returncode == 0 and "0 broken" in clean.stdout, clean.stdout + clean.stderr
+    # #84: the scan looks for lumps as the report does (the raised wave carries none on this rig)
+    assert all(v["lump"] == 0 and v["lump_near"] == "" for v in verdicts) and "0 with lumps" in clean.stdout
 
 
 def test_keys_with_an_unknown_bone_names_the_line_and_writes_nothing(made, tmp_path):

@@ -107,6 +107,28 @@ def test_a_150_degree_elbow_opens_no_wedge(mannequin_rig):
     assert int((open_.volume > 0).sum()) < int((r.volume > 0).sum())
 
 
+def test_the_walk_clip_carries_no_pelvis_lump(mannequin_rig):
+    """The real walk clip on the default rig: the hips turn 14-24 degrees against the spine at every step. Owners by
+    each tube's relative depth gave the thin thigh a third of the pelvis it overlaps (7,094 voxels of the
+    capsules' spine), which the report then flagged at every frame as a lump near PELVIS (2,227 voxels at frame
+    644, Dice 0.962). Owners by depth in voxels, as the true parts are made: no lump, and closer to the truth."""
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.motion.retarget import Retarget
+    from volanim_core.reconstruct.breakage import RestParts, breakage_report
+    from volanim_core.rig.pose import posed_joints
+
+    s, conn = mannequin_rig
+    theirs = np.isin(s.part, [s.bones.index("SPINE") + 1])
+    owners = conn.ownership.volume(s.mask.shape)
+    assert (owners[theirs] == s.bones.index("SPINE") + 1).mean() > 0.94  # the relative rule: 0.82
+    m = Retarget.build(s.bones, read_bvh(samples.walk_clip())).matrices()[644]
+    rep = breakage_report(conn.posed(m), dict(s.bones.joints), posed_joints(s.bones, m), rest=RestParts.of(conn))
+    assert rep.lumps == [], rep.verdict
+    r = reconstruct(conn.posed(m), mode="binary")
+    truth = posed_sample("mannequin", m)
+    assert compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin).dice > 0.966
+
+
 def test_smooth_joints_and_method_spheres_still_regrow_spheres(mannequin_rig):
     from volanim_core.rig.skinning import Joints
 

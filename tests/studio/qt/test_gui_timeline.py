@@ -385,9 +385,16 @@ def test_the_scan_window_says_cracks_alone_are_not_broken(qtbot, window):
     assert cracked.healthy and not cracked.broken and torn.broken and not torn.healthy
     dialog = ScanDialog(window)
     qtbot.addWidget(dialog)
-    dialog.show_verdicts([torn, cracked])
+    lumpy = FrameVerdict(frame=5, pieces=1, detached=0, cracks=0, gap=0.0, worst_joint="", lump=812,
+                         lump_near="L_SHOULDER")
+    dialog.show_verdicts([torn, lumpy, cracked])
     assert dialog.summary.text().startswith(
-        "2 frames scanned: 1 broken (a piece torn off or a stump left behind), 1 with cracks")
+        "3 frames scanned: 1 broken (a piece torn off or a stump left behind), 1 with lumps, 1 with cracks")
+    # #84: the scan looks for lumps; the row says how large and where
+    from volanim_studio.qt.scan_dialog import COLUMNS
+
+    row = [dialog.table.item(1, c).text() for c in range(len(COLUMNS))]
+    assert row[COLUMNS.index("lump voxels")] == "812" and row[-1] == "L_SHOULDER"
 
 
 def test_a_folder_of_frames_is_read_off_the_gui_thread(qtbot, rigged, tmp_path, monkeypatch):
