@@ -72,3 +72,15 @@ def voxel_at(shape, axis: int, index: int, column: int, row: int) -> tuple[int, 
     at = [0, 0, 0]
     at[axis], at[u], at[v] = index, column, shape[v] - 1 - row
     return tuple(at)
+
+
+def tinted(picture: np.ndarray, labels: np.ndarray, axis: int, index: int, table: np.ndarray,
+           share: float = 0.55) -> np.ndarray:
+    """``picture`` (:func:`slice_picture` of the same slice) with each voxel of label l > 0 in ``labels`` (the
+    volume's shape, ``[x, y, z]``) blended ``share`` of the way to ``table[l]`` (``(L, 3)`` uint8): which bone owns
+    each voxel, over the scan's own grey (the studio's *Show ownership on slices*)."""
+    plane = np.take(labels, index, axis=axis).T[::-1]  # as slice_picture lays the slice out
+    out = picture.astype(np.float32)
+    on = plane > 0
+    out[on] = (1.0 - share) * out[on] + share * table[plane[on]].astype(np.float32)
+    return np.round(out).astype(np.uint8)

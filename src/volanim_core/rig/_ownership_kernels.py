@@ -53,7 +53,7 @@ def tube_depth(tube, px, py, pz, yields):
         return np.inf
     dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
     raw = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
-    if yields and raw > 1.0:  # past a joint that bones go on from, the round end holds only what they do not
+    if (raw < 0.0 and yields[0]) or (raw > 1.0 and yields[1]):  # a round end that yields (ownership._yields)
         return YIELDED + d
     t = min(1.0, max(0.0, raw))
     n1 = math.sqrt(tube[9] * tube[9] + tube[10] * tube[10] + tube[11] * tube[11])

@@ -15,8 +15,11 @@ inside the torso's, so the torso holds it deeper; the tube's radius is measured 
 the torso) the voxel goes to the one whose surface is farther, as the mannequin's true parts are made: a
 rule relative to each tube's size gave the thin thigh a third of the pelvis it overlaps, which it then
 carried off at every step of the walk clip as a lump of 2,200 voxels (#84; the absolute rule: none, and
-the frog's leaf poses 4/6 and 3/6 healthy where they were 2/6 and 1/6). The ball at the joint keeps the
-torso whole where a limb leaves it.
+the frog's leaf poses 3/6 and 3/6 healthy where they were 2/6 and 1/6). A tube's round end past a joint
+yields (holds only what no other tube holds) where the body there is another bone's: behind a bone's
+proximal joint when a bone ends there, past its distal joint when one bone goes on (_yields). Without it the
+thick parent's round end took the base of a thin leaf (the rabbit's and Spot's leaf bent 90 degrees tore
+off). The ball at the joint keeps the torso whole where a limb leaves it.
 
 Every voxel of the mask gets an owner, so at the identity pose the posed body is the mask voxel for
 voxel. The animator repaints ownership where the rule is wrong (the studio, ``volanim connect
@@ -220,18 +223,24 @@ def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None
     ab = np.array([s.distal - s.proximal for s in conn.bones], np.float64)
     labels = np.zeros(box.shape, label_dtype(len(conn.bones)), order="F")
     tubes = tube_rows(a, ab, radii, cross_sections(box, lo, tube_rows(a, ab, radii, [None] * len(a))))
-    own_by_tubes(box, lo.astype(np.float64), tubes, _limb_goes_on(conn.bones), _z_reach(tubes, lo[2]), labels)
+    own_by_tubes(box, lo.astype(np.float64), tubes, _yields(conn.bones), _z_reach(tubes, lo[2]), labels)
     join_specks(labels, len(a))
     balls = np.array([_ball_inside(box, s.proximal - lo) for s in conn.bones])
     return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes)
 
 
-def _limb_goes_on(bones: list[BoneSegment]) -> np.ndarray:
-    """``(B,)`` whether exactly one bone goes on from each bone's distal joint: a limb's segment, whose round end
-    there is the next segment's flesh and yields to it (a branching joint's, the shoulders' above the spine, is
-    body)."""
+def _yields(bones: list[BoneSegment]) -> np.ndarray:
+    """``(B, 2)`` whether each bone's round end behind its proximal joint and past its distal one yields to the
+    other tubes (holds only what none holds): behind the proximal joint when a bone ends there (the thigh's end
+    inside the pelvis is the pelvis's flesh), past the distal joint when exactly one bone goes on from it (a
+    limb's next segment; a branching joint's end, the shoulders' above the spine, is body)."""
     starts = np.array([b.proximal for b in bones], np.float64)
-    return np.array([int(np.all(np.abs(starts - b.distal) < 1e-6, axis=1).sum()) == 1 for b in bones])
+    ends = np.array([b.distal for b in bones], np.float64)
+    out = np.zeros((len(bones), 2), np.bool_)
+    for k, b in enumerate(bones):
+        out[k, 0] = bool(np.all(np.abs(ends - b.proximal) < 1e-6, axis=1).any())
+        out[k, 1] = int(np.all(np.abs(starts - b.distal) < 1e-6, axis=1).sum()) == 1
+    return out
 
 
 def _z_reach(tubes: np.ndarray, z0: int) -> np.ndarray:

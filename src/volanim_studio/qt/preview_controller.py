@@ -73,6 +73,7 @@ class PreviewController(Controller):
         action("Save frame (.tskel)…", lambda: self.save_dialog("tskel"), menu=menu)
         action("Export reconstruction…", lambda: self.save_dialog("volume"), menu=menu)
         action("Give the cube's voxels to the working bone", lambda: self.own_cube(), menu=menu)
+        action("Show ownership on slices", lambda: self.show_ownership(), menu=menu)
 
     def wire(self, pose_panel, reconstruct_panel) -> None:
         """Connect the Pose and Reconstruct tabs' buttons to this controller."""
@@ -308,6 +309,35 @@ class PreviewController(Controller):
         self.attempt("Ownership", lambda: self.doc.ownership.paint_box(lo, hi, bone),
                      f"The body inside the cube now moves with {self.doc.bones.bones[bone].label} (Ctrl+Z undoes); "
                      "preview again (F5).")
+
+    def show_ownership(self) -> Worker | None:
+        """The scan's slices, each voxel tinted by the bone that moves it (the ownership with the repaints), in a
+        window of its own (``viewers[-1]``); the mouse says whose each voxel is. Made in a worker: on the
+        Visible Human the ownership takes seconds the first time."""
+        if self.doc.settings.body != "owned" or not self.doc.ownership.available:
+            self.show_error("Ownership", "ownership is the body's: open a volume and choose Body: owned")
+            return None
+        conn = self.doc.pose.tskel().connectivity
+        doc, names = self.doc, tuple(b.label for b in self.doc.bones.bones)
+
+        def done(own) -> None:
+            from volanim_core.render.slices import default_window, describe
+
+            from .slice_window import SlicesSource, SliceWindow
+
+            if own is None:
+                self.show_error("Ownership", "nothing attached: connect points to bones first")
+                return
+            grey = default_window(doc.volume) if doc.volume.ndim == 3 else None
+            source = SlicesSource(doc.volume, doc.spacing, grey, describe(doc.volume, grey),
+                                  own.volume(doc.mask.shape), names)
+            window = SliceWindow(doc.volume_path or "body", source, self.window)
+            self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
+            window.show()
+            doc.message(f"Ownership of {int(own.mask.sum()):,} voxels by {len(names)} bones; the mouse says "
+                        "whose a voxel is. Repaint with the cube (Pose menu) or Fix a lump.")
+
+        return self.jobs.run("Ownership", lambda progress, cancel: doc.ownership.of(conn), done)
 
     def fix_hint(self, joint: str) -> str:
         """What to do about the finding near ``joint``, naming the bone to give the points to (#83: "Fix the

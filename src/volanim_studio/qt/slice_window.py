@@ -20,7 +20,8 @@ from PySide6.QtCore import QRectF, Qt, Signal
 from PySide6.QtGui import QImage, QPainter
 from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QMainWindow, QSlider, QVBoxLayout, QWidget
 
-from volanim_core.render.slices import AXES, default_window, describe, pixel_aspect, slice_picture, voxel_at
+from volanim_core.render.bone_colours import label_table
+from volanim_core.render.slices import AXES, default_window, describe, pixel_aspect, slice_picture, tinted, voxel_at
 
 
 @dataclass(frozen=True)
@@ -31,6 +32,8 @@ class SlicesSource:
     spacing: tuple
     grey: tuple | None
     what: str
+    owners: np.ndarray | None = None  # labels [x, y, z] (0: none, b + 1: bone b) tinted over the slices
+    owner_names: tuple = ()  # bone b's name, to say whose voxel the mouse is over
 
 
 def read_for_slices(path) -> SlicesSource:
@@ -89,7 +92,8 @@ class SliceWindow(QMainWindow):
     def __init__(self, path, source: SlicesSource, parent=None):
         super().__init__(parent)
         self.path, self.volume, self.spacing, self.grey = Path(path), source.volume, source.spacing, source.grey
-        self.setWindowTitle(f"Slices — {self.path.name}")
+        self.owners, self.owner_names = source.owners, source.owner_names
+        self.setWindowTitle(f"{'Ownership' if self.owners is not None else 'Slices'} — {self.path.name}")
         self.resize(700, 760)
         self.canvas = SliceCanvas()
         self.axis_box = QComboBox()
@@ -125,8 +129,10 @@ class SliceWindow(QMainWindow):
         self.show_slice(n // 2)
 
     def show_slice(self, index: int) -> None:
-        self.canvas.set_picture(slice_picture(self.volume, self.axis, index, self.grey),
-                                pixel_aspect(self.spacing, self.axis))
+        picture = slice_picture(self.volume, self.axis, index, self.grey)
+        if self.owners is not None:
+            picture = tinted(picture, self.owners, self.axis, index, label_table(len(self.owner_names)))
+        self.canvas.set_picture(picture, pixel_aspect(self.spacing, self.axis))
         self.label.setText(f"{AXES[self.axis]} = {index} of 0..{self.volume.shape[self.axis] - 1}")
         self.statusBar().showMessage(f"{self.path.name}: {self.what}. Slider or Page Up / Page Down to move.")
 
@@ -134,7 +140,9 @@ class SliceWindow(QMainWindow):
         x, y, z = voxel_at(self.volume.shape, self.axis, self.slider.value(), col, row)
         value = self.volume[x, y, z]
         shown = " ".join(str(int(v)) for v in value) if np.ndim(value) else f"{value:g}"
-        self.statusBar().showMessage(f"voxel {x} {y} {z} = {shown}")
+        owner = int(self.owners[x, y, z]) if self.owners is not None else 0
+        whose = f", moved by {self.owner_names[owner - 1]}" if 0 < owner <= len(self.owner_names) else ""
+        self.statusBar().showMessage(f"voxel {x} {y} {z} = {shown}{whose}")
 
     def keyPressEvent(self, event) -> None:
         step = {Qt.Key_PageUp: 1, Qt.Key_PageDown: -1, Qt.Key_Up: 1, Qt.Key_Down: -1}.get(event.key())

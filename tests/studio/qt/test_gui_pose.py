@@ -584,3 +584,54 @@ def test_a_live_picture_drawn_again_stays_where_its_voxels_are(qtbot, window, tm
         assert np.abs(body - want).max() <= 1.5 * p.factor, (body, want)
     slider.setSliderDown(False)
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+
+
+def test_ownership_on_slices_shows_whose_each_voxel_is_and_follows_a_repaint(qtbot, posed_window, tmp_path):
+    """#84: the ownership the animator sees. Pose → Show ownership on slices opens the scan's slices, each body
+    voxel tinted by the colour of the bone that moves it: the picture is compared pixel by pixel with the
+    ownership made here by the core over the same mask and attachments (not read back from the window), and a
+    cube repaint shows in the next one; the mouse names the owner."""
+    from volanim_core.render.bone_colours import label_table
+    from volanim_core.render.slices import default_window, slice_picture
+    from volanim_core.rig.ownership import ownership
+
+    w = posed_window
+    doc = w.doc
+    own = ownership(doc.mask, doc.pose.tskel().connectivity).volume(doc.mask.shape)
+    table = label_table(len(doc.bones.bones)).astype(int)
+
+    def opened():
+        before = len(getattr(w.previews, "viewers", []))
+        w.previews.show_ownership()
+        qtbot.waitUntil(lambda: not w.busy and len(getattr(w.previews, "viewers", [])) > before,
+                        timeout=JOB_TIMEOUT_MS)
+        view = w.previews.viewers[-1]
+        qtbot.addWidget(view)
+        view.axis_box.setCurrentIndex(1)  # y slices: the front view, arm and torso side by side
+        view.slider.setValue(50)
+        return view
+
+    view = opened()
+    grey = slice_picture(doc.volume, 1, 50, default_window(doc.volume)).astype(float)  # the scan alone
+
+    def expected(labels):
+        plane = labels[:, 50, :].T[::-1]  # x to the right, z up, as the window lays a y slice out
+        out = grey.copy()
+        out[plane > 0] = 0.45 * out[plane > 0] + 0.55 * table[plane[plane > 0]]
+        return np.round(out).astype(int), plane
+
+    want, plane = expected(own)
+    for bone in ("SPINE", "L_UPPERARM", "R_THIGH"):
+        assert (plane == doc.bones.index(bone) + 1).sum() > 50  # each seen on this slice
+    assert np.abs(view.canvas.picture.astype(int) - want).max() <= 1
+    row, col = np.argwhere(plane == doc.bones.index("L_UPPERARM") + 1)[0]
+    view.report(int(col), int(row))
+    assert "moved by L_UPPERARM" in view.statusBar().currentMessage()
+    # a repaint (the armpit given to the arm) shows in the next view
+    arm = doc.bones.index("L_UPPERARM")
+    doc.ownership.paint_box((96, 40, 200), (107, 59, 221), arm)
+    painted = own.copy()
+    box = painted[96:108, 40:60, 200:222]
+    box[box != 0] = arm + 1
+    after = opened().canvas.picture.astype(int)
+    assert np.abs(after - expected(painted)[0]).max() <= 1 and not np.array_equal(after, want)
