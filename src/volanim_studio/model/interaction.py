@@ -294,9 +294,22 @@ class LassoMode(ModeHandler):
         bone = _working(self.doc, remove)
         if bone is None:
             return 0
-        n = self.doc.attachments.assign(idx, bone)
-        self.doc.message(f"{'Removed' if remove else 'Connected'} {n} of {len(idx)} points under the lasso "
-                         f"({settings.lasso_depth}).")
+        doc = self.doc
+        # in the owned body (the default) the flesh those points stand for goes with them: one undo step (#84)
+        repaint = not remove and settings.body == "owned" and doc.ownership.available and len(idx)
+        name = doc.bones.bones[bone].label if bone >= 0 else ""
+        flesh = ()
+        if repaint:
+            with doc.undo.group(f"Connect {len(idx)} points and their flesh ({name})"):
+                n = doc.attachments.assign(idx, bone)
+                flesh = doc.ownership.flesh_of(idx)
+                if len(flesh):
+                    doc.ownership.paint_voxels(flesh, bone)
+        else:
+            n = doc.attachments.assign(idx, bone)
+        also = f"; {len(flesh):,} voxels of their flesh now move with {name}" if len(flesh) else ""
+        doc.message(f"{'Removed' if remove else 'Connected'} {n} of {len(idx)} points under the lasso "
+                    f"({settings.lasso_depth}){also}.")
         return n
 
 

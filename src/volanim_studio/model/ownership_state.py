@@ -110,6 +110,25 @@ class OwnershipState:
         self._push(label or f"Own {len(indices)} voxels by {self.doc.bones.bones[bone].label}",
                    (bone, ("voxels", indices)))
 
+    def flesh_of(self, points: np.ndarray) -> np.ndarray:
+        """Flat indices (Fortran order over the volume's grid) of the body's voxels inside the spheres of skeleton
+        points ``points`` (indices into the skeleton): the flesh those points stand for, which a lasso gives to a
+        bone with them (the thesis's sphere of each point: its distance-transform radius)."""
+        sk, mask = self.doc.skeleton, self.doc.mask
+        if sk is None or mask is None or not len(points):
+            return np.zeros(0, np.int64)
+        centres = sk.points[np.asarray(points, np.int64)].astype(np.int64)
+        radii = sk.dt[np.asarray(points, np.int64)] / (3.0 if sk.metric == "345" else 1.0)
+        found = []
+        for c, r in zip(centres, radii):
+            lo = np.maximum(c - int(np.floor(r)), 0)
+            hi = np.minimum(c + int(np.floor(r)), np.asarray(mask.shape) - 1)
+            axes = [np.arange(a, b + 1) for a, b in zip(lo, hi)]
+            x, y, z = np.meshgrid(*axes, indexing="ij")
+            inside = ((x - c[0]) ** 2 + (y - c[1]) ** 2 + (z - c[2]) ** 2 <= r * r) & mask[x, y, z]
+            found.append(np.ravel_multi_index((x[inside], y[inside], z[inside]), mask.shape, order="F"))
+        return np.unique(np.concatenate(found)) if found else np.zeros(0, np.int64)
+
     def _check(self, bone: int) -> None:
         if not 0 <= bone < len(self.doc.bones):
             raise ValueError(f"no bone {bone}")

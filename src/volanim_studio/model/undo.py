@@ -8,6 +8,7 @@ in the Edit menu. ``push`` runs ``redo`` once; the GUI only calls
 from __future__ import annotations
 
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from .events import EventEmitter
@@ -34,6 +35,7 @@ class UndoStack:
         self.events = EventEmitter("changed")
         self.edits = 0  # monotonically counts pushes, undos and redos (autosave watches it)
         self._clean_top: object = None  # the command on top when the document was last saved or opened
+        self._group: list[Command] | None = None  # commands pushed inside group(), one step at its end
 
     # The document is unmodified when the command on top is the one that was on top when it was
     # saved (None: an empty stack). Undoing back to the saved state makes it unmodified again,
@@ -56,7 +58,26 @@ class UndoStack:
     def _top(self) -> Command | None:
         return self._done[-1] if self._done else None
 
+    @contextmanager
+    def group(self, label: str):
+        """Every command pushed inside the ``with`` becomes one step labelled ``label`` (QUndoStack's macro): a
+        lasso that connects points and repaints the flesh they stand for is undone by one Ctrl+Z."""
+        outer, self._group = self._group, []
+        try:
+            yield
+        finally:
+            done, self._group = self._group, outer
+            if len(done) == 1:
+                self._record(Command(label, done[0].redo, done[0].undo))
+            elif done:
+                self._record(Command(label, lambda: [c.redo() for c in done],
+                                     lambda: [c.undo() for c in reversed(done)]))
+
     def push(self, command: Command) -> None:
+        if self._group is not None:  # inside group(): run now, recorded as one step at its end
+            command.redo()
+            self._group.append(command)
+            return
         top = self._top
         if command.merge_key and top is not None and top.merge_key == command.merge_key and not self._undone:
             command.redo()
@@ -64,6 +85,10 @@ class UndoStack:
             self._changed()
             return
         command.redo()
+        self._record(command)
+
+    def _record(self, command: Command) -> None:
+        """``command`` (already run) on top of the history."""
         self._done.append(command)
         if len(self._done) > self.limit:
             if self._clean_top is None or self._clean_top is self._done[0]:

@@ -223,3 +223,43 @@ def test_auto_connect_measures_apart_from_the_document_and_refuses_a_result_for_
     with pytest.raises(ValueError, match="changed while auto-connect ran"):
         apply(result)
     assert np.array_equal(doc.attachments.bone, before)
+
+
+def test_a_lasso_in_the_owned_body_gives_the_points_flesh_with_them_in_one_undo_step(doc):
+    """#84: ownership repainted by lasso as points are. The default body moves the scan's voxels by their owners,
+    which the points' attachments do not choose: a lasso that connects points also gives their flesh (the voxels
+    of each point's sphere, the body's) to the working bone, and one Ctrl+Z takes both back."""
+    from volanim_core.rig.ownership import ownership
+
+    arm = doc.bones.index("L_UPPERARM")
+    doc.attachments.auto(scope="unconnected")
+    mode = LassoMode(doc)
+    doc.settings.lasso_depth = "through"
+    doc.select_bones([arm])
+    shown = doc.shown_indices()
+    p = doc.skeleton.points[shown]
+    xy = p[:, [0, 2]].astype(float)
+    outline = [(96, 200), (108, 200), (108, 222), (96, 222)]  # the armpit's side of the torso, front view
+    zeros = np.zeros(len(xy))
+    before = doc.undo.edits
+    n = mode.finish(outline, xy, zeros, zeros, shown)
+    assert n > 0 and doc.undo.edits == before + 1 and "their flesh" in doc.undo.undo_label
+    # the flesh, computed here: every body voxel within a lassoed point's distance (its sphere)
+    picked = doc.point_selection  # the points under the outline (selection.py's test, edges included)
+    assert len(picked) and set(picked) >= set(shown[(xy[:, 0] > 96) & (xy[:, 0] < 108) & (xy[:, 1] > 200)
+                                                      & (xy[:, 1] < 222)])
+    grid = np.indices(doc.mask.shape).reshape(3, -1).T
+    flesh = np.zeros(doc.mask.shape, bool)
+    for k in picked:
+        c, r = doc.skeleton.points[k], doc.skeleton.dt[k]
+        near = grid[(np.abs(grid - c) <= r).all(1)]
+        near = near[((near - c) ** 2).sum(1) <= r * r]
+        flesh[tuple(near.T)] = True
+    flesh &= doc.mask
+    conn = doc.pose.tskel().connectivity
+    owners = doc.ownership.of(conn).volume(doc.mask.shape)
+    assert flesh.sum() > 500 and (owners[flesh] == arm + 1).all()
+    made = ownership(doc.mask, conn).volume(doc.mask.shape)
+    assert np.array_equal(owners[~flesh], made[~flesh])  # nothing else repainted
+    doc.undo.undo()
+    assert not doc.ownership.paints and not (doc.attachments.bone[picked] == arm).all()

@@ -246,3 +246,19 @@ def test_a_project_that_is_a_device_is_refused_not_read_forever(tmp_path):
     link.symlink_to("/dev/zero")
     with pytest.raises(FormatError, match="zero.volanim: is not a regular file"):
         read_project(link)
+
+
+def test_an_undo_group_is_one_step_undone_in_reverse():
+    """UndoStack.group (QUndoStack's macro): the lasso's points and their flesh are one Ctrl+Z (#84)."""
+    from volanim_studio.model.undo import Command, UndoStack
+
+    log, stack = [], UndoStack()
+    with stack.group("both"):
+        stack.push(Command("a", lambda: log.append("a"), lambda: log.append("-a")))
+        stack.push(Command("b", lambda: log.append("b"), lambda: log.append("-b")))
+    assert log == ["a", "b"] and stack.undo_label == "both" and stack.edits == 1
+    assert stack.undo() == "both" and log[2:] == ["-b", "-a"] and not stack.can_undo
+    assert stack.redo() == "both" and log[4:] == ["a", "b"]
+    with stack.group("nothing"):
+        pass
+    assert stack.undo_label == "both"  # an empty group leaves no step
