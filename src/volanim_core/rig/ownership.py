@@ -286,7 +286,7 @@ def cross_sections(box: np.ndarray, lo: np.ndarray, round_tubes: np.ndarray) -> 
     hip's gap on the mannequin from 4.6 % to 11 % of the leg, so the fit is sensitive to it."""
     step = max(1, int(np.ceil((box.size / SECTION_VOXELS) ** (1 / 3))))
     sums = np.zeros((len(round_tubes), 10))
-    section_moments(box, lo.astype(np.float64), round_tubes, step, sums)
+    section_moments(box, lo.astype(np.float64), round_tubes, _z_reach(round_tubes, lo[2]), step, sums)
     out = []
     for s in sums:
         if s[0] < 30:
