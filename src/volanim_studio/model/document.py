@@ -58,7 +58,7 @@ class Document:
         self.events = EventEmitter("volume", "skeleton", "hull", "thinness", "bones", "selection", "picked",
                                    "symmetry", "message", "project", "attachments", "filter", "cube",
                                    "point_selection", "pose", "pose_settled", "preview", "timeline", "camera",
-                                   "transfer", "stale", "ownership")
+                                   "transfer", "stale", "ownership", "owners_shown")
         self.undo = UndoStack()
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None

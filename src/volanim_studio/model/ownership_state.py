@@ -29,11 +29,22 @@ class OwnershipState:
         self._made = None  # (key, Ownership before the paints)
         self._lock = threading.Lock()  # the preview's worker makes it while the GUI thread may ask again
         self.version = 0  # counts repaints: a preview made before one is old
+        self.shown: Ownership | None = None  # what the hull is coloured by (show()); None: not made for this rig
         for event in ("attachments", "bones", "volume", "skeleton", "thinness"):
             getattr(doc.events, event).connect(lambda **_: self._forget())
+        doc.events.ownership.connect(lambda **_: self.show(None))
 
     def _forget(self) -> None:
         self._made = None
+        self.show(None)
+
+    def show(self, own: Ownership | None) -> None:
+        """The ownership the hull shows, made for the rig as it is now (None: none yet, or the rig changed since:
+        the hull shows its own colour rather than an old ownership). On the GUI thread."""
+        if own is self.shown:
+            return
+        self.shown = own
+        self.doc.events.owners_shown.emit()
 
     @property
     def available(self) -> bool:

@@ -98,6 +98,7 @@ SETTINGS: dict[str, Setting] = {
     "hull_visible": Setting(True, flag, "show the translucent hull"),
     "names_visible": Setting(True, flag, "joint and bone names in the viewport"),
     "hull_opacity": Setting(0.15, number(0, 1), "hull opacity"),
+    "hull_owners": Setting(False, flag, "colour the hull by the bone that owns each surface voxel"),
     "clip_axis": Setting(None, axis_or_none, "axis of the hull's clipping plane (None: no clipping)"),
     "clip_position": Setting(0.5, number(0, 1), "clipping plane position along its axis, 0..1"),
     "slices": Setting(False, flag, "orthogonal slices through the preview"),

@@ -44,6 +44,9 @@ class DisplayPanel(QWidget):
         self.spheres = QCheckBox("Points as spheres")
         self.names_visible = QCheckBox("Joint and bone names")
         self.hull_visible = QCheckBox("Show hull")
+        self.hull_owners = QCheckBox("Colour by owning bone")
+        self.hull_owners.setToolTip("Each part of the hull in the colour of the bone that moves it (the body's "
+                                    "ownership, repaints included); Pose → Show ownership on slices looks inside")
         self.hull_opacity = QSlider(Qt.Horizontal)
         self.hull_opacity.setRange(0, 100)
         self.clip_axis = QComboBox()
@@ -56,6 +59,7 @@ class DisplayPanel(QWidget):
         bind(self.spheres, s, "spheres")
         bind(self.names_visible, s, "names_visible")
         bind(self.hull_visible, s, "hull_visible")
+        bind(self.hull_owners, s, "hull_owners")
         bind(self.hull_opacity, s, "hull_opacity", scale=0.01)
         bind(self.clip_axis, s, "clip_axis", to_value=lambda text: CLIP_CHOICES.index(text) - 1 if text in
              CLIP_CHOICES[1:] else None, to_widget=lambda axis: CLIP_CHOICES[0 if axis is None else axis + 1])
@@ -75,6 +79,7 @@ class DisplayPanel(QWidget):
         hull = QGroupBox("Hull")
         hform = QFormLayout(hull)
         hform.addRow(self.hull_visible)
+        hform.addRow(self.hull_owners)
         hform.addRow("Opacity", self.hull_opacity)
         hform.addRow(self.clip_axis, self.clip_position)
         layout = QVBoxLayout(self)

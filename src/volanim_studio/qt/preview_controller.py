@@ -61,6 +61,12 @@ class PreviewController(Controller):
         self._body_again.setSingleShot(True)
         self._body_again.setInterval(50)
         self._body_again.timeout.connect(self.show_body)
+        self._owners_again = QTimer(window)  # the hull's ownership colours, made once no job runs
+        self._owners_again.setSingleShot(True)
+        self._owners_again.setInterval(50)
+        self._owners_again.timeout.connect(self.colour_hull_by_owners)
+        st.hull_owners.connect(lambda **_: self._owners_again.start())
+        ev.owners_shown.connect(lambda **_: self._owners_again.start())
         st.joints.connect(lambda **_: self._joints_changed())
         st.blend.connect(lambda **_: self._joints_changed() if self.doc.settings.joints == "smooth" else None)
 
@@ -336,6 +342,27 @@ class PreviewController(Controller):
             window.show()
             doc.message(f"Ownership of {int(own.mask.sum()):,} voxels by {len(names)} bones; the mouse says "
                         "whose a voxel is. Repaint with the cube (Pose menu) or Fix a lump.")
+
+        return self.jobs.run("Ownership", lambda progress, cancel: doc.ownership.of(conn), done)
+
+    def colour_hull_by_owners(self) -> Worker | None:
+        """With *Colour by owning bone* on, the ownership of the rig as it is made in the background and handed to
+        the hull (``doc.ownership.show``); made again after any change that makes the shown one old. A result
+        for a rig edited meanwhile is dropped and made again."""
+        doc = self.doc
+        if not doc.settings.hull_owners or doc.ownership.shown is not None or not doc.ownership.available \
+                or not len(doc.bones):
+            return None
+        if self.jobs.running:
+            self._owners_again.start()
+            return None
+        conn, edits = doc.pose.tskel().connectivity, (doc.undo.edits, doc.ownership.version)
+
+        def done(own) -> None:
+            if (doc.undo.edits, doc.ownership.version) != edits or own is None:
+                self._owners_again.start() if own is not None else None
+                return
+            doc.ownership.show(own)
 
         return self.jobs.run("Ownership", lambda progress, cancel: doc.ownership.of(conn), done)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 
+from volanim_core.render.bone_colours import label_table
 from volanim_core.render.surfaces import filled_voxel_values
 
 HULL_COLOUR = "#d8c8b0"
@@ -19,6 +20,8 @@ class HullLayer:
         self._meshes = None  # (full, coarse) once a hull exists; coarse is full when it has no LOD
         view.doc.events.volume.connect(self._on_hull_changed)
         view.doc.events.hull.connect(self._on_hull_changed)
+        view.doc.events.owners_shown.connect(self._on_owners)
+        view.settings.events.hull_owners.connect(self._on_owners)
         for name in ("hull_visible", "hull_opacity", "clip_axis", "clip_position"):
             getattr(view.settings.events, name).connect(self._on_state_changed)
 
@@ -42,6 +45,7 @@ class HullLayer:
             opacity=view.settings.hull_opacity, pickable=False, smooth_shading=True, name="hull", render=False,
             reset_camera=False)
         self._apply_state()
+        self._on_owners()
         view.apply_stage()
         view.front_view()
 
@@ -52,6 +56,31 @@ class HullLayer:
         if colour:  # a colour scan's hull shows the colours of its surface voxels
             mesh.point_data["rgb"] = filled_voxel_values(view.doc.volume, np.asarray(verts, np.float64))
         return mesh
+
+    def _on_owners(self, **_) -> None:
+        """Colour the hull by the bone owning each surface voxel (``doc.ownership.shown``) while *Colour by owning
+        bone* is on and an ownership for the rig as it is has been made; its own colours otherwise."""
+        if self.actor is None:
+            return
+        doc = self.view.doc
+        own = doc.ownership.shown if self.view.settings.hull_owners else None
+        mapper = self.actor.GetMapper()
+        if own is None:
+            colour = doc.volume is not None and doc.volume.ndim == 4 and len(doc.hull[0])
+            for mesh, verts in zip(self._meshes, (doc.hull[0], (doc.hull_lod or doc.hull)[0])):
+                if colour:
+                    mesh.point_data["rgb"] = filled_voxel_values(doc.volume, np.asarray(verts, np.float64))
+            mapper.SetScalarVisibility(bool(colour))
+        else:
+            labels = own.volume(doc.mask.shape)
+            table = label_table(len(own.bones))
+            for mesh, verts in zip(self._meshes, (doc.hull[0], (doc.hull_lod or doc.hull)[0])):
+                mesh.point_data["rgb"] = table[filled_voxel_values(labels, np.asarray(verts, np.float64))]
+            mapper.SetScalarModeToUsePointFieldData()
+            mapper.SelectColorArray("rgb")
+            mapper.SetColorModeToDirectScalars()
+            mapper.SetScalarVisibility(True)
+        self.view.render()
 
     def set_dragging(self, on: bool) -> None:
         """The coarse hull while a slider is held, the full one after (same actor, clip and opacity)."""

@@ -635,3 +635,37 @@ def test_ownership_on_slices_shows_whose_each_voxel_is_and_follows_a_repaint(qtb
     box[box != 0] = arm + 1
     after = opened().canvas.picture.astype(int)
     assert np.abs(after - expected(painted)[0]).max() <= 1 and not np.array_equal(after, want)
+
+
+def test_the_hull_coloured_by_owning_bone_follows_a_repaint(qtbot, posed_window):
+    """#84: ownership seen on the hull. *Colour by owning bone* gives each hull vertex the colour of the bone that
+    owns the body voxel it lies on, compared with the ownership made here by the core; a repaint makes the shown
+    colours old at once (the hull's own colour until the new ownership is made), then shows the repaint."""
+    from volanim_core.render.bone_colours import label_table
+    from volanim_core.render.surfaces import filled_voxel_values
+    from volanim_core.rig.ownership import ownership
+
+    w = posed_window
+    doc = w.doc
+    verts = np.asarray(doc.hull[0], np.float64)
+    table = label_table(len(doc.bones.bones))
+    made = ownership(doc.mask, doc.pose.tskel().connectivity).volume(doc.mask.shape)
+
+    def drawn():
+        mapper = w.scene.hull.actor.GetMapper()
+        return (np.asarray(w.scene.hull._meshes[0].point_data["rgb"]) if mapper.GetScalarVisibility() else None)
+
+    w.display_panel.hull_owners.setChecked(True)
+    qtbot.waitUntil(lambda: doc.ownership.shown is not None and not w.busy, timeout=JOB_TIMEOUT_MS)
+    want = table[filled_voxel_values(made, verts)]
+    assert np.array_equal(drawn(), want) and len(np.unique(want, axis=0)) >= 15  # the bones' colours
+    arm = doc.bones.index("L_UPPERARM")
+    doc.ownership.paint_box((96, 40, 200), (107, 59, 221), arm)
+    assert doc.ownership.shown is None and drawn() is None  # never the old colours
+    qtbot.waitUntil(lambda: doc.ownership.shown is not None and not w.busy, timeout=JOB_TIMEOUT_MS)
+    box = made[96:108, 40:60, 200:222]
+    box[box != 0] = arm + 1
+    after = drawn()
+    assert np.array_equal(after, table[filled_voxel_values(made, verts)]) and not np.array_equal(after, want)
+    w.display_panel.hull_owners.setChecked(False)
+    assert drawn() is None
