@@ -301,11 +301,26 @@ def cross_sections(box: np.ndarray, lo: np.ndarray, round_tubes: np.ndarray) -> 
     return out
 
 
-def join_specks(labels: np.ndarray, n_bones: int) -> int:
+def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
     """Give each piece of a bone's voxels cut off from its largest piece (26-connected) to the bone its
     neighbours mostly belong to, in place; returns the voxels moved. Why: the tube rule can leave a speck
     of one bone inside another's flesh (a voxel of spine in the shoulder), which then stays behind, alone,
-    when the limb around it moves. cc3d labels every bone's pieces in one pass over the label volume."""
+    when the limb around it moves. cc3d labels every bone's pieces in one pass over the label volume.
+
+    A speck joins, where it can, a neighbour's *largest* piece: two specks side by side would otherwise
+    trade labels and leave a new speck (the ant's abdomen kept two voxels in a leg, torn off when the leg
+    stepped). Specks that touch only specks go the next round, once their neighbours have joined.
+    """
+    moved = 0
+    for _ in range(rounds):
+        n = _join_specks_once(labels, n_bones)
+        moved += n
+        if n == 0:
+            break
+    return moved
+
+
+def _join_specks_once(labels: np.ndarray, n_bones: int) -> int:
     import cc3d
     from scipy import ndimage
 
@@ -318,20 +333,35 @@ def join_specks(labels: np.ndarray, n_bones: int) -> int:
     for piece in np.argsort(sizes)[::-1]:  # each bone's first piece seen is its largest
         if piece and owner[piece] and largest[owner[piece]] == 0:
             largest[owner[piece]] = piece
+    is_main = np.zeros(len(sizes), bool)
+    is_main[largest[largest > 0]] = True
     ball = np.ones((3, 3, 3), bool)
     moved = 0
-    for piece in np.flatnonzero((owner > 0) & (np.arange(len(sizes)) > 0)):
-        if largest[owner[piece]] == piece:
-            continue
+    for piece in np.flatnonzero((owner > 0) & ~is_main):
         box = stats["bounding_boxes"][piece]
         grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in box)
         mine = pieces[grown] == piece
         ring = ndimage.binary_dilation(mine, ball) & ~mine
-        around = labels[grown][ring]
-        around = around[(around != 0) & (around != owner[piece])]
-        if len(around):
-            labels[grown][mine] = np.bincount(around).argmax()
+        near = pieces[grown][ring]
+        main = near[is_main[near]]
+        if len(main):  # a neighbour's main piece, measured before this round's moves
+            labels[grown][mine] = np.bincount(owner[main]).argmax()
             moved += int(mine.sum())
+    if moved == 0:  # specks touching only specks: their labels as they are, none read from a speck that moved
+        changed = np.zeros(len(sizes), bool)
+        for piece in np.flatnonzero((owner > 0) & ~is_main):
+            box = stats["bounding_boxes"][piece]
+            grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in box)
+            mine = pieces[grown] == piece
+            ring = ndimage.binary_dilation(mine, ball) & ~mine
+            near = pieces[grown][ring]
+            if changed[near].any():
+                continue  # the next round sees it
+            near = near[(near != 0) & (owner[near] != owner[piece])]
+            if len(near):
+                labels[grown][mine] = np.bincount(owner[near]).argmax()
+                changed[piece] = True
+                moved += int(mine.sum())
     return moved
 
 
