@@ -85,7 +85,7 @@ def bench_preview(app) -> None:
 
     root = Path(__file__).resolve().parents[1]
     names = [a for a in sys.argv[1:] if not a.startswith("-")] or ["mannequin", "frog", "mannequin-large"]
-    rows = []
+    rows, stage_rows = [], []
     for name in names:
         w = MainWindow()
         w.resize(1200, 800)
@@ -124,11 +124,20 @@ def bench_preview(app) -> None:
         w.doc.select_bones([bone])
         w.doc.settings.dragging = True  # what pressing a pose slider does
         w.previews.live_timings.clear()
+        pictures = []
+        w.doc.events.preview.connect(lambda w=w, pictures=pictures, **_: pictures.append(w.doc.preview))
         t0 = time.perf_counter()
         for a in range(0, -46, -3):
             w.doc.pose.set_angles(bone, (0, a, 0))  # -> live preview (coalesced) -> drawn
             app.processEvents()
         elapsed = time.perf_counter() - t0
+        stages = [p.stages for p in pictures[1:] if p is not None and p.live and p.stages]
+        stage_rows.append([name] + [f"{1000 * statistics.median(st[k] for st in stages):.0f}" if stages else "-"
+                                    for k in ("pose", "body", "surface")]
+                          + [f"{1000 * statistics.median(st['last draw'] for st in stages if 'last draw' in st):.0f}"
+                             if any("last draw" in st for st in stages) else "-",
+                             f"{1000 * statistics.median(st['pose'] + st['body'] + st['surface'] for st in stages):.0f}"
+                             if stages else "-"])
         live = statistics.median(w.previews.live_timings[1:]) if len(w.previews.live_timings) > 1 else float("nan")
         rate = len(w.previews.live_timings) / elapsed
         factor = live_factor(w.doc.pose.tskel())
@@ -151,6 +160,9 @@ def bench_preview(app) -> None:
                        "release -> report s"]))
     print("targets (#65): mannequin-large live >= 10/s, full <= 0.5 s, slider <= 50 ms; frog live >= 15/s, "
           "full <= 0.3 s; mannequin live at full resolution >= 30/s")
+    print("\na live update by stage (median ms over the drag; draw: software GL, what a GPU desktop makes cheap)")
+    print(table(stage_rows, ["body", "pose (frame + ownership)", "body (kernel: what moved)", "surface",
+                             "draw", "this machine's stages (goal: mannequin <= 20, frog <= 40, large <= 60)"]))
 
 
 if __name__ == "__main__":

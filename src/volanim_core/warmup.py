@@ -49,6 +49,7 @@ def compile_kernels(progress=None) -> float:
     from volanim_core.rig.connectivity import BoneSegment, Connectivity, Tskel
     from volanim_core.rig.curve_skeleton import balls
     from volanim_core.rig.pose import pose_matrices
+    from volanim_core.rig.tskel_tools import coarse_tskel
     from volanim_core.sequence.effects import fall
     from volanim_core.skeleton.skeletonize import skeletonize
 
@@ -95,6 +96,7 @@ def compile_kernels(progress=None) -> float:
     owned = conn.with_ownership(ownership(mask, conn)).posed(matrices)
     for mode in MODES:
         reconstruct(owned, mode=mode, source=source if mode == "sampled" else None)
+    reconstruct(coarse_tskel(owned, 2), mode="bone")  # a live preview at half size: the ownership pooled (#85)
     _report(progress, total, total)
     return time.perf_counter() - t0
 

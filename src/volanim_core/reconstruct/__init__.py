@@ -5,6 +5,7 @@ engine.py .......... reconstruct(): runs the plan, five modes, two metrics; resu
 owned.py ........... the default when the rig has an ownership: each rest voxel moved by the bone that
                      owns it, joints closed by balls (_owned_kernels.py, tested against tests/naive.py)
 live.py ............ LiveFrame: frame after frame on one grid, redoing only the slices moved spheres reach
+live_owned.py ...... LiveOwned: the owned body frame after frame on one grid, redoing only the box moved bones reach
 _plan_kernels.py ... the plan's numba kernels; _kernels.py the fill and sample kernels (tested
                      against tests/naive.py); _clip_kernels.py what falls outside the grid
 radii.py ........... sphere radii as the kernels compare them (squared, integer metric units)

@@ -139,10 +139,11 @@ def reconstruct(
     >>> int((r.volume > 0).sum()), r.origin   # voxels strictly within 2 of the centre: 3x3x3
     (27, (3, 3, 3))
     """
-    if _owned(tskel, method):
+    if moves_owned(tskel, method):
         from volanim_core.reconstruct.owned import reconstruct_owned
 
-        return reconstruct_owned(tskel.ownership, tskel.matrices, mode="bone" if mode == OWNER else mode,
+        own = tskel.ownership  # a coarse frame's is pooled (Ownership.coarse): its rest voxels are every f-th
+        return reconstruct_owned(own, own.rest_matrices(tskel.matrices), mode="bone" if mode == OWNER else mode,
                                  source=source, source_geometry=source_geometry, kernel=kernel, bounds=bounds,
                                  padding=padding, value=value, threads=threads, progress=progress, cancel=cancel,
                                  clock=clock)
@@ -192,7 +193,7 @@ def reconstruct(
     return Reconstruction(volume, tuple(int(v) for v in lo), stats, plan.tskel.geometry.shifted(lo))
 
 
-def _owned(tskel: Tskel, method: str) -> bool:
+def moves_owned(tskel: Tskel, method: str) -> bool:
     """Whether this frame is made from its rig's ownership (see :func:`reconstruct`)."""
     if method not in ("auto", "owned", "spheres"):
         raise ValueError(f"method must be 'auto', 'owned' or 'spheres', got {method!r}")

@@ -63,20 +63,13 @@ def posed_boxes(own: Ownership, matrices: np.ndarray) -> np.ndarray:
 def joint_balls(own: Ownership, matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The balls closing the joints, posed: centres ``(K, 3)``, squared radii, the bone each fills for.
     One ball a joint (bones sharing a proximal joint carry it to one place; the first in root order fills)."""
-    centres, r2s, bones, seen = [], [], [], []
-    for b, seg in enumerate(own.bones):
-        r = own.ball_radii[b]
-        if r <= 0:
-            continue
-        c = seg.proximal @ matrices[b, :3, :3] + matrices[b, 3, :3]
-        if any(np.allclose(c, s, atol=1e-6) for s in seen):
-            continue
-        seen.append(c)
-        centres.append(c)
-        r2s.append(r * r)
-        bones.append(b)
-    return (np.array(centres, np.float64).reshape(-1, 3), np.array(r2s, np.float64),
-            np.array(bones, np.int64))
+    has = np.flatnonzero(own.ball_radii > 0)
+    prox = np.array([own.bones[b].proximal for b in has], np.float64).reshape(-1, 3)
+    m = np.asarray(matrices, np.float64)[has]
+    posed = np.einsum("ki,kij->kj", prox, m[:, :3, :3]) + m[:, 3, :3]
+    keep = [k for k in range(len(has)) if not (np.abs(posed[:k] - posed[k]).max(1, initial=np.inf) <= 1e-6).any()]
+    return (np.ascontiguousarray(posed[keep]).reshape(-1, 3), own.ball_radii[has[keep]] ** 2,
+            has[keep].astype(np.int64))
 
 
 def reconstruct_owned(
@@ -127,7 +120,9 @@ def reconstruct_owned(
     inv = np.ascontiguousarray(np.linalg.inv(matrices))
     rest_lo = np.asarray(own.origin, np.int64)
     shifts = whole_voxel_shifts(matrices)
-    turned, turned_spans = _turned_spans(own, matrices, shifts, lo, (nz, ny))
+    # a bone whose posed box misses the grid adds nothing (a live update's box holds few): not splatted
+    reaches = (boxes[:, 3:] >= lo).all(1) & (boxes[:, :3] <= np.asarray(grid.hi)).all(1)
+    turned, turned_spans = _turned_spans(own, matrices, (shifts[:, 3] == 0) & reaches, lo, (nz, ny))
     nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
@@ -146,13 +141,15 @@ def reconstruct_owned(
             report(z1, total)
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
         spans = own.spans()
-        for b in np.flatnonzero(shifts[:, 3] == 0):
+        for b in np.flatnonzero((shifts[:, 3] == 0) & reaches):
             K.splat_turned(own.labels, spans[b], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi, claims, count)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
         volume = _by_mode(owner, claims, mode, n_bones, value)
         if mode == "sampled":
-            to_source = np.eye(4) if source_geometry is None else own.geometry.index_map(source_geometry)
+            # a coarse ownership's voxel c is the source's voxel factor c (Ownership.coarse)
+            to_source = np.diag([float(own.factor)] * 3 + [1.0]) if source_geometry is None else \
+                own.geometry.index_map(source_geometry)
             maps = grid_to_source(inv, lo.astype(np.float64), to_source)
             volume = sample_source(owner, source, maps, kernel, (row_lo, row_hi), nthreads, SLAB,
                                    lambda done: report(nz + done, total))
@@ -172,11 +169,12 @@ def reconstruct_owned(
     return Reconstruction(xyz, tuple(int(v) for v in lo), stats, own.geometry.shifted(lo))
 
 
-def _turned_spans(own: Ownership, matrices: np.ndarray, shifts: np.ndarray, lo: np.ndarray, shape_zy):
-    """For each turned bone (not moved by whole voxels), where its voxels land on each output row: ``turned[b]``
-    its index in ``spans (T, nz, ny, 2)`` (0 for the others, whose entry is never read)."""
+def _turned_spans(own: Ownership, matrices: np.ndarray, which: np.ndarray, lo: np.ndarray, shape_zy):
+    """For each turned bone that reaches the grid (``which``: not moved by whole voxels), where its voxels land on
+    each output row: ``turned[b]`` its index in ``spans (T, nz, ny, 2)`` (0 for the others, whose entry is never
+    read)."""
     turned = np.zeros(len(matrices), np.int64)
-    which = [b for b in range(len(matrices)) if shifts[b, 3] == 0]
+    which = np.flatnonzero(which)
     spans = np.empty((max(1, len(which)), *shape_zy, 2), np.int32)
     spans[..., 0], spans[..., 1] = shape_zy[1] * 0 + 2**30, -(2**30)
     rest_spans = own.spans()
@@ -213,6 +211,11 @@ def _checked(own: Ownership, matrices, mode, source, kernel) -> np.ndarray:
     if abs(np.linalg.det(m[:, :3, :3])).min() < 1e-9:
         raise ValueError("a bone's matrix is singular: it cannot be inverted to find the rest voxels it moves")
     return np.ascontiguousarray(m)
+
+
+def posed_bounds(own: Ownership, matrices: np.ndarray, padding: int = 2) -> Bounds:
+    """The grid :func:`reconstruct_owned` makes the pose on when given no bounds."""
+    return _grid(posed_boxes(own, matrices), *joint_balls(own, matrices)[:2], padding)
 
 
 def _grid(boxes: np.ndarray, centres: np.ndarray, r2s: np.ndarray, padding: int) -> Bounds:

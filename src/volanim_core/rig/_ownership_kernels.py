@@ -214,3 +214,50 @@ def piece_labels(pieces, labels, out):
     fp, fl = pieces.ravel(), labels.ravel()
     for i in range(fp.size):
         out[fp[i]] = fl[i]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def pool_labels(labels, offset, f, out):
+    """``out[c]`` (``[x, y, z]``) = the label most of coarse voxel c's filled fine voxels carry (ties: the one met
+    first), where at least half its ``f^3`` block is filled, else 0. Block c covers the fine voxels
+    ``f c - offset .. f c - offset + f - 1`` of ``labels`` ``[x, y, z]`` (beyond them: empty)."""
+    nx, ny, nz = labels.shape
+    cx, cy, cz = out.shape
+    block = f * f * f
+    for k in numba.prange(cz):
+        seen = np.zeros(block, np.int64)
+        count = np.zeros(block, np.int64)
+        for j in range(cy):
+            for i in range(cx):
+                m = 0
+                filled = 0
+                for dz in range(f):
+                    z = k * f + dz - offset[2]
+                    if z < 0 or z >= nz:
+                        continue
+                    for dy in range(f):
+                        y = j * f + dy - offset[1]
+                        if y < 0 or y >= ny:
+                            continue
+                        for dx in range(f):
+                            x = i * f + dx - offset[0]
+                            if x < 0 or x >= nx:
+                                continue
+                            v = labels[x, y, z]
+                            if v == 0:
+                                continue
+                            filled += 1
+                            q = 0
+                            while q < m and seen[q] != v:
+                                q += 1
+                            if q == m:
+                                seen[m] = v
+                                count[m] = 0
+                                m += 1
+                            count[q] += 1
+                if 2 * filled >= block:
+                    best = 0
+                    for q in range(1, m):
+                        if count[q] > count[best]:
+                            best = q
+                    out[i, j, k] = seen[best]

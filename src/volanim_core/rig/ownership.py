@@ -37,6 +37,7 @@ from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
     own_by_tubes,
     piece_labels,
+    pool_labels,
     row_ends,
     row_spans,
     section_moments,
@@ -68,6 +69,10 @@ class Ownership:
     geometry: Geometry = IDENTITY
     tubes: np.ndarray | None = None  # (B, TUBE_COLUMNS): the tubes the rule used (_ownership_kernels.tube_distance)
     path: object = None  # the file it was read from or saved to (a .tskel names it)
+    #: the rest grid is every ``factor``-th voxel of the skeleton's (:meth:`coarse`: a live preview's), its
+    #: voxel c the skeleton's voxels ``factor c .. factor c + factor - 1``
+    factor: int = 1
+    _coarse: dict = field(default_factory=dict, repr=False)
     _hulls: list | None = field(default=None, repr=False)
     _spans: np.ndarray | None = field(default=None, repr=False)
 
@@ -119,6 +124,35 @@ class Ownership:
     def counts(self) -> np.ndarray:
         """Each bone's owned voxels."""
         return np.bincount(self.labels.ravel(), minlength=len(self.bones) + 1)[1:len(self.bones) + 1]
+
+    def coarse(self, factor: int) -> Ownership:
+        """This ownership on a ``factor``-times coarser grid (kept: made once per factor): each coarse voxel the
+        bone most of its block's body voxels belong to, where at least half the block is body (the body's
+        size kept, as the coarse spheres keep it), its joints and balls scaled alike. Pose it with
+        :meth:`rest_matrices` of the coarse frame's matrices (:func:`~volanim_core.rig.pose.scaled`)."""
+        if factor == 1:
+            return self
+        if factor not in self._coarse:
+            lo = np.asarray(self.origin)
+            coarse_lo = np.floor_divide(lo, factor)
+            offset = lo - coarse_lo * factor
+            shape = -(-(offset + self.labels.shape) // factor)
+            labels = np.zeros(tuple(int(n) for n in shape), self.labels.dtype, order="F")
+            pool_labels(self.labels, offset.astype(np.int64), int(factor), labels)
+            bones = [BoneSegment(b.proximal / factor, b.distal / factor, b.name)
+                     for b in self.bones]
+            self._coarse[factor] = Ownership(labels, tuple(coarse_lo), bones, self.ball_radii / factor,
+                                             self.geometry.with_spacing(np.multiply(self.geometry.spacing, factor)),
+                                             factor=self.factor * factor)
+        return self._coarse[factor]
+
+    def rest_matrices(self, matrices: np.ndarray) -> np.ndarray:
+        """Bone matrices that take the skeleton's rest voxels to posed ones (a coarse frame's: followed by a
+        1/factor scale) made to take this grid's rest voxels: a coarse voxel c is the skeleton's voxel factor c."""
+        if self.factor == 1:
+            return matrices
+        s = np.diag([float(self.factor)] * 3 + [1.0])
+        return np.ascontiguousarray(s @ np.asarray(matrices, np.float64))
 
     def with_labels(self, labels: np.ndarray) -> Ownership:
         """The same rig with other owners (a repaint); the labels must cover the same body."""

@@ -42,16 +42,19 @@ def identity_tskel(conn: Connectivity) -> Tskel:
 
 
 def coarse_tskel(tskel: Tskel, factor: int) -> Tskel:
-    """The frame on a ``factor``-times coarser grid: matrices followed by a 1/factor scale, radii alike
-    (live previews and the clip scan: factor^3 fewer voxels, the same shape). Smooth joints keep the
-    fine frame's blend weights: the coarse frame bends exactly as the full one does."""
+    """The frame on a ``factor``-times coarser grid: matrices followed by a 1/factor scale, radii alike, its
+    rig's ownership pooled (live previews and the clip scan: factor^3 fewer voxels, the same shape).
+    Smooth joints keep the fine frame's blend weights: the coarse frame bends exactly as the full one does."""
     if factor == 1:
         return tskel
     from volanim_core.rig.pose import scaled
 
-    return Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
-                 tskel.bone, tskel.metric, tskel.geometry.with_spacing(np.multiply(tskel.geometry.spacing, factor)),
-                 joints=tskel.joints, skin=tskel.skin if tskel.joints.smooth else None)
+    out = Tskel(tskel.bones, scaled(tskel.matrices, factor), tskel.points, tskel.dt / factor, tskel.thinness,
+                tskel.bone, tskel.metric, tskel.geometry.with_spacing(np.multiply(tskel.geometry.spacing, factor)),
+                joints=tskel.joints, skin=tskel.skin if tskel.joints.smooth else None)
+    if tskel.ownership is not None:  # the owned body on the coarse grid too: a half-size preview is no sphere body
+        out.ownership = tskel.ownership.coarse(factor)
+    return out
 
 
 def sort_tskel(tskel: Tskel) -> Tskel:

@@ -27,6 +27,7 @@ class OwnershipState:
         # ((bone, ("box", lo, hi) | ("voxels", flat indices, Fortran order)), ...): replaced whole, never changed
         self.paints: tuple = ()
         self._made = None  # (key, Ownership before the paints)
+        self._painted_made = None  # (the Ownership before the paints, the paints, the Ownership with them)
         self._lock = threading.Lock()  # the preview's worker makes it while the GUI thread may ask again
         self.version = 0  # counts repaints: a preview made before one is old
         self.shown: Ownership | None = None  # what the hull is coloured by (show()); None: not made for this rig
@@ -35,7 +36,7 @@ class OwnershipState:
         doc.events.ownership.connect(lambda **_: self.show(None))
 
     def _forget(self) -> None:
-        self._made = None
+        self._made = self._painted_made = None
         self.show(None)
 
     def show(self, own: Ownership | None) -> None:
@@ -66,7 +67,15 @@ class OwnershipState:
             made = (key, ownership(self.doc.mask, conn))
             with self._lock:
                 self._made = made
-        return self._painted(made[1], self.paints)
+        paints = self.paints
+        with self._lock:
+            painted = self._painted_made
+        if painted is None or painted[0] is not made[1] or painted[1] != paints:
+            # kept: every live picture of a drag asks, and each new object would start the live grid again
+            painted = (made[1], paints, self._painted(made[1], paints))
+            with self._lock:
+                self._painted_made = painted
+        return painted[2]
 
     def _painted(self, own: Ownership, paints) -> Ownership:
         if not paints:

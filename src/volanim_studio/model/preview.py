@@ -5,9 +5,10 @@ matrices are followed by a 1/factor scale and radii shrink alike, so the
 voxel count (the cost) drops by factor^3 while the shape stays.
 
 Live previews (a drag, the timeline playing) come from :class:`LivePreviews`: one
-:class:`~volanim_core.reconstruct.live.LiveFrame` on a grid with room around the body, so each
-pose redoes only the slices the moved spheres reach (#65); what it hands out is cropped to the
-frame's own grid, the very preview :func:`make_preview` makes.
+:class:`~volanim_core.reconstruct.live_owned.LiveOwned` (the rig's owned body: only the box the moved
+bones reach is redone, #85) or :class:`~volanim_core.reconstruct.live.LiveFrame` (the thesis's spheres:
+only the slices the moved spheres reach, #65) on a grid with room around the body; what it hands out is
+cropped to the frame's own grid, the very preview :func:`make_preview` makes.
 """
 
 from __future__ import annotations
@@ -17,8 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.reconstruct.breakage import BreakageReport, RestParts, breakage_report
-from volanim_core.reconstruct.engine import Reconstruction, grid_bounds, reconstruct
+from volanim_core.reconstruct.engine import Reconstruction, grid_bounds, moves_owned, reconstruct
 from volanim_core.reconstruct.live import LiveFrame
+from volanim_core.reconstruct.live_owned import LiveOwned
+from volanim_core.reconstruct.owned import posed_bounds
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.tskel_tools import coarse_tskel
 from volanim_core.volume import Bounds
@@ -41,6 +44,9 @@ class Preview:
     surface: object = None  # a live preview's surface (pyvista PolyData in world units), made off the GUI thread
     view: np.ndarray | None = None  # what the view draws of a full preview ([x, y, z] in Fortran order, every
     view_step: int = 1  # ``view_step``-th voxel of the reconstruction), made off the GUI thread (view_volume)
+    #: a live preview's cost by stage, seconds: pose (the frame and its ownership), body (the kernel: only what
+    #: moved), surface (the mesh drawn); the scene adds draw (software GL) once it has drawn it
+    stages: dict | None = None
 
     def view_volume(self) -> None:
         """Make :attr:`view`: the reconstruction, or every second voxel of one over :data:`VIEW_FULL_VOXELS`,
@@ -150,10 +156,19 @@ class LivePreviews:
             kept = self._live is not None and self._key[0] == mode
             factor = self._key[1] if kept else live_factor(tskel)
         coarse = coarse_tskel(tskel, factor)
-        own = grid_bounds(coarse, max(1, padding // factor))
-        if self._live is None or self._key != (mode, factor) or not _inside(own, self._live.bounds):
-            self._live, self._key = LiveFrame(_grown(own, self.margin), mode=mode), (mode, factor)
-        r = self._live.update(coarse, copy=False)
+        pad = max(1, padding // factor)
+        if moves_owned(coarse, "auto"):  # the rig's owned body (reconstruct's default), only the moved bones redone
+            rig = coarse.ownership  # pooled on the coarse grid (Ownership.coarse), kept with the rig
+            matrices = rig.rest_matrices(coarse.matrices)
+            own, key = posed_bounds(rig, matrices, pad), (mode, factor, id(rig))
+            if self._live is None or self._key != key or not _inside(own, self._live.bounds):
+                self._live, self._key = LiveOwned(rig, _grown(own, self.margin), mode=mode), key
+            r = self._live.update(matrices, copy=False)
+        else:
+            own = grid_bounds(coarse, pad)
+            if self._live is None or self._key != (mode, factor) or not _inside(own, self._live.bounds):
+                self._live, self._key = LiveFrame(_grown(own, self.margin), mode=mode), (mode, factor)
+            r = self._live.update(coarse, copy=False)
         lo = np.subtract(own.lo, r.origin)
         box = tuple(slice(a, a + n) for a, n in zip(lo, own.shape))
         # copied in its memory's order (the [x, y, z] view of [z, y, x] arrays, as reconstruct returns them):
@@ -168,7 +183,8 @@ class LivePreviews:
 
     @property
     def redone(self) -> int:
-        """Slices the last preview redid (all of its grid's on a fresh one)."""
+        """What the last preview redid: output slices of the spheres' grid, or voxels of the owned body's (all
+        of its grid's on a fresh one)."""
         return 0 if self._live is None else self._live.redone
 
 

@@ -17,6 +17,7 @@ dialogs and windows ... threshold_dialog.py, mapping_dialog.py, movie_dialog.py,
                         scan_dialog.py, look_dialog.py, recovery_dialog.py, quicklook_window.py, slice_window.py,
                         transfer_editor.py (the thesis's Icol)
 status_line.py ........ the status bar; verdict_label.py the last preview's verdict
+fine_slider.py ........ FineSlider: the pose sliders, a degree per 5 pixels with Shift held
 mode_keys.py .......... the mode letters work wherever the focus is
 interactor.py ......... a pyvistaqt interactor closed without a stale wrapper; gui_gc.py: garbage
                         collected on the GUI thread only

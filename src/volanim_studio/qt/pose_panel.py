@@ -4,7 +4,6 @@ pose events write the widgets back with signals blocked."""
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
     QDoubleSpinBox,
     QFormLayout,
@@ -12,12 +11,12 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QPushButton,
-    QSlider,
     QVBoxLayout,
     QWidget,
 )
 
 from ..model.document import Document
+from .fine_slider import FineSlider
 from .verdict_label import VerdictLabel
 
 
@@ -32,7 +31,7 @@ class PosePanel(QWidget):
         box = QGroupBox("Rotate about the proximal joint (children follow)")
         form = QFormLayout(box)
         for axis, colour, name in (("x", "#e63c3c", "red"), ("y", "#3cc850", "green"), ("z", "#4678ff", "blue")):
-            slider = QSlider(Qt.Horizontal)
+            slider = FineSlider()  # Shift while dragging: a degree per 5 pixels (#85)
             slider.setRange(-180, 180)
             spin = QDoubleSpinBox(decimals=1, minimum=-180.0, maximum=180.0, singleStep=1.0)
             row = QHBoxLayout()

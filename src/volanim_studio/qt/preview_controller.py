@@ -2,7 +2,8 @@
 
     settings.dragging (a pose slider, the timeline held or playing) + doc.events.pose
         --> live_preview (coalesced) --> LiveWorker (its thread, newest pose first: full resolution on a
-            small body, else half; the surface too) --> _live_made --> doc.set_preview
+            small body, else half; the owned body as the full preview's, only the moved bones redone;
+            the surface too) --> _live_made --> doc.set_preview
     settings.current_frame (a step) --> live_preview
     dragging back to False in Pose mode, doc.events.pose_settled, F5, Pose mode entered, a clip loaded
         (show_body: unless the picture shown is current)
@@ -176,23 +177,30 @@ class PreviewController(Controller):
         too; the GUI thread only draws what comes back (:meth:`_live_made`)."""
         mode = self.doc.settings.preview_mode
         mode = mode if mode in ("binary", "bone") else "bone"
+        t0 = time.perf_counter()
         try:
             tskel = self.doc.pose.tskel()
         except ValueError as exc:
             self.doc.message(str(exc))
             return
-        t0 = time.perf_counter()
+        posing = time.perf_counter() - t0
         basis, full = self.doc.picture_basis, self._full_asked
         # what it shows: playing, the scene draws these bones with it, never the newer pose's
         joints = self.doc.pose.posed_joints()
         frame = self.doc.settings.current_frame if self.doc.timeline.active else None
         function, n_bones, live = self.doc.transfer.function, len(self.doc.bones), self.live
         spacing = tuple(self.scene.spacing)  # the view's world units
+        owned = self.doc.ownership  # the body the full preview shows (its ownership made here once per rig)
 
         def make():
-            p = live.make(tskel, mode=mode, padding=2)  # only what moved; full or half resolution
+            t1 = time.perf_counter()
+            attached = owned.attach(tskel)
+            t2 = time.perf_counter()
+            p = live.make(attached, mode=mode, padding=2)  # only what moved; full or half resolution
+            t3 = time.perf_counter()
             p.basis, p.joints, p.frame = basis, joints, frame
             p.surface = live_surface(p, function, n_bones, spacing)
+            p.stages = {"pose": posing + t2 - t1, "body": t3 - t2, "surface": time.perf_counter() - t3}
             return p, full, t0
 
         self.live_worker.ask(make)

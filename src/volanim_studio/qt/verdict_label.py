@@ -51,6 +51,8 @@ class VerdictLabel(ElidedLabel):
         elif not p.live:  # the picture is shown, its report follows (a background job): no old verdict meanwhile
             self._report, self._checking = None, True
             self.set_styled(CHECKING, COLOURS["stale"])
+        elif p.stages is not None:  # dragging or playing: at what resolution, and what each picture costs
+            self.set_styled(live_text(p), COLOURS["stale"])
 
     def _on_stale(self, what: str, **_) -> None:
         if self._checking:  # that check is of what was: cancelled or soon old
@@ -62,3 +64,13 @@ class VerdictLabel(ElidedLabel):
     def _show_stale(self, what: str | None) -> None:
         self.set_styled(f"{self._report.verdict} (before the last change of {what or 'the session'}: "
                         "F5 checks again)", COLOURS["stale"])
+
+
+def live_text(p) -> str:
+    """What a live picture says while the pose moves (#85): its resolution and its cost by stage, in ms."""
+    size = "full size" if p.factor == 1 else f"1/{p.factor}"
+    ms = {k: round(1000 * v) for k, v in p.stages.items()}
+    parts = [f"pose {ms['pose']}", f"body {ms['body']}", f"surface {ms['surface']}"]
+    if "last draw" in ms:
+        parts.append(f"draw {ms['last draw']}")
+    return f"Live at {size}: " + ", ".join(parts) + " ms (release for the full picture and its verdict)"

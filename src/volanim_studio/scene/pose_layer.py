@@ -352,6 +352,8 @@ class PoseLayer:
             plotter.add_mesh(surf, color=SKIN, name="preview", render=False, reset_camera=False)
         view.apply_stage()
         view.render()
+        if p.stages is not None:  # the draw the last live picture took (this one's is known once drawn)
+            p.stages["last draw"] = view.draw_seconds
 
     def clear(self, render: bool = True) -> None:
         self.view.plotter.remove_actor("preview", render=False)

@@ -11,6 +11,7 @@ intercept a click and HiDPI scaling cannot offset it.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 
 import numpy as np
@@ -65,6 +66,11 @@ class SceneView:
         self._after_drag: tuple[bool, bool] | None = None  # the renderer's FXAA and OIT, put back on release
         self._render_pending = False
         self._drawn_once = False
+        self.draw_seconds = 0.0  # how long the last frame took to draw (software GL: most of a live update's)
+        self._draw_began = 0.0
+        window = plotter.render_window
+        window.AddObserver("StartEvent", lambda *_: setattr(self, "_draw_began", time.perf_counter()))
+        window.AddObserver("EndEvent", lambda *_: setattr(self, "draw_seconds", time.perf_counter() - self._draw_began))
         plotter.set_background("#1e1f24")
         self._fix_pixel_ratio()
         self._quiet_keys()

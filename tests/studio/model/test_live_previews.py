@@ -55,3 +55,28 @@ def test_a_small_body_is_previewed_live_at_full_resolution_a_large_one_at_half()
     assert np.array_equal(first.reconstruction.volume, make_preview(small, mode="bone").reconstruction.volume)
     assert live.make(small, mode="bone").factor == 1  # kept
     assert np.prod(live.bounds.shape) < 2 * LIVE_FULL_VOXELS
+
+
+@pytest.mark.parametrize("factor", [1, 2])
+def test_a_drag_of_an_owned_body_is_the_full_preview_s_body_and_redoes_the_moved_bones_box(factor):
+    """#85: with the rig's ownership (the default body) the live pictures were still the thesis's spheres, so a
+    raised arm swung its armpit lump while dragged and lost it on release. Now each live picture is the owned body
+    make_preview makes (half size: the ownership pooled), redoing only the box the moved bones reach."""
+    from volanim_core.rig.ownership import ownership
+
+    s = samples.mannequin()
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
+    conn = conn.with_ownership(ownership(s.mask, conn))
+    live = LivePreviews()
+    redone = []
+    for pose in DRAG:
+        t = conn.posed(pose_matrices(s.bones, pose))
+        got = live.make(t, mode="bone", factor=factor, padding=2)
+        want = make_preview(t, mode="bone", factor=factor, padding=2)
+        assert want.reconstruction.stats["method"] == "owned"
+        assert got.reconstruction.origin == want.reconstruction.origin
+        assert np.array_equal(got.reconstruction.volume, want.reconstruction.volume)
+        assert np.array_equal(got.origin_voxels, want.origin_voxels)
+        redone.append(live.redone)
+    whole = int(np.prod(live.bounds.shape))
+    assert all(0 < n < whole // 10 for n in redone[1:7])  # each step of the forearm: its own box

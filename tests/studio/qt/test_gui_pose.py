@@ -82,6 +82,36 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     assert w.mode == Mode.VIEW
 
 
+def test_a_drag_shows_the_owned_body_the_release_shows_and_says_what_each_picture_costs(qtbot, posed_window):
+    """#85: while a bone was dragged the live pictures were the thesis's spheres, the armpit lump and all, and the
+    release swapped in the owned body. Now every live picture is the owned body (the last one, of the release's
+    pose, is the full preview's voxel for voxel), and the Pose tab says at what size and cost each is made."""
+    w = posed_window
+    live = []
+    w.doc.events.preview.connect(lambda **_: live.append(w.doc.preview) if w.doc.preview.live else None)
+    w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
+    slider = w.pose_panel.sliders[1]
+    slider.setSliderDown(True)
+    for v in range(0, -91, -15):
+        slider.setValue(v)
+        qtbot.wait(1)
+    qtbot.waitUntil(lambda: w.previews.live_worker.idle and live and live[-1].joints is not None
+                    and np.allclose(live[-1].joints["L_ELBOW"], w.doc.pose.posed_joints()["L_ELBOW"]),
+                    timeout=JOB_TIMEOUT_MS)
+    last = live[-1]
+    assert all(p.reconstruction.stats["method"] == "owned" for p in live)
+    said = w.pose_panel.verdict.plain
+    assert said.startswith("Live at full size: pose ") and " body " in said and said == w.verdict_label.plain
+    slider.setSliderDown(False)
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and w.doc.preview.report is not None,
+                    timeout=JOB_TIMEOUT_MS)
+    full = w.doc.preview
+    assert not full.live and full.factor == last.factor == 1
+    assert last.reconstruction.origin == full.reconstruction.origin
+    assert np.array_equal(last.reconstruction.volume, full.reconstruction.volume)
+    assert not w.pose_panel.verdict.plain.startswith("Live")  # the verdict of the full picture
+
+
 def test_the_full_preview_is_drawn_before_its_report_is_made(qtbot, posed_window):
     """#65: the release showed nothing new until the report's three more reconstructions had run (on
     mannequin-large: 0.2 s of picture, then 5 s of report). Now the picture is set and drawn by itself, and the
@@ -134,7 +164,8 @@ def test_the_report_is_checked_behind_the_picture_and_a_new_drag_cancels_it(qtbo
     assert job is not None and job.background and seen["dialog"] is None and not seen["busy"]
     assert seen["verdict"] == CHECKING
     assert job.cancelled and w.doc.preview.live and w.doc.preview.report is None  # the stale report: dropped
-    assert w.verdict_label.plain == ""  # no verdict of a pose that is gone
+    # no verdict of a pose that is gone: what the live picture is (#85)
+    assert w.verdict_label.plain.startswith("Live at full size: ")
     w.doc.events.preview.disconnect(on_picture)
     w.pose_panel.sliders[1].setSliderDown(False)  # the release: the picture, then its report
     qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
@@ -669,3 +700,33 @@ def test_the_hull_coloured_by_owning_bone_follows_a_repaint(qtbot, posed_window)
     assert np.array_equal(after, table[filled_voxel_values(made, verts)]) and not np.array_equal(after, want)
     w.display_panel.hull_owners.setChecked(False)
     assert drawn() is None
+
+
+def test_shift_while_dragging_a_pose_slider_lands_on_every_whole_degree(qtbot, posed_window):
+    """#85: the sliders turned two degrees a pixel, so 0 or -90 could not be hit by mouse. Shift held while dragging
+    turns one degree per FINE_PIXELS pixels from where it was held, for the rest of that drag."""
+    from PySide6.QtCore import QPoint, QPointF
+    from PySide6.QtGui import QMouseEvent
+    from PySide6.QtTest import QTest
+    from PySide6.QtWidgets import QApplication
+
+    from volanim_studio.qt.fine_slider import FINE_PIXELS
+
+    w = posed_window
+    bone = w.doc.bones.index("L_UPPERARM")
+    w.bone_panel.tree.topLevelItem(bone).setSelected(True)
+    slider = w.pose_panel.sliders[1]
+    assert 360 / slider.width() > 1.5  # the plain drag: more than a degree and a half a pixel
+    handle = QPoint(slider.width() // 2, slider.height() // 2)  # the handle at 0
+    QTest.mousePress(slider, Qt.LeftButton, Qt.NoModifier, handle)
+    assert slider.isSliderDown() and slider.value() == 0
+    seen = []
+    for dx in range(0, 8 * FINE_PIXELS + 1):  # QTest's moves carry no modifier: the event is made here
+        at = QPointF(handle - QPoint(dx, 0))
+        QApplication.sendEvent(slider, QMouseEvent(QMouseEvent.Type.MouseMove, at, slider.mapToGlobal(at),
+                                                   Qt.NoButton, Qt.LeftButton, Qt.ShiftModifier))
+        seen.append(slider.value())
+    QTest.mouseRelease(slider, Qt.LeftButton, Qt.NoModifier, handle - QPoint(8 * FINE_PIXELS, 0))
+    assert seen[-1] == -8 and sorted(set(seen), reverse=True) == list(range(0, -9, -1))  # every degree on the way
+    assert w.doc.pose.angles_of(bone)[1] == -8.0
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
