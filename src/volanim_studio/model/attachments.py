@@ -41,6 +41,11 @@ def connectivity(skeleton: Skeleton, bones: BoneSkeleton, attached: np.ndarray, 
     return conn.grouped()
 
 
+def joints_of(settings) -> Joints:
+    """How bones meet, as the settings say (rigid, or smooth with a blend width)."""
+    return Joints(settings.joints, settings.blend)
+
+
 class Attachments:
     def __init__(self, doc):
         self.doc = doc
@@ -169,7 +174,7 @@ class Attachments:
         s = doc.skeleton
         if s is None:  # an empty studio: F5, exports and saves end here, with words instead of a traceback
             raise ValueError("nothing loaded yet: open a volume, a demo or a project first (File menu)")
-        return connectivity(s, doc.bones, self.bone, Joints(doc.settings.joints, doc.settings.blend), thinness)
+        return connectivity(s, doc.bones, self.bone, joints_of(doc.settings), thinness)
 
     def save(self, path, thinness: float | None = None) -> int:
         """Write attached points with thinness >= ``thinness`` (default: the slider) atomically."""

@@ -197,9 +197,25 @@ class PoseState:
 
     def tskel(self, thinness: float | None = None) -> Tskel:
         """The posed frame of the attached points with thinness >= ``thinness`` (default: the slider)."""
-        conn = self.doc.attachments.to_connectivity()
-        t = self.doc.thinness if thinness is None else thinness
-        return conn.take(np.flatnonzero(~(conn.thinness < t))).posed(self.matrices())
+        return self.frame_maker(thinness)()
+
+    def frame_maker(self, thinness: float | None = None):
+        """:meth:`tskel` as a function of what it reads, copied now: call it on any thread. The live thread makes
+        each drag's frame itself (#85: grouping the frog's 400 k attached points by bone took the GUI thread
+        10-15 ms a picture); what is copied here is the attachments array and the matrices."""
+        from .attachments import connectivity, joints_of
+
+        doc = self.doc
+        if doc.skeleton is None:  # an empty studio: F5, exports and saves end here, with words instead of a traceback
+            raise ValueError("nothing loaded yet: open a volume, a demo or a project first (File menu)")
+        skeleton, bones, attached = doc.skeleton, doc.bones, doc.attachments.bone.copy()
+        joints, matrices = joints_of(doc.settings), self.matrices()
+        t = doc.thinness if thinness is None else thinness
+
+        def make() -> Tskel:
+            conn = connectivity(skeleton, bones, attached, joints)
+            return conn.take(np.flatnonzero(~(conn.thinness < t))).posed(matrices)
+        return make
 
     def posed_box(self) -> tuple[np.ndarray, np.ndarray] | None:
         """The voxel box the posed spheres of every attached point fill (None: nothing attached): where the

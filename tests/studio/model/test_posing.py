@@ -117,3 +117,27 @@ def test_a_report_made_with_kept_rest_parts_equals_a_fresh_one_and_edits_drop_th
     assert doc.pose.rest_parts(doc.pose.tskel()) is None
     doc.thinness = 0.8  # another slider position is another frame
     assert doc.pose.rest_parts(doc.pose.tskel()) is None
+
+
+def test_a_frame_maker_makes_on_any_thread_the_frame_of_the_moment_it_was_asked(doc):
+    """#85: the live thread makes each drag's frame itself (grouping the frog's 400 k points took the GUI thread
+    10-15 ms a picture). The maker copies what the frame is made of when it is asked for: an edit after that (a
+    point given to another bone, the pose turned on) is not in the frame it makes, which is tskel() of then."""
+    import threading
+
+    b = doc.bones.index("L_UPPERARM")
+    doc.pose.set_angles(b, (0, -40, 0))
+    want = doc.pose.tskel()
+    make = doc.pose.frame_maker()
+    shown = np.flatnonzero(doc.skeleton.thinness >= doc.thinness)[:50]  # points the frame holds
+    doc.attachments.assign_many(shown, np.full(len(shown), doc.bones.index("HEAD")), "to the head")
+    doc.pose.set_angles(b, (0, -80, 0))
+    made = []
+    worker = threading.Thread(target=lambda: made.append(make()))
+    worker.start()
+    worker.join()
+    got = made[0]
+    assert np.array_equal(got.points, want.points) and np.array_equal(got.bone, want.bone)
+    assert np.array_equal(got.matrices, want.matrices)
+    now = doc.pose.tskel()  # the document moved on: other attachments, another pose
+    assert not np.array_equal(now.bone, got.bone) and not np.array_equal(now.matrices, got.matrices)
