@@ -354,9 +354,18 @@ def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
     return moved
 
 
+def _around(pieces: np.ndarray, stats: dict, piece: int) -> tuple:
+    """A piece's box grown by a voxel, its voxels there, and the piece numbers of the 26-neighbours around it."""
+    from scipy import ndimage
+
+    grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in stats["bounding_boxes"][piece])
+    mine = pieces[grown] == piece
+    ring = ndimage.binary_dilation(mine, np.ones((3, 3, 3), bool)) & ~mine
+    return grown, mine, pieces[grown][ring]
+
+
 def _join_specks_once(labels: np.ndarray, n_bones: int) -> int:
     import cc3d
-    from scipy import ndimage
 
     pieces = cc3d.connected_components(labels, connectivity=26)
     stats = cc3d.statistics(pieces)
@@ -369,14 +378,9 @@ def _join_specks_once(labels: np.ndarray, n_bones: int) -> int:
             largest[owner[piece]] = piece
     is_main = np.zeros(len(sizes), bool)
     is_main[largest[largest > 0]] = True
-    ball = np.ones((3, 3, 3), bool)
     moved = 0
     for piece in np.flatnonzero((owner > 0) & ~is_main):
-        box = stats["bounding_boxes"][piece]
-        grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in box)
-        mine = pieces[grown] == piece
-        ring = ndimage.binary_dilation(mine, ball) & ~mine
-        near = pieces[grown][ring]
+        grown, mine, near = _around(pieces, stats, piece)
         main = near[is_main[near]]
         if len(main):  # a neighbour's main piece, measured before this round's moves
             labels[grown][mine] = np.bincount(owner[main]).argmax()
@@ -384,11 +388,7 @@ def _join_specks_once(labels: np.ndarray, n_bones: int) -> int:
     if moved == 0:  # specks touching only specks: their labels as they are, none read from a speck that moved
         changed = np.zeros(len(sizes), bool)
         for piece in np.flatnonzero((owner > 0) & ~is_main):
-            box = stats["bounding_boxes"][piece]
-            grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in box)
-            mine = pieces[grown] == piece
-            ring = ndimage.binary_dilation(mine, ball) & ~mine
-            near = pieces[grown][ring]
+            grown, mine, near = _around(pieces, stats, piece)
             if changed[near].any():
                 continue  # the next round sees it
             near = near[(near != 0) & (owner[near] != owner[piece])]

@@ -16,7 +16,6 @@ from volanim_core.rig.ownership import ownership
 from volanim_core.rig.pose import pose_matrices
 from volanim_core.rig.tskel_tools import coarse_tskel
 from volanim_core.skeleton.skeletonize import skeletonize
-from volanim_core.volume import Bounds
 
 # a forearm dragged, a foot, the spine (everything above it moves), a clavicle, then the whole body walked off
 DRAG = ([{"L_FOREARM": (-a, 0, 0)} for a in range(0, 80, 10)] + [{"L_FOREARM": (-70, 0, 0), "R_FOOT": (20, 0, 0)}]
@@ -110,4 +109,3 @@ def test_a_coarse_ownership_is_made_once_and_poses_on_its_own_grid(rig):
     # a coarse rest voxel c is the skeleton's voxel 2c: posed by the full matrix, then halved
     p = np.array([31.0, 40.0, 55.0])
     assert np.allclose(np.append(p, 1) @ c, (np.append(2 * p, 1) @ m) / np.array([2, 2, 2, 1]))
-    assert Bounds((0, 0, 0), (1, 1, 1)).shape == (2, 2, 2)
