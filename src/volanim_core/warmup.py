@@ -94,6 +94,11 @@ def compile_kernels(progress=None) -> float:
     from volanim_core.rig.ownership import ownership
 
     owned = conn.with_ownership(ownership(mask, conn)).posed(matrices)
+    from volanim_core.rig.specks import join_specks
+
+    specks = np.ones((6, 4, 4), np.uint8, order="F")
+    specks[5], specks[2, 1, 1] = 2, 2  # bone 2's flesh at one end, a speck of it in bone 1's
+    join_specks(specks, 2)  # a speck of one bone inside another's flesh
     for mode in MODES:
         reconstruct(owned, mode=mode, source=source if mode == "sampled" else None)
     reconstruct(coarse_tskel(owned, 2), mode="bone")  # a live preview at half size: the ownership pooled (#85)

@@ -261,3 +261,36 @@ def pool_labels(labels, offset, f, out):
                         if count[q] > count[best]:
                             best = q
                     out[i, j, k] = seen[best]
+
+
+@njit(cache=True, nogil=True)
+def speck_rings(pieces, specks, boxes):
+    """Each speck's ring: the piece (0: outside the body) of every voxel 26-next to speck ``specks[k]`` and not in
+    it, once each. ``boxes[k]``: the speck's box ``x0 y0 z0 x1 y1 z1`` (stops excluded). Returns ``starts``
+    (``K + 1``) and the rings' pieces, speck k's at ``ring[starts[k]:starts[k + 1]]``."""
+    nx, ny, nz = pieces.shape
+    room = 0
+    for k in range(len(specks)):
+        room += (boxes[k, 3] - boxes[k, 0] + 2) * (boxes[k, 4] - boxes[k, 1] + 2) * (boxes[k, 5] - boxes[k, 2] + 2)
+    ring = np.empty(room, np.int64)
+    starts = np.zeros(len(specks) + 1, np.int64)
+    n = 0
+    for k in range(len(specks)):
+        p = specks[k]
+        x0, y0, z0 = max(0, boxes[k, 0] - 1), max(0, boxes[k, 1] - 1), max(0, boxes[k, 2] - 1)
+        x1, y1, z1 = min(nx, boxes[k, 3] + 1), min(ny, boxes[k, 4] + 1), min(nz, boxes[k, 5] + 1)
+        seen = np.zeros((x1 - x0, y1 - y0, z1 - z0), np.bool_)
+        for z in range(boxes[k, 2], boxes[k, 5]):
+            for y in range(boxes[k, 1], boxes[k, 4]):
+                for x in range(boxes[k, 0], boxes[k, 3]):
+                    if pieces[x, y, z] != p:
+                        continue
+                    for c in range(max(z0, z - 1), min(z1, z + 2)):
+                        for b in range(max(y0, y - 1), min(y1, y + 2)):
+                            for a in range(max(x0, x - 1), min(x1, x + 2)):
+                                if pieces[a, b, c] != p and not seen[a - x0, b - y0, c - z0]:
+                                    seen[a - x0, b - y0, c - z0] = True
+                                    ring[n] = pieces[a, b, c]
+                                    n += 1
+        starts[k + 1] = n
+    return starts, ring[:n]

@@ -36,13 +36,13 @@ from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
     own_by_tubes,
-    piece_labels,
     pool_labels,
     row_ends,
     row_spans,
     section_moments,
 )
 from volanim_core.rig.connectivity import BoneSegment, Connectivity
+from volanim_core.rig.specks import join_specks
 from volanim_core.volume import tight_bounds
 
 SECTION_VOXELS = 64_000_000  # the lattice the cross-sections' moments are gathered on
@@ -333,70 +333,6 @@ def cross_sections(box: np.ndarray, lo: np.ndarray, round_tubes: np.ndarray) -> 
         semi = 2.0 * np.sqrt(np.maximum(w[::-1][:2], 0.0))
         out.append(None if semi.min() < 0.5 else (e[:, ::-1][:, :2].T, semi))
     return out
-
-
-def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
-    """Give each piece of a bone's voxels cut off from its largest piece (26-connected) to the bone its
-    neighbours mostly belong to, in place; returns the voxels moved. Why: the tube rule can leave a speck
-    of one bone inside another's flesh (a voxel of spine in the shoulder), which then stays behind, alone,
-    when the limb around it moves. cc3d labels every bone's pieces in one pass over the label volume.
-
-    A speck joins, where it can, a neighbour's *largest* piece: two specks side by side would otherwise
-    trade labels and leave a new speck (the ant's abdomen kept two voxels in a leg, torn off when the leg
-    stepped). Specks that touch only specks go the next round, once their neighbours have joined.
-    """
-    moved = 0
-    for _ in range(rounds):
-        n = _join_specks_once(labels, n_bones)
-        moved += n
-        if n == 0:
-            break
-    return moved
-
-
-def _around(pieces: np.ndarray, stats: dict, piece: int) -> tuple:
-    """A piece's box grown by a voxel, its voxels there, and the piece numbers of the 26-neighbours around it."""
-    from scipy import ndimage
-
-    grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in stats["bounding_boxes"][piece])
-    mine = pieces[grown] == piece
-    ring = ndimage.binary_dilation(mine, np.ones((3, 3, 3), bool)) & ~mine
-    return grown, mine, pieces[grown][ring]
-
-
-def _join_specks_once(labels: np.ndarray, n_bones: int) -> int:
-    import cc3d
-
-    pieces = cc3d.connected_components(labels, connectivity=26)
-    stats = cc3d.statistics(pieces)
-    sizes = np.asarray(stats["voxel_counts"])
-    owner = np.zeros(len(sizes), np.int64)
-    piece_labels(np.asfortranarray(pieces).T, labels.T, owner)  # the same F-ordered voxels, C views
-    largest = np.zeros(n_bones + 1, np.int64)
-    for piece in np.argsort(sizes)[::-1]:  # each bone's first piece seen is its largest
-        if piece and owner[piece] and largest[owner[piece]] == 0:
-            largest[owner[piece]] = piece
-    is_main = np.zeros(len(sizes), bool)
-    is_main[largest[largest > 0]] = True
-    moved = 0
-    for piece in np.flatnonzero((owner > 0) & ~is_main):
-        grown, mine, near = _around(pieces, stats, piece)
-        main = near[is_main[near]]
-        if len(main):  # a neighbour's main piece, measured before this round's moves
-            labels[grown][mine] = np.bincount(owner[main]).argmax()
-            moved += int(mine.sum())
-    if moved == 0:  # specks touching only specks: their labels as they are, none read from a speck that moved
-        changed = np.zeros(len(sizes), bool)
-        for piece in np.flatnonzero((owner > 0) & ~is_main):
-            grown, mine, near = _around(pieces, stats, piece)
-            if changed[near].any():
-                continue  # the next round sees it
-            near = near[(near != 0) & (owner[near] != owner[piece])]
-            if len(near):
-                labels[grown][mine] = np.bincount(owner[near]).argmax()
-                changed[piece] = True
-                moved += int(mine.sum())
-    return moved
 
 
 def body_depth(box: np.ndarray, p) -> float:

@@ -1,4 +1,4 @@
-"""The rest body's owners (rig/ownership.py): no bone keeps a speck inside another bone's flesh."""
+"""The rest body's owners (rig/ownership.py, rig/specks.py): no bone keeps a speck inside another bone's flesh."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from scipy import ndimage
 from volanim_core import samples
 from volanim_core.cli import main
 from volanim_core.io import read_connect
-from volanim_core.rig.ownership import join_specks
+from volanim_core.rig.specks import join_specks
 
 
 def specks(labels: np.ndarray) -> list[tuple[int, int]]:
