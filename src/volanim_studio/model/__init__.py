@@ -13,6 +13,7 @@
     proposal.py ......... auto-rig's proposal, previewed before the user accepts it
     posing.py ........... the pose being previewed: per-bone rotations and shifts driving FK
     preview.py .......... preview reconstructions, full or reduced, with the breakage report
+    live_resolution.py .. the live preview's resolution: the one that keeps 10 pictures a second
     timeline.py ......... the clip or pose keys on the timeline; the current frame drives the pose
     transfer.py ......... the user's transfer function, edited with undo
     project.py .......... the .volanim project: written, read and applied

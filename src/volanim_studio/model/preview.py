@@ -25,6 +25,7 @@ from volanim_core.reconstruct.owned import posed_bounds
 from volanim_core.rig.connectivity import Tskel
 from volanim_core.rig.tskel_tools import coarse_tskel
 from volanim_core.volume import Bounds
+from volanim_studio.model.live_resolution import LiveResolution
 
 #: A full preview of more voxels than this is drawn from every second voxel (:meth:`Preview.view_volume`).
 VIEW_FULL_VOXELS = 32_000_000
@@ -142,19 +143,22 @@ class LivePreviews:
     first frame with ``margin`` of its size to spare each side. A frame outside that grid, another mode
     or factor start a new one (every slice once); other attachments are found by the LiveFrame itself."""
 
-    def __init__(self, margin: float = 0.15):
+    def __init__(self, margin: float = 0.15, resolution: LiveResolution | None = None):
         self.margin = margin
+        self.resolution = resolution or LiveResolution()  # each picture's factor (auto: the one keeping the rate)
         self._live: LiveFrame | None = None
         self._key = None
 
     def make(self, tskel: Tskel, *, mode: str = "bone", factor: int | None = None, padding: int = 2) -> Preview:
         """The preview :func:`make_preview` makes of ``tskel`` (same voxels, same grid), redoing only what moved.
-        ``factor`` None: :func:`live_factor`'s, decided on the first frame of a mode and kept after it."""
+        ``factor`` None: :attr:`resolution`'s (:func:`live_factor`'s on the first frame of a mode, then the one
+        that keeps the rate; tell it each picture's cost, :meth:`LiveResolution.took`)."""
         if not len(tskel):
             raise ValueError("no attached points to reconstruct: connect points to bones first")
-        if factor is None:  # the live grid's, while there is one of this mode
-            kept = self._live is not None and self._key[0] == mode
-            factor = self._key[1] if kept else live_factor(tskel)
+        if factor is None:
+            if self._live is None or self._key[0] != mode:  # another mode: the size rule again
+                self.resolution.reset()
+            factor = self.resolution.factor_for(live_factor(tskel) if self.resolution.factor is None else 1)
         coarse = coarse_tskel(tskel, factor)
         pad = max(1, padding // factor)
         if moves_owned(coarse, "auto"):  # the rig's owned body (reconstruct's default), only the moved bones redone

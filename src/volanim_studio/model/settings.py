@@ -21,6 +21,7 @@ from volanim_core.modes import MODES
 from volanim_core.rig.attach import METHODS
 
 from .events import EventEmitter
+from .live_resolution import CHOICES as LIVE_CHOICES
 from .selection import DEPTH_MODES
 
 
@@ -111,6 +112,8 @@ SETTINGS: dict[str, Setting] = {
     "body": Setting("owned", one_of("owned", "spheres"), "how a full preview moves the body: each voxel by the "
                     "bone that owns it (needs the volume), or the thesis's spheres"),
     "live_preview": Setting(True, flag, "a preview while a pose slider moves (half resolution on a large body)"),
+    "live_resolution": Setting("auto", one_of(*LIVE_CHOICES), "the live preview's resolution: auto keeps 10 "
+                               "pictures a second where it can; full, half or quarter size"),
     "show_rest": Setting(False, flag, "show the rest pose's reconstruction instead (compare)"),
     # connect tools
     "lasso_depth": Setting("visible", one_of(*DEPTH_MODES), "which points under the lasso it takes"),

@@ -26,6 +26,7 @@ from PySide6.QtWidgets import QFileDialog
 
 from volanim_core import io
 
+from ..model.live_resolution import LiveResolution
 from ..model.preview import LivePreviews, live_surface, make_preview, with_report
 from ..model.settings import Mode
 from .controller import FAILED, Controller
@@ -37,7 +38,9 @@ class PreviewController(Controller):
     def __init__(self, window):
         super().__init__(window)
         self.live_timings: list[float] = []  # seconds per live update (pose change -> drawn)
-        self.live = LivePreviews()  # redoes only the slices the moved spheres reach; used by the live thread only
+        # redoes only what moved, at the resolution that keeps the rate; used by the live thread only
+        self.live = LivePreviews(resolution=LiveResolution(self.doc.settings.live_resolution))
+        self.clock = time.perf_counter  # times the live pictures (a test's own clock: the resolution it picks)
         self.live_worker = LiveWorker(window)  # makes them off the GUI thread, the newest pose first
         self.live_worker.made.connect(self._live_made)
         self._full_asked = 0  # full previews asked for: a live picture asked for before the last is dropped
@@ -49,6 +52,7 @@ class PreviewController(Controller):
         ev.pose.connect(self._on_pose_changed)
         ev.pose_settled.connect(lambda **_: self._settled())
         st.dragging.connect(self._on_dragging)
+        st.live_resolution.connect(lambda value, **_: setattr(self.live, "resolution", LiveResolution(value)))
         st.current_frame.connect(lambda **_: self.live_preview_soon() if self.doc.timeline.active else None)
         st.mode.connect(self._on_mode)
         # a clip loaded (or keys changed) moves the body to its frame: drawn, not left under the new bones (#83);
@@ -177,7 +181,8 @@ class PreviewController(Controller):
         too; the GUI thread only draws what comes back (:meth:`_live_made`)."""
         mode = self.doc.settings.preview_mode
         mode = mode if mode in ("binary", "bone") else "bone"
-        t0 = time.perf_counter()
+        clock = self.clock
+        t0 = clock()
         try:
             make_frame = self.doc.pose.frame_maker()  # a snapshot: the frame itself is made in the live thread
         except ValueError as exc:
@@ -192,14 +197,14 @@ class PreviewController(Controller):
         owned = self.doc.ownership  # the body the full preview shows (its ownership made here once per rig)
 
         def make():
-            t1 = time.perf_counter()
+            t1 = clock()
             attached = owned.attach(make_frame())
-            t2 = time.perf_counter()
-            p = live.make(attached, mode=mode, padding=2)  # only what moved; full or half resolution
-            t3 = time.perf_counter()
+            t2 = clock()
+            p = live.make(attached, mode=mode, padding=2)  # only what moved, at the resolution keeping the rate
+            t3 = clock()
             p.basis, p.joints, p.frame = basis, joints, frame
             p.surface = live_surface(p, function, n_bones, spacing)
-            p.stages = {"pose": t2 - t1, "body": t3 - t2, "surface": time.perf_counter() - t3}
+            p.stages = {"pose": t2 - t1, "body": t3 - t2, "surface": clock() - t3}
             return p, full, t0
 
         self.live_worker.ask(make)
@@ -212,10 +217,12 @@ class PreviewController(Controller):
         if isinstance(result, Exception):
             raise result  # a bug: seen, as on the GUI thread
         p, full, t0 = result
-        self.live_timings.append(time.perf_counter() - t0)  # asked -> made (drawn at the next render)
+        self.live_timings.append(self.clock() - t0)  # asked -> made (drawn at the next render)
         if full != self._full_asked or self.doc.settings.mode != Mode.POSE:
             return
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
+        # its cost (made, and the last picture's draw: the scene adds it) picks the next one's resolution
+        self.live.resolution.took(p.factor, sum(p.stages.values()))
 
     def preview(self, *, report: bool = True, background: bool = False) -> Worker | None:
         """Full-resolution reconstruction in the background, shown as soon as it is made; then, as a second

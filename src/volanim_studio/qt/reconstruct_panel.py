@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (
 )
 
 from ..model.document import Document
+from ..model.live_resolution import CHOICES as LIVE_CHOICES
 from ..model.settings import PREVIEW_MODES
 from .bindings import bind
 from .verdict_label import verdict_html
@@ -52,12 +53,17 @@ class ReconstructPanel(QWidget):
         self.blend = QDoubleSpinBox(minimum=0.1, maximum=10.0, singleStep=0.25, decimals=2)
         self.blend.setToolTip("smooth joints: how far from a joint the blend reaches, times the bones' thickness")
         self.live = QCheckBox("Live preview while posing")
-        self.live.setToolTip("Full resolution on a body of up to 8 M voxels (the mannequin), half on a larger one")
+        self.live.setToolTip("A picture as a pose slider moves or the timeline plays: only what moved redone")
+        self.live_resolution = QComboBox()
+        self.live_resolution.addItems(LIVE_CHOICES)
+        self.live_resolution.setToolTip("auto: the resolution that keeps 10 live pictures a second (it says which);\n"
+                                        "full, half, quarter: always that one. Releasing draws full size.")
         self.slices = QCheckBox("Orthogonal slices")
         self.show_rest = QCheckBox("Show the rest pose instead (compare)")
         s = doc.settings
         for widget, name, conv in ((self.mode, "preview_mode", None), (self.kernel, "preview_kernel", int),
                                    (self.padding, "preview_padding", None), (self.live, "live_preview", None),
+                                   (self.live_resolution, "live_resolution", None),
                                    (self.slices, "slices", None), (self.show_rest, "show_rest", None),
                                    (self.joint_kind, "joints", None), (self.blend, "blend", None),
                                    (self.body, "body", None)):
@@ -80,6 +86,7 @@ class ReconstructPanel(QWidget):
         form.addRow("Blend (× bone thickness)", self.blend)
         form.addRow("Metric (from the skeleton)", self.metric_label)
         form.addRow(self.live)
+        form.addRow("Live resolution", self.live_resolution)
         form.addRow(self.preview_button)
         view = QGroupBox("View")
         vl = QVBoxLayout(view)
