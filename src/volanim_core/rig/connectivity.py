@@ -136,6 +136,7 @@ class Connectivity:
         t = Tskel(self.bones, matrices, self.points, self.dt, self.thinness, self.bone, self.metric,
                   self.geometry, joints=joints, skin=skin)
         t.ownership = self.ownership
+        t._posed_from = self  # its connectivity, while the frame's joints and ownership are still these
         return t
 
     def with_ownership(self, ownership) -> Connectivity:
@@ -249,6 +250,11 @@ class Tskel(Connectivity):
 
     @property
     def connectivity(self) -> Connectivity:
+        """The frame's points as a connectivity: the one it was posed from when the frame still has its joints and
+        ownership (a drag's pictures then share one object, whose ownership is looked up once, #85)."""
+        source = getattr(self, "_posed_from", None)
+        if source is not None and source.joints == self.joints and source.ownership is self.ownership:
+            return source
         c = Connectivity(self.bones, self.points, self.dt, self.thinness, self.bone, self.metric,
                          geometry=self.geometry, joints=self.joints)
         c.ownership = self.ownership

@@ -28,6 +28,8 @@ class OwnershipState:
         self.paints: tuple = ()
         self._made = None  # (key, Ownership before the paints)
         self._painted_made = None  # (the Ownership before the paints, the paints, the Ownership with them)
+        self._last_key = None  # (connectivity, mask, its key): the last one asked about
+        self._attached = None  # (connectivity, ownership, the connectivity with it): attach's last
         self._lock = threading.Lock()  # the preview's worker makes it while the GUI thread may ask again
         self.version = 0  # counts repaints: a preview made before one is old
         self.shown: Ownership | None = None  # what the hull is coloured by (show()); None: not made for this rig
@@ -36,7 +38,7 @@ class OwnershipState:
         doc.events.ownership.connect(lambda **_: self.show(None))
 
     def _forget(self) -> None:
-        self._made = self._painted_made = None
+        self._made = self._painted_made = self._last_key = self._attached = None
         self.show(None)
 
     def show(self, own: Ownership | None) -> None:
@@ -59,8 +61,15 @@ class OwnershipState:
         thread: call it from a worker."""
         if not self.available or not len(conn):
             return None
-        key = (id(self.doc.mask), len(conn), conn.points.tobytes().__hash__(), conn.bone.tobytes().__hash__(),
-               tuple(b.label for b in conn.bones))
+        with self._lock:
+            last = self._last_key
+        if last is not None and last[0] is conn and last[1] is self.doc.mask:
+            key = last[2]  # the same connectivity as the last picture's (a drag): not hashed again
+        else:
+            key = (id(self.doc.mask), len(conn), conn.points.tobytes().__hash__(), conn.bone.tobytes().__hash__(),
+                   tuple(b.label for b in conn.bones))
+            with self._lock:
+                self._last_key = (conn, self.doc.mask, key)
         with self._lock:
             made = self._made
         if made is None or made[0] != key:
@@ -97,11 +106,17 @@ class OwnershipState:
         joints, a volume loaded); as it is otherwise. Runs in the preview's worker."""
         if self.doc.settings.body != "owned" or tskel.joints.smooth:
             return tskel
-        own = self.of(tskel.connectivity)
+        conn = tskel.connectivity
+        own = self.of(conn)
         if own is None:
             return tskel
-        conn = tskel.connectivity.with_ownership(own)
-        return conn.posed(tskel.matrices)
+        with self._lock:
+            last = self._attached
+        if last is None or last[0] is not conn or last[1] is not own:  # else a drag's next picture: kept
+            last = (conn, own, conn.with_ownership(own))  # (a copy of the frog's 400 k points)
+            with self._lock:
+                self._attached = last
+        return last[2].posed(tskel.matrices)
 
     # ------------------------------------------------------------------ repainting
     def _set(self, paints: tuple) -> None:

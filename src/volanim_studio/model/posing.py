@@ -27,6 +27,7 @@ class PoseState:
         self._rest_parts = None  # (key, breakage.RestParts) of the current attachments
         self.rest_version = 0  # counts attachment changes: a report made before one must not be kept
         self._rest_preview = None  # (key, Preview) of the rest pose, for Compare (settings.show_rest)
+        self._frame_conn = None  # (what it was made of, the connectivity): frame_maker's, kept between pictures
         doc.events.attachments.connect(self._forget_rest_parts)
         doc.events.bones.connect(self._forget_rest_parts)
 
@@ -213,8 +214,16 @@ class PoseState:
         t = doc.thinness if thinness is None else thinness
 
         def make() -> Tskel:
+            # the same attachments as the last picture's (a drag): the same connectivity, not grouped again (the
+            # frog's 400 k points: 40-90 ms a picture), and the same object, so its ownership is found at once
+            of = (skeleton, bones.segments(), tuple(b.label for b in bones.bones), joints, t, attached)
+            kept = self._frame_conn
+            if kept is not None and _same(kept[0], of):
+                return kept[1].posed(matrices)
             conn = connectivity(skeleton, bones, attached, joints)
-            return conn.take(np.flatnonzero(~(conn.thinness < t))).posed(matrices)
+            conn = conn.take(np.flatnonzero(~(conn.thinness < t)))
+            self._frame_conn = (of, conn)
+            return conn.posed(matrices)
         return make
 
     def posed_box(self) -> tuple[np.ndarray, np.ndarray] | None:
@@ -235,3 +244,8 @@ class PoseState:
         t = self.tskel()
         io.write_tskel(path, t)
         return len(t)
+
+
+def _same(a: tuple, b: tuple) -> bool:
+    """Whether two frames are made of the same things: the skeleton itself, the rest by value."""
+    return a[0] is b[0] and np.array_equal(a[1], b[1]) and a[2:5] == b[2:5] and np.array_equal(a[5], b[5])

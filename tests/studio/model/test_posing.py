@@ -141,3 +141,28 @@ def test_a_frame_maker_makes_on_any_thread_the_frame_of_the_moment_it_was_asked(
     assert np.array_equal(got.matrices, want.matrices)
     now = doc.pose.tskel()  # the document moved on: other attachments, another pose
     assert not np.array_equal(now.bone, got.bone) and not np.array_equal(now.matrices, got.matrices)
+
+
+def test_a_drag_s_pictures_share_one_connectivity_and_any_edit_makes_a_new_one(doc):
+    """#85: each live picture grouped the frog's 400 k points by bone again, copied them to attach the ownership and
+    hashed them to find it: 95 ms of a picture's 256. Now a drag's pictures share the connectivity (and its
+    ownership); a point given to another bone, a bone moved or another thinness is a new one, never the old."""
+    b = doc.bones.index("L_UPPERARM")
+    first = doc.pose.frame_maker()()
+    doc.pose.set_angles(b, (0, -40, 0))
+    second = doc.pose.frame_maker()()
+    assert second.connectivity is first.connectivity
+    assert not np.array_equal(second.matrices, first.matrices)
+    assert np.array_equal(second.matrices, doc.pose.tskel().matrices)
+    shown = np.flatnonzero(doc.skeleton.thinness >= doc.thinness)[:50]
+    doc.attachments.assign_many(shown, np.full(len(shown), doc.bones.index("HEAD")), "to the head")
+    third = doc.pose.frame_maker()()
+    assert third.connectivity is not first.connectivity
+    assert np.array_equal(third.bone, doc.pose.tskel().bone) and not np.array_equal(third.bone, first.bone)
+    doc.thinness = min(1.0, doc.thinness + 0.1)
+    fourth = doc.pose.frame_maker()()
+    assert len(fourth) == len(doc.pose.tskel()) < len(third)
+    # the owned frame of two pictures: one connectivity with the ownership, the same as a fresh attach's
+    a, b2 = doc.ownership.attach(fourth), doc.ownership.attach(doc.pose.frame_maker()())
+    assert a.ownership is not None and b2.connectivity is a.connectivity
+    assert np.array_equal(a.ownership.labels, doc.ownership.attach(doc.pose.tskel()).ownership.labels)
