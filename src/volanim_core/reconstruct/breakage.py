@@ -7,12 +7,13 @@
         should reappear at round(v @ M_b) --> lost voxels (a count)
     posed reconstruction --> connected components (26-neighbour) and sizes
     points lying along another bone than their own, which the pose carries far from
-        where that bone went --> stumps (a piece left behind that stays connected)
+        where that bone went --> stumps (a piece left behind that stays connected; spheres only)
 
-Why cracks and not lost voxels rank the joints: points wrongly left on the
-torso stay put as a stump, and their voxels reappear where they were -- nothing
-is "lost" -- but the stump's spheres and the arm's part company: a crack at
-the shoulder, which is where the user must re-attach points.
+Why cracks and not lost voxels rank the joints: points wrongly left on the torso stay put as a stump, and
+their voxels reappear where they were -- nothing is "lost" -- but the stump's spheres and the arm's part
+company: a crack at the shoulder, which is where the user must re-attach points. An owned body (#84) moves by
+its ownership, not its points: no stumps (shoulder points on the torso moved 65 of its voxels and its raised arm
+came out whole, yet "STUMP left behind"); its flesh in the wrong place is what the lumps find.
 
 Why stumps as well: cracks open at every bent joint (the outside of an elbow),
 so their count alone cannot tell a healthy bend from "a part of the upper arm
@@ -32,7 +33,7 @@ import numpy as np
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
-from volanim_core.reconstruct.engine import OWNER, Reconstruction, reconstruct
+from volanim_core.reconstruct.engine import OWNER, Reconstruction, moves_owned, reconstruct
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.pose import apply_matrices, apply_rows
@@ -111,15 +112,13 @@ class BreakageReport:
         return f"healthy: {whole}"
 
     def lines(self) -> list[str]:
-        out = [f"{len(self.components)} connected component(s)"
-               + ("" if len(self.components) == 1 else ": " + ", ".join(str(c) for c in self.components[:6])
-                  + " voxels")
+        sizes = "" if len(self.components) == 1 else ": " + ", ".join(str(c) for c in self.components[:6]) + " voxels"
+        out = [f"{len(self.components)} connected component(s){sizes}"
                + (f"; {self.rest_pieces:,} at rest" if self.rest_pieces > 1 else ""),
                *(f"piece of {n} voxels torn off near {j}" for n, j, _ in self.pieces[:5]),
                *(s.text() for s in self.stumps[:5]),
                *(lump.text() for lump in self.lumps[:5]),
-               f"{self.posed_voxels:,} voxels, {self.size_change} ({self.lost_voxels:,} rest voxels not "
-               "covered in the pose)",
+               f"{self.posed_voxels:,} voxels, {self.size_change} ({self.lost_voxels:,} rest voxels not covered)",
                f"{self.cracks} cracks (sphere pairs of different bones that touched at rest and part in the pose)",
                f"hotspot: up to {self.hotspot_max} spheres on one voxel, mean {self.hotspot_mean:.1f}"]
         if self.source_coverage is not None:
@@ -412,7 +411,8 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
         if rest.piece is not None else {k for _, _, k in parts[1:]}
     report = BreakageReport([n for n, _, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
-                            cracks=len(gaps), stumps=stumps(tskel, joints), rest_pieces=rest.pieces)
+                            cracks=len(gaps), rest_pieces=rest.pieces,
+                            stumps=[] if moves_owned(tskel, "auto") else stumps(tskel, joints))
     if not tskel.joints.smooth:  # a blended voxel has no one bone to follow back
         report.lumps = _lumps(tskel, posed, rest, {n: posed_joints.get(n, joints[n]) for n in joints})
     names = list(joints)

@@ -65,6 +65,26 @@ def test_a_stump_that_stays_one_piece_is_not_healthy(man):
     assert "stump near L_SHOULDER" in "\n".join(r.lines())
 
 
+def test_an_owned_body_is_not_judged_by_its_points_attachments(man):
+    """#84: the owned body moves by its ownership. Shoulder points on the torso changed 65 of its voxels' owners,
+    the raised arm came out whole (as the right attachments give it), and the report still said "STUMP left
+    behind near L_SHOULDER: 27 points of SPINE" from the points. The same mistake on the spheres is a stump."""
+    from volanim_core.rig.ownership import ownership
+
+    s, conn = man
+    bad = shoulder_on_torso(s, conn, radius=12.0)
+    owned = bad.with_ownership(ownership(s.mask, bad))
+    right = conn.with_ownership(ownership(s.mask, conn))
+    assert (owned.ownership.labels != right.ownership.labels).sum() < 100
+    t, pj = frame(s, owned, {"L_UPPERARM": (0, -90, 0)})
+    r = breakage_report(t, s.bones.joints, pj)
+    assert r.stumps == [] and r.healthy and len(r.components) == 1, r.verdict
+    good, _ = frame(s, right, {"L_UPPERARM": (0, -90, 0)})
+    assert abs(r.posed_voxels - breakage_report(good, s.bones.joints, pj).posed_voxels) < 100  # the same body
+    spheres, _ = frame(s, bad, {"L_UPPERARM": (0, -90, 0)})
+    assert breakage_report(spheres, s.bones.joints, pj).verdict.startswith("STUMP left behind near L_SHOULDER")
+
+
 @pytest.mark.parametrize("rotations", [{"L_UPPERARM": (0, -90, 0)}, {"L_FOREARM": (90, 0, 0)},
                                        {"L_THIGH": (90, 0, 0), "R_SHIN": (-90, 0, 0)}, {"SPINE": (0, 0, 45)},
                                        {"HEAD": (30, 0, 60), "R_UPPERARM": (0, 90, 0), "R_FOREARM": (0, 0, 90)}])

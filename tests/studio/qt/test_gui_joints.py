@@ -20,6 +20,7 @@ J = samples.mannequin_bones().joints
 def test_smooth_joints_mend_the_stump_a_rigid_shoulder_leaves(qtbot, window, tmp_path):
     w = rig_and_pose(qtbot, window)
     doc = w.doc
+    doc.settings.body = "spheres"  # the thesis's re-growth, which the points' attachments move (not the owned body)
     ua, spine = doc.bones.index("L_UPPERARM"), doc.bones.index("SPINE")
     near = np.flatnonzero((np.linalg.norm(doc.skeleton.points - J["L_SHOULDER"], axis=1) < 12)
                           & (doc.attachments.bone == ua))
