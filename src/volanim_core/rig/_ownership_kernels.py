@@ -209,11 +209,23 @@ def row_spans(labels, spans):
 
 
 @njit(cache=True, nogil=True)
-def piece_labels(pieces, labels, out):
-    """``out[p]`` = the label of piece ``p`` (pieces of a label volume hold one label each)."""
-    fp, fl = pieces.ravel(), labels.ravel()
-    for i in range(fp.size):
-        out[fp[i]] = fl[i]
+def piece_stats(pieces, labels, label, count, box):
+    """Each piece ``p`` of a label volume (``pieces``, ``labels``: ``[x, y, z]``): ``label[p]`` its label (a piece
+    holds one), ``count[p]`` its voxels, ``box[p]`` its box ``x0 y0 z0 x1 y1 z1`` (stops excluded; fill ``box``
+    with ``(n, n, n, -1, -1, -1)`` first). One pass, in place of cc3d.statistics (centroids too: 0.09 s on
+    mannequin-large's 17 M voxels, where its pieces took 0.03)."""
+    nx, ny, nz = pieces.shape
+    for z in range(nz):
+        for y in range(ny):
+            for x in range(nx):
+                p = pieces[x, y, z]
+                if p == 0:
+                    continue
+                label[p] = labels[x, y, z]
+                count[p] += 1
+                b = box[p]
+                b[0], b[1], b[2] = min(b[0], x), min(b[1], y), min(b[2], z)
+                b[3], b[4], b[5] = max(b[3], x + 1), max(b[4], y + 1), max(b[5], z + 1)
 
 
 @njit(cache=True, nogil=True, parallel=True)

@@ -1,7 +1,9 @@
 """Specks of a bone's flesh cut off inside another's, given to the flesh around them: ownership's last step.
 
     labels [x, y, z] (1 + bone, 0 outside)
-        --cc3d (26-connected pieces of each label, once)--> pieces, each bone's largest its main piece
+        --cc3d (26-connected pieces of each label, once)--> pieces
+        --_ownership_kernels.piece_stats (one pass: each piece's label, size, box)--> each bone's largest piece
+          its main one, the others specks
         --_ownership_kernels.speck_rings (each speck's ring: the pieces of the voxels around it, counted)-->
         --rounds on the pieces' graph (union-find: a speck that joins a bone merges with the pieces of
           that bone it touches)--> each speck's new bone
@@ -16,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.rig._ownership_kernels import piece_labels, speck_rings
+from volanim_core.rig._ownership_kernels import piece_stats, speck_rings
 
 
 def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
@@ -34,11 +36,11 @@ def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
     import cc3d
 
     # one piece dtype whatever the volume's size: the kernels compile once (the warm-up's)
-    pieces = cc3d.connected_components(labels, connectivity=26, out_dtype=np.uint32)
-    stats = cc3d.statistics(pieces)
-    sizes = np.asarray(stats["voxel_counts"])
-    bone = np.zeros(len(sizes), np.int64)
-    piece_labels(np.asfortranarray(pieces).T, labels.T, bone)  # the same F-ordered voxels, C views
+    pieces, n = cc3d.connected_components(labels, connectivity=26, out_dtype=np.uint32, return_N=True)
+    bone, sizes = np.zeros(n + 1, np.int64), np.zeros(n + 1, np.int64)
+    boxes_all = np.empty((n + 1, 6), np.int64)
+    boxes_all[:, :3], boxes_all[:, 3:] = np.iinfo(np.int64).max, -1
+    piece_stats(pieces, labels, bone, sizes, boxes_all)
     main, has = np.zeros(len(sizes), bool), np.zeros(n_bones + 1, bool)
     for piece in np.argsort(sizes, kind="stable")[::-1]:  # each bone's first piece seen is its largest
         if piece and bone[piece] and not has[bone[piece]]:
@@ -46,8 +48,7 @@ def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
     specks = np.flatnonzero((bone > 0) & ~main)
     if not len(specks):
         return 0
-    boxes = np.array([[s.start for s in stats["bounding_boxes"][p]] + [s.stop for s in stats["bounding_boxes"][p]]
-                      for p in specks], np.int64)
+    boxes = np.ascontiguousarray(boxes_all[specks])
     starts, ring = speck_rings(pieces, specks.astype(np.int64), boxes)
     near = [np.unique(ring[starts[k]:starts[k + 1]], return_counts=True) for k in range(len(specks))]
     new = _rounds(specks, near, bone.copy(), main, rounds)
