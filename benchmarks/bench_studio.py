@@ -140,7 +140,12 @@ def bench_preview(app) -> None:
                              if stages else "-"])
         live = statistics.median(w.previews.live_timings[1:]) if len(w.previews.live_timings) > 1 else float("nan")
         rate = len(w.previews.live_timings) / elapsed
-        factor = live_factor(w.doc.pose.tskel())
+        used = [p.factor for p in pictures if p is not None and p.live]  # the live resolution's (auto: adapts)
+        factor = "/".join(f"1/{f}" for f in dict.fromkeys(used)) or f"1/{live_factor(w.doc.pose.tskel())}"
+        if "--verbose" in sys.argv:
+            for p in pictures:
+                if p is not None and p.live:
+                    print(name, f"1/{p.factor}", {k: round(1000 * v) for k, v in p.stages.items()})
         t0 = time.perf_counter()
         w.doc.settings.dragging = False  # the release: the full preview, drawn, then its report
         picture = None
@@ -152,7 +157,7 @@ def bench_preview(app) -> None:
         app.processEvents()
         full = time.perf_counter() - t0
         rows.append([name, f"{opened:.1f}", f"{1000 * statistics.median(slider):.0f}",
-                     f"{1000 * live:.0f} (1/{factor})", f"{rate:.1f}", f"{picture:.2f}", f"{full:.2f}"])
+                     f"{1000 * live:.0f} ({factor})", f"{rate:.1f}", f"{picture:.2f}", f"{full:.2f}"])
         w.close()
     print("\nthe three bodies in the studio (bone mode; 1200x800 window, software GL)")
     print(table(rows, ["body", "open s (segment, skeletonize, hull)", "thinness step ms (median, held)",

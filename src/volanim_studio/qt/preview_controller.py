@@ -217,12 +217,14 @@ class PreviewController(Controller):
         if isinstance(result, Exception):
             raise result  # a bug: seen, as on the GUI thread
         p, full, t0 = result
-        self.live_timings.append(self.clock() - t0)  # asked -> made (drawn at the next render)
+        asked = self.clock() - t0  # asked -> made (drawn at the next render): a drag's pace, waits included
+        self.live_timings.append(asked)
         if full != self._full_asked or self.doc.settings.mode != Mode.POSE:
             return
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
-        # its cost (made, and the last picture's draw: the scene adds it) picks the next one's resolution
-        self.live.resolution.took(p.factor, sum(p.stages.values()))
+        # its cost picks the next one's resolution: its stages (the scene adds the last draw), or the wait from
+        # asking, when longer (the frog's half-size pictures: 59 ms of stages, one drawn every 140 ms)
+        self.live.resolution.took(p.factor, max(sum(p.stages.values()), asked))
 
     def preview(self, *, report: bool = True, background: bool = False) -> Worker | None:
         """Full-resolution reconstruction in the background, shown as soon as it is made; then, as a second
