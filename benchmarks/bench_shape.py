@@ -79,6 +79,10 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
     rest_segments = [(b.proximal, b.distal) for b in conn.bones]
     reach = bone_reach(rest_segments, *rest.voxels)
     limbs = limb_voxels(rest_segments, rest.voxels[1])
+    from volanim_core.reconstruct.lumps import frame_lumps
+    from volanim_core.rig.skinning import Joints
+
+    smooth_rest = RestParts.of(conn.with_joints(Joints("smooth")))  # smooth frames: followed back by their blends
     rows = []
     for label in joints:
         bone, top, rotation = JOINTS[label]
@@ -93,12 +97,14 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
             segments = {s.label: (at[s.proximal], at[s.distal]) for s in bones.bones}
             for method in METHODS:
                 t0 = time.perf_counter()
-                r = reconstruct(frame[method](m), mode="bone")
+                t = frame[method](m)
+                r = reconstruct(t, mode="bone")
                 seconds = time.perf_counter() - t0
                 rep = compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin,
                                      joints=at, segments=segments)
                 lumps = find_lumps(r.volume, r.origin, m, rest_segments, reach, rest.rest_bone.volume,
-                                   rest.rest_bone.origin, at, limbs) if method in ("rigid", "owned") else []
+                                   rest.rest_bone.origin, at, limbs) if method in ("rigid", "owned") else \
+                    frame_lumps(t, r, smooth_rest, at) if method == "smooth" else []
                 if lumps:  # once a frame, whatever the number of lumps
                     extra, lo = extra_flesh(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin)
                 real = [lump_is_real(lump, extra, lo) for lump in lumps]
@@ -165,7 +171,7 @@ def print_lumps(rows: list[dict]) -> None:
     """The report's lumps (no truth) against the truth's, over the rigid rows: recall, the share of rows with a
     true lump (largest extra blob >= 0.5 % of the moved limb) that the report flags; precision, the share of
     flags that are real (mostly voxels the true shape does not have, :func:`lump_is_real`)."""
-    for body, method in [(b, m) for b in dict.fromkeys(r["body"] for r in rows) for m in ("owned", "rigid")]:
+    for body, method in [(b, m) for b in dict.fromkeys(r["body"] for r in rows) for m in ("owned", "rigid", "smooth")]:
         mine = [r for r in rows if r["method"] == method and r["body"] == body]
         true = [r for r in mine if r["true lump"]]
         hit = [r for r in true if r["flagged"]]

@@ -413,8 +413,7 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
                             cracks=len(gaps), rest_pieces=rest.pieces,
                             stumps=[] if moves_owned(tskel, "auto") else stumps(tskel, joints))
-    if not tskel.joints.smooth:  # a blended voxel has no one bone to follow back
-        report.lumps = _lumps(tskel, posed, rest, {n: posed_joints.get(n, joints[n]) for n in joints})
+    report.lumps = _lumps(tskel, posed, rest, {n: posed_joints.get(n, joints[n]) for n in joints})
     names = list(joints)
     posed_pos = np.array([posed_joints.get(n, joints[n]) for n in names], np.float64) if names else None
     for size, centroid, k in parts:
@@ -438,13 +437,6 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
 
 
 def _lumps(tskel: Tskel, posed: Reconstruction, rest: RestParts, posed_joints: dict) -> list:
-    """Flesh the pose carried off (:mod:`.lumps`); ``posed`` must be the bone-mode reconstruction."""
-    from volanim_core.reconstruct.lumps import bone_reach, find_lumps, limb_voxels
+    from volanim_core.reconstruct.lumps import frame_lumps
 
-    segments = [(b.proximal, b.distal) for b in tskel.bones]
-    if rest.reach is None:
-        rest.reach = bone_reach(segments, *rest.voxels), limb_voxels(segments, rest.voxels[1])
-    reach, limbs = rest.reach
-    return find_lumps(posed.volume, posed.origin, np.asarray(tskel.matrices, np.float64), segments, reach,
-                      rest.rest_bone.volume, rest.rest_bone.origin, posed_joints, limbs,
-                      labels=[b.label for b in tskel.bones])
+    return frame_lumps(tskel, posed, rest, posed_joints)

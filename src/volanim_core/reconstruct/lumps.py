@@ -20,8 +20,8 @@ bone's own flesh is, is a lump. Measured against the mannequins' true shapes (be
 the README), over the 70 rigid poses of each: it flags 26 of the mannequin's 27 rows whose largest extra
 blob is 0.5 % of the moved limb or more, and 24 of its 27 flags are flesh the true shape lacks;
 mannequin-large 28 of 32 and 26 of 29 (it misses the neck, whose reach is learnt from the flesh the head
-wrongly carries). Frames with smooth joints are not judged (a blended voxel
-has no one bone to follow back).
+wrongly carries). A smooth frame's voxel is followed back by the blend that moved it (its row of the
+transform table, the owner-mode reconstruction) and is the flesh of its point's bone.
 """
 
 from __future__ import annotations
@@ -102,15 +102,19 @@ def limb_voxels(segments, bone: np.ndarray) -> np.ndarray:
 
 def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, reach: np.ndarray,
                rest_owner: np.ndarray, rest_origin, joints: dict[str, np.ndarray],
-               limbs: np.ndarray | None = None, labels: list[str] | None = None) -> list[Lump]:
-    """The lumps of a rigid frame (see the module docstring), largest first.
+               limbs: np.ndarray | None = None, labels: list[str] | None = None,
+               row_bone: np.ndarray | None = None) -> list[Lump]:
+    """The lumps of a frame (see the module docstring), largest first.
 
     Parameters
     ----------
     posed_bone : (X, Y, Z) ints
-        The frame's bone-mode reconstruction (bone + 1 per voxel), its voxel [0, 0, 0] at ``origin``.
+        The frame's bone-mode reconstruction (bone + 1 per voxel), its voxel [0, 0, 0] at ``origin``; with
+        ``row_bone``, its owner-mode one (each voxel's row of ``matrices`` + 1).
     matrices : (B, 4, 4)
-        The frame's bone matrices, rest voxels -> posed (``[x y z 1] @ M``).
+        The frame's bone matrices, rest voxels -> posed (``[x y z 1] @ M``); with ``row_bone``, its transform
+        table (:func:`~volanim_core.rig.skinning.transform_table`: the bone matrices, then smooth joints'
+        blended ones).
     segments : list of (proximal, distal)
         Each bone's rest segment (the ``Root:`` records).
     reach : (B,)
@@ -124,16 +128,20 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
         (None: every piece of MIN_VOXELS or more).
     labels : list of str, optional
         The bones' names: each lump then says which bone carried it and which bone its flesh belongs to.
+    row_bone : (R,) ints, optional
+        Each row's bone (a blended row's: its point's): a smooth frame's voxel is followed back by the blend
+        that moved it, and is its bone's flesh.
     """
     q = np.argwhere(posed_bone > 0)
-    own = posed_bone[tuple(q.T)].astype(np.int64) - 1
+    row = posed_bone[tuple(q.T)].astype(np.int64) - 1
+    own = row if row_bone is None else np.asarray(row_bone, np.int64)[row]
     qf = q.astype(np.float64) + np.asarray(origin, np.float64)
     inverse = np.linalg.inv(matrices)
-    rest = np.empty_like(qf)
+    # where each voxel's flesh lay at rest (by the matrix that moved it), and whether its own bone reaches there
+    rest = np.einsum("ni,nij->nj", qf, inverse[row, :3, :3]) + inverse[row, 3, :3]
     beyond = np.zeros(len(q), bool)
-    for b in np.unique(own):  # where each voxel's flesh lay at rest, and whether its own bone reaches there
+    for b in np.unique(own):
         sel = own == b
-        rest[sel] = qf[sel] @ inverse[b, :3, :3] + inverse[b, 3, :3]
         beyond[sel] = segment_distance(rest[sel], *segments[b]) > reach[b]
     # flesh its own bone left where it lay at rest was not carried anywhere: the body had flesh there
     # (a groin point of the thigh's, held by the still pelvis while the thigh lifts, is not a lump)
@@ -188,7 +196,8 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
         if sizes[k] < MIN_VOXELS:
             break
         piece = pieces == k + 1
-        carrier = np.bincount(posed_bone[piece].astype(np.int64) - 1).argmax()  # its voxels' most common owner
+        carried = posed_bone[piece].astype(np.int64) - 1
+        carrier = np.bincount(carried if row_bone is None else row_bone[carried]).argmax()  # its most common owner
         if limbs is not None and sizes[k] < SHARE * limbs[carrier]:  # under SHARE of the limb that carried it
             continue
         where = np.argwhere(piece) + np.asarray(origin, np.float64)
@@ -201,3 +210,31 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
                           carrier=labels[carrier] if labels else "",
                           belongs_to=labels[belongs] if labels and belongs >= 0 else ""))
     return lumps
+
+
+def frame_lumps(tskel, posed, rest, posed_joints: dict) -> list[Lump]:
+    """The lumps of a frame (``tskel``) whose bone-mode reconstruction is ``posed`` (``rest``: its
+    :class:`~volanim_core.reconstruct.breakage.RestParts`, whose reach it keeps). A smooth frame is followed
+    back by the blends: its owner-mode reconstruction on the same grid, each row the flesh of its point's bone."""
+    from volanim_core.reconstruct.engine import OWNER, reconstruct
+    from volanim_core.rig.skinning import transform_table
+
+    segments = [(b.proximal, b.distal) for b in tskel.bones]
+    labels = [b.label for b in tskel.bones]
+    row_bone = None
+    if tskel.joints.smooth:  # rows of the transform table: a bone's own row is the bone, a blended row its point's
+        table, row = transform_table(tskel)
+        row_bone = np.arange(len(table), dtype=np.int64)
+        row_bone[row] = np.asarray(tskel.bone, np.int64)
+    points, rows = rest.voxels  # the rest frame's rows: the same points blend the same way
+    if rest.reach is None:
+        bones = rows if row_bone is None else row_bone[rows]
+        rest.reach = bone_reach(segments, points, bones), limb_voxels(segments, bones)
+    reach, limbs = rest.reach
+    if row_bone is None:
+        return find_lumps(posed.volume, posed.origin, np.asarray(tskel.matrices, np.float64), segments, reach,
+                          rest.rest_bone.volume, rest.rest_bone.origin, posed_joints, limbs, labels=labels)
+    rest_owner = np.concatenate([[0], row_bone + 1])[rest.rest_bone.volume]  # each rest voxel's bone + 1
+    owner = reconstruct(tskel, mode=OWNER, bounds=posed.bounds)
+    return find_lumps(owner.volume, owner.origin, table, segments, reach, rest_owner, rest.rest_bone.origin,
+                      posed_joints, limbs, labels=labels, row_bone=row_bone)

@@ -53,9 +53,24 @@ def test_poses_whose_true_shape_has_no_lump_have_none(rig, rotations):
     assert rep.lumps == [] and "lump" not in rep.verdict
 
 
-def test_frames_with_smooth_joints_are_not_judged(rig):
-    rep, _ = _report(rig, {"L_UPPERARM": (0, -90, 0)}, Joints("smooth"))
-    assert rep.lumps == []
+def test_a_smooth_frame_is_judged_too_each_voxel_followed_back_by_its_blend(rig):
+    """#84: frames with smooth joints were not judged ("a blended voxel has no one bone to follow back"), so the
+    raised arm's armpit flesh (the true shape's extra blob: 3,037 voxels) hung under it unreported. Each voxel is
+    now followed back by the blend that moved it (its row of the transform table)."""
+    from volanim_core.reconstruct.engine import reconstruct
+
+    rep, m = _report(rig, {"L_UPPERARM": (0, -90, 0)}, Joints("smooth"))
+    assert rep.lumps and rep.lumps[0].near == "L_SHOULDER" and rep.lumps[0].carrier == "L_UPPERARM"
+    from volanim_core.reconstruct.shape import extra_flesh
+
+    posed = reconstruct(rig[0].with_joints(Joints("smooth")).posed(m), mode="bone")
+    truth = posed_sample("mannequin", m)
+    extra, lo = extra_flesh(posed.volume, truth.volume, ours_origin=posed.origin, truth_origin=truth.origin)
+    lump = rep.lumps[0]
+    box = tuple(slice(int(a), int(b) + 1) for a, b in zip(np.asarray(lump.lo) - lo, np.asarray(lump.hi) - lo))
+    assert extra[box].sum() >= lump.voxels / 2  # flesh the true shape does not have
+    for rotations in ({}, {"L_FOREARM": (-90, 0, 0)}):  # the rest pose and a bent elbow: none
+        assert _report(rig, rotations, Joints("smooth"))[0].lumps == []
 
 
 def test_a_limb_is_its_bone_and_every_bone_below_it():
