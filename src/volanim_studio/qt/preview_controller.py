@@ -300,9 +300,10 @@ class PreviewController(Controller):
             return
         lump = report.lumps[k]
         names = [b.label for b in self.doc.bones.bones]
-        if self.doc.settings.body != "owned" or not self.doc.ownership.available:
-            self.show_error("Fix lump", "a lump is fixed by repainting ownership: choose Body: owned and open the "
-                                        "volume, or give the points there to another bone (Lasso, L)")
+        if self.doc.settings.body != "owned" or not self.doc.ownership.available or self.doc.settings.joints != "rigid":
+            # smooth joints move the spheres by blends, which ownership does not steer
+            self.show_error("Fix lump", "a lump is fixed by repainting ownership: choose Body: owned, rigid joints, "
+                                        "and open the volume, or give the points there to another bone (Lasso, L)")
             return
         if lump.belongs_to not in names:
             self.show_error("Fix lump", f"the lump near {lump.near} names no bone to give its flesh to")

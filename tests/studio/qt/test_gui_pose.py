@@ -440,6 +440,25 @@ def test_the_default_body_raises_the_arm_clean_and_fix_gives_a_painted_lump_back
     assert len(doc.ownership.paints) == 1
 
 
+def test_a_smooth_frame_lists_its_lump_and_fix_says_to_give_the_points_instead(qtbot, posed_window):
+    """#84: smooth frames are judged for lumps now. Their spheres move by blends, which a repaint of ownership
+    does not steer: Fix says so (and what to do) instead of painting flesh that would change nothing."""
+    w = posed_window
+    doc = w.doc
+    doc.settings.joints = "smooth"
+    doc.select_bones([doc.bones.index("L_UPPERARM")])
+    drag(qtbot, w, 1, range(0, -91, -10))
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
+    r = doc.preview.report
+    assert r.lumps and r.lumps[0].near == "L_SHOULDER"
+    panel = w.reconstruct_panel
+    item = next(panel.joints.item(i) for i in range(panel.joints.count())
+                if panel.joints.item(i).text().startswith("lump:"))
+    panel.joints.setCurrentItem(item)
+    qtbot.mouseClick(panel.fix_button, Qt.LeftButton)
+    assert "rigid joints" in w.last_error and "Lasso" in w.last_error and doc.ownership.paints == ()
+
+
 def test_a_project_opened_in_pose_mode_shows_its_body_not_only_its_bones(qtbot, posed_window, tmp_path):
     """#61 item 2: a recovered (or opened) session in Pose mode drew the posed bones and no body until F5
     or a pose change. The body the window draws is the core's reconstruction of the saved pose."""
