@@ -34,6 +34,7 @@ from volanim_core.progress import Reporter
 from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import OWNER, Reconstruction, moves_owned, reconstruct
+from volanim_core.reconstruct.lumps import frame_lumps
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.pose import apply_matrices, apply_rows
@@ -160,9 +161,10 @@ def misplaced_points(conn: Connectivity) -> tuple[np.ndarray, np.ndarray]:
     ``CLEARLY`` share of the distance, so points far from every bone (a web between the toes) never
     do. And part of that bone's flesh: its sphere reaches one of the bone's spheres. A point the body keeps apart from
     that bone by a gap (the torso's flank beside a hanging arm, nearer the arm's segment than the
-    spine's) is not a piece of the limb, and stays where it is in any pose.
+    spine's) is not a piece of the limb, and stays where it is in any pose. None on an owned connectivity or
+    frame (#84): its body moves by its ownership, so no point's attachment leaves flesh behind.
     """
-    if not len(conn) or len(conn.bones) < 2:
+    if not len(conn) or len(conn.bones) < 2 or moves_owned(conn, "auto"):
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
 
     segs = np.array([[b.proximal, b.distal] for b in conn.bones])
@@ -411,9 +413,8 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
         if rest.piece is not None else {k for _, _, k in parts[1:]}
     report = BreakageReport([n for n, _, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
-                            cracks=len(gaps), rest_pieces=rest.pieces,
-                            stumps=[] if moves_owned(tskel, "auto") else stumps(tskel, joints))
-    report.lumps = _lumps(tskel, posed, rest, {n: posed_joints.get(n, joints[n]) for n in joints})
+                            cracks=len(gaps), stumps=stumps(tskel, joints), rest_pieces=rest.pieces)
+    report.lumps = frame_lumps(tskel, posed, rest, {n: posed_joints.get(n, joints[n]) for n in joints})
     names = list(joints)
     posed_pos = np.array([posed_joints.get(n, joints[n]) for n in names], np.float64) if names else None
     for size, centroid, k in parts:
@@ -435,8 +436,3 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
                                                np.asarray(posed_joints.get(n, joints[n])), float(weight[k])))
     return report
 
-
-def _lumps(tskel: Tskel, posed: Reconstruction, rest: RestParts, posed_joints: dict) -> list:
-    from volanim_core.reconstruct.lumps import frame_lumps
-
-    return frame_lumps(tskel, posed, rest, posed_joints)

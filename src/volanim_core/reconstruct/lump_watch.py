@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.reconstruct.breakage import RestParts, _lumps
+from volanim_core.reconstruct.breakage import RestParts
 from volanim_core.reconstruct.engine import reconstruct
-from volanim_core.reconstruct.lumps import MIN_VOXELS, MOVED, SHARE, bone_reach, limb_voxels
+from volanim_core.reconstruct.lumps import MIN_VOXELS, MOVED, SHARE, bone_reach, frame_lumps, limb_voxels
 from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.skinning import segment_distance
 
@@ -72,4 +72,4 @@ class LumpWatch:
         if not self.may_carry(matrices):
             return []
         tskel = self.conn.posed(np.asarray(matrices, np.float64))
-        return _lumps(tskel, reconstruct(tskel, mode="bone"), self.rest, joints)
+        return frame_lumps(tskel, reconstruct(tskel, mode="bone"), self.rest, joints)

@@ -137,8 +137,17 @@ def find_lumps(posed_bone: np.ndarray, origin, matrices: np.ndarray, segments, r
     own = row if row_bone is None else np.asarray(row_bone, np.int64)[row]
     qf = q.astype(np.float64) + np.asarray(origin, np.float64)
     inverse = np.linalg.inv(matrices)
-    # where each voxel's flesh lay at rest (by the matrix that moved it), and whether its own bone reaches there
-    rest = np.einsum("ni,nij->nj", qf, inverse[row, :3, :3]) + inverse[row, 3, :3]
+    # where each voxel's flesh lay at rest (by the matrix that moved it), and whether its own bone reaches there:
+    # a bone's own matrix for most voxels (one product a bone); a smooth frame's blended ones one by one (the few
+    # voxels near a bent joint: a matrix gathered per voxel of mannequin-large's body would be 300 MB)
+    rest = np.empty_like(qf)
+    plain = row < len(segments)
+    for b in np.unique(row[plain]):
+        sel = row == b
+        rest[sel] = qf[sel] @ inverse[b, :3, :3] + inverse[b, 3, :3]
+    if not plain.all():
+        r = row[~plain]
+        rest[~plain] = np.einsum("ni,nij->nj", qf[~plain], inverse[r, :3, :3]) + inverse[r, 3, :3]
     beyond = np.zeros(len(q), bool)
     for b in np.unique(own):
         sel = own == b

@@ -27,7 +27,7 @@ import numpy as np
 from volanim_core.progress import Reporter
 from volanim_core.reconstruct.breakage import components, misplaced_points, stumps
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
-from volanim_core.reconstruct.engine import moves_owned, reconstruct
+from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.reconstruct.lump_watch import LumpWatch
 from volanim_core.reconstruct.whole import WholeProof
 from volanim_core.rig.connectivity import Connectivity
@@ -82,8 +82,7 @@ class Scanner:
         # a frame proved whole from its spheres needs no voxels (whole.py): most frames of a clip
         self.whole = WholeProof(coarse) if self.rest_pieces == 1 else None
         self.pairs = touching_pairs(rest)
-        self.owned = moves_owned(rest, "auto")  # no stumps: the points' attachments leave nothing behind
-        self.misplaced = None if self.owned else misplaced_points(rest)
+        self.misplaced = misplaced_points(rest)  # none on an owned body (moved by its ownership)
         self.names = list(self.joints)
         self.near = cKDTree(np.array([self.joints[n] for n in self.names], np.float64)) if self.names else None
         # lumps as the report finds them, at full resolution, in the frames that can carry one (lump_watch.py)
@@ -102,7 +101,7 @@ class Scanner:
             sizes = [0]  # one piece (its size is not needed: nothing is detached)
         else:
             sizes = components(reconstruct(coarse, mode="bone", padding=1).volume)
-        behind = [] if self.owned else stumps(posed, self.joints, self.misplaced)
+        behind = stumps(posed, self.joints, self.misplaced)
         lumps = [] if self.watch is None else self.watch.lumps(mats, self.posed_joints(mats))
         return FrameVerdict(frame, len(sizes), int(sum(sizes[self.rest_pieces:])) * self.factor ** 3, len(gaps),
                             float(gaps.sum()), worst or (behind[0].joint if behind else ""),

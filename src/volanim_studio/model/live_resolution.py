@@ -16,6 +16,7 @@ draws the full picture at full size whatever the live factor.
 from __future__ import annotations
 
 import statistics
+from collections.abc import Callable
 
 RATE = 10.0  # live pictures a second the studio keeps (#85's goal), when it can
 WINDOW = 3  # pictures at one factor before it is judged: one slow picture (a first frame) changes nothing
@@ -35,12 +36,12 @@ class LiveResolution:
         self.factor: int | None = None  # auto: the factor in use (None: the size rule's, on the first picture)
         self._costs: list[float] = []
 
-    def factor_for(self, size_factor: int) -> int:
-        """The next live picture's factor; ``size_factor``: the size rule's (the first picture's, on auto)."""
+    def factor_for(self, size_rule: Callable[[], int]) -> int:
+        """The next live picture's factor; ``size_rule()``: the size rule's, asked only for an auto first picture."""
         if self.choice != "auto":
             return FIXED[self.choice]
         if self.factor is None:
-            self.factor = size_factor
+            self.factor = int(size_rule())
         return self.factor
 
     def took(self, factor: int, seconds: float) -> None:

@@ -158,7 +158,7 @@ class LivePreviews:
         if factor is None:
             if self._live is None or self._key[0] != mode:  # another mode: the size rule again
                 self.resolution.reset()
-            factor = self.resolution.factor_for(live_factor(tskel) if self.resolution.factor is None else 1)
+            factor = self.resolution.factor_for(lambda: live_factor(tskel))
         coarse = coarse_tskel(tskel, factor)
         pad = max(1, padding // factor)
         if moves_owned(coarse, "auto"):  # the rig's owned body (reconstruct's default), only the moved bones redone

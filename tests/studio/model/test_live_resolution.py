@@ -11,7 +11,7 @@ def factors(res: LiveResolution, costs: list[float], size_factor: int = 1) -> li
     """The factor each picture is made at, each then costing the next of ``costs`` (seconds)."""
     out = []
     for cost in costs:
-        f = res.factor_for(size_factor)
+        f = res.factor_for(lambda: size_factor)
         out.append(f)
         res.took(f, cost)
     return out
@@ -40,11 +40,11 @@ def test_a_fixed_choice_is_kept_whatever_the_cost_and_reset_starts_from_the_size
     assert factors(LiveResolution("quarter"), [0.001] * 6) == [4] * 6
     res = LiveResolution()
     factors(res, [0.2] * WINDOW)
-    assert res.factor_for(1) == 2
+    assert res.factor_for(lambda: 1) == 2
     res.reset()
-    assert res.factor_for(1) == 1
+    assert res.factor_for(lambda: 1) == 1
     res.took(2, 1.0)  # a picture of the old factor, arriving late, is not counted
-    assert factors(res, [0.2] * (WINDOW - 1)) == [1] * (WINDOW - 1) and res.factor_for(1) == 1
+    assert factors(res, [0.2] * (WINDOW - 1)) == [1] * (WINDOW - 1) and res.factor_for(lambda: 1) == 1
 
 
 def test_an_unknown_choice_is_refused_by_name():
