@@ -15,6 +15,8 @@ cli/. The modules beside them:
     modes.py ............. the reconstruction modes' names
     camera.py ............ a camera as plain data; transfer_function.py: value -> colour and opacity
     isosurface.py ........ an isosurface as plain arrays (VTK's flying edges) for code below render/
+    voxel_faces.py ....... the faces between filled and empty voxels as plain arrays: the live preview's
+                           surface (numba kernels in _face_kernels.py)
     memo.py .............. a few recent results kept by a hash of their inputs
     parallel.py .......... where many tasks run: this process, a spawn pool, or a Dask cluster
     volume.py ............ the old pipeline's volume tools as pure functions, and the value helpers

@@ -118,9 +118,13 @@ def voxel_points(points) -> np.ndarray:
         raise ValueError(f"point coordinates must be numbers, got {raw.dtype}")
     if raw.size and raw.dtype.kind == "f":
         bad = ~np.isfinite(raw) | (np.abs(raw) > MAX_COORD) | (raw != np.round(raw))
+    elif raw.size and (raw.max() > MAX_COORD or raw.min() < -MAX_COORD):
+        # integers: two reductions, then the voxels found only when one is out of range (an int64 copy and its
+        # abs for every call cost 14 ms of each live picture of the frog's 1.3 M points)
+        bad = (raw > MAX_COORD) | (raw < -MAX_COORD)  # no cast: a uint64 over 2^63 would wrap negative
     else:
-        bad = np.abs(raw.astype(np.int64)) > MAX_COORD if raw.size else np.zeros(raw.shape, bool)
-    if bad.any():
+        bad = None
+    if bad is not None and bad.any():
         i = int(np.argwhere(bad.reshape(-1, 3) if bad.size % 3 == 0 else bad)[0][0])
         shown = raw.reshape(-1, 3)[i].tolist() if raw.size % 3 == 0 else raw.tolist()
         raise ValueError(f"point {i} {shown} is not a voxel: coordinates must be finite whole numbers "

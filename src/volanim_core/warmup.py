@@ -5,7 +5,8 @@
         (every mode x metric, sampled with kernel 1 and 3, and a colour source) --> palette
         orderings --> breakage report (+ detached pieces; a clip's scan uses the same kernels, and its
         proof of one piece)
-        --> a crumble's heap --> a proposed rig's balls --> the rig's ownership and a frame from it
+        --> a live picture's voxel faces --> a crumble's heap --> a proposed rig's balls --> the rig's ownership
+        and a frame from it
 
 Every kernel a user's command or the studio calls is in that list (a test holds it to that): a fresh
 install that skipped this compiles on first use instead -- the walk's first `volanim scan` took 22 s
@@ -52,6 +53,7 @@ def compile_kernels(progress=None) -> float:
     from volanim_core.rig.tskel_tools import coarse_tskel
     from volanim_core.sequence.effects import fall
     from volanim_core.skeleton.skeletonize import skeletonize
+    from volanim_core.voxel_faces import face_arrays
 
     t0 = time.perf_counter()
     mask = _tiny_body()
@@ -78,6 +80,8 @@ def compile_kernels(progress=None) -> float:
             _report(progress, done, total)
     rgb = np.repeat(source[..., None], 3, axis=3)
     reconstruct(tskel, mode="sampled", source=rgb, kernel=3)  # a colour source: float32 linear light
+    for labels in (np.uint8, np.uint16):  # a live picture's faces: bone labels of up to 254 bones, and more
+        face_arrays(np.asfortranarray(_tiny_body().astype(labels)), (0, 0, 0), (1, 1, 1), np.zeros((2, 3), np.uint8))
     sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "path")  # all moves
     sort_palette(np.arange(12, dtype=np.uint8).repeat(3).reshape(-1, 3), "farthest-seeds")
     sort_palette(rgb[10:13, 5, 5:8].reshape(-1, 3) + np.arange(9, dtype=np.uint8)[:, None], "ramp")  # the default

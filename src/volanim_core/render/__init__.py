@@ -2,7 +2,8 @@
 
     bone_colours.py . bone colours (32 distinct, by root order), label tables, point colour maps
     volume_style.py . how each reconstruction mode's volume is drawn: label steps, VTK transfer functions
-    surfaces.py ..... label-coloured isosurfaces (the fast live-preview look)
+    surfaces.py ..... label-coloured surfaces: flying edges (the surface style), voxel faces (the live preview's;
+                      its arrays made by ../voxel_faces.py)
     views.py ........ named views and follow cameras from boxes (no frames, no files)
     framing.py ...... place_camera: a render's camera from its inputs (a view of every body, given, follow)
     scene.py ........ RenderSettings, presets, the off-screen Renderer, cut-aways

@@ -155,3 +155,16 @@ def test_six_channel_child_holding_its_local_position_replaces_its_offset(tmp_pa
     m = read_bvh(write(tmp_path, text))
     _, pos = m.forward_kinematics()
     assert np.allclose(pos[:, 1], [[0, 10, 0], [0, 10.5, 0]])  # not (0, 20, 0)
+
+
+@pytest.mark.parametrize("axes", ["ZXY", "XYZ", "YZX", "ZYX", "XZY", "YXZ", "Z", "XY"])
+def test_euler_rotations_are_scipys(axes):
+    """The channels' rotations are written out (scipy 1.17's from_euler took 56 of the walk's 75 ms of forward
+    kinematics); they are scipy's intrinsic rotations, angle for angle, whatever the order and range."""
+    from scipy.spatial.transform import Rotation
+
+    from volanim_core.io.bvh_files import euler_matrices
+
+    angles = np.random.default_rng(3).uniform(-400, 400, (64, len(axes)))
+    want = Rotation.from_euler(axes, angles, degrees=True).as_matrix()
+    assert np.allclose(euler_matrices(axes, angles), want, rtol=0, atol=1e-12)

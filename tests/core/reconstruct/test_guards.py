@@ -54,6 +54,9 @@ def test_a_huge_radius_in_small_bounds_finishes_and_estimates_what_it_clipped():
     ([[1e300, 0, 0]], [1.0], "is not a voxel"),
     ([[np.nan, 0, 0]], [1.0], "is not a voxel"),
     ([[3e9, 0, 0]], [1.0], "is not a voxel"),
+    (np.array([[0, 2**31 - 1, 0]], np.int32), [1.0], "is not a voxel"),  # integers: found by their min and max
+    (np.array([[0, 0, -(2**40)]], np.int64), [1.0], "is not a voxel"),
+    (np.array([[0, 0, 2**63 + 5]], np.uint64), [1.0], "is not a voxel"),
     ([[0, 0, 0]], [1e300], "reaches 1e\\+300 voxels"),
     ([[0, 0, 0]], [np.nan], "NaN, infinite or negative"),
     ([[0, 0, 0]], [-2.0], "NaN, infinite or negative"),

@@ -80,3 +80,28 @@ def test_a_drag_of_an_owned_body_is_the_full_preview_s_body_and_redoes_the_moved
         redone.append(live.redone)
     whole = int(np.prod(live.bounds.shape))
     assert all(0 < n < whole // 10 for n in redone[1:7])  # each step of the forearm: its own box
+
+
+@pytest.mark.parametrize("owned", [True, False])
+def test_a_factor_taken_again_redoes_what_moved_since_its_last_picture_not_its_whole_grid(owned):
+    """#85: the live resolution went half, quarter, half... and every change made a whole new grid (the frog's
+    half-size one: 100 ms a picture). Each factor's grid is kept while the mode lasts: back at half size only
+    what moved since its last half-size picture is redone, and the picture is still make_preview's."""
+    from volanim_core.rig.ownership import ownership
+
+    s = samples.mannequin()
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
+    if owned:
+        conn = conn.with_ownership(ownership(s.mask, conn))
+    live = LivePreviews()
+    factors = [2, 4, 2, 4, 2]
+    for i, (f, pose) in enumerate(zip(factors, DRAG[1:6])):
+        t = conn.posed(pose_matrices(s.bones, pose))
+        got = live.make(t, mode="bone", factor=f, padding=2)
+        want = make_preview(t, mode="bone", factor=f, padding=2)
+        assert got.factor == f and np.array_equal(got.reconstruction.volume, want.reconstruction.volume)
+        whole = int(np.prod(live.bounds.shape)) if owned else live.bounds.shape[2]
+        if i >= 2:  # the factor's grid made before: only what moved since
+            assert 0 < live.redone < whole // 2
+    live.make(conn.posed(pose_matrices(s.bones, DRAG[1])), mode="binary", factor=2, padding=2)
+    assert live.redone == (int(np.prod(live.bounds.shape)) if owned else live.bounds.shape[2])  # another mode: anew

@@ -35,6 +35,22 @@ def test_fast_pictures_come_back_to_full_size_and_a_middling_one_stays():
     assert factors(LiveResolution(), [0.04] * (3 * WINDOW), size_factor=2) == [2] * (3 * WINDOW)
 
 
+def test_a_step_found_too_slow_is_not_tried_again_on_a_guess():
+    """The frog's quarter-size pictures cost 15 ms, its half-size ones 120 ms: x 5 guessed 75 ms for half size,
+    and the factor went 2, 4, 2, 4, ... for the whole drag (each change a picture of a whole grid). After one
+    round trip the step's ratio (8) is known, and quarter size stays."""
+    res = LiveResolution()
+    cost = {2: 0.12, 4: 0.015}
+    got = []
+    for _ in range(8 * WINDOW):
+        f = res.factor_for(lambda: 2)
+        got.append(f)
+        res.took(f, cost[f])
+    assert got == [2] * WINDOW + [4] * WINDOW + [2] * WINDOW + [4] * (5 * WINDOW)
+    res.reset()  # another body: nothing is known of it
+    assert factors(res, [0.01] * (2 * WINDOW), size_factor=4) == [4] * WINDOW + [2] * WINDOW
+
+
 def test_a_fixed_choice_is_kept_whatever_the_cost_and_reset_starts_from_the_size_rule():
     assert factors(LiveResolution("full"), [1.0] * 6, size_factor=2) == [1] * 6
     assert factors(LiveResolution("quarter"), [0.001] * 6) == [4] * 6

@@ -120,3 +120,25 @@ def test_the_movie_camera_is_the_view_the_user_sees(qtbot, colour_window, tmp_pa
     assert (cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp()) == before
     saved = io.read_camera(tmp_path / "view.camera")
     assert np.allclose(saved.position, before[0]) and np.allclose(saved.focal_point, before[1])
+
+
+@pytest.mark.parametrize("resolution", ["full", "half"])
+def test_a_live_picture_shows_the_voxels_it_made_from_every_side(qtbot, colour_window, resolution):
+    """#85: a drag's picture is its voxels' own faces (voxel_faces, made in the live thread): against the oracle's
+    silhouette of the live voxels, at full and half size, from the front, the side and above."""
+    w = colour_window
+    doc = w.doc
+    doc.settings.live_resolution = resolution
+    doc.settings.dragging = True  # a pose slider held
+    doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, -60, 0))
+    qtbot.waitUntil(lambda: doc.preview is not None and doc.preview.live and doc.preview_is_current
+                    and w.previews.live_worker.idle and not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert doc.preview.factor == {"full": 1, "half": 2}[resolution]
+    views = {"front": ((0, -1, 0), (0, 0, 1)), "side": ((1, 0, 0), (0, 0, 1)), "above": ((0, 0, 1), (0, 1, 0))}
+    for view, (towards, up) in views.items():
+        w.plotter.view_vector(towards, up)
+        w.plotter.reset_camera()
+        got, outside = studio_picture(w)
+        assert outside == 0.0 and got["stray"] < 0.01 and got["iou_rim"] >= 0.9, (resolution, view, got)
+    doc.settings.dragging = False
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
