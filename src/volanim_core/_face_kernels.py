@@ -49,7 +49,7 @@ def faces_per_slice(vol, counts):
 def fill_faces(vol, starts, corners, origin, spacing, table, points, faces, rgb):
     """Each face of slice z written from ``starts[z]``: ``points[4f:4f+4]`` its corners in world units
     (``origin + spacing * (voxel + corner)``, (x, y, z)), ``faces[f]`` their indices, ``rgb[4f:4f+4]`` the
-    colour ``table[value]`` of its filled voxel (values past the table: its last row)."""
+    colour ``table[value]`` of its filled voxel (RGB or RGBA, as the table's rows; past the table: its last row)."""
     nz, ny, nx = vol.shape
     top = table.shape[0] - 1
     for z in prange(nz):
@@ -72,5 +72,6 @@ def fill_faces(vol, starts, corners, origin, spacing, table, points, faces, rgb)
                         points[p, 1] = origin[1] + spacing[1] * (y + corners[d, k, 1])
                         points[p, 2] = origin[2] + spacing[2] * (z + corners[d, k, 2])
                         faces[f, k] = p
-                        rgb[p, 0], rgb[p, 1], rgb[p, 2] = c[0], c[1], c[2]
+                        for ch in range(rgb.shape[1]):  # RGB, or RGBA (a transfer function's opacity)
+                            rgb[p, ch] = c[ch]
                     f += 1

@@ -15,7 +15,7 @@ from volanim_core._face_kernels import CORNERS, faces_per_slice, fill_faces
 
 def face_arrays(volume: np.ndarray, origin, spacing, table: np.ndarray | None = None
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(points (4F, 3) float32, faces (F, 4) int64, rgb (4F, 3) uint8)``: each face between a non-zero voxel of
+    """``(points (4F, 3) float32, faces (F, 4) int64, rgb (4F, 3 or 4) uint8)``: each face between a non-zero voxel of
     ``volume`` (labels ``[x, y, z]``) and an empty one or the grid's edge, its corners in world units
     (``origin + spacing * voxel``) and their colour ``table[label]`` (the table's last row past its end; zeros
     without a table)."""
@@ -27,10 +27,11 @@ def face_arrays(volume: np.ndarray, origin, spacing, table: np.ndarray | None = 
     faces_per_slice(vol, counts)
     starts = np.concatenate([[0], np.cumsum(counts)])
     n = int(starts[-1])
-    rows = np.zeros((1, 3), np.uint8) if table is None else np.ascontiguousarray(table[:, :3], np.uint8)
+    # a user's transfer function gives RGBA rows: its opacity is kept (a faint bone stays faint while dragged)
+    rows = np.zeros((1, 3), np.uint8) if table is None else np.ascontiguousarray(table, np.uint8)
     points = np.empty((4 * n, 3), np.float32)
     faces = np.empty((n, 4), np.int64)
-    rgb = np.empty((4 * n, 3), np.uint8)
+    rgb = np.empty((4 * n, rows.shape[1]), np.uint8)
     fill_faces(vol, starts, CORNERS, np.asarray(origin, np.float64), np.asarray(spacing, np.float64), rows, points,
                faces, rgb)
     return points, faces, rgb

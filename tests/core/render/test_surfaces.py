@@ -75,3 +75,14 @@ def test_voxel_faces_of_any_memory_order_of_labels_and_of_nothing():
     assert voxel_faces(np.zeros((4, 4, 4), np.uint8), (0, 0, 0), (1, 1, 1), table).n_cells == 0
     with pytest.raises(ValueError, match="label volume"):
         voxel_faces(ball.astype(np.float32), (0, 0, 0), (1, 1, 1), table)
+
+
+def test_voxel_faces_keep_a_transfer_function_s_opacity():
+    """Review of #85: the live picture's faces took only RGB of the user's RGBA table, so a bone made faint by the
+    transfer function was drawn solid while dragged (flying edges had kept the alpha)."""
+    vol = np.zeros((6, 6, 6), np.uint8)
+    vol[1:3, 1:5, 1:5], vol[3:5, 1:5, 1:5] = 1, 2
+    table = np.array([[0, 0, 0, 0], [200, 10, 10, 255], [10, 10, 200, 26]], np.uint8)  # label 2 at 0.1
+    mesh = voxel_faces(vol, (0, 0, 0), (1, 1, 1), table)
+    rgba = np.asarray(mesh.point_data["rgb"])
+    assert rgba.shape[1] == 4 and set(map(tuple, rgba.tolist())) == {tuple(table[1]), tuple(table[2])}
