@@ -16,7 +16,7 @@ from volanim_core import samples
 from volanim_core.geometry import IDENTITY
 from volanim_core.io import read_scan, read_skeleton
 from volanim_core.progress import Reporter, stage
-from volanim_core.skeleton.hull import display_hulls
+from volanim_core.skeleton.hull import display_hulls, vertex_normals
 from volanim_core.skeleton.skeletonize import DEFAULT_MIN_THINNESS, skeletonize
 from volanim_core.volume import is_colour, isotropic_mask, resample, segment, to_grey
 
@@ -76,6 +76,8 @@ def prepare_volume(volume: np.ndarray, segmentation: Segmentation, *, skeleton_p
                            progress=stage(report, 10, 80), cancel=cancel)
     report(80, 100)
     hull, lod = display_hulls(mask)  # lod: drawn while a slider is held
+    # with their normals: VTK's smooth shading made them on the GUI thread (70 ms of mannequin-large's open)
+    hull, lod = ((*h, vertex_normals(*h)) if h is not None else None for h in (hull, lod))
     report(90, 100)
     pieces = regrown_pieces(skel, mask)
     report(100, 100)

@@ -80,6 +80,14 @@ def open_project(qtbot, window, path) -> bool:
     return opened[0]
 
 
+def save_project(qtbot, window, **kw):
+    """Save as Ctrl+S does (``FilesController.save_project``: written on the savers' thread) and wait until
+    the document has adopted it; its result (the path, None when nothing was started)."""
+    path = window.files.save_project(**kw)
+    qtbot.waitUntil(lambda: not window.savers.busy, timeout=JOB_TIMEOUT_MS)
+    return path
+
+
 @pytest.fixture(autouse=True)
 def widgets_deleted_in_their_own_test():
     """Destroy the test's closed widgets before the next test starts.

@@ -26,6 +26,7 @@ document: ``bone_edits`` changes the bones, ``attachments`` the connectivity,
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,6 +43,9 @@ from .settings import Settings
 from .timeline import Timeline
 from .transfer import TransferState
 from .undo import UndoStack
+
+if TYPE_CHECKING:
+    from .project import SaveTaken
 
 #: Changes that make the shown picture (and its verdict) old, with the words the verdict says them in.
 #: (A clip or keys matter through the pose they set: the timeline's own event is not one of these. Nor is the
@@ -60,6 +64,7 @@ class Document:
                                    "point_selection", "pose", "pose_settled", "preview", "timeline", "camera",
                                    "transfer", "stale", "ownership", "owners_shown")
         self.undo = UndoStack()
+        self.generation = 0  # counts reset(): which document a save in flight was taken from
         self.volume: np.ndarray | None = None
         self.mask: np.ndarray | None = None
         self.spacing = (1.0, 1.0, 1.0)
@@ -68,8 +73,8 @@ class Document:
         self.segmentation: dict | None = None  # threshold lo/hi, fill, metric, min_thinness (saved in projects)
         self.skeleton: Skeleton | None = None
         self.mskel_path: str | None = None
-        self.hull: tuple[np.ndarray, np.ndarray] | None = None
-        self.hull_lod: tuple[np.ndarray, np.ndarray] | None = None  # drawn while a slider is held
+        self.hull: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # vertices, faces, normals
+        self.hull_lod: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # drawn while a slider is held
         self._thinness = 0.0
         self.bones = BoneSkeleton()
         self.bones_path: str | None = None
@@ -137,11 +142,13 @@ class Document:
         self.events.thinness.emit(value=self._thinness)
         self.events.attachments.emit(indices=None)
 
-    def set_hull(self, vertices, faces, lod=None) -> None:
-        """The hull to draw, and ``lod``: a coarser ``(vertices, faces)`` of it for frames drawn
-        while a slider is held (None: the hull is light enough as it is)."""
-        self.hull = None if vertices is None else (np.asarray(vertices), np.asarray(faces))
-        self.hull_lod = None if vertices is None or lod is None else (np.asarray(lod[0]), np.asarray(lod[1]))
+    def set_hull(self, vertices, faces, normals=None, *, lod=None) -> None:
+        """The hull to draw, ``(vertices, faces, normals)``, and ``lod``: a coarser one of it for frames drawn
+        while a slider is held (None: the hull is light enough as it is). Normals not given are made here
+        (:func:`~volanim_core.skeleton.hull.vertex_normals`); the volume's worker gives them, so the GUI
+        thread only hands arrays to VTK."""
+        self.hull = None if vertices is None else _hull(vertices, faces, normals)
+        self.hull_lod = None if vertices is None or lod is None else _hull(*lod)
         self.events.hull.emit()
 
     @property
@@ -323,6 +330,7 @@ class Document:
         Opening a volume, a demo or a project starts here, so nothing of the previous
         project (bones, connectivity, pose, keys, its path) leaks into the new one.
         """
+        self.generation += 1  # a save of the old document finishing now is not adopted by the new one
         self.timeline.unload()
         self.timeline._set_keys({})
         self.pose._write({}, {})
@@ -355,29 +363,49 @@ class Document:
 
         The bone skeleton, the attachments (all of them, whatever the slider)
         and the skeleton are stored under content names; the manifest is
-        replaced last (see :mod:`volanim_studio.model.project`).
+        replaced last (see :mod:`volanim_studio.model.project`). The studio's
+        Save does the same in three steps (:meth:`take_save`, the write on a
+        thread, :meth:`adopt_save`) so the GUI thread never formats files.
         """
+        from .project import write_save
+
+        save = self.take_save(path)
+        self.adopt_save(save, write_save(save))
+        return save.path
+
+    def take_save(self, path) -> SaveTaken:
+        """What a save of the document to ``path`` (``.volanim`` added when missing) writes, taken now
+        (cheap: :class:`~volanim_studio.model.project.Snapshot`). Raises ValueError when nothing can be saved."""
+        from .project import SaveTaken, snapshot
+
         self.check_savable()
         path = Path(path)
         if path.suffix != ".volanim":
             path = path.with_suffix(".volanim")
-        written = self.write_project(path)
+        return SaveTaken(path, snapshot(self, path), self.undo.state, self.generation)
+
+    def adopt_save(self, save: SaveTaken, written: dict) -> bool:
+        """The document is now the project ``save`` wrote (``written``: :func:`write_save`'s paths), unmodified
+        as of when it was taken (edits made while it was written stay unsaved). False, and nothing adopted,
+        when the document was replaced meanwhile (another volume or project opened)."""
+        if save.generation != self.generation:
+            return False
         self.bones_path = written["bones"]
         self.mskel_path = written["mskel"]
-        self.project_path = str(path)
-        self.undo.mark_clean()
-        self.events.project.emit(path=str(path))
-        return path
+        self.project_path = str(save.path)
+        self.undo.mark_clean(save.state)
+        self.events.project.emit(path=str(save.path))
+        return True
 
     def write_project(self, path) -> dict:
-        """Write the project files without adopting their paths (autosave uses this)."""
-        from volanim_core.io import bundle
+        """Write the project files without adopting their paths (what the tests of saves drive)."""
+        from .project import SaveTaken, snapshot, write_save
 
-        from .project import write_project
+        return write_save(SaveTaken(Path(path), snapshot(self, path), self.undo.state, self.generation))
 
-        try:
-            return write_project(self, path)
-        except BaseException:  # a full disk: the files this save stored, which no manifest names, go
-            bundle.collect_garbage(path)
-            raise
 
+def _hull(vertices, faces, normals=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    from volanim_core.skeleton.hull import vertex_normals
+
+    vertices, faces = np.asarray(vertices), np.asarray(faces)
+    return vertices, faces, vertex_normals(vertices, faces) if normals is None else np.asarray(normals)

@@ -191,6 +191,7 @@ ATTRIBUTES = {
     "mskel_path": "the .mskel data file's place", "bones_path": "the .bones data file's place",
     "project_path": "where the project is", "demo_name": "saved as \"demo\"",
     "hull": "made again from the volume", "hull_lod": "made again from the volume",
+    "generation": "counts documents in one window, for saves in flight: a session starts its own",
     "preview": "a reconstruction: made again with F5",
     "picture_basis": "counts changes since the preview: a new session has no preview",
     "body_pieces": "counted again when the volume is segmented",

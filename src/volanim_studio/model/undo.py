@@ -40,10 +40,16 @@ class UndoStack:
     # The document is unmodified when the command on top is the one that was on top when it was
     # saved (None: an empty stack). Undoing back to the saved state makes it unmodified again,
     # like QUndoStack's clean index; an edit merged into the top command replaces it, so it counts.
-    def mark_clean(self) -> None:
-        """The document was saved or opened: this state is unmodified."""
-        self._clean_top = self._top
+    def mark_clean(self, state=_UNREACHABLE) -> None:
+        """The document was saved or opened: this state (or ``state``, a :attr:`state` taken earlier: a save
+        written on a thread while the user went on editing) is unmodified."""
+        self._clean_top = self._top if state is _UNREACHABLE else state
         self.events.changed.emit()
+
+    @property
+    def state(self) -> object:
+        """A token of the history as it is now, for :meth:`mark_clean` once what was taken of it is saved."""
+        return self._top
 
     def mark_modified(self) -> None:
         """This state is saved nowhere (a restored autosave): modified until saved."""

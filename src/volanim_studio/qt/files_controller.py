@@ -23,7 +23,7 @@ from volanim_core import io
 
 from .. import tasks
 from ..model import autosave
-from ..model.project import apply_project, read_project, read_project_files
+from ..model.project import apply_project_files, apply_project_state, read_project, read_project_files, write_save
 from .controller import FAILED, Controller
 from .look_dialog import LookDialog
 from .threshold_dialog import ThresholdDialog
@@ -297,13 +297,21 @@ class FilesController(Controller):
             return data, read_project_files(data, path, skeleton=True)
 
         def rest(data, files, reset=False):
-            warnings = self.attempt("Open project", lambda: apply_project(self.doc, data, path, reset=reset,
-                                                                          files=files))
-            if warnings is FAILED:
+            # in two passes of the event loop, the runner busy between them (see apply_project)
+            first = self.attempt("Open project", lambda: apply_project_files(self.doc, data, path, reset=reset,
+                                                                             files=files))
+            if first is FAILED:
                 done(False)
                 return
-            if warnings:
-                self.show_error("Open project", "\n".join(warnings))
+            self.jobs.later(lambda: state(*first))
+
+        def state(warnings, saved_state):
+            more = self.attempt("Open project", lambda: apply_project_state(self.doc, saved_state, path))
+            if more is FAILED:
+                done(False)
+                return
+            if warnings + more:
+                self.show_error("Open project", "\n".join(warnings + more))
             self.doc.undo.mark_clean()  # as saved: loading its bones is not an edit to save
             self.doc.message(f"Opened {name}.")
             done(True)
@@ -369,7 +377,11 @@ class FilesController(Controller):
              "connect": self.open_connect, "connections": self.open_connections}[kind](path)
 
     # -------------------------------------------------------------- saving
-    def save_project(self, ask: bool = False, path=None) -> Path | None:
+    def save_project(self, ask: bool = False, path=None, then=None) -> Path | None:
+        """Save the project (asking where when ``ask``, or when it has no name yet): taken from the document
+        now, written on the savers' thread, adopted when written, then ``then()``. Returns the path being
+        written, or None when nothing was started (the user cancelled the file dialog, nothing to save,
+        a save already under way: said in the status bar)."""
         try:
             self.doc.check_savable()
         except ValueError as exc:  # said before asking for a name, not after it (#61)
@@ -384,9 +396,25 @@ class FilesController(Controller):
                 path, _ = QFileDialog.getSaveFileName(self.window, title, where, "Projects (*.volanim)")
                 if not path:
                     return None
-        saved = self.attempt("Save project", lambda: self.doc.save_project(path),
-                             lambda saved: f"Saved {saved}.")
-        return None if saved is FAILED else saved
+        savers = self.window.savers
+        if savers.busy:
+            self.doc.message("Still saving the project: save again when it has been written.")
+            return None
+        save = self.attempt("Save project", lambda: self.doc.take_save(path))
+        if save is FAILED:
+            return None
+
+        def written(paths: dict) -> None:
+            if self.doc.adopt_save(save, paths):
+                self.doc.message(f"Saved {save.path}.")
+                if then is not None:
+                    then()
+            else:  # another project was opened while this one was written
+                self.doc.message(f"Saved {save.path} (no longer the open project).")
+        # a dialog only after 300 ms, no Cancel (a save stops at no half-way point)
+        savers.run(f"Saving {save.path.name}", lambda progress, cancel: write_save(save), written,
+                   cancellable=False)
+        return save.path
 
     def save_bones(self, path) -> bool:
         return self.attempt("Save bones", lambda: self.doc.bone_edits.save_bones(path),

@@ -76,6 +76,9 @@ class MainWindow(QMainWindow):
         # Files read only to look at them (View slices, View volume or mesh) have a runner of their own:
         # a large scan's read neither freezes the window nor waits for (or blocks) the document's job.
         self.readers = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text))
+        # ... and a project's saves: written on a thread (no file formatted on the GUI thread), never
+        # refused because a reconstruction runs
+        self.savers = JobRunner(self, show_error=self.show_error, message=lambda text: self.doc.message(text))
         self.last_error: str | None = None
         self._error_box: QMessageBox | None = None
 
@@ -356,8 +359,10 @@ class MainWindow(QMainWindow):
 
     @property
     def busy(self) -> bool:
-        """A background job, a read for a viewer or a live picture is running (its thread has not ended yet)."""
-        return self.jobs.running or self.readers.busy or not self.previews.live_worker.idle
+        """A background job, a read for a viewer, a save or a live picture is running (its thread has not
+        ended yet)."""
+        return (self.jobs.running or self.readers.busy or self.savers.busy
+                or not self.previews.live_worker.idle)
 
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
@@ -370,6 +375,7 @@ class MainWindow(QMainWindow):
         self.jobs.shutdown()  # cancel and wait for the worker: destroying a running QThread aborts
         self.previews.live_worker.close()  # and for the live picture being made
         self.readers.shutdown()
+        self.savers.shutdown()  # a save under way is finished, never cut
         self.session.close()
         close_interactor(self.plotter)
         super().closeEvent(event)

@@ -119,9 +119,9 @@ class SessionController(Controller):
         def answered(_result) -> None:
             self.save_box = None
             button = box.standardButton(box.clickedButton()) if box.clickedButton() else QMessageBox.Cancel
-            if button == QMessageBox.Save:
-                if self.window.files.save_project() is None:
-                    return  # not saved (the user cancelled the file dialog, or it failed and said why)
+            if button == QMessageBox.Save:  # then() once it is written (not if it fails: the error is said)
+                self.window.files.save_project(then=lambda: self.when_saved_or_discarded(then, doing))
+                return
             elif button == QMessageBox.Discard:
                 try:
                     kept = self.autosaver.set_aside()

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import copy
 import time
 from pathlib import Path
 
@@ -26,6 +27,7 @@ from volanim_core.reconstruct.scan import scan_frames, scan_summary, worst_first
 from volanim_core.render.views import Camera
 
 from ..model.settings import Mode
+from ..model.timeline import retarget_clip
 from .controller import FAILED, Controller
 from .mapping_dialog import MappingDialog
 from .movie_dialog import MovieDialog
@@ -192,23 +194,30 @@ class TimelineController(Controller):
         self.stop()
         return self.read_then(path, lambda progress: read_bvh(path), lambda motion: self._retarget(path, motion, ask))
 
-    def _retarget(self, path, motion, ask) -> bool:
+    def _retarget(self, path, motion, ask) -> None:
+        """The mapping asked (``ask``), the clip retargeted in the reader thread (#83 item 13: 70 ms of
+        mannequin-large's walk on the GUI thread), then put on the timeline."""
         mapping, up, forward = None, "auto", "auto"
         if ask is not None:
             dialog = MappingDialog(self.doc.bones, motion, Path(path).name, self.window)
             if not ask(dialog):
-                return False
+                return
             mapping, (up, forward) = dialog.mapping(), dialog.axes()
-        r = self.attempt("Load BVH", lambda: self.doc.timeline.load_bvh(path, mapping, up, forward, motion))
+        bones = copy.deepcopy(self.doc.bones)  # the load uses it only while the document's bones are these
+        self.window.readers.run(f"Retargeting {Path(path).name}",
+                                lambda progress, cancel: retarget_clip(path, bones, motion, mapping, up, forward),
+                                lambda built: self._put_clip(path, mapping, up, forward, motion, built))
+
+    def _put_clip(self, path, mapping, up, forward, motion, built) -> None:
+        r = self.attempt("Load BVH", lambda: self.doc.timeline.load_bvh(path, mapping, up, forward, motion, built))
         if r is FAILED:
-            return False
+            return
         absorbed = r.absorbed_degrees()
         worst = max(absorbed, key=absorbed.get) if absorbed else None
         self.doc.message(f"{Path(path).name}: {motion.frames} frames at {motion.fps:.4g} fps on {len(r.mapping)} of "
                          f"{len(self.doc.bones)} bones (up {r.up}, facing {r.forward})"
                          + (f"; largest rest difference {absorbed[worst]:.0f}° at {worst}" if worst else "")
                          + ". Space plays, arrows step.")
-        return True
 
     def load_bvh_dialog(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "Load a motion-capture clip", self.folder(),

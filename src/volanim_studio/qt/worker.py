@@ -8,6 +8,8 @@
             on_done raises --> failed(message): said, and whoever waits on the job hears it failed
     JobRunner.run(..., background=True)   no dialog and nothing modal: the user goes on working; the next
         job asked for cancels it and starts once its thread has ended (a full preview's breakage report)
+    JobRunner.run(..., cancellable=False)   a dialog without Cancel, for what stops at no half-way point
+        (a project's save: the window's own runner, ``savers``, writes it while the user goes on)
     JobRunner.shutdown()   (window close) cancel, show "Finishing…", wait as long as it takes
 
 Why ``shutdown`` never gives up: a QThread object destroyed while its thread
@@ -121,9 +123,11 @@ class JobRunner(QObject):
         # playback tick) run between the two steps instead of after both
         QTimer.singleShot(1, self._window, run)
 
-    def run(self, label: str, task: Callable, on_done: Callable, *, background: bool = False) -> Worker:
+    def run(self, label: str, task: Callable, on_done: Callable, *, background: bool = False,
+            cancellable: bool = True) -> Worker:
         """Run ``task(progress, cancel)`` in a worker with a progress dialog and Cancel (``background``: with
-        neither, cancelled by the next job asked for)."""
+        neither, cancelled by the next job asked for; not ``cancellable``: a dialog without Cancel, for a task
+        that cannot stop half-way, like a save)."""
         # Ending a background job handles events while its thread winds down; a timer firing then (a preview
         # asked for "when idle") must see a busy runner and wait, not start a job inside this one (#83: F5 just
         # after entering Pose mode raised "another job is running"); and a background job its last signals
@@ -146,7 +150,10 @@ class JobRunner(QObject):
             dialog.setWindowModality(Qt.WindowModal)
             dialog.setMinimumDuration(300)
             worker.progressed.connect(lambda d, t: dialog.setValue(int(100 * d / max(t, 1))))
-            dialog.canceled.connect(worker.cancel)
+            if cancellable:
+                dialog.canceled.connect(worker.cancel)
+            else:
+                dialog.setCancelButton(None)
 
         def finish():
             worker.wait()  # run() is returning: make "not busy" mean the thread has ended

@@ -42,17 +42,18 @@ class HullLayer:
         self.actor = view.plotter.add_mesh(
             lod if view.dragging else mesh, color=None if colour else HULL_COLOUR,
             scalars="rgb" if colour else None, rgb=bool(colour),
-            opacity=view.settings.hull_opacity, pickable=False, smooth_shading=True, name="hull", render=False,
-            reset_camera=False)
+            opacity=view.settings.hull_opacity, pickable=False, name="hull", render=False, reset_camera=False,
+            interpolation="phong")  # smooth shading by the model's normals, what smooth_shading=True drew
         self._apply_state()
         self._on_owners()
         view.apply_stage()
         view.front_view()
 
-    def _mesh(self, verts, faces, colour: bool) -> pv.PolyData:
+    def _mesh(self, verts, faces, normals, colour: bool) -> pv.PolyData:
         view = self.view
-        cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
-        mesh = pv.PolyData(view.world(verts).astype(np.float32), cells)
+        mesh = pv.PolyData.from_regular_faces(view.world(verts).astype(np.float32), faces)
+        mesh.point_data.set_array(_scaled_normals(normals, view.spacing), "Normals")
+        mesh.point_data.active_normals_name = "Normals"
         if colour:  # a colour scan's hull shows the colours of its surface voxels
             mesh.point_data["rgb"] = filled_voxel_values(view.doc.volume, np.asarray(verts, np.float64))
         return mesh
@@ -115,3 +116,14 @@ class HullLayer:
         self._apply_state()
         self.view.apply_stage()
         self.view.render()
+
+
+def _scaled_normals(normals, spacing) -> np.ndarray:
+    """Voxel-frame unit normals in a world of voxels ``spacing`` apart: scaled by 1 / spacing (normals go
+    by the inverse transpose of the points' scaling), made unit again."""
+    spacing = np.asarray(spacing, np.float64)
+    if (spacing == spacing[0]).all():  # cubes: the same directions
+        return np.asarray(normals, np.float32)
+    n = np.asarray(normals, np.float64) / spacing
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return (n / np.where(length > 0, length, 1.0)).astype(np.float32)

@@ -62,7 +62,9 @@ class NamesLayer:
             joints = view.world(np.array([bones.joints[n] for n in names]))
             mids = view.world(bones.segments()[named].mean(1)) if named else np.zeros((0, 3))
             self._labels = (joints, names, mids, [bones.bones[i].name for i in named])
-            self._lay_out()
+            # laid out (their actors made) as the next frame starts: by then a project being opened is in
+            # its saved mode, and in Pose mode none are made (37 made twice: 50 ms of mannequin-large's open)
+            view.render()
         self.hovered = None
         plotter.remove_actor("hover", render=False)
         self._on_picked()
@@ -73,8 +75,8 @@ class NamesLayer:
         if self._labels is None:
             return
         view, plotter = self.view, self.view.plotter
-        if view.posing and self.label_actors:  # hidden in Pose mode: no layout (20 ms a render on 30 bones)
-            for actor in self.label_actors:
+        if view.posing:  # hidden in Pose mode: no layout (20 ms a render on 30 bones), and none made (a project
+            for actor in self.label_actors:  # opened in Pose mode made 37 twice: 50 ms of the GUI thread)
                 actor.SetVisibility(False)
             return
         joints, names, mids, bone_names = self._labels
@@ -103,7 +105,9 @@ class NamesLayer:
         prop.SetColor(*((0.82, 0.82, 0.82) if bone else (1.0, 1.0, 1.0)))
         prop.SetShadow(True)
         actor.SetPickable(False)
-        self.view.plotter.add_actor(actor, reset_camera=False, name=f"label:{text}", pickable=False, render=False)
+        # the kind in the name: a bone named as a joint ("HEAD") replaced, and so hid, the joint's label
+        self.view.plotter.add_actor(actor, reset_camera=False, name=f"label:{'bone' if bone else 'joint'}:{text}",
+                                    pickable=False, render=False)
         return actor
 
     def _size(self, actor) -> tuple[float, float]:

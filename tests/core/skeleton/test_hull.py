@@ -76,3 +76,31 @@ def test_display_hulls_give_a_level_of_detail_only_for_a_heavy_hull():
     assert len(f) == len(isosurface(big)[1]) > hull.LOD_FACES
     assert lod is not None and 0 < len(lod[1]) <= hull.LOD_FACES
     assert np.allclose(lod[0].min(0), v.min(0), atol=3.0) and np.allclose(lod[0].max(0), v.max(0), atol=3.0)
+
+
+def test_vertex_normals_are_vtk_s_and_point_out_of_the_body():
+    """The hull's normals (made off the GUI thread) against VTK's vtkPolyDataNormals, what smooth shading
+    made when the actor was added; and outward on a ball (the faces' winding)."""
+    import pyvista as pv
+
+    from volanim_core.skeleton.hull import vertex_normals
+
+    r = np.linalg.norm(np.indices((31, 31, 31)) - 15.0, axis=0)
+    v, f = isosurface(r <= 11)
+    n = vertex_normals(v, f)
+    assert n.dtype == np.float32 and n.shape == v.shape
+    assert np.allclose(np.linalg.norm(n, axis=1), 1, atol=1e-5)
+    theirs = pv.PolyData.from_regular_faces(v, f).compute_normals(
+        cell_normals=False, split_vertices=False, consistent_normals=False, auto_orient_normals=False)
+    dot = (np.asarray(theirs.point_data["Normals"]) * n).sum(axis=1)
+    assert np.percentile(dot, 1) > 0.99 and dot.min() > 0.9
+    radial = (v - 15.0) / np.linalg.norm(v - 15.0, axis=1, keepdims=True)
+    assert (radial * n).sum(axis=1).min() > 0.5  # out of the ball (a voxel corner's normal leans)
+
+
+def test_a_vertex_no_face_uses_has_no_normal():
+    from volanim_core.skeleton.hull import vertex_normals
+
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]], np.float32)
+    n = vertex_normals(v, np.array([[0, 1, 2]]))
+    assert np.allclose(n[:3], [0, 0, 1]) and np.allclose(n[3], 0)

@@ -263,3 +263,20 @@ def test_a_lasso_in_the_owned_body_gives_the_points_flesh_with_them_in_one_undo_
     assert np.array_equal(owners[~flesh], made[~flesh])  # nothing else repainted
     doc.undo.undo()
     assert not doc.ownership.paints and not (doc.attachments.bone[picked] == arm).all()
+
+
+# voxel points (one integer key each), and points no integer key holds: halves, a coordinate past 2**21
+@pytest.mark.parametrize("shift, far", [(0.0, 0), (0.5, 0), (0.0, 2 ** 22)])
+def test_a_file_s_points_are_found_in_the_skeleton_as_a_dict_of_tuples_finds_them(shift, far):
+    from volanim_studio.model.attachments import row_positions
+
+    rng = np.random.default_rng(7)
+    points = np.unique(rng.integers(0, 40, (6000, 3)), axis=0).astype(np.float64) + shift
+    rng.shuffle(points)
+    wanted = np.vstack([points[rng.integers(0, len(points), 2000)], rng.integers(0, 50, (800, 3)) + shift,
+                        [[0.0, 0.0, 0.0]], [[-0.0, 0.0, 0.0]], [[far, 1, 1]]])
+    index = {tuple(p): i for i, p in enumerate(points.tolist())}
+    want = np.array([index.get(tuple(p), -1) for p in wanted.tolist()])
+    assert (want >= 0).sum() > 2000 and (want < 0).any()
+    assert np.array_equal(row_positions(points, wanted), want)
+    assert np.array_equal(row_positions(points[:0], wanted), np.full(len(wanted), -1))

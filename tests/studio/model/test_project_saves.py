@@ -315,3 +315,16 @@ def test_the_recovery_question_says_what_each_autosave_holds(tmp_path, doc):
     assert text.endswith(": mannequin, 18 bones, 8 attachments, a pose, 1 key"), text
     (saver.folder / autosave.SUMMARY).unlink()  # an older studio's autosave: read from the project
     assert autosave.describe(saver.path).endswith(": mannequin, 18 bones, 8 attachments, a pose, 1 key")
+
+
+def test_a_save_taken_from_a_document_since_replaced_is_not_adopted(tmp_path):
+    """A save finishing after another volume or project was opened writes its files, but the new document
+    does not take its path (Ctrl+S would have overwritten the old project with the new volume)."""
+    from volanim_studio.model.project import write_save
+
+    doc = Document()
+    doc.bone_edits.set_bones(samples.mannequin_bones())
+    save = doc.take_save(tmp_path / "a")
+    doc.reset()
+    assert not doc.adopt_save(save, write_save(save)) and doc.project_path is None
+    assert save.path == tmp_path / "a.volanim" and save.path.exists()

@@ -13,7 +13,7 @@ from volanim_core.errors import FormatError
 from volanim_core.io.frame_files import write_frames
 from volanim_core.rig.key_pose import KeyPose
 from volanim_studio.model import Document
-from volanim_studio.model.project import apply_project, read_project, write_project
+from volanim_studio.model.project import apply_project, read_project
 
 
 @pytest.fixture
@@ -95,7 +95,7 @@ def test_a_project_keeps_keys_options_and_the_clip(doc, tmp_path):
     doc.pose.set_angles(arm(doc), (0, -30, 0))
     tl.set_key(12)
     tl.set_options(ease=False, length=90, fps=30)
-    write_project(doc, tmp_path / "anim.volanim")
+    doc.write_project(tmp_path / "anim.volanim")
     other = Document()
     apply_project(other, read_project(tmp_path / "anim.volanim"), tmp_path / "anim.volanim")
     t2 = other.timeline
@@ -103,7 +103,7 @@ def test_a_project_keeps_keys_options_and_the_clip(doc, tmp_path):
     assert np.allclose(t2.keys[12].angles[("L_SHOULDER", "L_ELBOW")], (0, -30, 0))
 
     tl.load_bvh(WALK)
-    write_project(doc, tmp_path / "walk.volanim")
+    doc.write_project(tmp_path / "walk.volanim")
     other = Document()
     apply_project(other, read_project(tmp_path / "walk.volanim"), tmp_path / "walk.volanim")
     assert other.timeline.clip is not None and other.timeline.frame_count == 1064
@@ -113,7 +113,7 @@ def test_a_missing_clip_is_a_warning_and_a_bad_timeline_names_the_project(doc, t
     clip = tmp_path / "gone.bvh"
     clip.write_bytes(WALK.read_bytes())
     doc.timeline.load_bvh(clip)
-    write_project(doc, tmp_path / "p.volanim")
+    doc.write_project(tmp_path / "p.volanim")
     clip.unlink()
     other = Document()
     warnings = apply_project(other, read_project(tmp_path / "p.volanim"), tmp_path / "p.volanim")

@@ -16,7 +16,7 @@ from paths import ASSETS
 from volanim_core import io, samples
 from volanim_studio.model.interaction import Mode
 
-from ..conftest import click, clickable_point, front_view, open_project
+from ..conftest import click, clickable_point, front_view, open_project, save_project
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
@@ -41,7 +41,7 @@ def test_two_clicks_make_a_bone_between_exactly_those_points(qtbot, window):
 def test_click_on_hull_with_no_point_behind_picks_nothing(qtbot, window):
     from volanim_studio.scene.view import PICK_RADIUS
 
-    verts, _ = window.doc.hull
+    verts = window.doc.hull[0]
     xy, _ = window.scene.project_world(window.scene.world(verts[::7]))
     pts, _ = window.scene.project_world(window.scene._world[: window.doc.visible_count])
     gap = np.array([np.min(np.linalg.norm(pts - p, axis=1)) for p in xy])
@@ -116,7 +116,7 @@ def test_rename_in_panel_and_save_reopen_identical(qtbot, window, tmp_path):
     assert doc.bones.bones[0].label == "L_THIGH" and doc.bones.bones[0].proximal == "L_HIP"
     assert window.files.save_bones(tmp_path / "a.bones")
     assert io.read_bones(tmp_path / "a.bones") == doc.bones
-    path = window.files.save_project(path=tmp_path / "s.volanim")
+    path = save_project(qtbot, window, path=tmp_path / "s.volanim")
     from volanim_studio.qt.main_window import MainWindow
 
     other = MainWindow()

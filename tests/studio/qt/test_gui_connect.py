@@ -19,7 +19,7 @@ from volanim_core.skeleton.points import Skeleton
 from volanim_studio.model.interaction import Mode
 from volanim_studio.model.project import read_project
 
-from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view, open_project
+from ..conftest import JOB_TIMEOUT_MS, click, clickable_point, front_view, open_project, save_project
 
 pytestmark = pytest.mark.gui
 
@@ -127,7 +127,7 @@ def test_auto_connect_and_mirror_in_the_gui(qtbot, window):
 def test_save_connect_quit_reopen_and_continue(qtbot, window, tmp_path):
     assert window.files.open_bones(ASSETS / "mannequin.bones")
     window.doc.attachments.auto(scope="all")
-    path = window.files.save_project(path=tmp_path / "man.volanim")
+    path = save_project(qtbot, window, path=tmp_path / "man.volanim")
     saved = window.files.save_connect(tmp_path / window.doc.attachments.default_filename("man"))
     assert saved.name.startswith("man.") and saved.suffix == ".connect"
     before = window.doc.attachments.bone.copy()
@@ -149,7 +149,7 @@ def test_autosave_file_appears(qtbot, window, recovery_dir):
     files = list(recovery_dir.glob("*/recovery.volanim"))
     assert len(files) == 1
     assert io.read_bones(read_project(files[0])["bones"]) == window.doc.bones
-    window.files.save_project(path=recovery_dir.parent / "man.volanim")
+    save_project(qtbot, window, path=recovery_dir.parent / "man.volanim")
     window.close()
     assert not list(recovery_dir.glob("*/recovery.volanim"))  # a clean exit when saved leaves nothing to recover
 

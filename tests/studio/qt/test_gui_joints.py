@@ -9,7 +9,7 @@ import pytest
 from volanim_core import io, samples
 from volanim_core.rig.skinning import Joints
 
-from ..conftest import JOB_TIMEOUT_MS, open_project, rig_and_pose
+from ..conftest import JOB_TIMEOUT_MS, open_project, rig_and_pose, save_project
 from .test_gui_pose import drag
 
 pytestmark = pytest.mark.gui
@@ -50,7 +50,7 @@ def test_smooth_joints_mend_the_stump_a_rigid_shoulder_leaves(qtbot, window, tmp
     qtbot.waitUntil(lambda: not w.busy and not w.previews._again.isActive() and bool(shown), timeout=JOB_TIMEOUT_MS)
     assert "A job is running" not in w.statusBar().currentMessage()  # the change was not dropped
     assert shown[-1].report is not None and shown[-1].report.healthy
-    path = w.files.save_project(path=tmp_path / "p.volanim")
+    path = save_project(qtbot, w, path=tmp_path / "p.volanim")
     assert path is not None
     # the project's .connect records them
     saved = [f.read_text() for f in (tmp_path / "p.volanim.d").glob("*.connect")]

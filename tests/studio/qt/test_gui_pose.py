@@ -14,7 +14,7 @@ from volanim_studio.model.interaction import Mode
 from volanim_studio.model.project import read_project
 from volanim_studio.qt.verdict_label import CHECKING
 
-from ..conftest import JOB_TIMEOUT_MS, rig_and_pose
+from ..conftest import JOB_TIMEOUT_MS, rig_and_pose, save_project
 
 pytestmark = pytest.mark.gui
 
@@ -433,7 +433,7 @@ def test_the_default_body_raises_the_arm_clean_and_fix_gives_a_painted_lump_back
                     and w.doc.preview.basis == doc.picture_basis, timeout=JOB_TIMEOUT_MS)
     assert not doc.preview.report.lumps and doc.preview.report.healthy
     assert "Fix lump near L_SHOULDER" in doc.undo.undo_label
-    w.files.save_project(path=tmp_path / "owned.volanim")
+    save_project(qtbot, w, path=tmp_path / "owned.volanim")
     saved = read_project(tmp_path / "owned.volanim")
     assert [bone for bone, _where in saved["state"]["ownership"]] == ["L_UPPERARM", "SPINE"]
     doc.undo.undo()
@@ -470,7 +470,7 @@ def test_a_project_opened_in_pose_mode_shows_its_body_not_only_its_bones(qtbot, 
     w.doc.pose.set_angles(w.doc.bones.index("L_UPPERARM"), (0, -45, 0), merge=False)
     qtbot.keyClick(w, Qt.Key_P)
     assert w.mode == Mode.POSE
-    path = w.files.save_project(path=tmp_path / "posed.volanim")
+    path = save_project(qtbot, w, path=tmp_path / "posed.volanim")
     other = MainWindow()
     qtbot.addWidget(other)
     other.resize(1200, 800)

@@ -11,7 +11,7 @@ import pytest
 from volanim_core import io, samples
 from volanim_core.geometry import Geometry
 
-from ..conftest import JOB_TIMEOUT_MS, open_project, viewer_opened
+from ..conftest import JOB_TIMEOUT_MS, open_project, save_project, viewer_opened
 
 pytestmark = pytest.mark.gui
 J = samples.mannequin_bones().joints
@@ -26,7 +26,7 @@ def test_a_project_reads_as_done_only_once_it_is_applied(qtbot, window, tmp_path
     from volanim_studio.qt.main_window import MainWindow
 
     window.doc.bone_edits.add_bone(np.array(J["L_HIP"]), np.array(J["L_KNEE"]))
-    path = window.files.save_project(path=tmp_path / "s.volanim")
+    path = save_project(qtbot, window, path=tmp_path / "s.volanim")
     other = MainWindow()
     qtbot.addWidget(other)
     opened, between = [], []
@@ -87,7 +87,7 @@ def save_close_reopen(qtbot, window, path):
     """Save ``window``'s project to ``path``, close it, and open the project in a new window."""
     from volanim_studio.qt.main_window import MainWindow
 
-    saved = window.files.save_project(path=path)
+    saved = save_project(qtbot, window, path=path)
     window.close()
     again = MainWindow()
     qtbot.addWidget(again)

@@ -8,7 +8,7 @@ from PySide6.QtCore import Qt
 from paths import ASSETS
 from volanim_studio.model.interaction import Mode
 
-from ..conftest import JOB_TIMEOUT_MS, new_window, open_project, rig_and_pose
+from ..conftest import JOB_TIMEOUT_MS, new_window, open_project, rig_and_pose, save_project
 
 
 def _close(w) -> None:
@@ -43,7 +43,7 @@ def test_the_whole_session_comes_back_on_reopen(qtbot, window, tmp_path):
     qtbot.keyClick(w, Qt.Key_3, Qt.ControlModifier)  # View > Side
     camera = w.scene.camera()
     angles = {i: doc.pose.angles_of(i) for i in range(len(doc.bones))}
-    path = w.files.save_project(path=tmp_path / "day.volanim")
+    path = save_project(qtbot, w, path=tmp_path / "day.volanim")
     assert path is not None and not w.isWindowModified()
 
     other = new_window(qtbot)

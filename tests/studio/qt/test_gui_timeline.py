@@ -13,7 +13,7 @@ from volanim_core import io
 from volanim_studio.model.interaction import Mode
 from volanim_studio.qt.mapping_dialog import UNMAPPED
 
-from ..conftest import JOB_TIMEOUT_MS
+from ..conftest import JOB_TIMEOUT_MS, save_project
 
 pytestmark = pytest.mark.gui
 
@@ -158,7 +158,7 @@ def test_key_a_wave_undo_scan_and_export(qtbot, rigged, tmp_path):
     assert scanned.startswith(said)
 
     # the keys live in the project: save, reopen in a fresh window's model
-    assert w.files.save_project(path=tmp_path / "wave.volanim")
+    assert save_project(qtbot, w, path=tmp_path / "wave.volanim")
     from volanim_studio.model import Document
     from volanim_studio.model.project import apply_project, read_project
 

@@ -36,7 +36,7 @@ def scene(mannequin):
     plotter = pv.Plotter(off_screen=True, window_size=SIZE)
     view = SceneView(plotter, doc)  # first, as the window makes it: the scene learns everything from events
     doc.set_volume(s.volume, s.mask)
-    doc.set_hull(verts, faces, lod)
+    doc.set_hull(verts, faces, lod=lod)
     doc.set_skeleton(skel)
     yield view
     plotter.close()
@@ -125,3 +125,25 @@ def test_posing_draws_the_posed_bones_where_the_pose_puts_the_joints(scene):
         assert np.linalg.norm(lines - scene.world(want[name][None]), axis=1).min() < 1.0, name
     assert np.linalg.norm(scene.world(want["L_WRIST"][None]) - scene.world(
         np.array([doc.bones.joints["L_WRIST"]])), axis=1)[0] > 20  # (the wrist did move)
+
+
+def test_the_hull_is_drawn_as_vtk_s_smooth_shading_drew_it(scene, mannequin):
+    """The hull's normals come with the document (made by the volume's worker); the picture is the one
+    pyvista's ``smooth_shading=True`` drew from normals it made on the GUI thread."""
+    from volanim_studio.scene.hull_layer import HULL_COLOUR
+
+    scene.doc.settings.hull_opacity = 1.0
+    for name in ("cloud", "bones", "joints", "selected"):
+        if name in scene.plotter.actors:
+            scene.plotter.actors[name].SetVisibility(False)
+    scene.plotter.view_xz()
+    ours = scene.plotter.screenshot(return_img=True).astype(int)
+    verts, faces = mannequin[2][0]
+    cells = np.hstack([np.full((len(faces), 1), 3), faces]).ravel()
+    scene.plotter.actors["hull"].SetVisibility(False)  # the same window, lights and camera; pyvista's own way
+    scene.plotter.add_mesh(pv.PolyData(scene.world(verts).astype(np.float32), cells), color=HULL_COLOUR,
+                           smooth_shading=True, name="theirs", reset_camera=False)
+    want = scene.plotter.screenshot(return_img=True).astype(int)
+    body = (want != want[0, 0]).any(axis=2)
+    assert body.mean() > 0.05  # (the body is in the picture)
+    assert np.abs(ours - want).max() <= 2, np.abs(ours - want).max()  # (area-weighted normals: 18)
