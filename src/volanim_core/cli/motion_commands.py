@@ -94,7 +94,7 @@ def _bvh2trans(args):
     for c in checks:
         print(f"# {c.line(sampled)}")
     if not args.no_check:
-        refuse_failed(args.clip, checks)
+        refuse_failed(args.clip, checks, used)
     conn = read_connect(args.connect) if args.connect else None
     mats = retarget.matrices(args.frames)
     write_frames(args.output, Path(args.clip).stem, bones, mats, frames, connect=conn,

@@ -60,19 +60,23 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
     mats = retarget.matrices(frames)
     checks = []
     clip, ours = retarget.report.get("kind"), rig_kind(bones)
-    if clip is not None and ours is not None:  # first: a quadruped's steps pass a person's checks
+    # a mapping the user gave is their word (#86): a clip of one arm drives what it maps, so the figure's kind
+    # is not asked, and only checks of bones it drives are made
+    given = retarget.report.get("scheme") == "given"
+    driven = set(retarget.mapping) if given else set(range(len(bones)))
+    if clip is not None and ours is not None and not given:  # first: a quadruped's steps pass a person's checks
         checks.append(Check(f"the clip's figure is a {ours}, as the rig", float(clip.kind == ours),
                             f"it is {'a ' if clip.kind != 'other' else ''}{clip.kind}: {clip.reason}; "
                             "a clip drives a rig of its own kind", whole=True))
     by_part = {part_of(b.label): k for k, b in enumerate(bones.bones)}
     spine = by_part.get((None, "SPINE"))
-    if spine is not None:
+    if spine is not None and spine in driven:
         bone = bones.bones[spine]
         top, bottom = _posed(bones, mats, bone.distal), _posed(bones, mats, bone.proximal)
         held = float(np.mean(top[:, 2] > bottom[:, 2]))
         checks.append(Check("head above pelvis", held, f"the up axis (up {retarget.up}; give another with --up)"))
     legs = [by_part[(s, "SHIN")] for s in "LR" if (s, "SHIN") in by_part]
-    if legs:
+    if legs and set(legs) <= driven:
         rest_floor = min(j[2] for j in bones.joints.values())
         leg = max(np.linalg.norm(bones.joints[bones.bones[b].distal] - bones.joints[bones.bones[b].proximal])
                   for b in legs)
@@ -95,13 +99,19 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
     return checks, len(frames)
 
 
-def refuse_failed(path, checks: list[Check]) -> None:
+def refuse_failed(path, checks: list[Check], suggested: dict[str, str] | None = None) -> None:
     """Raise ValueError naming the clip and every failed check (``bvh2trans``, ``sequence``): nothing is
-    written from a clip that does not look like the rig's figure standing."""
+    written from a clip that does not look like the rig's figure standing. ``suggested``: the mapping found
+    from the names (bone -> clip joint), shown as a map file when the clip is of part of a body."""
     failed = [c for c in checks if not c.ok]
     if failed:
+        part = ""
+        if suggested and any(c.whole and "it is other" in c.suspect for c in failed):
+            lines = "; ".join(f"'{bone} {joint}'" for bone, joint in suggested.items())
+            part = (". A clip of part of a body (an arm, a hand) drives the bones a map file names and leaves "
+                    f"the rest at rest: for example a file of the lines {lines}, given with --map FILE")
         raise ValueError(f"{path}: the retargeted clip does not look like the rig's figure standing: "
-                         + "; ".join(c.failure() for c in failed)
+                         + "; ".join(c.failure() for c in failed) + part
                          + ". Nothing was written; give --up/--forward/--map, or --no-check to write it anyway")
 
 

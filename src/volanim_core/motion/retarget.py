@@ -316,6 +316,8 @@ class Retarget:
         a = self.axes
         shift = (world_pos[:, 0] - world_pos[:1, 0]) @ a.T * self.scale  # root displacement, our axes
         parents = bones.parents()
+        if not any(p is None and b in self.mapping for b, p in enumerate(parents)):  # no root bone driven (a
+            shift[:] = 0.0  # clip of one arm, mapped so): the body stays where it stands, the arm turns (#86)
         rot = np.empty((n, len(bones), 3, 3))
         out = np.zeros((n, len(bones), 4, 4))
         for b in parents_first(parents):

@@ -85,6 +85,7 @@ class MappingDialog(QDialog):
         found = match(bones, motion)
         self.combos: dict[str, QComboBox] = {}
         self.how: dict[str, QLabel] = {}
+        self.chosen = False  # a mapping the user changed is their word: the clip's kind is not asked (#86)
         form = QFormLayout()
         for b in bones.bones:
             combo = QComboBox()
@@ -145,6 +146,7 @@ class MappingDialog(QDialog):
 
     def _edited(self, label: str) -> None:
         self.how[label].setText("your choice")
+        self.chosen = True
         self.refresh()
 
     def mapping(self) -> dict[str, str]:
@@ -161,7 +163,7 @@ class MappingDialog(QDialog):
     def refresh(self) -> None:
         """Retarget with what the dialog shows now: the detected axes, units and checks, and the figure."""
         try:
-            r = Retarget.build(self.bones, self.motion, self.mapping(), *self.axes())
+            r = Retarget.build(self.bones, self.motion, self.mapping() if self.chosen else None, *self.axes())
         except ValueError as exc:  # e.g. up and facing on one axis: said, not raised
             self.retarget = None
             self.detected.setText(f"Cannot retarget this way: {exc}")

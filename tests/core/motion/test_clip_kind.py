@@ -155,3 +155,68 @@ def test_sequence_refuses_the_quadruped_clip_too(tmp_path, capsys):
             str(ASSETS / "mannequin.bones"), "--frames", "0:4:2", "-o", str(tmp_path / "e.zarr")]
     assert main(argv) == 2
     assert "it is a quadruped" in capsys.readouterr().err and not (tmp_path / "e.zarr").exists()
+
+
+ARM = ("Spine", "LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand")  # a chest and one arm of the real walk
+
+
+def arm_bvh(path) -> None:
+    """One arm of the real walk as a capture of its own (hand and arm captures are common): the chest the
+    root, moving as the walk's hips moved, the shoulder, arm, forearm and hand turning as they turned."""
+    m = read_bvh(WALK)
+    starts = np.cumsum([0] + [len(c) for c in m.channels])
+    joints = [m.names.index(n) for n in ARM]
+    lines, cols = ["HIERARCHY"], []
+    for depth, j in enumerate(joints):
+        pad = "\t" * depth
+        lines += [f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {m.names[j]}", pad + "{",
+                  f"{pad}\tOFFSET " + " ".join(f"{v:.4f}" for v in (m.offsets[j] if depth else np.zeros(3)))]
+        rot = [k for k, c in enumerate(m.channels[j]) if c.endswith("rotation")]
+        names = [m.channels[j][k].capitalize() for k in rot]
+        lines.append(f"{pad}\tCHANNELS {len(rot) + 3 * (depth == 0)} "
+                     + ("Xposition Yposition Zposition " if depth == 0 else "") + " ".join(names))
+        cols.append((depth == 0, [starts[j] + k for k in rot]))
+    pad = "\t" * len(joints)
+    lines += [pad + "End Site", pad + "{", pad + "\tOFFSET 5.0 0.0 0.0", pad + "}"]
+    lines += ["\t" * d + "}" for d in reversed(range(len(joints)))]
+    lines += ["MOTION", f"Frames: {m.frames}", f"Frame Time: {m.frame_time:.6f}"]
+    for row in m.values:
+        values = []
+        for root, c in cols:
+            values += (list(row[:3]) if root else []) + list(row[c])  # the hips' Xposition Yposition Zposition
+        lines.append(" ".join(f"{v:.4f}" for v in values))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_one_arm_clip_with_map_drives_the_mapped_arm_and_leaves_the_rest_at_rest(tmp_path, capsys):
+    """#86 item 3: the arm clip with an explicit --map was refused ("other: no pair of twin limbs"), and the
+    refusal told the user to give --map. The map is the user's word: only its chains are checked."""
+    from volanim_core.io import write_bones
+    from volanim_core.io.frame_files import read_frames
+
+    arm_bvh(tmp_path / "arm.bvh")
+    write_bones(tmp_path / "m.bones", mannequin_bones())
+    (tmp_path / "arm.map").write_text("L_CLAVICLE LeftShoulder\nL_UPPERARM LeftArm\nL_FOREARM LeftForeArm\n"
+                                      "L_HAND LeftHand\n")
+    assert main(["bvh2trans", str(tmp_path / "arm.bvh"), "--bones", str(tmp_path / "m.bones"),
+                 "--map", str(tmp_path / "arm.map"), "-o", str(tmp_path / "f")]) == 0
+    bones = mannequin_bones()
+    mats, paths = read_frames(tmp_path / "f", bones)
+    assert len(paths) == read_bvh(WALK).frames
+    r = mats[:, :, :3, :3]
+    assert np.allclose(r @ np.swapaxes(r, -1, -2), np.eye(3), atol=1e-5)  # rigid
+    moved = {b.label for k, b in enumerate(bones.bones) if not np.allclose(mats[:, k], np.eye(4), atol=1e-6)}
+    assert moved == {"L_CLAVICLE", "L_UPPERARM", "L_FOREARM", "L_HAND"}, moved  # the rest stays at rest
+
+
+def test_a_one_arm_clip_without_map_is_refused_showing_a_map_that_would_work(tmp_path, capsys):
+    from volanim_core.io import write_bones
+
+    arm_bvh(tmp_path / "arm.bvh")
+    write_bones(tmp_path / "m.bones", mannequin_bones())
+    assert main(["bvh2trans", str(tmp_path / "arm.bvh"), "--bones", str(tmp_path / "m.bones"),
+                 "-o", str(tmp_path / "f")]) == 2
+    err = capsys.readouterr().err
+    assert "it is other" in err and "part of a body" in err
+    assert "L_UPPERARM LeftArm" in err and "--map" in err  # a map file that would work, shown
+    assert not (tmp_path / "f").exists()

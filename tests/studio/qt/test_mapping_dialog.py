@@ -7,7 +7,7 @@ import numpy as np
 from real_clips import clip
 from volanim_core.io.bvh_files import read_bvh
 from volanim_core.samples import mannequin_bones
-from volanim_studio.qt.mapping_dialog import MappingDialog
+from volanim_studio.qt.mapping_dialog import UNMAPPED, MappingDialog
 
 
 def lit_extent(dialog, half: int) -> tuple[int, int]:
@@ -49,3 +49,23 @@ def test_a_biovision_clip_shows_its_scheme_confidence_units_and_an_upright_figur
     assert dialog.frame_label.text().startswith("200 /")
     w200, h200 = lit_extent(dialog, 0)
     assert h200 < height
+
+
+def test_a_one_arm_clip_is_refused_as_found_and_taken_once_the_user_maps_it(qtbot, tmp_path):
+    """#86 item 3 in the studio: the arm clip's suggested mapping is checked as a whole figure (other: not
+    the rig's kind, said); a row the user changes makes the mapping theirs, and only what it drives is
+    checked."""
+    from core.motion.test_clip_kind import arm_bvh
+
+    arm_bvh(tmp_path / "arm.bvh")
+    bones = mannequin_bones()
+    dialog = MappingDialog(bones, read_bvh(tmp_path / "arm.bvh"), "arm.bvh")
+    qtbot.addWidget(dialog)
+    assert "the clip's figure is a biped, as the rig: no" in dialog.detected.text()
+    arm = {"L_CLAVICLE": "LeftShoulder", "L_UPPERARM": "LeftArm", "L_FOREARM": "LeftForeArm", "L_HAND": "LeftHand"}
+    for b in bones.bones:  # the user maps the arm, and nothing else
+        dialog.combos[b.label].setCurrentText(arm.get(b.label, UNMAPPED))
+    assert dialog.mapping() == arm
+    text = dialog.detected.text()
+    assert "as the rig" not in text and "FAILS" not in text, text
+    assert "L elbow bends" in text  # the mapped arm is still checked
