@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from volanim_core.skeleton.points import voxel_keys
+
 NEIGHBOURS = 8  # balls compared with each ball: its nearest ones of each size class
 SLACK = 1.8  # voxels: two balls whose painted voxels touch (26-connected) may be this much further apart
 ROUNDS = 4  # an island given to a bone may join an island of that bone's: a few rounds settle it
@@ -92,7 +94,8 @@ def _painted_islands(points, radius, bone, weight):
                     box = boxes[v - 1]
                     inside = label[box] == v
                     edge = inside & ~ndimage.binary_erosion(inside, cube, border_value=0)
-                    surface[int(b)] = np.sort(_keys(np.argwhere(edge) + lo.astype(np.int64) + [t.start for t in box]))
+                    at = np.argwhere(edge) + lo.astype(np.int64) + [t.start for t in box]
+                    surface[int(b)] = np.sort(voxel_keys(at))
             else:
                 box = boxes[v - 1] if v <= k else None
                 voxels[count + local] = None if box is None else \
@@ -101,18 +104,12 @@ def _painted_islands(points, radius, bone, weight):
     return count, island, main, voxels, surface
 
 
-def _keys(vox: np.ndarray) -> np.ndarray:
-    """One int64 per voxel (coordinates within +-2^20 of the origin)."""
-    v = np.asarray(vox, np.int64) + (1 << 20)
-    return (v[:, 0] << 42) | (v[:, 1] << 21) | v[:, 2]
-
-
 def _touching(vox: np.ndarray | None, own: int, surface: dict) -> set[int]:
     """The bones other than ``own`` whose largest island the voxels ``vox`` touch (26-neighbours or shared
     voxels): where an island joins that bone's flesh when given to it."""
     if vox is None:
         return set()
-    near = np.unique(_keys((vox[:, None, :] + _CUBE[None]).reshape(-1, 3)))
+    near = np.unique(voxel_keys((vox[:, None, :] + _CUBE[None]).reshape(-1, 3)))
     return {b for b, keys in surface.items() if b != own and np.isin(near, keys, assume_unique=True).any()}
 
 

@@ -100,3 +100,14 @@ class Skeleton:
         """The skeleton at ``thinness``: the points with thinness >= it."""
         n = self.count_at(thinness)
         return Skeleton(self.points[:n], self.dt[:n], self.thinness[:n], self.metric, self.geometry)
+
+
+#: voxel_keys packs coordinates within this distance of the origin (21 bits each, signed)
+KEY_REACH = 1 << 20
+
+
+def voxel_keys(vox: np.ndarray) -> np.ndarray:
+    """One int64 per voxel (integer coordinates within +-``KEY_REACH`` of the origin): a set of voxels
+    compared, sorted or searched as plain integers."""
+    v = np.asarray(vox, np.int64) + KEY_REACH
+    return (v[:, 0] << 42) | (v[:, 1] << 21) | v[:, 2]
