@@ -45,6 +45,7 @@ class TimelineController(Controller):
         self._play = QTimer(window)
         self._play.timeout.connect(self._tick)
         self._start = (0.0, 0)
+        self._followed: int | None = None
         self.doc.settings.events.current_frame.connect(lambda **_: self._frame_changed())
         self.doc.events.preview.connect(lambda **_: self._picture_changed())
 
@@ -98,7 +99,17 @@ class TimelineController(Controller):
         p = self.doc.preview
         if (self.playing and self.doc.settings.follow_body and self.scene.posing and p is not None
                 and p.joints is not None):
-            self.follow_body(blend=0.35, joints=p.joints)
+            self.follow_body(blend=self._ease(p.frame), joints=p.joints)
+
+    def _ease(self, frame: int) -> float:
+        """How far the playing camera moves to the body drawn: by the clip's time since the last picture
+        (:func:`camera_moves.follow_blend`), landing on it at the first picture and when the clip went round."""
+        from volanim_studio.scene import camera_moves
+
+        last, self._followed = self._followed, frame
+        if last is None or frame < last:
+            return 1.0
+        return camera_moves.follow_blend((frame - last) / self.doc.timeline.frame_rate)
 
     def follow_body(self, blend: float = 1.0, joints: dict | None = None) -> None:
         """Centre the view on the posed body (the middle of its posed joints' box; ``joints``: those of the
@@ -137,6 +148,7 @@ class TimelineController(Controller):
         self.doc.settings.dragging = True  # held while playing: live previews follow, a full one is cancelled
         self.doc.settings.playing = True  # the bones drawn wait for the body of their frame
         self.shown_frames = []
+        self._followed = None  # the frame the camera last moved to (its easing is in clip time)
         self._start = (time.perf_counter(), self.doc.settings.current_frame)
         self._play.start(max(5, int(1000 / tl.frame_rate)))
         self._sync_button()

@@ -502,14 +502,35 @@ def test_cancel_ends_a_movie_whose_worker_hangs(qtbot, rigged, tmp_path):
     qtbot.waitUntil(lambda: not _pool_workers(), timeout=ENDS_WITHIN_MS)
 
 
+def _on_screen(renderer, world, size) -> np.ndarray:
+    """Pixels (row, column of a screenshot) where world points land: the camera's own composite matrix,
+    checked against vtkCoordinate on a few points (not the scene's code)."""
+    import vtk
+
+    cam = renderer.GetActiveCamera()
+    m = cam.GetCompositeProjectionTransformMatrix(renderer.GetTiledAspectRatio(), -1, 1)
+    m = np.array([[m.GetElement(i, j) for j in range(4)] for i in range(4)])
+    h = np.c_[world, np.ones(len(world))] @ m.T
+    xy = (h[:, :2] / h[:, 3:] + 1) / 2 * np.array(size)
+    c = vtk.vtkCoordinate()
+    c.SetCoordinateSystemToWorld()
+    for k in np.linspace(0, len(world) - 1, 5).astype(int):
+        c.SetValue(*map(float, world[k]))
+        assert np.allclose(c.GetComputedDoubleDisplayValue(renderer), xy[k], atol=1.0)
+    return np.c_[size[1] - 1 - np.floor(xy[:, 1]), np.floor(xy[:, 0])].astype(int)
+
+
 def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtbot, rigged, tmp_path):
     """#83 item 5: a picture grabbed while the walk played on a loaded machine showed a forearm and a leg
     apart, no torso or head: 19 % of the drawn bones lay on the body. Now a live picture is made whole in
     its own thread, for the newest frame asked, and drawn with the bones of *its* frame (frames in between
     are dropped, never half drawn). Checked on every picture drawn while playing: the bones drawn are its
     frame's, and >= 90 % of points along them lie in its voxels (read from the reconstruction, not the
-    screen); and at three moments the picture on screen covers >= 80 % of what the same frame's does paused
-    (the camera follows the body drawn, not the newest frame: on a loaded machine it ran ahead of it)."""
+    screen). At three moments the screen is compared with its picture's voxels projected by the camera
+    (the camera follows the body drawn, not the newest frame: on a loaded machine it ran ahead of it):
+    the body is in view, its voxels land on drawn pixels, and the drawn pixels on its voxels. (This
+    compared the pixel count with the same frame's paused picture, which is drawn another way: under
+    load the ratio wandered from 0.62 to 1.25 with nothing wrong on screen.)"""
     import imageio.v3 as iio
     from scipy import ndimage
 
@@ -518,10 +539,32 @@ def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtb
     seen, grabs = [], []
     background = np.array(w.plotter.background_color.int_rgb)
 
-    def foreground(name) -> int:
+    def grab(p) -> tuple[float, float]:
+        """What the screen shows vs the voxels of the picture p it was drawn from. The scene asks for a
+        paint in the next event-loop pass and a screenshot reads the last one painted, so the frame the
+        paint will show is rendered here first (no event is handled in between: it is p's)."""
+        w.plotter.render()
         img = np.asarray(w.plotter.screenshot(return_img=True))[..., :3]
-        iio.imwrite(tmp_path / f"{name}.png", img)  # to look at
-        return int((np.abs(img.astype(int) - background).max(axis=-1) > 30).sum())
+        iio.imwrite(tmp_path / f"playing-{p.frame}.png", img)  # to look at
+        drawn = np.abs(img.astype(int) - background).max(axis=-1) > 30
+        shell = p.reconstruction.volume > 0
+        shell &= ~ndimage.binary_erosion(shell)
+        # each voxel's cube as the live surface draws it, sampled 4 times along each side
+        corners = np.stack(np.meshgrid(*[np.linspace(-0.5, 0.5, 4)] * 3, indexing="ij"), -1).reshape(-1, 3)
+        at = (np.argwhere(shell)[:, None] + corners[None]).reshape(-1, 3)
+        rc = _on_screen(w.plotter.renderer, w.scene.world(at * p.factor + p.origin_voxels), drawn.shape[::-1])
+        centre = rc.mean(axis=0) / drawn.shape
+        assert (np.abs(centre - 0.5) < 0.25).all(), "the camera did not follow the body drawn"
+        inside = ((rc >= 0) & (rc < drawn.shape)).all(axis=1)  # the user's zoom may cut a head or a foot
+        body = np.zeros_like(drawn)
+        body[tuple(rc[inside].T)] = True
+        body = ndimage.binary_fill_holes(ndimage.binary_closing(body, iterations=2))
+        dots = np.zeros(drawn.shape + (3,), np.uint8)
+        dots[drawn] = 80
+        dots[body] += np.array([100, 0, 0], np.uint8)
+        iio.imwrite(tmp_path / f"both-{p.frame}.png", dots)  # grey: drawn, red: its voxels
+        near = lambda m: ndimage.binary_dilation(m, iterations=2)  # noqa: E731 (edges antialiased)
+        return near(drawn)[body].mean(), near(body)[drawn].mean()
 
     def on_preview(**_):
         p = w.doc.preview
@@ -537,16 +580,9 @@ def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtb
     qtbot.keyClick(w, Qt.Key_Space)
     for moment in (6, 12, 18):  # three moments of the walk, each a picture drawn by the scene
         qtbot.waitUntil(lambda m=moment: len(seen) >= m, timeout=JOB_TIMEOUT_MS)
-        grabs.append((seen[-1][0].frame, foreground(f"playing-{seen[-1][0].frame}")))
+        grabs.append(grab(seen[-1][0]))
     qtbot.keyClick(w, Qt.Key_Space)
-    qtbot.waitUntil(lambda: not w.busy and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)
-    paused = []  # each moment's frame, paused on: its full picture
-    for frame, _ in grabs:
-        w.timeline.go(frame)
-        w.previews.preview()
-        qtbot.waitUntil(lambda: not w.busy and w.doc.preview_is_current and not w.doc.preview.live
-                        and w.doc.preview.report is not None, timeout=JOB_TIMEOUT_MS)  # this frame's, not the last
-        paused.append(foreground(f"paused-{frame}"))
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
 
     bones = w.doc.bones
     on_body = []
@@ -562,8 +598,7 @@ def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtb
         hits = np.zeros(len(at), bool)
         hits[inside] = filled[tuple(at[inside].T)]
         on_body.append(hits.mean())
-    ratios = [g / p for (_, g), p in zip(grabs, paused)]
-    print(f"pictures while playing: {len(seen)}, bones on the body: min {min(on_body):.0%}; foreground "
-          f"{[round(r, 2) for r in ratios]} of the same frame's paused picture")
+    print(f"pictures while playing: {len(seen)}, bones on the body: min {min(on_body):.0%}; "
+          f"(voxels on drawn pixels, drawn pixels on voxels): {[tuple(round(x, 3) for x in g) for g in grabs]}")
     assert min(on_body) >= 0.9
-    assert min(ratios) >= 0.8
+    assert min(g[0] for g in grabs) >= 0.9 and min(g[1] for g in grabs) >= 0.9  # another frame: ~0.65
