@@ -86,8 +86,12 @@ def _bvh2trans(args):
     print(format_mapping(used, bones, report["how"]), end="")
     for note in report["notes"]:
         print(f"# note: {note}")
-    for label, angle in retarget.absorbed_degrees().items():
-        print(f"# {label}: rest poses differ by {angle:.1f} degrees (absorbed)")
+    if report.get("figure") is not None:
+        print("# rest: each bone keeps its own (a creature's build is not the clip's); the clip's motion "
+              "from its rest is applied")
+    else:
+        for label, angle in retarget.absorbed_degrees().items():
+            print(f"# {label}: rest poses differ by {angle:.1f} degrees (absorbed)")
     print(f"# axes: up {retarget.up}, forward {retarget.forward} ({report['axes']})")
     print(f"# units: {report['units']}; scale {retarget.scale:.3g} voxels per BVH unit ({report['scale']})")
     checks, sampled = check_clip(retarget)

@@ -87,12 +87,18 @@ def _limb(motion: Motion, s: Sampled, kids, far, pair) -> np.ndarray:
     return out / len(pair)
 
 
-def rig_kind(bones) -> str | None:
-    """The kind our bones are, by their names (the auto-rig templates' and the mannequin's); None when the
-    names do not say (a rig of one's own)."""
+def rig_kind(bones, by_shape: bool = True) -> str | None:
+    """The kind our bones are, by their names (the auto-rig templates' and the mannequin's), else by their
+    shape (:func:`.chains.read_figure`: an auto-rig's chains, ``ANT2_1``, name no part); None when neither
+    says (``by_shape=False``: the names alone)."""
     parts = {part_of(b.label) for b in bones.bones}
     if ("L", "UPPERARM") in parts and ({("L", "THIGH"), ("L", "SHIN")} & parts):
         return "biped"
     if ("L", "HUMERUS") in parts and ("L", "FEMUR") in parts:
         return "quadruped"
-    return None
+    if not by_shape:
+        return None
+    from .chains import rig_figure
+
+    kind = rig_figure(bones)[0].kind
+    return None if kind == "other" else kind

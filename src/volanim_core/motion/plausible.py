@@ -5,6 +5,9 @@
         head above pelvis        the spine's top over its bottom: not on its back, not upside down
         feet near the floor      the lowest joint within half a leg of our rest floor (scale, up)
         knees and elbows bend    a limb's lower bone never folds back more than 165 degrees onto the upper
+    a creature matched by its chains (motion/chains.py), along its own up:
+        feet near the floor      the lowest foot within half a leg of the rest floor
+        feet below the body      each foot lower than where its leg leaves the body (no leg flung over the back)
 
 A check that holds in fewer than ``MOST`` of the frames names what is suspect
 (the up axis, the scale, a bone's mapping), so ``bvh2trans`` refuses instead of
@@ -68,9 +71,12 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
         checks.append(Check(f"the clip's figure is a {ours}, as the rig", float(clip.kind == ours),
                             f"it is {'a ' if clip.kind != 'other' else ''}{clip.kind}: {clip.reason}; "
                             "a clip drives a rig of its own kind", whole=True))
+    figure = retarget.report.get("figure")
+    if figure is not None:
+        checks += _creature_checks(bones, mats, figure, retarget, driven)
     by_part = {part_of(b.label): k for k, b in enumerate(bones.bones)}
     spine = by_part.get((None, "SPINE"))
-    if spine is not None and spine in driven:
+    if spine is not None and spine in driven and ours != "quadruped":  # a quadruped's spine lies level
         bone = bones.bones[spine]
         top, bottom = _posed(bones, mats, bone.distal), _posed(bones, mats, bone.proximal)
         held = float(np.mean(top[:, 2] > bottom[:, 2]))
@@ -113,6 +119,24 @@ def refuse_failed(path, checks: list[Check], suggested: dict[str, str] | None = 
         raise ValueError(f"{path}: the retargeted clip does not look like the rig's figure standing: "
                          + "; ".join(c.failure() for c in failed) + part
                          + ". Nothing was written; give --up/--forward/--map, or --no-check to write it anyway")
+
+
+def _creature_checks(bones, mats: np.ndarray, figure, retarget, driven: set[int]) -> list[Check]:
+    """The checks of a creature's figure (:class:`~.chains.Figure`), along its own up."""
+    names = list(bones.joints)  # the figure's points, as chains.rig_figure read them
+    bone_at = {b.distal: k for k, b in enumerate(bones.bones)}
+    legs = [path for pair in figure.legs for path in pair.values()]
+    if not legs or not {bone_at[names[n]] for path in legs for n in path[1:]} <= driven:
+        return []
+    up = figure.up
+    feet = np.stack([_posed(bones, mats, names[path[-1]]) @ up for path in legs], axis=1)  # (F, legs)
+    forks = np.stack([_posed(bones, mats, names[path[0]]) @ up for path in legs], axis=1)
+    rest_floor = min(figure.points[path[-1]] @ up for path in legs)
+    leg = float(np.mean([figure.reach(path) for path in legs]))
+    suspect = f"the scale ({retarget.scale:.3g} voxels per BVH unit) or the up axis (up {retarget.up})"
+    return [Check("feet near the floor", float(np.mean(np.abs(feet.min(axis=1) - rest_floor) <= 0.5 * leg)), suspect),
+            Check("feet below the body", float(np.mean((feet < forks).all(axis=1))),
+                  f"the up axis (up {retarget.up}) or the legs' chains ({', '.join(figure.chains())})")]
 
 
 def _direction(bones, mats, b: int) -> np.ndarray:

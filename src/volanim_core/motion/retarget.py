@@ -46,7 +46,8 @@ from .body import (
     up_over,
     upright,
 )
-from .kind import clip_kind
+from .chains import ChainMatch, match_chains
+from .kind import clip_kind, rig_kind
 from .presets import best_preset, part_key, part_of
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -68,6 +69,7 @@ class Match:
     how: dict[str, str]  # label -> "name and shape", "name", "shape", or "name (shape says X)"
     scheme: str
     notes: list[str]
+    chains: ChainMatch | None = None  # how a rig of another kind than ours was matched chain to chain
 
 
 def match(bones: BoneSkeleton, motion: Motion, sampled: Sampled | None = None) -> Match:
@@ -81,6 +83,10 @@ def match(bones: BoneSkeleton, motion: Motion, sampled: Sampled | None = None) -
     if all(b.label in motion.names for b in bones.bones):  # a clip volanim wrote for these bones (trans2bvh)
         own = {b.label: b.label for b in bones.bones}
         return Match(own, dict.fromkeys(own, "its own joint (a clip volanim wrote)"), "volanim trans2bvh", [])
+    if rig_kind(bones, by_shape=False) != "biped":  # a creature: matched by its chains, names aside (#86)
+        chained, why = match_chains(bones, motion)
+        if chained is not None:
+            return Match(chained.mapping, chained.how, f"chains ({chained.rig.kind})", [], chained)
     preset, named = best_preset(motion.names)
     s = sampled if sampled is not None else sample(motion)
     body = read_body(motion, s)
@@ -284,14 +290,26 @@ class Retarget:
             except KeyError:
                 raise ValueError(f"the mapping names bone {label!r}, which the bone skeleton lacks") from None
             index[b] = motion.index(joint)
-        up, forward, axes_how, reference, pose = detect_axes(bones, motion, index, up, forward, s)
-        axes = axes_matrix(up, forward)
+        chained = found.chains
+        if chained is None and mapping is not None and rig_kind(bones, by_shape=False) != "biped":
+            chained = match_chains(bones, motion)[0]  # a creature's axes are its own, whoever mapped it
+        if chained is not None:  # its figure's up and forward onto ours: a cow's volume need not stand in z
+            axes, reference, pose = chained.axes, None, rest_pose(motion)
+            up, forward = nearest_axis(chained.clip_frame[:, 2])[0], nearest_axis(chained.clip_frame[:, 0])[0]
+            axes_how = "from the figures (feet lowest, hind legs to front legs), the clip's and the rig's"
+        else:
+            up, forward, axes_how, reference, pose = detect_axes(bones, motion, index, up, forward, s)
+            axes = axes_matrix(up, forward)
         up_clip = axes.T @ OUR_UP  # the clip's up, in its own axes
         align = np.tile(np.eye(3), (len(bones), 1, 1))
-        for b, (ours, clip) in rest_directions(bones, motion, index, pose).items():
+        # a creature keeps its own build: two kinds' rest directions differ by build, not by pose (a cow's
+        # horn is no elephant's head), so only the clip's motion from its rest is applied (Q_b = I)
+        for b, (ours, clip) in ({} if chained is not None else rest_directions(bones, motion, index, pose)).items():
             align[b] = least_rotation(ours, axes @ clip)
         legs = _legs(bones, motion, index)
-        if legs:
+        if chained is not None:
+            scale, scale_how, units = chained.scale, "leg length (the legs' chains)", units_of(chained.clip_leg)
+        elif legs:
             scale = float(np.mean([ours / clip for ours, clip in legs]))
             scale_how, units = "leg length (hip to ankle)", units_of(float(np.mean([c for _, c in legs])))
         else:
@@ -303,7 +321,8 @@ class Retarget:
             scale = our_height / clip_height if clip_height > 1e-9 and our_height > 0 else 1.0
             scale_how, units = "hip height at rest", "unknown"
         report = {"scheme": found.scheme, "how": found.how, "notes": found.notes, "axes": axes_how,
-                  "scale": scale_how, "reference": reference, "units": units, "kind": clip_kind(motion, s)}
+                  "scale": scale_how, "reference": reference, "units": units, "kind": clip_kind(motion, s),
+                  "figure": None if chained is None else chained.rig}
         return cls(bones, motion, index, axes, float(scale), align, up, forward, reference, report)
 
     def matrices(self, frames=slice(None)) -> np.ndarray:

@@ -1,0 +1,292 @@
+"""A figure read as chains, the same way from a clip and from a rig, and one matched chain to chain (#86).
+
+    a rooted tree of points (a clip's joints and End Sites; a rig's joints)
+      --from each end inwards to the first fork-->  end chains (fork first)
+      --two at one fork, the same number of segments, reaches within TWINS-->  twin pairs
+      --the two longest pairs, and any other whose ends stand as low-->  legs
+    legs  -> up: from the feet to where the legs leave the body
+          -> spine: the tree path from the hind pair's fork to the front pair's
+    the other end chains, by the spine end they hang from -> head (the end whose chains reach highest
+                                                             along up) and tail (the other), each the
+                                                             longest path out from its end
+    sides -> the figure's left is up x forward (forward: hind fork -> front fork)
+    kind  -> quadruped: two pairs of legs reaching across the spine; many-legged: three or more
+
+    rig figure, clip figure --the same kind, as many legs--> each of our bones on a chain takes the clip's
+                                                             segment at the same share of that chain's
+                                                             length (hind legs, front legs, spine, head,
+                                                             tail; left with left)
+
+Why chains and not names: an auto-rig's bones are named by where they lie in the volume (``ANT2_1``),
+a clip's by its rigging tool; the shape is what the two have in common. A bone driven by a clip joint
+takes that joint's world rotation (:mod:`.retarget`), so a chain of three bones can follow a chain of
+four joints: each bone turns as the segment beside it does. Bones on no chain (a second horn, an ear)
+follow their parent.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from volanim_core.io.bvh_files import Motion
+
+from .body import TWINS, nearest_axis
+
+ACROSS = 40.0  # a quadruped's legs stand within this of square to its spine (as kind.ACROSS)
+LOW = 0.25  # another pair is a pair of legs when its ends stand this share of a leg's reach from the floor
+
+
+@dataclass
+class Figure:
+    """A tree of points read as a body: node paths (fork first), its up and forward, and its kind."""
+
+    points: np.ndarray  # (N, 3) rest positions
+    parent: np.ndarray  # (N,) each point's parent, -1 for the root
+    legs: list[dict[str, list[int]]] = field(default_factory=list)  # hind pair first: {"L": path, "R": path}
+    spine: list[int] = field(default_factory=list)  # hind fork -> front fork
+    head: list[int] = field(default_factory=list)  # front fork -> the head's end
+    tail: list[int] = field(default_factory=list)  # hind fork -> the tail's end
+    up: np.ndarray | None = None
+    forward: np.ndarray | None = None
+    kind: str = "other"
+    reason: str = ""
+
+    def chains(self) -> dict[str, list[int]]:
+        """Name -> node path: ``hind L leg``, ``front R leg`` (``leg 2 L`` between them), spine, head, tail."""
+        out = {}
+        for i, pair in enumerate(self.legs):
+            which = "hind" if i == 0 else "front" if i == len(self.legs) - 1 else f"middle {i}"
+            for side, path in pair.items():
+                out[f"{which} {side} leg"] = path
+        for name in ("spine", "head", "tail"):
+            if len(getattr(self, name)) >= 2:
+                out[name] = getattr(self, name)
+        return out
+
+    def reach(self, path: list[int]) -> float:
+        return float(np.linalg.norm(np.diff(self.points[path], axis=0), axis=1).sum())
+
+
+def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None) -> Figure:
+    """The figure of a tree of points (module docstring). ``hips``: the point a clip's hierarchy starts
+    at, which is its hind end when nothing else tells head from tail."""
+    points, parent = np.asarray(points, np.float64), np.asarray(parent, np.int64)
+    fig = Figure(points, parent)
+    nbrs: list[list[int]] = [[] for _ in range(len(points))]
+    for c, p in enumerate(parent):
+        if p >= 0:
+            nbrs[c].append(int(p))
+            nbrs[int(p)].append(c)
+    ends = _end_chains(nbrs)
+    if not ends:
+        fig.reason = "the tree does not fork"
+        return fig
+    pairs = _pairs(fig, ends)
+    if len(pairs) < 2:
+        fig.reason = f"{'one pair' if pairs else 'no pair'} of twin limbs, not two"
+        return fig
+    legs = pairs[:2]
+    up = -np.mean([_unit(points[p[-1]] - points[p[0]]) for pair in legs for p in pair], axis=0)
+    up = _unit(up)
+    floor = min(points[p[-1]] @ up for pair in legs for p in pair)
+    leg_reach = np.mean([fig.reach(p) for pair in legs for p in pair])
+    legs += [pair for pair in pairs[2:] if max(points[p[-1]] @ up for p in pair) - floor <= LOW * leg_reach]
+    forks = [pair[0][0] for pair in legs]
+    a, b = max(((x, y) for x in forks for y in forks), key=lambda xy: len(_path(nbrs, *xy)))
+    spine = _path(nbrs, a, b)
+    if not set(forks) <= set(spine) or len(spine) < 2:
+        fig.reason = "the limbs do not leave the body along one spine"
+        return fig
+    legs.sort(key=lambda pair: spine.index(pair[0][0]))
+    used = {n for pair in legs for p in pair for n in p[1:]}
+    out = {a: [], b: []}  # each spine end: paths out from it through no leg and no other spine point
+    for path in ends:
+        if path[-1] in used:
+            continue
+        way = _path(nbrs, path[-1], a)
+        hit = next(n for n in way if n in spine)
+        if hit in out and not set(way[:way.index(hit)]) & (set(spine) | used):
+            out[hit].append(_path(nbrs, hit, path[-1]))
+    high = {e: max((points[n] @ up for p in paths for n in p[1:]), default=-np.inf) for e, paths in out.items()}
+    if high[a] == high[b] and hips is not None:  # nothing tells: a clip's hierarchy starts at its hips
+        front = b if len(_path(nbrs, hips, a)) <= len(_path(nbrs, hips, b)) else a
+    else:
+        front = a if high[a] > high[b] else b
+    hind = b if front == a else a
+    if spine[0] != hind:
+        spine.reverse()
+        legs.reverse()
+    fig.spine, fig.up = spine, up
+    fig.head = max(out[front], key=fig.reach, default=[])
+    fig.tail = max(out[hind], key=fig.reach, default=[])
+    fig.forward = _unit(_flat(points[front] - points[hind], up))
+    left = np.cross(up, fig.forward)
+    fig.legs = [dict(zip("LR", sorted(pair, key=lambda p: -(points[p[1:]].mean(axis=0) - points[p[0]]) @ left)))
+                for pair in legs]
+    hind_leg = np.mean([_unit(points[p[-1]] - points[p[0]]) for p in fig.legs[0].values()], axis=0)
+    angle = float(np.degrees(np.arccos(np.clip(_unit(hind_leg) @ _unit(points[front] - points[hind]), -1, 1))))
+    said = f"{len(fig.legs)} pairs of legs, the hind ones at {angle:.0f} degrees from the spine"
+    if abs(angle - 90.0) > ACROSS:
+        fig.reason = f"the legs do not reach across the spine ({said})"
+    else:
+        fig.kind = "quadruped" if len(fig.legs) == 2 else "many-legged"
+        fig.reason = said
+    return fig
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = float(np.linalg.norm(v))
+    return v / n if n > 1e-12 else v
+
+
+def _flat(v: np.ndarray, up: np.ndarray) -> np.ndarray:
+    return v - (v @ up) * up
+
+
+def _end_chains(nbrs: list[list[int]]) -> list[list[int]]:
+    """From each end (one neighbour) inwards to the first fork (three or more): the path, fork first."""
+    out = []
+    for end in (n for n in range(len(nbrs)) if len(nbrs[n]) == 1):
+        path, prev = [end], -1
+        while len(nbrs[path[-1]]) <= 2:
+            nxt = [n for n in nbrs[path[-1]] if n != prev]
+            if not nxt:
+                return []  # a tree without a fork: one path
+            prev = path[-1]
+            path.append(nxt[0])
+        out.append(path[::-1])
+    return out
+
+
+def _pairs(fig: Figure, ends: list[list[int]]) -> list[tuple[list[int], list[int]]]:
+    """Twin end chains at one fork, the longest pairs first."""
+    out = []
+    for fork in {p[0] for p in ends}:
+        here = sorted((p for p in ends if p[0] == fork), key=lambda p: -fig.reach(p))
+        while len(here) >= 2:
+            a = here.pop(0)
+            twin = next((b for b in here if len(b) == len(a) and fig.reach(b) >= (1 - TWINS) * fig.reach(a)), None)
+            if twin is not None:
+                here.remove(twin)
+                out.append((a, twin))
+    return sorted(out, key=lambda pair: -(fig.reach(pair[0]) + fig.reach(pair[1])))
+
+
+def _path(nbrs: list[list[int]], a: int, b: int) -> list[int]:
+    """The tree path from ``a`` to ``b``."""
+    prev = {a: -1}
+    todo = [a]
+    while todo and b not in prev:
+        n = todo.pop()
+        for m in nbrs[n]:
+            if m not in prev:
+                prev[m] = n
+                todo.append(m)
+    path = [b]
+    while path[-1] != a:
+        path.append(prev[path[-1]])
+    return path[::-1]
+
+
+def rig_figure(bones) -> tuple[Figure, list[str]]:
+    """Our bones' figure, and the joint name of each of its points."""
+    names = list(bones.joints)
+    at = {n: k for k, n in enumerate(names)}
+    parent = np.full(len(names), -1)
+    for b in bones.bones:
+        parent[at[b.distal]] = at[b.proximal]
+    return read_figure(np.array([bones.joints[n] for n in names]), parent), names
+
+
+def clip_figure(motion: Motion) -> Figure:
+    """A clip's figure at its OFFSET pose: its joints, then one point per End Site."""
+    rest = motion.rest_positions()
+    sites = sorted(motion.end_sites)
+    points = np.vstack([rest, [rest[j] + motion.end_sites[j] for j in sites]]) if sites else rest
+    parent = np.concatenate([np.asarray(motion.parents, np.int64), np.array(sites, np.int64)])
+    return read_figure(points, parent, hips=0)
+
+
+def frame_of(fig: Figure) -> np.ndarray:
+    """``(3, 3)`` columns forward, left, up, each snapped to the nearest axis: the figure's own axes."""
+    up_name = nearest_axis(fig.up)[0]
+    fwd_name = nearest_axis(fig.forward, exclude=up_name)[0]
+    up, fwd = (np.eye(3)["xyz".index(n[-1])] * (-1.0 if n.startswith("-") else 1.0) for n in (up_name, fwd_name))
+    return np.column_stack([fwd, np.cross(up, fwd), up])
+
+
+@dataclass
+class ChainMatch:
+    mapping: dict[str, str]  # our bone label -> the clip joint that drives it
+    how: dict[str, str]  # label -> which chain and where along it
+    axes: np.ndarray  # (3, 3): the clip's axes -> ours (its forward and up onto the rig's)
+    scale: float  # clip units -> voxels: the legs' reach, ours over the clip's
+    rig: Figure
+    rig_names: list[str]  # the rig figure's points' joint names
+    clip_frame: np.ndarray  # (3, 3): the clip's forward, left and up, in its axes (:func:`frame_of`)
+    clip_leg: float  # the clip's mean leg reach, in its units
+
+
+def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
+    """Our bones matched to the clip's chain by chain (module docstring), or None and why not."""
+    rig, names = rig_figure(bones)
+    clip = clip_figure(motion)
+    if rig.kind == "other" or clip.kind == "other":
+        return None, f"the rig: {rig.kind} ({rig.reason}); the clip: {clip.kind} ({clip.reason})"
+    if len(rig.legs) != len(clip.legs):
+        return None, f"the rig has {len(rig.legs)} pairs of legs, the clip {len(clip.legs)}"
+    bone_of = {b.distal: k for k, b in enumerate(bones.bones)}  # a bone is the path step to its distal joint
+    mapping, how = {}, {}
+    theirs = clip.chains()
+    for chain, path in rig.chains().items():
+        other = theirs.get(chain)
+        if other is None:
+            continue
+        parts = zip(_limb_parts(rig, path), _limb_parts(clip, other)) if chain.endswith("leg") else [(path, other)]
+        for mine, its in parts:
+            for (u, v), t in _steps(rig, mine):
+                joint = _driver(clip, its, t)
+                k = path.index(u)  # the step's number along the whole chain
+                bone = bones.bones[bone_of[names[v if rig.parent[v] == u else u]]]
+                if joint < len(motion.names) and bone.label not in mapping:
+                    mapping[bone.label] = motion.names[joint]
+                    how[bone.label] = f"chain: {chain}, {k + 1} of {len(path) - 1}"
+    ours = np.mean([rig.reach(p) for pair in rig.legs for p in pair.values()])
+    clips = np.mean([clip.reach(p) for pair in clip.legs for p in pair.values()])
+    theirs_frame = frame_of(clip)
+    return ChainMatch(mapping, how, frame_of(rig) @ theirs_frame.T, float(ours / clips) if clips > 1e-9 else 1.0,
+                      rig, names, theirs_frame, float(clips)), ""
+
+
+def _limb_parts(fig: Figure, path: list[int]) -> list[list[int]]:
+    """A leg as ``[before, limb]``: the limb from the first of its two longest consecutive steps (thigh and
+    shin, upper arm and forearm) to the foot, and what leads to it (a clavicle, a scapula), so a clip's
+    clavicle does not drive a rig's upper leg. ``before`` is ``[]`` when the limb starts at the fork."""
+    lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
+    if len(lengths) < 3:
+        return [[], path]
+    i = int(np.argmax(lengths[:-1] + lengths[1:]))
+    return [path[:i + 1] if i else [], path[i:]]
+
+
+def _steps(fig: Figure, path: list[int]) -> list[tuple[tuple[int, int], float]]:
+    """``((u, v), t)`` per step of a path: its two points and the share of the path's length at its middle."""
+    if len(path) < 2:
+        return []
+    lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
+    mids = (np.cumsum(lengths) - lengths / 2) / max(float(lengths.sum()), 1e-12)
+    return [((path[k], path[k + 1]), float(mids[k])) for k in range(len(path) - 1)]
+
+
+def _driver(fig: Figure, path: list[int], t: float) -> int:
+    """The clip joint turning the step of ``path`` at share ``t`` of its length: the step's upper point
+    (a path with no step: its only point's own)."""
+    if len(path) < 2:
+        return path[0] if path else len(fig.points)
+    lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
+    ends = np.cumsum(lengths) / max(float(lengths.sum()), 1e-12)
+    k = min(int(np.searchsorted(ends, t)), len(path) - 2)
+    u, v = path[k], path[k + 1]
+    return u if fig.parent[v] == u else v
