@@ -94,13 +94,20 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
     leg_reach = np.mean([fig.reach(p) for pair in legs for p in pair])
     legs += [pair for pair in pairs[2:] if max(points[p[-1]] @ up for p in pair) - floor <= LOW * leg_reach]
     forks = [pair[0][0] for pair in legs]
+    used = {n for pair in legs for p in pair for n in p[1:]}
     a, b = max(((x, y) for x in forks for y in forks), key=lambda xy: len(_path(nbrs, *xy)))
+    if a == b:  # every leg leaves one point (an insect's thorax): the body is the longest way through it
+        body = sorted((p for p in ends if p[0] == a and p[-1] not in used), key=lambda p: -fig.reach(p))
+        if len(body) < 2:
+            fig.reason = "every leg leaves one point, and no body runs through it"
+            return fig
+        a, b = body[0][-1], body[1][-1]
     spine = _path(nbrs, a, b)
     if not set(forks) <= set(spine) or len(spine) < 2:
         fig.reason = "the limbs do not leave the body along one spine"
         return fig
-    legs.sort(key=lambda pair: spine.index(pair[0][0]))
-    used = {n for pair in legs for p in pair for n in p[1:]}
+    axis = _unit(points[b] - points[a])  # legs at one fork are ordered by where their hips lie along it
+    legs.sort(key=lambda pair: (spine.index(pair[0][0]), np.mean([points[p[1]] @ axis for p in pair])))
     out = {a: [], b: []}  # each spine end: paths out from it through no leg and no other spine point
     for path in ends:
         if path[-1] in used:
@@ -109,7 +116,7 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
         hit = next(n for n in way if n in spine)
         if hit in out and not set(way[:way.index(hit)]) & (set(spine) | used):
             out[hit].append(_path(nbrs, hit, path[-1]))
-    high = {e: max((points[n] @ up for p in paths for n in p[1:]), default=-np.inf) for e, paths in out.items()}
+    high = {e: max((points[n] @ up for p in paths for n in p), default=points[e] @ up) for e, paths in out.items()}
     if high[a] == high[b] and hips is not None:  # nothing tells: a clip's hierarchy starts at its hips
         front = b if len(_path(nbrs, hips, a)) <= len(_path(nbrs, hips, b)) else a
     else:
@@ -125,9 +132,10 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
     left = np.cross(up, fig.forward)
     fig.legs = [dict(zip("LR", sorted(pair, key=lambda p: -(points[p[1:]].mean(axis=0) - points[p[0]]) @ left)))
                 for pair in legs]
-    hind_leg = np.mean([_unit(points[p[-1]] - points[p[0]]) for p in fig.legs[0].values()], axis=0)
-    angle = float(np.degrees(np.arccos(np.clip(_unit(hind_leg) @ _unit(points[front] - points[hind]), -1, 1))))
-    said = f"{len(fig.legs)} pairs of legs, the hind ones at {angle:.0f} degrees from the spine"
+    # all legs' mean: an insect's front legs reach forward and its hind legs back, square to the body together
+    leg = np.mean([_unit(points[p[-1]] - points[p[0]]) for pair in fig.legs for p in pair.values()], axis=0)
+    angle = float(np.degrees(np.arccos(np.clip(_unit(leg) @ _unit(points[front] - points[hind]), -1, 1))))
+    said = f"{len(fig.legs)} pairs of legs, at {angle:.0f} degrees from the spine"
     if abs(angle - 90.0) > ACROSS:
         fig.reason = f"the legs do not reach across the spine ({said})"
     else:
@@ -161,16 +169,23 @@ def _end_chains(nbrs: list[list[int]]) -> list[list[int]]:
 
 
 def _pairs(fig: Figure, ends: list[list[int]]) -> list[tuple[list[int], list[int]]]:
-    """Twin end chains at one fork, the longest pairs first."""
+    """Twin end chains at one fork (as many segments, reaches within TWINS), the longest pairs first. Where
+    four or more such chains leave one fork (an insect's legs from its thorax) a chain's twin is the one
+    across the body from it: their hips differ least along the line the hips lie on (their main axis);
+    the leg beside it, a step along that line, is as long but no twin."""
     out = []
     for fork in {p[0] for p in ends}:
         here = sorted((p for p in ends if p[0] == fork), key=lambda p: -fig.reach(p))
+        hips = np.array([fig.points[p[1]] for p in here])
+        axis = np.linalg.svd(hips - hips.mean(axis=0))[2][0] if len(here) >= 4 else None
         while len(here) >= 2:
             a = here.pop(0)
-            twin = next((b for b in here if len(b) == len(a) and fig.reach(b) >= (1 - TWINS) * fig.reach(a)), None)
-            if twin is not None:
-                here.remove(twin)
-                out.append((a, twin))
+            like = [b for b in here if len(b) == len(a) and fig.reach(b) >= (1 - TWINS) * fig.reach(a)]
+            if axis is not None and len(like) >= 2:
+                like.sort(key=lambda b: abs(_unit(fig.points[a[1]] - fig.points[b[1]]) @ axis))
+            if like:
+                here.remove(like[0])
+                out.append((a, like[0]))
     return sorted(out, key=lambda pair: -(fig.reach(pair[0]) + fig.reach(pair[1])))
 
 

@@ -9,6 +9,7 @@
                       quadruped  both pairs reach across the spine (hind within ACROSS of 90 degrees)
                                  and the same way (fore within SAME of hind)
                       other      no twin legs, no twin arms, or neither rule
+    (first: three pairs of legs or more along one body, read as chains, motion/chains.py: many-legged)
 
 Names cannot tell: 3ds Max's biped (``Bip01 L Thigh``) rigs elephants and horses too, with the front
 legs named as arms. Gravity is not needed either: the angles are between the clip's own limbs, so
@@ -35,7 +36,7 @@ SAME = 45.0  # and its front and hind legs reach the same way, within this
 
 @dataclass(frozen=True)
 class Kind:
-    kind: str  # "biped", "quadruped" or "other"
+    kind: str  # "biped", "quadruped", "many-legged" or "other"
     reason: str
 
 
@@ -46,6 +47,11 @@ def _angles(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def clip_kind(motion: Motion, s: Sampled) -> Kind:
     """The kind of the clip's figure, and the reason in words (printed by ``bvh2trans``)."""
+    from .chains import clip_figure
+
+    figure = clip_figure(motion)
+    if figure.kind == "many-legged":  # three pairs or more: no biped's or quadruped's reading applies (#86)
+        return Kind("many-legged", figure.reason)
     kids, far, size = children(motion), reach(motion), sizes(motion)
     pairs = [p for j in range(len(motion.names)) for p in _pairs(motion, size, far, kids[j])]
     if len(pairs) < 2:

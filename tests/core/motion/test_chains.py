@@ -109,3 +109,95 @@ def test_a_creature_keeps_its_build_only_the_clip_s_motion_is_applied(spot):
     assert all(v == 0.0 for v in retarget.absorbed_degrees().values())
     checks, _ = check_clip(retarget)
     assert all(c.ok for c in checks) and {c.name for c in checks} >= {"feet near the floor", "feet below the body"}
+
+
+# joint, parent, offset (cm, Y up, facing +z): an insect, six legs from the thorax, as a tripod walks
+INSECT = [("Thorax", None, (0, 10, 0)), ("Abdomen", "Thorax", (0, 0, -8)), ("AbdomenTip", "Abdomen", (0, -1, -8)),
+          ("Neck", "Thorax", (0, 0, 6)), ("Head", "Neck", (0, 1, 3)),
+          *[(f"{s}{part}{i}", f"{s}{parent}{i}" if parent else "Thorax", (sign * o[0], o[1], z if k == 0 else 0))
+            for s, sign in (("L", 1), ("R", -1)) for i, z in ((1, 3), (2, 0), (3, -3))
+            for k, (part, parent, o) in enumerate((("Coxa", None, (2, 0)), ("Femur", "Coxa", (4, 3)),
+                                                   ("Tibia", "Femur", (3, -4)), ("Tarsus", "Tibia", (3, -8))))]]
+
+
+def insect_bvh(path, frames: int = 48) -> None:
+    """Tripod gait: legs L1, R2, L3 swing forward about the vertical while R1, L2, R3 swing back."""
+    kids: dict = {}
+    for name, parent, _ in INSECT:
+        kids.setdefault(parent, []).append(name)
+    offsets = {name: o for name, _, o in INSECT}
+    order, lines = [], ["HIERARCHY"]
+
+    def write(name, depth):
+        pad = "  " * depth
+        lines.extend([f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {name}", f"{pad}{{",
+                      f"{pad}  OFFSET {' '.join(f'{v:g}' for v in offsets[name])}",
+                      f"{pad}  CHANNELS " + ("6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"
+                                             if depth == 0 else "3 Zrotation Xrotation Yrotation")])
+        order.append(name)
+        for k in kids.get(name, []):
+            write(k, depth + 1)
+        if name not in kids:
+            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0 -1 0", f"{pad}  }}"])
+        lines.append(f"{pad}}}")
+
+    write("Thorax", 0)
+    lines += ["MOTION", f"Frames: {frames}", "Frame Time: 0.0333333"]
+    tripod = {"LCoxa1": 1, "RCoxa2": 1, "LCoxa3": 1, "RCoxa1": -1, "LCoxa2": -1, "RCoxa3": -1}
+    for f in range(frames):
+        phase = np.sin(2 * np.pi * f / 24)
+        row = []
+        for name in order:
+            # about the vertical, forward: the left legs turn with -y, the right ones with +y
+            swing = 20 * phase * tripod.get(name, 0) * (-1 if name.startswith("L") else 1)
+            row += [0, 10, 0.5 * f, 0, 0, 0] if name == "Thorax" else [0, 0, swing]
+        lines.append(" ".join(f"{v:.4f}" for v in row))
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.fixture(scope="module")
+def ant(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("ant")
+    assert main(["samples", "ant", "-o", str(folder)]) == 0
+    assert main(["voxelize", str(folder / "ant.ply"), str(folder / "ant.nrrd"), "--size", "160"]) == 0
+    assert main(["markups", str(folder / "ant.mrk.json"), "--like", str(folder / "ant.nrrd"),
+                 "-o", str(folder / "ant.bones")]) == 0
+    insect_bvh(folder / "insect.bvh")
+    return folder
+
+
+def test_the_ant_walks_an_insect_s_tripod_each_leg_with_its_twin_of_the_clip(ant, tmp_path, capsys):
+    """The ant's six legs leave its thorax at one point; they are ordered front to hind by where their hips
+    lie along the body, left by up x forward. Each leg of the ant is driven by the clip's leg of the same
+    place and side (the step from the thorax to the hip may turn with the clip's thorax, as the clip's own
+    does), and the ant's front left foot swings as the insect's does (the clip's own FK)."""
+    from volanim_core.io import read_bones
+
+    bones = read_bones(ant / "ant.bones")
+    motion = read_bvh(ant / "insect.bvh")
+    assert rig_kind(bones) == "many-legged"
+    found, why = match_chains(bones, motion)
+    assert found is not None, why
+    for k, pair in enumerate(found.rig.legs):
+        number = 3 - k  # hind first: the ant's and the insect's legs are numbered 1 front .. 3 hind
+        for side, path in pair.items():
+            for n in path[1:]:
+                bone = next(b for b in bones.bones if b.distal == found.rig_names[n])
+                assert bone.distal.startswith(f"{side}_") and bone.distal.endswith(str(number))  # the ant's joints
+                joint = found.mapping[bone.label]
+                if n == path[1] and joint == "Thorax":  # the step leaving the body turns with the body, in both
+                    continue
+                assert joint.startswith(side) and joint.endswith(str(number)), (bone.label, joint)
+    retarget = Retarget.build(bones, motion)
+    mats = retarget.matrices()
+    foot = _bone_ending(bones, "L_FOOT1")
+    ours = bones.joints["L_FOOT1"] @ mats[:, foot, :3, :3] + mats[:, foot, 3, :3]
+    thorax = bones.joints["THORAX"] @ mats[:, 0, :3, :3] + mats[:, 0, 3, :3]
+    _, pos = motion.forward_kinematics(slice(None))
+    theirs = pos[:, motion.index("LTarsus1")] - pos[:, 0]
+    assert np.corrcoef((ours - thorax) @ found.rig.forward, theirs[:, 2])[0, 1] > 0.95
+    assert main(["bvh2trans", str(ant / "insect.bvh"), "--bones", str(ant / "ant.bones"),
+                 "-o", str(tmp_path / "f")]) == 0
+    out = capsys.readouterr().out
+    assert "# the clip's figure: many-legged: 3 pairs of legs" in out
+    assert "the clip's figure is a many-legged, as the rig: yes" in out and "feet below the body: 100%" in out
