@@ -18,6 +18,7 @@ from volanim_core.motion.chains import match_chains, rig_figure
 from volanim_core.motion.kind import rig_kind
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget
+from written_clips import write_bvh
 
 
 @pytest.fixture(scope="module")
@@ -122,37 +123,15 @@ INSECT = [("Thorax", None, (0, 10, 0)), ("Abdomen", "Thorax", (0, 0, -8)), ("Abd
 
 def insect_bvh(path, frames: int = 48) -> None:
     """Tripod gait: legs L1, R2, L3 swing forward about the vertical while R1, L2, R3 swing back."""
-    kids: dict = {}
-    for name, parent, _ in INSECT:
-        kids.setdefault(parent, []).append(name)
-    offsets = {name: o for name, _, o in INSECT}
-    order, lines = [], ["HIERARCHY"]
-
-    def write(name, depth):
-        pad = "  " * depth
-        lines.extend([f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {name}", f"{pad}{{",
-                      f"{pad}  OFFSET {' '.join(f'{v:g}' for v in offsets[name])}",
-                      f"{pad}  CHANNELS " + ("6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"
-                                             if depth == 0 else "3 Zrotation Xrotation Yrotation")])
-        order.append(name)
-        for k in kids.get(name, []):
-            write(k, depth + 1)
-        if name not in kids:
-            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0 -1 0", f"{pad}  }}"])
-        lines.append(f"{pad}}}")
-
-    write("Thorax", 0)
-    lines += ["MOTION", f"Frames: {frames}", "Frame Time: 0.0333333"]
     tripod = {"LCoxa1": 1, "RCoxa2": 1, "LCoxa3": 1, "RCoxa1": -1, "LCoxa2": -1, "RCoxa3": -1}
-    for f in range(frames):
-        phase = np.sin(2 * np.pi * f / 24)
-        row = []
-        for name in order:
-            # about the vertical, forward: the left legs turn with -y, the right ones with +y
-            swing = 20 * phase * tripod.get(name, 0) * (-1 if name.startswith("L") else 1)
-            row += [0, 10, 0.5 * f, 0, 0, 0] if name == "Thorax" else [0, 0, swing]
-        lines.append(" ".join(f"{v:.4f}" for v in row))
-    path.write_text("\n".join(lines) + "\n")
+
+    def channels(f, name):
+        if name == "Thorax":
+            return [0, 10, 0.5 * f, 0, 0, 0]
+        # about the vertical, forward: the left legs turn with -y, the right ones with +y
+        return [0, 0, 20 * np.sin(2 * np.pi * f / 24) * tripod.get(name, 0) * (-1 if name.startswith("L") else 1)]
+
+    write_bvh(path, INSECT, channels, frames)
 
 
 @pytest.fixture(scope="module")

@@ -22,6 +22,7 @@ from volanim_core.motion.kind import clip_kind
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget
 from volanim_core.samples import mannequin_bones
+from written_clips import write_bvh
 
 # joint, parent, offset (cm, Y up, facing +z): an elephant as 3ds Max's biped rigs one
 ELEPHANT = [
@@ -42,41 +43,15 @@ ELEPHANT = [
 
 def elephant_bvh(path, frames: int = 48, side: bool = False) -> None:
     """The elephant trotting (diagonal legs together); ``side``: the whole clip lying on its side."""
-    kids = {}
-    for name, parent, _ in ELEPHANT:
-        kids.setdefault(parent, []).append(name)
-    offsets = {name: o for name, _, o in ELEPHANT}
-    order: list[str] = []
-    lines = ["HIERARCHY"]
-
-    def write(name, depth):
-        pad = "  " * depth
-        lines.append(f"{pad}{'ROOT' if depth == 0 else 'JOINT'} {name}")
-        lines.append(f"{pad}{{")
-        lines.append(f"{pad}  OFFSET {' '.join(f'{v:g}' for v in offsets[name])}")
-        chans = "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation" if depth == 0 \
-            else "3 Zrotation Xrotation Yrotation"
-        lines.append(f"{pad}  CHANNELS {chans}")
-        order.append(name)
-        for k in kids.get(name, []):
-            write(k, depth + 1)
-        if name not in kids:
-            lines.extend([f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0 -10 0", f"{pad}  }}"])
-        lines.append(f"{pad}}}")
-
-    write("Bip01", 0)
-    lines += ["MOTION", f"Frames: {frames}", "Frame Time: 0.0333333"]
     swing = {"Bip01_L_Thigh": 1, "Bip01_R_UpperArm": 1, "Bip01_R_Thigh": -1, "Bip01_L_UpperArm": -1}
-    for f in range(frames):
+
+    def channels(f, name):
         phase = np.sin(2 * np.pi * f / 24)
-        row = []
-        for name in order:
-            if name == "Bip01":
-                row += [0, 160, 3.0 * f, 90 if side else 0, 0, 0]
-            else:
-                row += [0, 25 * phase * swing.get(name, 0) + (10 * abs(phase) if "Calf" in name else 0), 0]
-        lines.append(" ".join(f"{v:.4f}" for v in row))
-    path.write_text("\n".join(lines) + "\n")
+        if name == "Bip01":
+            return [0, 160, 3.0 * f, 90 if side else 0, 0, 0]
+        return [0, 25 * phase * swing.get(name, 0) + (10 * abs(phase) if "Calf" in name else 0), 0]
+
+    write_bvh(path, ELEPHANT, channels, frames, end=(0, -10, 0))
 
 
 def test_the_elephant_is_a_quadruped_upright_or_on_its_side(tmp_path):
