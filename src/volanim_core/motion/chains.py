@@ -236,12 +236,22 @@ def frame_of(fig: Figure) -> np.ndarray:
 class ChainMatch:
     mapping: dict[str, str]  # our bone label -> the clip joint that drives it
     how: dict[str, str]  # label -> which chain and where along it
-    axes: np.ndarray  # (3, 3): the clip's axes -> ours (its forward and up onto the rig's)
     scale: float  # clip units -> voxels: the legs' reach, ours over the clip's
     rig: Figure
     rig_names: list[str]  # the rig figure's points' joint names
-    clip_frame: np.ndarray  # (3, 3): the clip's forward, left and up, in its axes (:func:`frame_of`)
+    rig_frame: np.ndarray  # (3, 3): the rig's forward, left and up (:func:`frame_of`)
+    clip_frame: np.ndarray  # (3, 3): the clip's, in its axes
     clip_leg: float  # the clip's mean leg reach, in its units
+
+    def axes(self, up: np.ndarray | None = None, forward: np.ndarray | None = None) -> np.ndarray:
+        """``(3, 3)``: the clip's axes -> ours, its forward and up onto the rig's; ``up``, ``forward``: the
+        clip's as the user gave them (unit axis vectors) instead of as its figure reads."""
+        clip = self.clip_frame
+        u = clip[:, 2] if up is None else np.asarray(up, np.float64)
+        f = clip[:, 0] if forward is None else np.asarray(forward, np.float64)
+        if abs(u @ f) > 0.5:  # a forward along the up given: the figure's own forward, square to it
+            f = _unit(_flat(clip[:, 0], u)) if abs(clip[:, 0] @ u) < 0.9 else _unit(_flat(clip[:, 1], u))
+        return self.rig_frame @ np.column_stack([f, np.cross(u, f), u]).T
 
 
 def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
@@ -270,9 +280,8 @@ def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
                     how[bone.label] = f"chain: {chain}, {k + 1} of {len(path) - 1}"
     ours = np.mean([rig.reach(p) for pair in rig.legs for p in pair.values()])
     clips = np.mean([clip.reach(p) for pair in clip.legs for p in pair.values()])
-    theirs_frame = frame_of(clip)
-    return ChainMatch(mapping, how, frame_of(rig) @ theirs_frame.T, float(ours / clips) if clips > 1e-9 else 1.0,
-                      rig, names, theirs_frame, float(clips)), ""
+    return ChainMatch(mapping, how, float(ours / clips) if clips > 1e-9 else 1.0, rig, names, frame_of(rig),
+                      frame_of(clip), float(clips)), ""
 
 
 def _limb_parts(fig: Figure, path: list[int]) -> list[list[int]]:

@@ -294,9 +294,12 @@ class Retarget:
         if chained is None and mapping is not None and rig_kind(bones, by_shape=False) != "biped":
             chained = match_chains(bones, motion)[0]  # a creature's axes are its own, whoever mapped it
         if chained is not None:  # its figure's up and forward onto ours: a cow's volume need not stand in z
-            axes, reference, pose = chained.axes, None, rest_pose(motion)
-            up, forward = nearest_axis(chained.clip_frame[:, 2])[0], nearest_axis(chained.clip_frame[:, 0])[0]
-            axes_how = "from the figures (feet lowest, hind legs to front legs), the clip's and the rig's"
+            given = [None if a == "auto" else axis_vector(a) for a in (up, forward)]
+            axes, reference, pose = chained.axes(*given), None, rest_pose(motion)
+            up, forward = nearest_axis(axes.T @ chained.rig_frame[:, 2])[0], \
+                nearest_axis(axes.T @ chained.rig_frame[:, 0])[0]
+            axes_how = ("given" if any(g is not None for g in given) else
+                        "from the figures (feet lowest, hind legs to front legs), the clip's and the rig's")
         else:
             up, forward, axes_how, reference, pose = detect_axes(bones, motion, index, up, forward, s)
             axes = axes_matrix(up, forward)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests.core.motion.test_clip_kind import elephant_bvh
 from tests.paths import WALK
 
 from volanim_core.cli import main
@@ -18,7 +17,7 @@ from volanim_core.motion.chains import match_chains, rig_figure
 from volanim_core.motion.kind import rig_kind
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget
-from written_clips import write_bvh
+from written_clips import elephant_bvh, insect_bvh
 
 
 @pytest.fixture(scope="module")
@@ -112,26 +111,6 @@ def test_a_creature_keeps_its_build_only_the_clip_s_motion_is_applied(spot):
     assert all(c.ok for c in checks) and {c.name for c in checks} >= {"feet near the floor", "feet below the body"}
 
 
-# joint, parent, offset (cm, Y up, facing +z): an insect, six legs from the thorax, as a tripod walks
-INSECT = [("Thorax", None, (0, 10, 0)), ("Abdomen", "Thorax", (0, 0, -8)), ("AbdomenTip", "Abdomen", (0, -1, -8)),
-          ("Neck", "Thorax", (0, 0, 6)), ("Head", "Neck", (0, 1, 3)),
-          *[(f"{s}{part}{i}", f"{s}{parent}{i}" if parent else "Thorax", (sign * o[0], o[1], z if k == 0 else 0))
-            for s, sign in (("L", 1), ("R", -1)) for i, z in ((1, 3), (2, 0), (3, -3))
-            for k, (part, parent, o) in enumerate((("Coxa", None, (2, 0)), ("Femur", "Coxa", (4, 3)),
-                                                   ("Tibia", "Femur", (3, -4)), ("Tarsus", "Tibia", (3, -8))))]]
-
-
-def insect_bvh(path, frames: int = 48) -> None:
-    """Tripod gait: legs L1, R2, L3 swing forward about the vertical while R1, L2, R3 swing back."""
-    tripod = {"LCoxa1": 1, "RCoxa2": 1, "LCoxa3": 1, "RCoxa1": -1, "LCoxa2": -1, "RCoxa3": -1}
-
-    def channels(f, name):
-        if name == "Thorax":
-            return [0, 10, 0.5 * f, 0, 0, 0]
-        # about the vertical, forward: the left legs turn with -y, the right ones with +y
-        return [0, 0, 20 * np.sin(2 * np.pi * f / 24) * tripod.get(name, 0) * (-1 if name.startswith("L") else 1)]
-
-    write_bvh(path, INSECT, channels, frames)
 
 
 @pytest.fixture(scope="module")
@@ -180,3 +159,15 @@ def test_the_ant_walks_an_insect_s_tripod_each_leg_with_its_twin_of_the_clip(ant
     out = capsys.readouterr().out
     assert "# the clip's figure: many-legged: 3 pairs of legs" in out
     assert "the clip's figure is a many-legged, as the rig: yes" in out and "feet below the body: 100%" in out
+
+
+def test_axes_given_as_the_figure_reads_them_change_nothing_and_a_reversed_forward_walks_backwards(spot):
+    folder, bones = spot
+    motion = read_bvh(folder / "elephant.bvh")
+    auto = Retarget.build(bones, motion)
+    assert (auto.up, auto.forward) == ("y", "z")
+    assert np.allclose(Retarget.build(bones, motion, up="y", forward="z").matrices(), auto.matrices())
+    back = Retarget.build(bones, motion, up="y", forward="-z")
+    travel = lambda r: r.matrices()[-1, 0, 3, :3] - r.matrices()[0, 0, 3, :3]  # noqa: E731
+    fwd = auto.report["figure"].forward
+    assert travel(auto) @ fwd > 0 > travel(back) @ fwd  # the elephant walks +z: Spot walks its own forward

@@ -2,7 +2,7 @@
 
 The report: a 3ds Max biped-named elephant (``Bip01_L_Thigh``, ``BN_Tail_01``) was mapped onto the
 mannequin (HEAD <- a calf, R_THIGH <- the tail) with every plausibility check passing. No real
-quadruped clip with a licence we can use is on hand, so the elephant here is written as such clips
+quadruped clip with a licence we can use is on hand, so the elephant (tests/written_clips.py) is written as such clips
 are: 3ds Max's biped hierarchy (the thighs off the spine's first joint, the clavicles off the neck,
 the front legs named as arms), a tail, Y up, trotting. The bipeds are the real clips of
 tests/real_clips.py and ../shared's walk.bvh, also renamed into 3ds Max's biped scheme.
@@ -22,36 +22,7 @@ from volanim_core.motion.kind import clip_kind
 from volanim_core.motion.plausible import check_clip
 from volanim_core.motion.retarget import Retarget
 from volanim_core.samples import mannequin_bones
-from written_clips import write_bvh
-
-# joint, parent, offset (cm, Y up, facing +z): an elephant as 3ds Max's biped rigs one
-ELEPHANT = [
-    ("Bip01", None, (0, 160, 0)), ("Bip01_Pelvis", "Bip01", (0, 0, 0)), ("Bip01_Spine", "Bip01_Pelvis", (0, 0, 5)),
-    *[(f"Bip01_{s}_{n}", p, o) for s, x in (("L", 30), ("R", -30)) for n, p, o in (
-        ("Thigh", "Bip01_Spine", (x, -15, -10)), ("Calf", f"Bip01_{s}_Thigh", (0, -55, 0)),
-        ("HorseLink", f"Bip01_{s}_Calf", (0, -45, 0)), ("Foot", f"Bip01_{s}_HorseLink", (0, -35, 0)))],
-    ("BN_Tail_01", "Bip01_Spine", (0, 0, -40)), ("BN_Tail_02", "BN_Tail_01", (0, -20, -40)),
-    ("BN_Tail_03", "BN_Tail_02", (0, -30, -30)),
-    ("Bip01_Spine1", "Bip01_Spine", (0, 5, 60)), ("Bip01_Spine2", "Bip01_Spine1", (0, 5, 60)),
-    ("Bip01_Neck", "Bip01_Spine2", (0, 10, 30)),
-    *[(f"Bip01_{s}_{n}", p, o) for s, x in (("L", 30), ("R", -30)) for n, p, o in (
-        ("Clavicle", "Bip01_Neck", (x / 2, -10, 0)), ("UpperArm", f"Bip01_{s}_Clavicle", (x / 2, -20, 0)),
-        ("Forearm", f"Bip01_{s}_UpperArm", (0, -60, 0)), ("Hand", f"Bip01_{s}_Forearm", (0, -55, 0)))],
-    ("Bip01_Head", "Bip01_Neck", (0, 20, 40)),
-]
-
-
-def elephant_bvh(path, frames: int = 48, side: bool = False) -> None:
-    """The elephant trotting (diagonal legs together); ``side``: the whole clip lying on its side."""
-    swing = {"Bip01_L_Thigh": 1, "Bip01_R_UpperArm": 1, "Bip01_R_Thigh": -1, "Bip01_L_UpperArm": -1}
-
-    def channels(f, name):
-        phase = np.sin(2 * np.pi * f / 24)
-        if name == "Bip01":
-            return [0, 160, 3.0 * f, 90 if side else 0, 0, 0]
-        return [0, 25 * phase * swing.get(name, 0) + (10 * abs(phase) if "Calf" in name else 0), 0]
-
-    write_bvh(path, ELEPHANT, channels, frames, end=(0, -10, 0))
+from written_clips import elephant_bvh
 
 
 def test_the_elephant_is_a_quadruped_upright_or_on_its_side(tmp_path):

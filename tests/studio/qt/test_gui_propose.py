@@ -94,3 +94,50 @@ def test_propose_on_the_ant_accept_connect_and_pose_a_leg_healthy(qtbot, window,
     # nothing torn off; the verdict also says the ant's rest pose is already in more pieces than its volume (#83:
     # thin legs keep few points at the default thinness), in amber instead of a plain green "healthy"
     assert "nothing torn off" in window.verdict_label.text()
+
+
+@pytest.mark.long("the ant voxelized and skeletonized, proposed, connected, then a clip loaded and played")
+def test_propose_bones_then_load_a_clip_of_the_ant_s_kind_and_play_it(qtbot, window, tmp_path):
+    """#86 item 4: Propose bones (auto) on the ant -> Load clip (an insect's tripod) -> Play. The mapping
+    dialog shows each leg bone's chain (the auto-rig's names say nothing of legs), the clip goes on the
+    timeline, and playing draws pictures of the ant with its legs moved."""
+    import numpy as np
+
+    from volanim_core.cli import main
+    from written_clips import insect_bvh
+
+    assert main(["samples", "ant", "-o", str(tmp_path)]) == 0
+    assert main(["voxelize", str(tmp_path / "ant.ply"), str(tmp_path / "ant.nrrd"), "--size", "160"]) == 0
+    insect_bvh(tmp_path / "insect.bvh")
+    window.files.open_volume(tmp_path / "ant.nrrd", params={"lo": 1, "hi": None, "fill": False})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    doc = window.doc
+    dialog = _propose(qtbot, window, "auto")
+    qtbot.mouseClick(dialog.buttons.button(QDialogButtonBox.Ok), Qt.LeftButton)
+    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    shown = {}
+
+    def ask(d):
+        shown.update({label: w.text() for label, w in d.how.items()})
+        return True
+
+    before = doc.timeline.clip
+    assert window.timeline.load_bvh(tmp_path / "insect.bvh", ask=ask) is not None
+    qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
+    assert doc.timeline.clip is not before and doc.timeline.frame_count == 48
+    legs = [text for label, text in shown.items() if "leg" in text]
+    assert len(legs) >= 12 and all(t.startswith("chain: ") for t in legs), shown
+    pictures = []
+    doc.events.preview.connect(lambda **_: pictures.append(doc.preview) if doc.settings.playing else None)
+    qtbot.keyClick(window, Qt.Key_Space)
+    qtbot.waitUntil(lambda: len(pictures) >= 3, timeout=JOB_TIMEOUT_MS)
+    qtbot.keyClick(window, Qt.Key_Space)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    frames = {p.frame for p in pictures}
+    assert len(frames) >= 2
+    moved = [p for p in pictures if p.joints is not None]
+    feet = [j for j in doc.bones.joints if not any(b.proximal == j for b in doc.bones.bones)]
+    root = next(j for j in doc.bones.joints if not any(b.distal == j for b in doc.bones.bones))
+    spread = np.ptp([[p.joints[f] - p.joints[root] for f in feet] for p in moved], axis=0).max()
+    assert spread > 2.0  # voxels: the legs' ends moved against the body between the pictures drawn
