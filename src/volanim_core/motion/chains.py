@@ -7,15 +7,16 @@
     legs  -> up: from the feet to where the legs leave the body
           -> spine: the tree path from the hind pair's fork to the front pair's
     the other end chains, by the spine end they hang from -> head (the end whose chains reach highest
-                                                             along up) and tail (the other), each the
-                                                             longest path out from its end
+                                                             along up) and tail (the other), each what
+                                                             the paths out of its end share
     sides -> the figure's left is up x forward (forward: hind fork -> front fork)
     kind  -> quadruped: two pairs of legs reaching across the spine; many-legged: three or more
 
     rig figure, clip figure --the same kind, as many legs--> each of our bones on a chain takes the clip's
                                                              segment at the same share of that chain's
-                                                             length (hind legs, front legs, spine, head,
-                                                             tail; left with left)
+                                                             length (legs, from their two longest steps
+                                                             down; left with left; the spine), or at the
+                                                             same step from the body (head, tail)
 
 Why chains and not names: an auto-rig's bones are named by where they lie in the volume (``ANT2_1``),
 a clip's by its rigging tool; the shape is what the two have in common. A bone driven by a clip joint
@@ -126,8 +127,7 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
         spine.reverse()
         legs.reverse()
     fig.spine, fig.up = spine, up
-    fig.head = max(out[front], key=fig.reach, default=[])
-    fig.tail = max(out[hind], key=fig.reach, default=[])
+    fig.head, fig.tail = _common(out[front]), _common(out[hind])
     fig.forward = _unit(_flat(points[front] - points[hind], up))
     left = np.cross(up, fig.forward)
     fig.legs = [dict(zip("LR", sorted(pair, key=lambda p: -(points[p[1:]].mean(axis=0) - points[p[0]]) @ left)))
@@ -151,6 +151,17 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 def _flat(v: np.ndarray, up: np.ndarray) -> np.ndarray:
     return v - (v @ up) * up
+
+
+def _common(paths: list[list[int]]) -> list[int]:
+    """What the paths out of one spine end share: the whole path when there is one; the trunk before they
+    part when there are several (Spot's neck, before its horns and its snout part: those follow it)."""
+    if len(paths) <= 1:
+        return paths[0] if paths else []
+    n = 0
+    while all(len(p) > n and p[n] == paths[0][n] for p in paths):
+        n += 1
+    return paths[0][:n] if n >= 2 else []
 
 
 def _end_chains(nbrs: list[list[int]]) -> list[list[int]]:
@@ -271,8 +282,11 @@ def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
             continue
         parts = zip(_limb_parts(rig, path), _limb_parts(clip, other)) if chain.endswith("leg") else [(path, other)]
         for mine, its in parts:
-            for (u, v), t in _steps(rig, mine):
-                joint = _driver(clip, its, t)
+            for k_step, ((u, v), t) in enumerate(_steps(rig, mine)):
+                # a head or a tail step by step from the body (a cow's neck turns as an elephant's, not as the
+                # trunk at the same share of a longer head); a leg or the spine at the same share of its length
+                joint = _driver(clip, its, t) if chain.endswith("leg") or chain == "spine" else \
+                    _driver_at_step(clip, its, k_step)
                 k = path.index(u)  # the step's number along the whole chain
                 bone = bones.bones[bone_of[names[v if rig.parent[v] == u else u]]]
                 if joint < len(motion.names) and bone.label not in mapping:
@@ -302,6 +316,15 @@ def _steps(fig: Figure, path: list[int]) -> list[tuple[tuple[int, int], float]]:
     lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
     mids = (np.cumsum(lengths) - lengths / 2) / max(float(lengths.sum()), 1e-12)
     return [((path[k], path[k + 1]), float(mids[k])) for k in range(len(path) - 1)]
+
+
+def _driver_at_step(fig: Figure, path: list[int], k: int) -> int:
+    """The clip joint turning step ``k`` of ``path`` (its last step past the end)."""
+    k = min(k, len(path) - 2)
+    if k < 0:
+        return path[0] if path else len(fig.points)
+    u, v = path[k], path[k + 1]
+    return u if fig.parent[v] == u else v
 
 
 def _driver(fig: Figure, path: list[int], t: float) -> int:
