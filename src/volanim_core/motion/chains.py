@@ -94,47 +94,52 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
     floor = min(points[p[-1]] @ up for pair in legs for p in pair)
     leg_reach = np.mean([fig.reach(p) for pair in legs for p in pair])
     legs += [pair for pair in pairs[2:] if max(points[p[-1]] @ up for p in pair) - floor <= LOW * leg_reach]
+    if not _mirrored(points, legs):
+        fig.reason = f"{len(legs)} pairs of limbs, but not mirror images of each other across one plane"
+        return fig
     forks = [pair[0][0] for pair in legs]
     used = {n for pair in legs for p in pair for n in p[1:]}
+    fig.up = up
     a, b = max(((x, y) for x in forks for y in forks), key=lambda xy: len(_path(nbrs, *xy)))
-    if a == b:  # every leg leaves one point (an insect's thorax): the body is the longest way through it
-        body = sorted((p for p in ends if p[0] == a and p[-1] not in used), key=lambda p: -fig.reach(p))
-        if len(body) < 2:
-            fig.reason = "every leg leaves one point, and no body runs through it"
+    if a == b:
+        along = _one_fork(fig, nbrs, ends, legs, a, used)
+        if along is None:
             return fig
-        a, b = body[0][-1], body[1][-1]
-    spine = _path(nbrs, a, b)
-    if not set(forks) <= set(spine) or len(spine) < 2:
-        fig.reason = "the limbs do not leave the body along one spine"
-        return fig
-    axis = _unit(points[b] - points[a])  # legs at one fork are ordered by where their hips lie along it
-    legs.sort(key=lambda pair: (spine.index(pair[0][0]), np.mean([points[p[1]] @ axis for p in pair])))
-    out = {a: [], b: []}  # each spine end: paths out from it through no leg and no other spine point
-    for path in ends:
-        if path[-1] in used:
-            continue
-        way = _path(nbrs, path[-1], a)
-        hit = next(n for n in way if n in spine)
-        if hit in out and not set(way[:way.index(hit)]) & (set(spine) | used):
-            out[hit].append(_path(nbrs, hit, path[-1]))
-    high = {e: max((points[n] @ up for p in paths for n in p), default=points[e] @ up) for e, paths in out.items()}
-    if high[a] == high[b] and hips is not None:  # nothing tells: a clip's hierarchy starts at its hips
-        front = b if len(_path(nbrs, hips, a)) <= len(_path(nbrs, hips, b)) else a
     else:
-        front = a if high[a] > high[b] else b
-    hind = b if front == a else a
-    if spine[0] != hind:
-        spine.reverse()
-        legs.reverse()
-    fig.spine, fig.up = spine, up
-    fig.head, fig.tail = _common(out[front]), _common(out[hind])
-    fig.forward = _unit(_flat(points[front] - points[hind], up))
+        spine = _path(nbrs, a, b)
+        if not set(forks) <= set(spine):
+            fig.reason = "the limbs do not leave the body along one spine"
+            return fig
+        axis = points[b] - points[a]  # pairs at one fork of the spine: by where their hips lie along it
+        legs.sort(key=lambda pair: (spine.index(pair[0][0]), np.mean([points[p[1]] @ axis for p in pair])))
+        out = {a: [], b: []}  # each spine end: paths out from it through no leg and no other spine point
+        for path in ends:
+            if path[-1] in used:
+                continue
+            way = _path(nbrs, path[-1], a)
+            hit = next(n for n in way if n in spine)
+            if hit in out and not set(way[:way.index(hit)]) & (set(spine) | used):
+                out[hit].append(_path(nbrs, hit, path[-1]))
+        high = {e: max((points[n] @ up for p in paths for n in p), default=points[e] @ up) for e, paths in out.items()}
+        if high[a] == high[b] and hips is not None:  # nothing tells: a clip's hierarchy starts at its hips
+            front = b if len(_path(nbrs, hips, a)) <= len(_path(nbrs, hips, b)) else a
+        else:
+            front = a if high[a] > high[b] else b
+        hind = b if front == a else a
+        if spine[0] != hind:
+            spine.reverse()
+            legs.reverse()
+        fig.spine, fig.head, fig.tail = spine, _common(out[front]), _common(out[hind])
+        along = points[front] - points[hind]
+        fig.forward = _unit(_flat(along, up))
+        fig.legs = legs
+    legs = fig.legs
     left = np.cross(up, fig.forward)
     fig.legs = [dict(zip("LR", sorted(pair, key=lambda p: -(points[p[1:]].mean(axis=0) - points[p[0]]) @ left)))
                 for pair in legs]
     # all legs' mean: an insect's front legs reach forward and its hind legs back, square to the body together
     leg = np.mean([_unit(points[p[-1]] - points[p[0]]) for pair in fig.legs for p in pair.values()], axis=0)
-    angle = float(np.degrees(np.arccos(np.clip(_unit(leg) @ _unit(points[front] - points[hind]), -1, 1))))
+    angle = float(np.degrees(np.arccos(np.clip(_unit(leg) @ _unit(along), -1, 1))))  # the body as it lies
     said = f"{len(fig.legs)} pairs of legs, at {angle:.0f} degrees from the spine"
     if abs(angle - 90.0) > ACROSS:
         fig.reason = f"the legs do not reach across the spine ({said})"
@@ -151,6 +156,45 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 def _flat(v: np.ndarray, up: np.ndarray) -> np.ndarray:
     return v - (v @ up) * up
+
+
+def _mirrored(points: np.ndarray, legs) -> bool:
+    """Whether the pairs are mirror images across one plane: each pair's ends differ across it (along one
+    normal, within 25 degrees) and meet on it (their middle within a quarter of their distance of the plane
+    through the pair's fork). A rabbit's tail, as long as its legs at the point they all leave, made a
+    "pair" with a hind leg: its ends differ along the body, not across it."""
+    diffs = [points[a[-1]] - points[b[-1]] for a, b in legs]
+    n = _unit(diffs[0])
+    n = _unit(np.sum([d if d @ n >= 0 else -d for d in diffs], axis=0))
+    for (a, b), d in zip(legs, diffs):
+        size = float(np.linalg.norm(d))
+        middle = (points[a[-1]] + points[b[-1]]) / 2 - points[a[0]]
+        if size <= 1e-9 or abs(d @ n) < np.cos(np.radians(25)) * size or abs(middle @ n) > 0.25 * size:
+            return False
+    return True
+
+
+def _one_fork(fig: Figure, nbrs, ends, legs, fork: int, used: set) -> np.ndarray | None:
+    """Every leg leaves one point (an insect's thorax; the rabbit's hips and shoulders, rigged as one): the
+    spine is that point, the head and the tail the two longest ways out of it through no leg (the head's
+    reaching higher), the legs ordered hind to front by where their hips lie along them. The body's
+    direction, tail end to head end; None (and the reason said) when fewer than two such ways leave it."""
+    points, up = fig.points, fig.up
+    ways: dict[int, list[list[int]]] = {}
+    for path in ends:
+        if path[-1] not in used and path[-1] != fork:
+            way = _path(nbrs, fork, path[-1])
+            ways.setdefault(way[1], []).append(way)
+    if len(ways) < 2:
+        fig.reason = "every leg leaves one point, and no body runs through it"
+        return None
+    two = sorted(ways.values(), key=lambda ps: -max(fig.reach(p) for p in ps))[:2]
+    head, tail = sorted(two, key=lambda ps: -max(points[n] @ up for p in ps for n in p[1:]))
+    fig.spine, fig.head, fig.tail = [fork], _common(head), _common(tail)
+    far = [max(ps, key=fig.reach)[-1] for ps in (head, tail)]
+    fig.forward = _unit(_flat(points[far[0]] - points[far[1]], up))
+    fig.legs = sorted(legs, key=lambda pair: np.mean([points[p[1]] @ fig.forward for p in pair]))
+    return points[far[0]] - points[far[1]]
 
 
 def _common(paths: list[list[int]]) -> list[int]:

@@ -171,3 +171,39 @@ def test_axes_given_as_the_figure_reads_them_change_nothing_and_a_reversed_forwa
     travel = lambda r: r.matrices()[-1, 0, 3, :3] - r.matrices()[0, 0, 3, :3]  # noqa: E731
     fwd = auto.report["figure"].forward
     assert travel(auto) @ fwd > 0 > travel(back) @ fwd  # the elephant walks +z: Spot walks its own forward
+
+
+def test_a_tail_as_long_as_the_legs_at_the_point_they_all_leave_is_no_leg():
+    """trimesh's rabbit auto-rigged: four legs and the tail leave one point, the tail as long as a leg and
+    two segments like them; the tail made a pair with a hind leg, the figure read a quadruped with a tail
+    for a leg and up tilted 45 degrees. Pairs must be mirror images across one plane: the rabbit is not read
+    (it was not before either), and the same figure with the tail shorter reads with its legs right."""
+    from volanim_core.motion.chains import read_figure
+
+    def figure(tail):
+        pts = [(0, 0, 10)]  # the point everything leaves (y forward, z up)
+        parent = [-1]
+        for x, y in ((4, 5), (-4, 5), (4, -5), (-4, -5)):  # legs: out, then down
+            pts += [(x, y, 6), (x + 1, y, 0)]
+            parent += [0, len(pts) - 2]
+        pts += [(0, -4, 8), (0, -4 - tail, 8 - tail)]  # the tail, back and down
+        parent += [0, len(pts) - 2]
+        pts += [(0, 6, 12), (0, 9, 14)]  # the head, forward and up
+        parent += [0, len(pts) - 2]
+        return read_figure(np.array(pts, float), np.array(parent))
+
+    fig = figure(tail=3.0)
+    assert fig.kind == "quadruped" and fig.reason.startswith("2 pairs of legs")
+    assert nearest(fig.up) == "z" and nearest(fig.forward) == "y"
+    assert {fig.points[p[-1]][0] > 0 for p in (fig.legs[0]["L"], fig.legs[1]["L"])} == {False}  # left: -x
+    assert fig.points[fig.tail[-1]][1] < 0 < fig.points[fig.head[-1]][1]
+    long_tail = figure(tail=6.0)  # as long as a leg, two segments like one: still no leg
+    tail_end = len(long_tail.points) - 3
+    assert long_tail.kind == "quadruped" and all(p[-1] != tail_end for pair in long_tail.legs for p in pair.values())
+    # the rabbit's pairing, the tail with a hind leg beside the other pair: no mirror images across one plane
+    from volanim_core.motion.chains import _mirrored
+
+    legs = {name: [0, k, k + 1] for name, k in (("fl", 1), ("fr", 3), ("hl", 5), ("hr", 7))}
+    tail = [0, 9, 10]
+    assert _mirrored(long_tail.points, [(legs["fl"], legs["fr"]), (legs["hl"], legs["hr"])])
+    assert not _mirrored(long_tail.points, [(legs["fl"], legs["fr"]), (legs["hl"], tail)])
