@@ -35,7 +35,7 @@ from volanim_core.io.bvh_files import Motion
 
 from .body import TWINS, nearest_axis
 
-ACROSS = 40.0  # a quadruped's legs stand within this of square to its spine (as kind.ACROSS)
+ACROSS = 40.0  # a quadruped's legs stand within this of square to its spine (kind.py's rule too)
 LOW = 0.25  # another pair is a pair of legs when its ends stand this share of a leg's reach from the floor
 
 
@@ -45,6 +45,7 @@ class Figure:
 
     points: np.ndarray  # (N, 3) rest positions
     parent: np.ndarray  # (N,) each point's parent, -1 for the root
+    names: list[str] = field(default_factory=list)  # each point's joint name (a clip's End Sites: "")
     legs: list[dict[str, list[int]]] = field(default_factory=list)  # hind pair first: {"L": path, "R": path}
     spine: list[int] = field(default_factory=list)  # hind fork -> front fork
     head: list[int] = field(default_factory=list)  # front fork -> the head's end
@@ -55,7 +56,8 @@ class Figure:
     reason: str = ""
 
     def chains(self) -> dict[str, list[int]]:
-        """Name -> node path: ``hind L leg``, ``front R leg`` (``leg 2 L`` between them), spine, head, tail."""
+        """Name -> node path: ``hind L leg``, ``front R leg`` (``middle 1 L leg`` between them), spine, head,
+        tail."""
         out = {}
         for i, pair in enumerate(self.legs):
             which = "hind" if i == 0 else "front" if i == len(self.legs) - 1 else f"middle {i}"
@@ -66,15 +68,20 @@ class Figure:
                 out[name] = getattr(self, name)
         return out
 
+    def lengths(self, path: list[int]) -> np.ndarray:
+        """Each step's length along a path."""
+        return np.linalg.norm(np.diff(self.points[path], axis=0), axis=1)
+
     def reach(self, path: list[int]) -> float:
-        return float(np.linalg.norm(np.diff(self.points[path], axis=0), axis=1).sum())
+        return float(self.lengths(path).sum())
 
 
-def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None) -> Figure:
-    """The figure of a tree of points (module docstring). ``hips``: the point a clip's hierarchy starts
-    at, which is its hind end when nothing else tells head from tail."""
+def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None, names=()) -> Figure:
+    """The figure of a tree of points (module docstring; a forest: the trees are read together, a path
+    between two of them is none). ``hips``: the point a clip's hierarchy starts at, which is its hind end
+    when nothing else tells head from tail. ``names``: each point's joint name."""
     points, parent = np.asarray(points, np.float64), np.asarray(parent, np.int64)
-    fig = Figure(points, parent)
+    fig = Figure(points, parent, list(names))
     nbrs: list[list[int]] = [[] for _ in range(len(points))]
     for c, p in enumerate(parent):
         if p >= 0:
@@ -107,7 +114,7 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
             return fig
     else:
         spine = _path(nbrs, a, b)
-        if not set(forks) <= set(spine):
+        if not spine or not set(forks) <= set(spine):
             fig.reason = "the limbs do not leave the body along one spine"
             return fig
         axis = points[b] - points[a]  # pairs at one fork of the spine: by where their hips lie along it
@@ -117,7 +124,7 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None)
             if path[-1] in used:
                 continue
             way = _path(nbrs, path[-1], a)
-            hit = next(n for n in way if n in spine)
+            hit = next((n for n in way if n in spine), None)  # None: a tree apart from the body's
             if hit in out and not set(way[:way.index(hit)]) & (set(spine) | used):
                 out[hit].append(_path(nbrs, hit, path[-1]))
         high = {e: max((points[n] @ up for p in paths for n in p), default=points[e] @ up) for e, paths in out.items()}
@@ -182,8 +189,8 @@ def _one_fork(fig: Figure, nbrs, ends, legs, fork: int, used: set) -> np.ndarray
     points, up = fig.points, fig.up
     ways: dict[int, list[list[int]]] = {}
     for path in ends:
-        if path[-1] not in used and path[-1] != fork:
-            way = _path(nbrs, fork, path[-1])
+        way = _path(nbrs, fork, path[-1]) if path[-1] not in used and path[-1] != fork else []
+        if way:
             ways.setdefault(way[1], []).append(way)
     if len(ways) < 2:
         fig.reason = "every leg leaves one point, and no body runs through it"
@@ -209,17 +216,19 @@ def _common(paths: list[list[int]]) -> list[int]:
 
 
 def _end_chains(nbrs: list[list[int]]) -> list[list[int]]:
-    """From each end (one neighbour) inwards to the first fork (three or more): the path, fork first."""
+    """From each end (one neighbour) inwards to the first fork (three or more): the path, fork first. A
+    tree without a fork (a lone bone beside the body) has none: it used to void the whole figure."""
     out = []
     for end in (n for n in range(len(nbrs)) if len(nbrs[n]) == 1):
         path, prev = [end], -1
         while len(nbrs[path[-1]]) <= 2:
             nxt = [n for n in nbrs[path[-1]] if n != prev]
             if not nxt:
-                return []  # a tree without a fork: one path
+                break  # the other end of a path without a fork
             prev = path[-1]
             path.append(nxt[0])
-        out.append(path[::-1])
+        else:
+            out.append(path[::-1])
     return out
 
 
@@ -245,7 +254,7 @@ def _pairs(fig: Figure, ends: list[list[int]]) -> list[tuple[list[int], list[int
 
 
 def _path(nbrs: list[list[int]], a: int, b: int) -> list[int]:
-    """The tree path from ``a`` to ``b``."""
+    """The tree path from ``a`` to ``b``; ``[]`` when they are in two trees."""
     prev = {a: -1}
     todo = [a]
     while todo and b not in prev:
@@ -254,20 +263,22 @@ def _path(nbrs: list[list[int]], a: int, b: int) -> list[int]:
             if m not in prev:
                 prev[m] = n
                 todo.append(m)
+    if b not in prev:
+        return []
     path = [b]
     while path[-1] != a:
         path.append(prev[path[-1]])
     return path[::-1]
 
 
-def rig_figure(bones) -> tuple[Figure, list[str]]:
-    """Our bones' figure, and the joint name of each of its points."""
+def rig_figure(bones) -> Figure:
+    """Our bones' figure: a point per joint, named as the joint."""
     names = list(bones.joints)
     at = {n: k for k, n in enumerate(names)}
     parent = np.full(len(names), -1)
     for b in bones.bones:
         parent[at[b.distal]] = at[b.proximal]
-    return read_figure(np.array([bones.joints[n] for n in names]), parent), names
+    return read_figure(np.array([bones.joints[n] for n in names]), parent, names=names)
 
 
 def clip_figure(motion: Motion) -> Figure:
@@ -276,7 +287,7 @@ def clip_figure(motion: Motion) -> Figure:
     sites = sorted(motion.end_sites)
     points = np.vstack([rest, [rest[j] + motion.end_sites[j] for j in sites]]) if sites else rest
     parent = np.concatenate([np.asarray(motion.parents, np.int64), np.array(sites, np.int64)])
-    return read_figure(points, parent, hips=0)
+    return read_figure(points, parent, hips=0, names=list(motion.names) + [""] * len(sites))
 
 
 def frame_of(fig: Figure) -> np.ndarray:
@@ -293,7 +304,6 @@ class ChainMatch:
     how: dict[str, str]  # label -> which chain and where along it
     scale: float  # clip units -> voxels: the legs' reach, ours over the clip's
     rig: Figure
-    rig_names: list[str]  # the rig figure's points' joint names
     rig_frame: np.ndarray  # (3, 3): the rig's forward, left and up (:func:`frame_of`)
     clip_frame: np.ndarray  # (3, 3): the clip's, in its axes
     clip_leg: float  # the clip's mean leg reach, in its units
@@ -311,8 +321,7 @@ class ChainMatch:
 
 def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
     """Our bones matched to the clip's chain by chain (module docstring), or None and why not."""
-    rig, names = rig_figure(bones)
-    clip = clip_figure(motion)
+    rig, clip = rig_figure(bones), clip_figure(motion)
     if rig.kind == "other" or clip.kind == "other":
         return None, f"the rig: {rig.kind} ({rig.reason}); the clip: {clip.kind} ({clip.reason})"
     if len(rig.legs) != len(clip.legs):
@@ -332,13 +341,13 @@ def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
                 joint = _driver(clip, its, t) if chain.endswith("leg") or chain == "spine" else \
                     _driver_at_step(clip, its, k_step)
                 k = path.index(u)  # the step's number along the whole chain
-                bone = bones.bones[bone_of[names[v if rig.parent[v] == u else u]]]
+                bone = bones.bones[bone_of[rig.names[v if rig.parent[v] == u else u]]]
                 if joint < len(motion.names) and bone.label not in mapping:
                     mapping[bone.label] = motion.names[joint]
                     how[bone.label] = f"chain: {chain}, {k + 1} of {len(path) - 1}"
     ours = np.mean([rig.reach(p) for pair in rig.legs for p in pair.values()])
     clips = np.mean([clip.reach(p) for pair in clip.legs for p in pair.values()])
-    return ChainMatch(mapping, how, float(ours / clips) if clips > 1e-9 else 1.0, rig, names, frame_of(rig),
+    return ChainMatch(mapping, how, float(ours / clips) if clips > 1e-9 else 1.0, rig, frame_of(rig),
                       frame_of(clip), float(clips)), ""
 
 
@@ -346,7 +355,7 @@ def _limb_parts(fig: Figure, path: list[int]) -> list[list[int]]:
     """A leg as ``[before, limb]``: the limb from the first of its two longest consecutive steps (thigh and
     shin, upper arm and forearm) to the foot, and what leads to it (a clavicle, a scapula), so a clip's
     clavicle does not drive a rig's upper leg. ``before`` is ``[]`` when the limb starts at the fork."""
-    lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
+    lengths = fig.lengths(path)
     if len(lengths) < 3:
         return [[], path]
     i = int(np.argmax(lengths[:-1] + lengths[1:]))
@@ -357,13 +366,14 @@ def _steps(fig: Figure, path: list[int]) -> list[tuple[tuple[int, int], float]]:
     """``((u, v), t)`` per step of a path: its two points and the share of the path's length at its middle."""
     if len(path) < 2:
         return []
-    lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
+    lengths = fig.lengths(path)
     mids = (np.cumsum(lengths) - lengths / 2) / max(float(lengths.sum()), 1e-12)
     return [((path[k], path[k + 1]), float(mids[k])) for k in range(len(path) - 1)]
 
 
 def _driver_at_step(fig: Figure, path: list[int], k: int) -> int:
-    """The clip joint turning step ``k`` of ``path`` (its last step past the end)."""
+    """The clip joint turning step ``k`` of ``path`` (its last step past the end): the step's upper point;
+    a path with no step: its only point; none (``len(points)``, no joint) for an empty one."""
     k = min(k, len(path) - 2)
     if k < 0:
         return path[0] if path else len(fig.points)
@@ -372,12 +382,8 @@ def _driver_at_step(fig: Figure, path: list[int], k: int) -> int:
 
 
 def _driver(fig: Figure, path: list[int], t: float) -> int:
-    """The clip joint turning the step of ``path`` at share ``t`` of its length: the step's upper point
-    (a path with no step: its only point's own)."""
+    """The clip joint turning the step of ``path`` at share ``t`` of its length (:func:`_driver_at_step`)."""
     if len(path) < 2:
-        return path[0] if path else len(fig.points)
-    lengths = np.linalg.norm(np.diff(fig.points[path], axis=0), axis=1)
-    ends = np.cumsum(lengths) / max(float(lengths.sum()), 1e-12)
-    k = min(int(np.searchsorted(ends, t)), len(path) - 2)
-    u, v = path[k], path[k + 1]
-    return u if fig.parent[v] == u else v
+        return _driver_at_step(fig, path, 0)
+    lengths = fig.lengths(path)
+    return _driver_at_step(fig, path, int(np.searchsorted(np.cumsum(lengths) / max(float(lengths.sum()), 1e-12), t)))

@@ -27,10 +27,10 @@ import numpy as np
 from volanim_core.io.bvh_files import Motion
 
 from .body import Sampled, children, longest_path, reach, sizes, twins
+from .chains import ACROSS, clip_figure, rig_figure
 from .presets import part_of
 
 BIPED = 120.0  # degrees between the spine and the legs: a person's are near 180, sitting near 135
-ACROSS = 40.0  # a quadruped's legs stand within this of square to its spine
 SAME = 45.0  # and its front and hind legs reach the same way, within this
 
 
@@ -47,8 +47,6 @@ def _angles(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def clip_kind(motion: Motion, s: Sampled) -> Kind:
     """The kind of the clip's figure, and the reason in words (printed by ``bvh2trans``)."""
-    from .chains import clip_figure
-
     figure = clip_figure(motion)
     if figure.kind == "many-legged":  # three pairs or more: no biped's or quadruped's reading applies (#86)
         return Kind("many-legged", figure.reason)
@@ -104,7 +102,5 @@ def rig_kind(bones, by_shape: bool = True) -> str | None:
         return "quadruped"
     if not by_shape:
         return None
-    from .chains import rig_figure
-
-    kind = rig_figure(bones)[0].kind
+    kind = rig_figure(bones).kind
     return None if kind == "other" else kind

@@ -62,7 +62,8 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
     frames = np.unique(np.linspace(0, motion.frames - 1, min(samples, motion.frames)).round().astype(int))
     mats = retarget.matrices(frames)
     checks = []
-    clip, ours = retarget.report.get("kind"), rig_kind(bones)
+    figure = retarget.report.get("figure")  # a creature matched by its chains: its kind, read once
+    clip, ours = retarget.report.get("kind"), (rig_kind(bones) if figure is None else figure.kind)
     # a mapping the user gave is their word (#86): a clip of one arm drives what it maps, so the figure's kind
     # is not asked, and only checks of bones it drives are made
     given = retarget.report.get("scheme") == "given"
@@ -71,7 +72,6 @@ def check_clip(retarget, samples: int = 64) -> tuple[list[Check], int]:
         checks.append(Check(f"the clip's figure is a {ours}, as the rig", float(clip.kind == ours),
                             f"it is {'a ' if clip.kind != 'other' else ''}{clip.kind}: {clip.reason}; "
                             "a clip drives a rig of its own kind", whole=True))
-    figure = retarget.report.get("figure")
     if figure is not None:
         checks += _creature_checks(bones, mats, figure, retarget, driven)
     by_part = {part_of(b.label): k for k, b in enumerate(bones.bones)}
@@ -123,7 +123,7 @@ def refuse_failed(path, checks: list[Check], suggested: dict[str, str] | None = 
 
 def _creature_checks(bones, mats: np.ndarray, figure, retarget, driven: set[int]) -> list[Check]:
     """The checks of a creature's figure (:class:`~.chains.Figure`), along its own up."""
-    names = list(bones.joints)  # the figure's points, as chains.rig_figure read them
+    names = figure.names
     bone_at = {b.distal: k for k, b in enumerate(bones.bones)}
     legs = [path for pair in figure.legs for path in pair.values()]
     if not legs or not {bone_at[names[n]] for path in legs for n in path[1:]} <= driven:

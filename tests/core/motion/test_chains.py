@@ -41,7 +41,7 @@ def test_spot_reads_as_a_quadruped_by_its_shape_though_no_bone_names_a_part(spot
     _, bones = spot
     assert not any("THIGH" in b.label or "FEMUR" in b.label for b in bones.bones)
     assert rig_kind(bones, by_shape=False) is None and rig_kind(bones) == "quadruped"
-    fig, names = rig_figure(bones)
+    fig = rig_figure(bones)
     assert len(fig.legs) == 2 and fig.head and nearest(fig.up) == "y"  # Spot's mesh stands in y
 
 
@@ -62,15 +62,15 @@ def test_each_leg_of_spot_follows_the_elephant_s_leg_of_the_same_pair_and_side(s
     for pair, limb in zip(rig.legs, ("Thigh|Calf|HorseLink|Foot", "UpperArm|Forearm|Hand")):
         for side, path in pair.items():
             for n in path[1:]:
-                joint = found.mapping[next(b.label for b in bones.bones if b.distal == found.rig_names[n])]
+                joint = found.mapping[next(b.label for b in bones.bones if b.distal == found.rig.names[n])]
                 assert joint.startswith(f"Bip01_{side}_") and joint.split("_")[-1] in limb.split("|"), (side, joint)
     retarget = Retarget.build(bones, motion)
     mats = retarget.matrices()
-    foot = found.rig_names[rig.legs[0]["L"][-1]]
+    foot = found.rig.names[rig.legs[0]["L"][-1]]
     ours = bones.joints[foot] @ mats[:, _bone_ending(bones, foot), :3, :3] + mats[:, _bone_ending(bones, foot), 3, :3]
     _, pos = motion.forward_kinematics(slice(None))
     theirs = pos[:, motion.index("Bip01_L_Foot")] - pos[:, motion.index("Bip01")]  # the foot from the body
-    root = bones.joints[found.rig_names[rig.spine[0]]] @ mats[:, 0, :3, :3] + mats[:, 0, 3, :3]
+    root = bones.joints[found.rig.names[rig.spine[0]]] @ mats[:, 0, :3, :3] + mats[:, 0, 3, :3]
     along_ours = (ours - root) @ rig.forward
     along_theirs = theirs @ np.array([0.0, 0.0, 1.0])  # the elephant faces +z
     assert np.corrcoef(along_ours, along_theirs)[0, 1] > 0.95
@@ -140,7 +140,7 @@ def test_the_ant_walks_an_insect_s_tripod_each_leg_with_its_twin_of_the_clip(ant
         number = 3 - k  # hind first: the ant's and the insect's legs are numbered 1 front .. 3 hind
         for side, path in pair.items():
             for n in path[1:]:
-                bone = next(b for b in bones.bones if b.distal == found.rig_names[n])
+                bone = next(b for b in bones.bones if b.distal == found.rig.names[n])
                 assert bone.distal.startswith(f"{side}_") and bone.distal.endswith(str(number))  # the ant's joints
                 joint = found.mapping[bone.label]
                 if n == path[1] and joint == "Thorax":  # the step leaving the body turns with the body, in both
@@ -207,3 +207,22 @@ def test_a_tail_as_long_as_the_legs_at_the_point_they_all_leave_is_no_leg():
     tail = [0, 9, 10]
     assert _mirrored(long_tail.points, [(legs["fl"], legs["fr"]), (legs["hl"], legs["hr"])])
     assert not _mirrored(long_tail.points, [(legs["fl"], legs["fr"]), (legs["hl"], tail)])
+
+
+
+@pytest.mark.parametrize("apart", [2, 3])  # a lone bone (a path of two points), a chain of two bones
+def test_bones_apart_from_the_body_leave_its_figure_read(spot, apart):
+    """Review: a rig may be a forest (a bone starting at a joint no bone ends at begins a tree of its own).
+    A lone bone beside Spot made ``_end_chains`` give up on the whole figure ("the tree does not fork") and
+    a path asked between two trees raised KeyError: bvh2trans would have refused or crashed on Spot."""
+    from volanim_core.rig.bones import Bone, BoneSkeleton
+
+    folder, bones = spot
+    joints = dict(bones.joints)
+    joints.update({f"APART_{k}": np.array([200.0 + 10 * k, 0.0, 0.0]) for k in range(apart)})
+    extra = [Bone(f"APART_{k}", f"APART_{k + 1}") for k in range(apart - 1)]
+    forest = BoneSkeleton(joints, bones.bones + extra, bones.geometry)
+    assert rig_kind(forest) == "quadruped"
+    found, why = match_chains(forest, read_bvh(folder / "elephant.bvh"))
+    assert found is not None, why
+    assert found.mapping == match_chains(bones, read_bvh(folder / "elephant.bvh"))[0].mapping
