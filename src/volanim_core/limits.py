@@ -110,10 +110,25 @@ def check_allocation(shape, bytes_per_voxel: int, what: str, advice: str) -> Non
                          f"{human_bytes(free)} of memory is available: {advice}")
 
 
+def shaped(value, shape: tuple, name: str, dtype=np.float64, hint: str = "") -> np.ndarray:
+    """``value`` as a C-contiguous array of ``shape`` (-1: any length), or a ValueError that names the argument,
+    the shape it needs and the one it has: the library's callers got numpy's "cannot reshape array of size 12
+    into shape (4,4)" (#89)."""
+    a = np.ascontiguousarray(value, dtype=dtype)
+    if a.ndim == 1 and len(shape) == 1 or a.ndim == len(shape):
+        if all(want in (-1, have) for want, have in zip(shape, a.shape)):
+            return a
+    want = " x ".join("N" if v == -1 else str(v) for v in shape)
+    raise ValueError(f"{name} must be an array of shape ({want}), got shape {a.shape}" + (f"; {hint}" if hint else ""))
+
+
 def voxel_points(points) -> np.ndarray:
     """``(N, 3)`` int32 voxel coordinates; NaN, fractions and magnitudes over ``MAX_COORD`` are a
     ValueError naming the point (a plain int32 cast wraps 3e9 to -2147483648)."""
     raw = np.asarray(points)
+    # (N, 3), or flat x y z x y z as some callers give them
+    if raw.size and (raw.ndim > 2 or raw.shape[-1] != 3 and raw.ndim == 2 or raw.size % 3):
+        raise ValueError(f"points must be an array of shape (N x 3): x, y, z of each voxel, got shape {raw.shape}")
     if raw.size and raw.dtype.kind not in "biuf":
         raise ValueError(f"point coordinates must be numbers, got {raw.dtype}")
     if raw.size and raw.dtype.kind == "f":

@@ -11,6 +11,7 @@ at a time; other formats (``.vti``, ``.nrrd``) are read whole, as their readers 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -108,7 +109,8 @@ def apply_palette(slabs: ColourSlabs, palette: np.ndarray, output, *, progress: 
     output = raw_volumes.raw_name_for(output, slabs.shape)
     report(0, slabs.shape[2])
     if Path(output).suffix.lower() == ".vol":
-        with atomic_open(output, "wb") as fh:
+        size = math.prod(slabs.shape[:3]) + (raw_volumes.HEADER_BYTES if Path(output).suffix == ".VOL" else 0)
+        with atomic_open(output, "wb", size=size) as fh:
             if Path(output).suffix == ".VOL":
                 fh.write(raw_volumes.header_bytes(slabs.shape))
             for _, _, slab in slabs.slabs(report):

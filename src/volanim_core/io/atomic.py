@@ -24,26 +24,47 @@ from pathlib import Path
 LEGACY_STALE_SECONDS = 600  # temporaries without a pid (older versions) are stale after this
 
 
-def out_of_room(exc: BaseException, path, what: str) -> OSError | None:
+def free_bytes(path) -> int | None:
+    """Bytes a user may still write on the device that holds ``path`` (its nearest existing folder); None
+    when that cannot be read."""
+    folder = Path(path)
+    while not folder.is_dir() and folder != folder.parent:
+        folder = folder.parent
+    try:
+        room = os.statvfs(folder)
+    except OSError:
+        return None
+    return room.f_bavail * room.f_frsize
+
+
+def out_of_room(exc: BaseException, path, what: str, needs=None) -> OSError | None:
     """The full disk ``exc`` (ENOSPC, no file named) said of ``path``, the file being written: the CLI names
-    an OSError's file, and named the *input* it was reading when none was given. None for anything else."""
+    an OSError's file, and named the *input* it was reading when none was given. None for anything else.
+
+    The message says how much room the write needs and how much is free (#89: "it needs more" left the user
+    guessing how much to clear). ``needs``: bytes (an int), a phrase ("up to 1,234 bytes"), or a callable
+    giving either, asked only when the disk filled (what is left to write is known only then)."""
     if isinstance(exc, OSError) and exc.errno == errno.ENOSPC and exc.filename is None:
-        return OSError(errno.ENOSPC, f"no space left on the device for {what}", str(path))
+        needs = needs() if callable(needs) else needs
+        need = f"{needs:,} bytes" if isinstance(needs, int) else (needs or "more room than there is")
+        free = free_bytes(path)
+        room = "the free room could not be read" if free is None else f"{free:,} bytes are free there"
+        return OSError(errno.ENOSPC, f"no space left on the device for {what}; it needs {need}, {room}", str(path))
     return None
 
 
 class naming_the_output:  # noqa: N801 - used as a context manager, named as one
-    """``with naming_the_output(path, what):`` re-raises a full disk met inside as :func:`out_of_room` of
+    """``with naming_the_output(path, what, needs):`` re-raises a full disk met inside as :func:`out_of_room` of
     ``path``. Reusable: one object may guard several blocks writing the same output."""
 
-    def __init__(self, path, what: str):
-        self.path, self.what = path, what
+    def __init__(self, path, what: str, needs=None):
+        self.path, self.what, self.needs = path, what, needs
 
     def __enter__(self):
         return self
 
     def __exit__(self, kind, exc, tb):
-        full = out_of_room(exc, self.path, self.what) if exc is not None else None
+        full = out_of_room(exc, self.path, self.what, self.needs) if exc is not None else None
         if full is not None:
             raise full from exc
         return False
@@ -140,8 +161,9 @@ _UMASK = _read_umask()  # read once: os.umask is process-wide, changing it per w
 
 
 @contextlib.contextmanager
-def atomic_open(path: str | Path, mode: str = "w", **kwargs):
-    """Open a temporary file for writing; on success rename it to ``path``."""
+def atomic_open(path: str | Path, mode: str = "w", *, size: int | None = None, **kwargs):
+    """Open a temporary file for writing; on success rename it to ``path``. ``size``: the bytes the file
+    will take, when the writer knows (a full disk's message says it)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(path.parent, path.name)
@@ -160,7 +182,8 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs):
         written = tmp.stat().st_size if tmp.exists() else 0
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
-        full = out_of_room(exc, path, f"it ({written:,} bytes were written when the disk filled; it needs more)")
+        needs = size if size is not None else f"more than {written:,} bytes (that much was written when it filled)"
+        full = out_of_room(exc, path, "it", needs)
         if full is not None:
             raise full from exc
         raise
@@ -168,13 +191,14 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs):
 
 def atomic_write_text(path: str | Path, text: str) -> None:
     """Write ``text`` to ``path`` atomically (UTF-8, ``\\n`` line ends)."""
-    with atomic_open(path, "w", encoding="utf-8", newline="\n") as fh:
-        fh.write(text)
+    data = text.encode("utf-8")  # its size known before writing: a full disk's message says it
+    with atomic_open(path, "wb", size=len(data)) as fh:
+        fh.write(data)
 
 
 def atomic_write_bytes(path: str | Path, data: bytes | memoryview) -> None:
     """Write ``data`` to ``path`` atomically."""
-    with atomic_open(path, "wb") as fh:
+    with atomic_open(path, "wb", size=memoryview(data).nbytes) as fh:
         fh.write(data)
 
 
@@ -209,8 +233,8 @@ def _check_room(path: Path, dataset) -> None:
     free = min(room.f_bavail, room.f_bfree) * room.f_frsize
     need = int(dataset.actual_memory_size * 1024 * (1.5 if path.suffix.lower() in _XML_SUFFIXES else 3)) + (1 << 20)
     if free < need:
-        raise OSError(errno.ENOSPC, f"not enough room to write {path}: {free:,} bytes free, it may take up to "
-                                    f"{need:,}; the file that was there is unchanged")
+        raise OSError(errno.ENOSPC, f"not enough room to write {path}: it needs up to {need:,} bytes, {free:,} "
+                                    "bytes are free there; the file that was there is unchanged")
 
 
 def _check_vtk_file(tmp: Path, path: Path, dataset) -> None:
@@ -236,5 +260,8 @@ def _check_vtk_file(tmp: Path, path: Path, dataset) -> None:
         except Exception:  # noqa: BLE001 - VTK's readers raise many types; any of them means not written
             complete = False
     if not complete:
-        raise OSError(errno.ENOSPC, f"VTK could not finish writing {path} (is the disk full?); "
-                                    "the file that was there is unchanged")
+        free = free_bytes(tmp.parent)
+        raise OSError(errno.ENOSPC, f"VTK could not finish writing {path} (is the disk full? it needs about "
+                                    f"{dataset.actual_memory_size * 1024:,} bytes, "
+                                    f"{'an unknown number of' if free is None else f'{free:,}'} bytes are free "
+                                    "there); the file that was there is unchanged")

@@ -46,7 +46,30 @@ def _format_root(b: BoneSegment) -> str:
     return f"Root: {p} :: {d}" + (f" {b.name}" if b.name else "")
 
 
-def _parse_matrix(rec: TextRecords, records, start: int, root_line: int) -> np.ndarray:
+def _whole(token: str) -> bool:
+    return token.lstrip("+-").isdigit()
+
+
+def _refuse_a_point_as_row_4(rec: TextRecords, records, start: int, rows) -> None:
+    """In a ``.tskel`` without ``# points:``, a 4th matrix row ``x y z 1`` of whole numbers may be the first
+    point (dt 1) after a matrix of 3 rows (docs/formats.md, ``.tskel``): read as a translation, the point was
+    silently gone (#89). The file's own writing tells them apart when rows 1-3 are written with decimals and
+    row 4 is not (a point line); when all four are whole numbers nothing can, and the file is refused with
+    what to add. A zero translation is read as one: no skeleton point lies at the grid's corner."""
+    line, toks = records[start + 3]
+    if not (all(_whole(t) for t in toks[:3]) and rows[3][3] == 1.0) or not any(rows[3][:3]):
+        return
+    above = [t for k in range(3) for t in records[start + k][1]]
+    if all(_whole(t) for t in above):
+        raise rec.error(line, f"'{' '.join(toks)}' may be this matrix's translation or, after a matrix of 3 rows, "
+                              "a point x y z with dt 1; add a '# points: N' line (the number of point lines) to "
+                              "the header to say which")
+    raise rec.error(line, f"the matrix has 3 rows: '{' '.join(toks)}' is written as a point (whole numbers, where "
+                          "the rows above it have decimals); expected 4 rows of 4 numbers")
+
+
+def _parse_matrix(rec: TextRecords, records, start: int, root_line: int, *, points_follow: bool = False
+                  ) -> np.ndarray:
     rows = []
     for k in range(4):
         if start + k >= len(records):
@@ -63,6 +86,8 @@ def _parse_matrix(rec: TextRecords, records, start: int, root_line: int) -> np.n
         line = records[start][0]
         raise rec.error(line, "matrix is not affine: its last column must be 0 0 0 1 "
                         "(row-vector convention, translation in row 4)")
+    if points_follow and "points" not in rec.header:
+        _refuse_a_point_as_row_4(rec, records, start, rows)
     return np.array(rows)
 
 
@@ -118,7 +143,7 @@ def _read_rooted(path, *, matrices: bool, points: bool):
             root_lines.append(line)
             i += 1
             if matrices:
-                mats.append(_parse_matrix(rec, records, i, line))
+                mats.append(_parse_matrix(rec, records, i, line, points_follow=points))
                 i += 4
             continue
         if not bones:

@@ -176,7 +176,7 @@ def write_tiff_stack(path: str | Path, vol: np.ndarray, geometry) -> None:
     buffer = io.BytesIO()  # tifffile wants a named file; the atomic temporary has none
     tifffile.imwrite(buffer, zyx, imagej=True, resolution=(1 / sx, 1 / sy),
                      metadata={"spacing": sz, "unit": "mm", "axes": "ZYXS" if zyx.ndim == 4 else "ZYX"})
-    with atomic_open(path, "wb") as fh:
+    with atomic_open(path, "wb", size=buffer.getbuffer().nbytes) as fh:
         fh.write(buffer.getvalue())
 
 
@@ -229,7 +229,8 @@ def write_slices(pattern: str, vol: np.ndarray) -> list[Path]:
     stage = folder / pending_name("stack")
     stage.mkdir()
     try:
-        with naming_the_output(pattern, "the slices (the folder's old slices are as they were)"):
+        with naming_the_output(pattern, "the slices (the folder's old slices are as they were)",
+                               f"up to {vol.nbytes:,} bytes (the slices uncompressed)"):
             for z, path in enumerate(out):
                 picture = np.ascontiguousarray(np.swapaxes(vol[:, :, z], 0, 1))
                 data = iio.imwrite("<bytes>", picture, extension=path.suffix)

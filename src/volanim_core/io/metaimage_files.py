@@ -105,6 +105,6 @@ def write_metaimage(path: str | Path, vol: np.ndarray, geometry: Geometry = IDEN
         + f"ElementType = {element}\nElementDataFile = LOCAL\n"
     )
     data = vol.transpose(2, 1, 0, 3) if rgb else vol.T
-    with atomic_open(path, "wb") as fh:
+    with atomic_open(path, "wb", size=len(header) + vol.nbytes) as fh:
         fh.write(header.encode("ascii"))
         fh.write(np.ascontiguousarray(data).astype(vol.dtype.newbyteorder("<")).tobytes())

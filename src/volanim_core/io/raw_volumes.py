@@ -189,7 +189,7 @@ def write_raw(path: str | Path, vol: np.ndarray, *, header: bool | None = None) 
     vol = _as_uint8(vol)
     if header is None:
         header = Path(path).suffix == ".VOL"
-    with atomic_open(path, "wb") as fh:
+    with atomic_open(path, "wb", size=vol.nbytes + (HEADER_BYTES if header else 0)) as fh:
         if header:
             fh.write(header_bytes(vol.shape))
         # Transposing the F-order view gives C order: bytes x fastest (RGB: channel, then x).
@@ -211,7 +211,7 @@ def add_header(src: str | Path, dst: str | Path, dims=None) -> tuple[int, int, i
     dims, offset, channels = raw_layout(src, dims, allocate=False)
     if offset:
         raise FormatError(src, "already has a .VOL header")
-    with Path(src).open("rb") as fin, atomic_open(dst, "wb") as fout:
+    with Path(src).open("rb") as fin, atomic_open(dst, "wb", size=HEADER_BYTES + math.prod(dims) * channels) as fout:
         fout.write(header_bytes(dims))
         _copy_stream(fin, fout, math.prod(dims) * channels)
     return dims

@@ -382,5 +382,5 @@ def _write_nifti(path: Path, vol: np.ndarray, geometry: Geometry) -> None:
         import gzip
 
         data = gzip.compress(data, compresslevel=6)
-    with atomic_open(path, "wb") as fh:
+    with atomic_open(path, "wb", size=len(data)) as fh:
         fh.write(data)

@@ -32,8 +32,14 @@ def interpolate(bones: BoneSkeleton, keys: dict[int, KeyPose], frames, *, ease: 
     """``(F, B, 4, 4)`` pose matrices (``.trans``) at ``frames`` from the keys (frame -> KeyPose)."""
     frames = np.asarray(frames, np.float64).reshape(-1)
     n = len(bones)
+    if not np.isfinite(frames).all():  # SciPy said "Interpolation times must be within the range" (#89)
+        i = int(np.flatnonzero(~np.isfinite(frames))[0])
+        raise ValueError(f"frames: item {i} is {frames[i]}; the frames asked for must be finite numbers")
     if not keys:
         return pose_frames(bones, np.tile(np.eye(3), (len(frames), n, 1, 1)))
+    bad = [k for k in keys if not np.isfinite(float(k)) or float(k) != round(float(k)) or not 0 <= k <= MAX_FRAMES]
+    if bad:
+        raise ValueError(f"keys: a key at frame {bad[0]}; keys sit at whole frames 0 to {MAX_FRAMES}")
     at = np.array(sorted(keys), np.float64)
     poses = [keys[int(k)] for k in at]
     names = bone_keys(bones)

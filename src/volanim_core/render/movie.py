@@ -414,7 +414,8 @@ def encode(pngs: list[Path], out: Path, fps: float) -> None:
     out.parent.mkdir(parents=True, exist_ok=True)
     clean_stale(out.parent, out.name)
     tmp = out.parent / (pending_name(out.name) + out.suffix)  # the encoder picks the format by extension
-    with naming_the_output(out, "the movie"):
+    pictures = sum(p.stat().st_size for p in pngs)
+    with naming_the_output(out, "the movie", f"about {pictures:,} bytes (its pictures' size)"):
         try:
             if out.suffix.lower() == ".mp4":
                 with iio2.get_writer(tmp, format="FFMPEG", fps=fps, codec="libx264", quality=8, macro_block_size=16,

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
-from volanim_core.limits import voxel_points
+from volanim_core.limits import shaped, voxel_points
 from volanim_core.rig.skinning import RIGID, Joints, Skin, cached_skin
 from volanim_core.skeleton.points import check_metric
 
@@ -37,8 +37,9 @@ class BoneSegment:
     name: str = ""
 
     def __post_init__(self):
-        self.proximal = np.asarray(self.proximal, dtype=np.float64).reshape(3)
-        self.distal = np.asarray(self.distal, dtype=np.float64).reshape(3)
+        whose = f"bone {self.name}'s" if self.name else "a bone's"
+        self.proximal = shaped(self.proximal, (3,), f"{whose} proximal joint")
+        self.distal = shaped(self.distal, (3,), f"{whose} distal joint")
 
     def __eq__(self, other) -> bool:
         return (
@@ -64,10 +65,10 @@ class BoneSegment:
 def _points_fields(points, dt, thinness, bone):
     points = voxel_points(points)
     n = len(points)
-    dt = np.ascontiguousarray(dt, dtype=np.float64).reshape(n)
+    dt = shaped(dt, (n,), f"dt (one radius for each of the {n:,} points)")
     thinness = np.full(n, np.nan) if thinness is None else thinness
-    thinness = np.ascontiguousarray(thinness, dtype=np.float64).reshape(n)
-    bone = np.ascontiguousarray(bone, dtype=np.int32).reshape(n)
+    thinness = shaped(thinness, (n,), f"thinness (one for each of the {n:,} points)")
+    bone = shaped(bone, (n,), f"bone (one bone index for each of the {n:,} points)", np.int32)
     return points, dt, thinness, bone
 
 
@@ -98,7 +99,9 @@ class Connectivity:
         )
         check_metric(self.metric)
         if len(self.bone) and (self.bone.min() < 0 or self.bone.max() >= len(self.bones)):
-            raise ValueError("point bone index out of range of the bone list")
+            i = int(np.flatnonzero((self.bone < 0) | (self.bone >= len(self.bones)))[0])
+            raise ValueError(f"bone: point {i}'s bone index {int(self.bone[i])} is not one of the "
+                             f"{len(self.bones)} bones (0 to {len(self.bones) - 1}, root order)")
         self._skin: Skin | None = None
 
     @property
@@ -164,9 +167,11 @@ class Connectivity:
 
 
 def _check_matrices(matrices, bones):
-    m = np.ascontiguousarray(matrices, dtype=np.float64).reshape(-1, 4, 4)
-    if len(m) != len(bones):
-        raise ValueError(f"{len(m)} matrices for {len(bones)} bones")
+    m = np.asarray(matrices, dtype=np.float64)
+    if m.shape == (4, 4) or m.size == 0:  # one bone's matrix alone; no bones, no matrices
+        m = m.reshape(-1, 4, 4)
+    m = shaped(m, (len(bones), 4, 4), f"matrices (one 4 x 4 for each of the {len(bones)} bones)",
+               hint="each maps [x y z 1] @ M, so a 3 x 4 affine needs the column 0 0 0 1 added")
     bad = ~np.isfinite(m).all(axis=(1, 2))
     if bad.any():  # as the files' readers refuse them: a NaN frame reconstructs to nothing
         b = int(np.argmax(bad))

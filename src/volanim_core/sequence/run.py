@@ -217,7 +217,15 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
     plan = {"key": key, "mode": mode, "kernel": kernel, "padding": padding, "frames": len(frames),
             "numbers": [f.number for f in frames], "bounds": [list(bounds.lo), list(bounds.hi)], "dtype": dtype.str}
     # a full disk names the store: it stopped there, and its finished frames stay for the next run
-    full_disk = naming_the_output(out, "the sequence store (its finished frames are kept: run again with room)")
+    records: dict[int, dict] = {}
+    frame_bytes = int(np.prod(bounds.shape, dtype=np.int64)) * dtype.itemsize  # a frame's most, uncompressed
+
+    def room_left() -> str:
+        left = len(frames) - len(records)
+        return f"up to {left * frame_bytes:,} bytes ({left} frames of at most {frame_bytes:,})"
+
+    full_disk = naming_the_output(out, "the sequence store (its finished frames are kept: run again with room)",
+                                  room_left)
     old = store.read_plan(out) if out.exists() else None
     if out.exists() and old is None and (out.is_file() or any(out.iterdir())):
         # never replaced, even with --force: it may be anything the user keeps there
@@ -239,7 +247,7 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
     todo = [i for i in range(len(frames)) if i not in done]
     payload = Payload(conn, mode, kernel, bounds, str(resolved(out)), source, source_geometry, every_frame_as,
                       threads_per_worker)
-    records = dict(done)
+    records.update(done)
     total = len(frames)
     task_seconds = DASK_TASK_SECONDS if scheduler is not None else 0.0
     with full_disk, executor(reconstruct_frames, payload, install, workers=n_workers, scheduler=scheduler,

@@ -130,7 +130,7 @@ def sequence_store(full: Path, spare: Path) -> dict:
         run_sequence(conn, walk, full / "s.zarr", SequenceSettings(mode="bone"), on=RunOn(workers=1))
         result["raised"] = None
     except OSError as exc:
-        result["raised"] = f"{type(exc).__name__}: {exc}"[:300]
+        result["raised"] = f"{type(exc).__name__}: {exc}"[:600]
     recorded = sorted(store.finished(full / "s.zarr"))
     result["recorded"] = len(recorded)
     result["frames"] = len(walk)
@@ -167,7 +167,7 @@ def frame_folder(full: Path, spare: Path) -> dict:
         write_frames(full / "out", "walk", bones, mats, range(len(mats)))
         result["raised"] = None
     except OSError as exc:
-        result["raised"] = f"{type(exc).__name__}: {exc}"[:300]
+        result["raised"] = f"{type(exc).__name__}: {exc}"[:600]
     result["written"] = len(list((full / "out").glob("*.trans")))
     result["marked"] = incomplete_marker(full / "out", "walk").is_file()
     try:
@@ -198,7 +198,7 @@ def main(full: Path, spare: Path) -> None:
             write(target)
             result["raised"] = None
         except Exception as exc:  # noqa: BLE001 - which type is part of the report
-            result["raised"] = f"{type(exc).__name__}: {exc}"[:300]
+            result["raised"] = f"{type(exc).__name__}: {exc}"[:600]
             result["traceback"] = "Traceback" if not isinstance(exc, OSError | ValueError) else ""
             if result["traceback"]:
                 result["traceback"] = traceback.format_exc()[-600:]

@@ -7,6 +7,7 @@ needed, nothing to unmount if the test dies), whose disk is filled to 24 kB befo
 from __future__ import annotations
 
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -43,6 +44,10 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
         assert r["litter"] == [], r
     unnamed = [(r["writer"], r["raised"]) for r in rows if r["target"] not in r["raised"]]
     assert not unnamed, unnamed  # the message names the file that did not fit (#64)
+    # and how much room it needs and how much is free (#89: "it needs more" said neither)
+    vague = [(r["writer"], r["raised"]) for r in rows if not re.search(r"needs? [^,;]*\d[\d,]* bytes", r["raised"])
+             or not re.search(r"[\d,]+ bytes (are )?free", r["raised"])]
+    assert not vague, vague
     # a clip's frames: the run stops naming a frame, the folder is marked and refused, the rerun completes it
     assert frames["writer"] == "frame folder .trans" and ".trans" in (frames["raised"] or ""), frames
     assert 0 < frames["written"] < frames["frames"] and frames["marked"], frames

@@ -154,7 +154,20 @@ def test_tskel_three_row_matrix_before_a_point_with_dt_1_is_refused_by_the_count
     # one bone translated by (10, 10, 10) holding one point, silently.
     body = "Root: 0 0 0 :: 0 0 10\n1 0 0 0\n0 1 0 0\n0 0 1 0\n10 10 10 1\n11 10 10 2\n"
     (tmp_path / "seed.tskel").write_text(body)
-    assert len(io.read_tskel(tmp_path / "seed.tskel")) == 1  # the seed's files: ambiguous, documented
+    # the seed's files have no count: all whole numbers cannot say which it is, so the line is named (#89:
+    # it was read as a translation, and the point was silently gone)
+    with pytest.raises(io.FormatError, match=r"seed.tskel:5: '10 10 10 1' may be this matrix's translation.*"
+                                             r"add a '# points: N' line"):
+        io.read_tskel(tmp_path / "seed.tskel")
+    # rows 1-3 written with decimals and row 4 not: row 4 is a point line
+    (tmp_path / "dec.tskel").write_text(body.replace("1 0 0 0\n0 1 0 0\n0 0 1 0",
+                                                     "1.0 0.0 0.0 0.0\n0.0 1.0 0.0 0.0\n0.0 0.0 1.0 0.0"))
+    with pytest.raises(io.FormatError, match=r"dec.tskel:5: the matrix has 3 rows: '10 10 10 1' is written as a point"):
+        io.read_tskel(tmp_path / "dec.tskel")
+    # what cannot be a point is read as the seed's files always were: a translation with a fraction, or none
+    for row, points in (("10 10 10.5 1", 1), ("0 0 0 1", 1)):
+        (tmp_path / "t.tskel").write_text(body.replace("10 10 10 1", row))
+        assert len(io.read_tskel(tmp_path / "t.tskel")) == points
     (tmp_path / "m.tskel").write_text("# volanim tskel 1\n# points: 2\n" + body)
     with pytest.raises(io.FormatError, match=r"m.tskel:2: the header says 2 points but the file has 1"):
         io.read_tskel(tmp_path / "m.tskel")
