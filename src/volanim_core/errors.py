@@ -30,6 +30,11 @@ class FormatError(ValueError):
         where = f"{self.path}:{line}" if line is not None else self.path
         super().__init__(f"{where}: {message}")
 
+    def __reduce__(self):
+        # pickled by its own arguments: a FormatError raised in a worker process (a frame read to render) came
+        # back as "a worker process died", as unpickling called __init__ with the message alone (#89)
+        return type(self), (self.path, self.reason, self.line)
+
 
 class Cancelled(Exception):
     """Raised inside long computations when the caller's cancel flag is set."""

@@ -2,8 +2,8 @@
 
 A case writes its files into a folder and names a target: a reader (run in the
 fault worker, see ``worker.py``) or a ``volanim`` command (run as a process).
-``expect`` is "refuse" (a clean error naming the file) or "accept" (works; for
-readers an optional ``check`` of the result, by name, in ``worker.CHECKS``).
+``expect`` is "refuse" (a clean error naming the file, and saying each of ``says``) or
+"accept" (works; for readers an optional ``check`` of the result, by name, in ``worker.CHECKS``).
 ``mutations`` turns valid text files into hostile ones; the runner draws them
 with hypothesis.
 """
@@ -31,6 +31,7 @@ class Case:
     check: str | None = None
     sparse: dict[str, int] = field(default_factory=dict)  # name -> size of a sparse file to create
     links: dict[str, str] = field(default_factory=dict)  # name -> what the symbolic link points at
+    says: tuple[str, ...] = ()  # a refusal must say each of these too (the other file, the bone, what to do)
 
     def write(self, folder: Path) -> None:
         for rel, data in self.files.items():

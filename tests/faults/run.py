@@ -9,7 +9,8 @@ Outcomes:
     hang    no answer within the time limit
     memory  MemoryError or an allocation abort under the memory cap
     silent  returned normally from input it should have refused, or refused without naming
-            the file, or a legitimate file refused / read wrong
+            the file (or without saying what the case's ``says`` lists), or a legitimate file
+            refused / read wrong
 """
 
 from __future__ import annotations
@@ -53,8 +54,14 @@ def _classify_reader(case, result: dict | None, folder: Path) -> tuple[str, str]
         return "silent", result.get("message", "accepted but read wrong")
     if outcome == "returned":
         return "silent", "accepted"
-    named = Path(case.arg).name in result["message"]
-    return ("clean" if named else "silent"), result["message"][:160]
+    named = Path(case.arg).name in result["message"] and _says(case, result["message"])
+    return ("clean" if named else "silent"), result["message"][:300]
+
+
+def _says(case, message: str) -> bool:
+    """Whether a refusal says what the case asks of it beyond the file's name (#89: which other file, which
+    bone, how they differ, what to do)."""
+    return all(part in message for part in case.says)
 
 
 def _pump(stream, lines: queue.Queue) -> None:
@@ -125,8 +132,8 @@ def _run_cli(case, folder: Path) -> tuple[str, str]:
         return "silent", f"exit 0: {out.stdout.strip()[-160:]}"
     files = [part for name in (*case.files, *case.sparse, *case.links)
              for part in (Path(name).name, Path(name).parts[0])]
-    named = any(f in err for f in files) or "error: argument" in err
-    return ("clean" if named else "silent"), err.strip()[:160]
+    named = (any(f in err for f in files) or "error: argument" in err) and _says(case, err)
+    return ("clean" if named else "silent"), err.strip()[-300:]
 
 
 def run_corpus(cases, folder: Path) -> list[tuple[object, str, str]]:

@@ -96,6 +96,7 @@ CHECKS = {
     "c3d_first_marker_missing": lambda r: np.isnan(r[1][0, 0]).all() and np.isfinite(r[1][0, 1]).all(),
     "c3d_qualisys": lambda r: len(r[0]) == 55 and r[1].shape == (340, 55, 3) and r[2] == 200.0,
     "shape_8_6_4": lambda r: tuple(r.shape) == (8, 6, 4) and int(r.max()) == 300,
+    "ct_6000": lambda r: tuple(r.shape) == (6, 5, 2) and r.dtype == np.uint16 and int(r.max()) == 6000,
     "two_frames": lambda r: len(r) == 2 and r[0].shape == (6, 5, 4) and int(r[1].max()) == 2,
 }
 

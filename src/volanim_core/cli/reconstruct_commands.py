@@ -6,9 +6,11 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 
+from volanim_core.errors import FormatError
 from volanim_core.io import (
     read_bones,
     read_connect,
@@ -113,7 +115,7 @@ def _compare(args):
     joints = segments = None
     if bones is not None and trans is not None:
         trans = trans.on_grid(bones.geometry)
-        check_root_order(root_bones(bones), trans.bones)
+        check_root_order(root_bones(bones), trans.bones, first=".bones")
         joints = posed_joints(bones, trans.matrices)
         segments = {b.label: (joints[b.proximal], joints[b.distal]) for b in bones.bones}
     bar = TextProgress("comparing")
@@ -157,6 +159,11 @@ def _scan(args):
 
     conn = joints_of(args, read_connect(args.connect))
     frames = [read_trans(p) for p in args.frames]
+    for path, t in zip(args.frames, frames):  # a frame of another rig, named by its file (scan names numbers)
+        try:
+            check_root_order(conn.bones, t.on_grid(conn.geometry).bones, Path(path).name, Path(args.connect).name)
+        except ValueError as exc:
+            raise FormatError(path, str(exc)) from None
     numbers = [frame_number(p) for p in args.frames]
     if None in numbers or len(set(numbers)) < len(numbers):
         numbers = list(range(len(args.frames)))  # names without (distinct) numbers: their order on the line

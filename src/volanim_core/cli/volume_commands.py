@@ -281,7 +281,7 @@ def _posed_sample(args):
     bar = TextProgress(f"posing {args.name}")
     truth = posed_sample(args.name, trans.matrices, progress=bar)
     bar.close()
-    check_root_order(root_bones(truth.bones), trans.bones)
+    check_root_order(root_bones(truth.bones), trans.bones, first=f"{args.name}'s bones")
     save(args.output, truth.volume, IDENTITY.shifted(truth.origin))
     print(f"the {args.name}'s capsules posed by {args.pose}: voxel [0, 0, 0] is {truth.origin} of the rest grid")
 

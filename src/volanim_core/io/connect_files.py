@@ -110,6 +110,28 @@ def _check_point_count(rec: TextRecords, found: int) -> None:
                               "a line is missing or extra (a matrix of 3 rows takes the next point as its 4th)")
 
 
+MAX_SCALE = 100.0  # a bone grown or shrunk a hundredfold is a unit mistake, not a pose
+
+
+def _refuse_what_no_pose_does(rec, bones: list[BoneSegment], lines: list[int], mats: np.ndarray) -> None:
+    """The first matrix that flattens its bone (singular) or scales it beyond ``MAX_SCALE``, refused at its first
+    row's line. Why here: reconstruct found them later, naming neither the file's line nor what to do (a scale of
+    1000 became "the output grid would be 1.1 PB"). All bones at once: a clip reads thousands of frames."""
+    if not len(mats):
+        return
+    stretch = np.linalg.svd(mats[:, :3, :3], compute_uv=False)  # (n, 3), each bone's largest stretch first
+    bad = np.flatnonzero((stretch[:, 0] > MAX_SCALE) | (stretch[:, 2] < 1 / MAX_SCALE))
+    if not len(bad):
+        return
+    b = int(bad[0])
+    largest, smallest = stretch[b, 0], stretch[b, 2]
+    what = ("is singular: it flattens the bone onto a plane, a line or a point" if smallest < 1e-9 else
+            f"scales the bone by {largest:.3g}" if largest > MAX_SCALE else f"shrinks the bone to {smallest:.3g}")
+    raise rec.error(lines[b], f"the matrix of bone {b} ({bones[b].label}) {what}; a pose moves each bone rigidly "
+                              f"(a rotation and a translation; scales between 1/{MAX_SCALE:g} and {MAX_SCALE:g} are "
+                              "read): write the frame again from its pose, keys or clip")
+
+
 def _refuse_twice_listed(rec, bones: list[BoneSegment], lines: list[int]) -> None:
     """The first bone (in file order) whose joints equal an earlier bone's (``BoneSegment.same_segment``'s
     tolerance), refused at its line. All pairs at once: pair by pair was three quarters of reading a
@@ -135,6 +157,7 @@ def _read_rooted(path, *, matrices: bool, points: bool):
     rows: list[tuple[int, list[str]]] = []
     owner: list[int] = []
     root_lines: list[int] = []
+    matrix_lines: list[int] = []
     i = 0
     while i < len(records):
         line, toks = records[i]
@@ -144,6 +167,7 @@ def _read_rooted(path, *, matrices: bool, points: bool):
             i += 1
             if matrices:
                 mats.append(_parse_matrix(rec, records, i, line, points_follow=points))
+                matrix_lines.append(records[i][0])
                 i += 4
             continue
         if not bones:
@@ -156,6 +180,8 @@ def _read_rooted(path, *, matrices: bool, points: bool):
     if not bones:
         raise rec.error(None, f"no {ROOT_SYNTAX} line, expected at least one bone")
     _refuse_twice_listed(rec, bones, root_lines)
+    if matrices:
+        _refuse_what_no_pose_does(rec, bones, matrix_lines, np.array(mats))
     arr = parse_point_rows(rec, rows, (4, 5), "x y z dt [thinness]")
     _check_point_count(rec, len(rows))
     if len(arr):

@@ -98,7 +98,7 @@ def read_dicom(path: str | Path, *, series: str | None = None):
         headers = list(found.values())[int(series) - 1]
     else:
         raise FormatError(path, f"has no series {series!r}; it has:\n  " + "\n  ".join(describe_series(found)))
-    if len(headers) == 1 and int(headers[0][1].get("NumberOfFrames", 1) or 1) > 1:
+    if len(headers) == 1 and _whole(*headers[0], "NumberOfFrames", 1) > 1:
         return _read_multiframe(headers[0][0])
     return _read_slices(path, headers)
 
@@ -170,17 +170,17 @@ def _pixels(f: Path, ds) -> np.ndarray:
     if "PixelData" not in ds:
         raise FormatError(f, "has no PixelData: a slice of the series without its image")
     syntax = str(getattr(getattr(ds, "file_meta", None), "TransferSyntaxUID", ""))
-    alloc, stored = int(ds.get("BitsAllocated", 0)), int(ds.get("BitsStored", 0) or 0)
-    if syntax in _PLAIN_SYNTAXES and int(ds.get("SamplesPerPixel", 1)) == 1 and alloc in (8, 16, 32) \
-            and 0 < stored <= alloc and int(ds.get("NumberOfFrames", 1) or 1) == 1:
-        rows, cols = int(ds.Rows), int(ds.Columns)
+    alloc, stored = _whole(f, ds, "BitsAllocated", 0), _whole(f, ds, "BitsStored", 0)
+    if syntax in _PLAIN_SYNTAXES and _whole(f, ds, "SamplesPerPixel", 1) == 1 and alloc in (8, 16, 32) \
+            and 0 < stored <= alloc and _whole(f, ds, "NumberOfFrames", 1) == 1:
+        rows, cols = _whole(f, ds, "Rows"), _whole(f, ds, "Columns")
         data = ds.PixelData
         need = rows * cols * alloc // 8
         if len(data) not in (need, need + 1):  # DICOM pads an odd length with one byte
             raise FormatError(f, f"its PixelData holds {len(data):,} bytes where {cols} x {rows} pixels of "
                                  f"BitsAllocated {alloc} need {need:,}: the header does not describe the pixels")
         if len(data) >= need:
-            signed = int(ds.get("PixelRepresentation", 0)) == 1
+            signed = _whole(f, ds, "PixelRepresentation", 0) == 1
             img = np.frombuffer(data, f"<{'i' if signed else 'u'}{alloc // 8}", count=rows * cols).reshape(rows, cols)
             if stored < alloc:  # the bits above BitsStored are not the pixel's: sign-extend or clear them
                 shift = alloc - stored
@@ -192,6 +192,45 @@ def _pixels(f: Path, ds) -> np.ndarray:
         syntax = getattr(getattr(ds, "file_meta", None), "TransferSyntaxUID", None)
         name = getattr(syntax, "name", syntax)
         raise FormatError(f, f"its pixel data cannot be decoded ({name}): {exc}") from None
+
+
+def _attr(f: Path, ds, attr: str, default=None):
+    """A header value; one pydicom cannot convert (``NumberOfFrames`` "two") is refused naming the file and the
+    attribute, where it raised a bare ValueError naming neither (#89)."""
+    try:
+        return ds.get(attr, default)
+    except (TypeError, ValueError) as exc:
+        raise FormatError(f, f"its {attr} cannot be read ({exc}): the header is damaged; fix the attribute or "
+                             "leave this file out") from None
+
+
+def _whole(f: Path, ds, attr: str, default: int | None = None) -> int:
+    """A whole-number header value (absent or empty is ``default``), refused naming the file and the attribute."""
+    raw = _attr(f, ds, attr, default)
+    try:
+        value = default if raw is None or raw == "" else int(raw)
+        if value is None:
+            raise ValueError
+    except (TypeError, ValueError):
+        raise FormatError(f, f"its {attr} is {raw!r}, not a whole number: the header is damaged; fix the "
+                             "attribute or leave this file out") from None
+    return value
+
+
+def _position(f: Path, ds, attr: str = "ImagePositionPatient") -> np.ndarray:
+    """Where a slice sits: three finite numbers, or refused naming the file (a NaN came out as "spacing must be
+    three finite numbers" naming the folder)."""
+    raw = _attr(f, ds, attr)
+    if raw is None:
+        raise FormatError(f, f"lacks {attr}: the slice cannot be placed in the series")
+    try:
+        at = np.asarray(raw, np.float64)
+    except (TypeError, ValueError):
+        at = np.full(1, np.nan)
+    if at.shape != (3,) or not np.isfinite(at).all():
+        raise FormatError(f, f"its {attr} is {list(raw) if at.ndim else raw!r}, not three finite numbers: the "
+                             "slice cannot be placed in the series; fix the attribute or leave this file out")
+    return at
 
 
 def _finite(f: Path, ds, attr: str, default: float) -> float:
@@ -211,18 +250,16 @@ def _read_slices(folder: Path, headers):
     f0, ds0 = headers[0]
     row, col = _orientation(f0, ds0.get("ImageOrientationPatient"))
     normal = np.cross(row, col)
-    rows, cols = int(ds0.Rows), int(ds0.Columns)
+    rows, cols = _whole(f0, ds0, "Rows"), _whole(f0, ds0, "Columns")
     places = []
     for f, ds in headers:
-        if int(ds.Rows) != rows or int(ds.Columns) != cols:
+        if _whole(f, ds, "Rows") != rows or _whole(f, ds, "Columns") != cols:
             raise FormatError(f, f"is {ds.Columns}x{ds.Rows} pixels, the series' first slice {cols}x{rows}")
-        ipp = ds.get("ImagePositionPatient")
-        if ipp is None or len(ipp) != 3:
-            raise FormatError(f, "lacks ImagePositionPatient: the slice cannot be placed in the series")
+        ipp = _position(f, ds)
         r, c = _orientation(f, ds.get("ImageOrientationPatient"))
         if not (np.allclose(r, row, atol=1e-3) and np.allclose(c, col, atol=1e-3)):
             raise FormatError(f, "is oriented differently from the series' other slices")
-        places.append(float(np.asarray(ipp, np.float64) @ normal))
+        places.append(float(ipp @ normal))
     order = np.argsort(places, kind="stable")
     positions = np.asarray(places)[order]
     steps = np.diff(positions)
@@ -233,8 +270,8 @@ def _read_slices(folder: Path, headers):
                                   f"mm between {a} and {b}, median {np.median(steps):.4g} mm): a missing or "
                                   "duplicate slice?")
     dz = float(np.median(steps)) if len(steps) else float(ds0.get("SliceThickness", 1.0) or 1.0)
-    bits = int(ds0.get("BitsAllocated", 16))
-    checked_grid(folder, (cols, rows, len(headers)), max(bits // 8, 1) * int(ds0.get("SamplesPerPixel", 1)),
+    bits = _whole(f0, ds0, "BitsAllocated", 16)
+    checked_grid(folder, (cols, rows, len(headers)), max(bits // 8, 1) * _whole(f0, ds0, "SamplesPerPixel", 1),
                  what="the series' size")
     first = None
     slopes, intercepts = [], []
@@ -249,7 +286,7 @@ def _read_slices(folder: Path, headers):
         slopes.append(_finite(f, ds, "RescaleSlope", 1.0))
         intercepts.append(_finite(f, ds, "RescaleIntercept", 0.0))
     dx, dy = _pixel_spacing(f0, ds0.get("PixelSpacing") or ds0.get("ImagerPixelSpacing"))
-    origin = np.asarray(headers[order[0]][1].ImagePositionPatient, np.float64)
+    origin = _position(*headers[order[0]])
     direction = np.column_stack([row, col, normal])
     return rescale(first, slopes, intercepts), Geometry((dx, dy, dz), tuple(origin),
                                                                  tuple(direction.reshape(-1)))
@@ -265,8 +302,9 @@ def _read_multiframe(path: Path):
         raise FormatError(path, f"is not a DICOM file pydicom can read: {exc}") from None
     if "PixelData" not in ds:
         raise FormatError(path, "is a DICOM file without image data")
-    frames = int(ds.get("NumberOfFrames", 1) or 1)
-    checked_grid(path, (int(ds.Columns), int(ds.Rows), frames), max(int(ds.get("BitsAllocated", 16)) // 8, 1),
+    frames = _whole(path, ds, "NumberOfFrames", 1)
+    checked_grid(path, (_whole(path, ds, "Columns"), _whole(path, ds, "Rows"), frames),
+                 max(_whole(path, ds, "BitsAllocated", 16) // 8, 1),
                  what="its frames")
     shared = ds.get("SharedFunctionalGroupsSequence", [None])[0]
     per_frame = ds.get("PerFrameFunctionalGroupsSequence")
@@ -280,7 +318,7 @@ def _read_multiframe(path: Path):
     if iop is None and per_frame:
         iop = item(per_frame[0], "PlaneOrientationSequence", "ImageOrientationPatient")
     ps = ds.get("PixelSpacing") or item(shared, "PixelMeasuresSequence", "PixelSpacing")
-    if int(ds.get("SamplesPerPixel", 1)) != 1:
+    if _whole(path, ds, "SamplesPerPixel", 1) != 1:
         raise FormatError(path, f"holds colour pixels ({ds.get('PhotometricInterpretation')}); volanim reads grey "
                                 "DICOM images and series")
     alone = frames == 1 and iop is None and "ImagePositionPatient" not in ds
@@ -301,7 +339,11 @@ def _read_multiframe(path: Path):
                                 "GridFrameOffsetVector): they cannot be placed in space")
     if len(positions) != frames:
         raise FormatError(path, f"lists {len(positions)} frame positions for {frames} frames")
-    pixels = _pixels(path, ds).reshape(frames, int(ds.Rows), int(ds.Columns))
+    if positions.shape[1:] != (3,) or not np.isfinite(positions).all():
+        bad = int(np.flatnonzero(~np.isfinite(positions).all(axis=1))[0]) if positions.shape[1:] == (3,) else 0
+        raise FormatError(path, f"frame {bad}'s position is {positions[bad].tolist()}, not three finite numbers: "
+                                "the frames cannot be placed in space; fix the file's positions")
+    pixels = _pixels(path, ds).reshape(frames, _whole(path, ds, "Rows"), _whole(path, ds, "Columns"))
     along = positions @ normal
     order = np.argsort(along, kind="stable")
     steps = np.diff(along[order])

@@ -105,7 +105,7 @@ def read_frames(paths, bones: BoneSkeleton, progress=None) -> tuple[np.ndarray, 
         report(i, len(paths))
         trans = io.read_trans(p).on_grid(bones.geometry)
         try:
-            check_root_order(roots, trans.bones, p.name)
+            check_root_order(roots, trans.bones, p.name, ".bones")
         except ValueError as exc:
             raise FormatError(p, str(exc)) from None
         mats[i] = trans.matrices

@@ -67,6 +67,10 @@ def read_mesh(path):
 
 
 
+def _point(p) -> str:
+    return "(" + ", ".join(f"{v:g}" for v in p) + ")"
+
+
 def voxelize(mesh, *, spacing: float | None = None, size: int | None = None, padding: int = 2, value: int = 255):
     """A closed surface mesh as a binary volume with its geometry: ``(vol[x, y, z] uint8, Geometry)``.
 
@@ -83,11 +87,20 @@ def voxelize(mesh, *, spacing: float | None = None, size: int | None = None, pad
     surface = mesh.extract_surface().triangulate() if not isinstance(mesh, pv.PolyData) else mesh.triangulate()
     if surface.n_cells == 0:
         raise ValueError("the mesh has no faces: there is no surface to fill")
-    if surface.n_open_edges:
-        raise ValueError(f"the mesh is not closed ({surface.n_open_edges} open edges): it has no inside to fill; "
-                         "close its holes first (e.g. pymeshfix, or Blender's 3D-Print toolbox)")
     lo, hi = np.asarray(surface.bounds, np.float64).reshape(3, 2).T
     extent = hi - lo
+    if not (extent > 0).all():  # checked before the open edges: a mesh of one point "had 3 open edges"
+        flat = "all at one point" if not extent.any() else "flat along " + " and ".join(
+            a for a, e in zip("xyz", extent) if not e > 0)
+        raise ValueError(f"the mesh has no volume: its {surface.n_points} points are {flat} "
+                         f"(bounds {lo.tolist()} to {hi.tolist()}); there is no inside to fill")
+    if surface.n_open_edges:
+        rim = surface.extract_feature_edges(boundary_edges=True, feature_edges=False, manifold_edges=False,
+                                            non_manifold_edges=False)
+        edge = rim.points[rim.lines[1:3]]  # the first line cell: [2, a, b, ...]
+        raise ValueError(f"the mesh is not closed ({surface.n_open_edges} open edges, one from "
+                         f"{_point(edge[0])} to {_point(edge[1])}): it has no inside to fill; close its holes "
+                         "first (e.g. pymeshfix, or Blender's 3D-Print toolbox)")
     if spacing is None:
         cells = max((size or 128) - 1 - 2 * padding, 1)
         spacing = float(extent.max()) / cells

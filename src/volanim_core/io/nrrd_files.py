@@ -105,6 +105,8 @@ def _read_header(path: Path, fh) -> tuple[dict, dict, dict]:
             raise FormatError(path, f"expected 'field: value', got {line!r}", number)
         fields[key.strip().lower()] = value.strip()
         lines[key.strip().lower()] = number
+        if key.strip().lower() in ("data file", "datafile") and value.strip().upper().startswith("LIST"):
+            return fields, lines, pairs  # the header's other lines are the listed files' names (refused in _data)
 
 
 def read_nrrd(path: str | Path, pairs: bool = False):
@@ -188,7 +190,12 @@ def _data(path: Path, fh, fields: dict, lines: dict, want: int, dtype, count: in
                                     "give a single data file", lines.get("data file", lines.get("datafile")))
         data_path = path.parent / name
         if not data_path.is_file():
-            raise FormatError(path, f"its data file {data_path} does not exist")
+            what = "a folder, not a file" if data_path.is_dir() else "missing"
+            raise FormatError(path, f"its data file {name} is {what} (looked for at {data_path.absolute()}): "
+                                    "the header's 'data file:' line names it relative to the header's own folder; "
+                                    "put the data file there (a detached header and its data travel together), "
+                                    "or correct the line",
+                              lines.get("data file", lines.get("datafile")))
         with data_path.open("rb") as dfh:
             return _read_body(data_path, dfh, fields, lines, want, dtype, count)
     return _read_body(path, fh, fields, lines, want, dtype, count)

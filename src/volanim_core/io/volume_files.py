@@ -154,6 +154,34 @@ def _without_alpha(img: np.ndarray, path: Path) -> np.ndarray:
     return img[..., 0] if img.shape[-1] == 2 else img[..., :3]
 
 
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+_PNG_COLOUR_TYPES = {0: "grey", 2: "RGB", 3: "palette", 4: "grey+alpha", 6: "RGBA"}
+
+
+def _png_depth(path: Path) -> tuple[int, int] | None:
+    """A PNG's ``(bit depth, colour type)`` from its header, or None for another kind of file."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(26)
+    except OSError:
+        return None  # the reader below names the file and why
+    if len(head) < 26 or not head.startswith(_PNG_SIGNATURE) or head[12:16] != b"IHDR":
+        return None
+    return head[24], head[25]
+
+
+def _refuse_16_bit_colour_png(path: Path) -> None:
+    """Refuse a 16-bit PNG with colour or alpha: Pillow, which reads the slices, keeps only the high byte of
+    each of its channels (a CT of values 0..6000 came in as 0..23, silently). Grey 16-bit PNGs and 16-bit
+    TIFFs of any kind are read in full."""
+    depth = _png_depth(path)
+    if depth is not None and depth[0] == 16 and depth[1] != 0:
+        kind = _PNG_COLOUR_TYPES.get(depth[1], f"colour type {depth[1]}")
+        raise FormatError(path, f"a 16-bit {kind} PNG: the image library volanim reads slices with (Pillow) keeps "
+                                "only the high 8 bits of each channel, which would give wrong values; save the "
+                                "slices as 16-bit grey PNG, or as TIFF (read in full at 16 bits)")
+
+
 def _keyed_transparency(path: Path) -> bool:
     """Whether the image keys transparency in its palette or by a colour (PNG's tRNS, GIF's), not in an alpha
     channel of its own."""
@@ -161,9 +189,26 @@ def _keyed_transparency(path: Path) -> bool:
         from PIL import Image
 
         with Image.open(path) as im:
-            return "transparency" in im.info and im.mode in ("P", "L", "RGB", "I", "I;16")
+            # not 16-bit grey ("I;16"): its conversion to RGBA clips the values to 255; _keyed_grey16 checks it
+            return "transparency" in im.info and im.mode in ("P", "L", "RGB")
     except Exception:  # noqa: BLE001 - not an image PIL opens: the reader below says why
         return False
+
+
+def _refuse_keyed_grey16(path: Path, img: np.ndarray) -> None:
+    """A 16-bit grey PNG whose tRNS chunk keys one value as transparent: refused where a pixel has it (as an
+    alpha channel with a transparent pixel is), read as it is where none has."""
+    if _png_depth(path) != (16, 0):
+        return
+    from PIL import Image
+
+    with Image.open(path) as im:
+        key = im.info.get("transparency")
+    seethrough = 0 if key is None else int(np.count_nonzero(img == key))
+    if seethrough:
+        raise FormatError(path, f"{seethrough} of {img.size} pixels are transparent (the PNG keys value {key} as "
+                                "transparent); volanim reads slices as opaque and will not guess what a "
+                                "transparent pixel holds: save the images without the transparency key")
 
 
 def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.ndarray:
@@ -174,12 +219,14 @@ def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.nd
     """
     import imageio.v3 as iio  # not skimage.io.imread: it moves the axes of a grey+alpha image 3 or 4 rows high
 
+    _refuse_16_bit_colour_png(path)
     try:
         # a palette (or grey, RGB) image with a tRNS chunk: its transparency is read as alpha, which PIL's
         # plain conversion drops (a mask's transparent background came in as opaque colour)
         img = np.asarray(iio.imread(path, mode="RGBA") if _keyed_transparency(path) else iio.imread(path))
     except Exception as exc:  # imageio/PIL raise many types
         raise FormatError(path, f"cannot read image: {exc}") from exc
+    _refuse_keyed_grey16(path, img)
     if img.ndim == 3 and img.shape[2] in (2, 4):  # grey+alpha or RGBA
         img = _without_alpha(img, path)
     is_rgb = img.ndim == 3 and img.shape[2] == 3

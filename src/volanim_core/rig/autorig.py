@@ -122,7 +122,8 @@ def chains(tree: Tree, geometry, *, bones: int | None = None) -> BoneSkeleton:
             out.append(Bone(prev, name, name))
             prev = name
     if not out:
-        raise NotRiggable("the skeleton has no branches longer than it is thick: nothing to bend (a ball?)")
+        raise NotRiggable("the skeleton has no branches longer than it is thick: nothing to bend (a ball, a box "
+                          "or a flat sheet?); autorig needs a body with limbs; draw the bones in the studio instead")
     return BoneSkeleton(joints, out)
 
 
@@ -203,7 +204,8 @@ def autorig(skeleton: Skeleton, *, thinness: float | None = None, template: str 
     notes += _pruning_notes(curve)
     tree = Tree(curve, left_axis(skel.geometry))
     if len(tree.ends()) < 2:
-        raise NotRiggable("the skeleton has no branches: nothing to bend (is the object a ball?)")
+        raise NotRiggable("the skeleton has no branches: nothing to bend (a ball, a box or a flat sheet?); "
+                          "autorig needs a body with limbs; draw the bones in the studio instead")
     if template == "auto" and bones is None:
         fit = templates.best_fit(tree)
         if fit is not None:

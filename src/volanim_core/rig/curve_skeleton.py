@@ -296,6 +296,10 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
         step()
     curve = thin(grid)
     dist = edt.edt(grid)
+    if not curve.any():  # Lee's thinning removes a box or a flat sheet whole: keep each piece's deepest voxel,
+        labels, pieces = ndimage.label(grid)  # so two boxes are two pieces and one is a ball (a numpy error was)
+        deepest = np.array(ndimage.maximum_position(dist, labels, range(1, pieces + 1)), np.int64).reshape(-1, 3)
+        curve[tuple(deepest.T)] = True
     idx = np.argwhere(curve)
     return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad, painted, porous)
 

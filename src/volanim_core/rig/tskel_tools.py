@@ -14,14 +14,42 @@ import numpy as np
 from volanim_core.rig.connectivity import Connectivity, Trans, Tskel
 
 
-def check_root_order(conn_bones, trans_bones, what: str = ".trans") -> None:
-    """Raise ValueError naming the first bone whose joints differ between two files."""
+def check_root_order(conn_bones, trans_bones, what: str = ".trans", first: str = ".connect") -> None:
+    """Raise ValueError saying how two files' bones differ: the bones only one of them has, two bones listed in
+    other orders, or the first bone whose joints moved (by how much), and what to do. The caller names the
+    files (the CLI's error prefix, or ``what``/``first``)."""
+    fix = (f"the {what} was written for another bone skeleton: write the frames from the bones of this "
+           f"{first} (volanim pose, keys or bvh2trans with its .bones)")
+    only_theirs = [b for b in trans_bones if not any(b.same_segment(a, tol=1e-3) for a in conn_bones)]
+    only_ours = [a for a in conn_bones if not any(a.same_segment(b, tol=1e-3) for b in trans_bones)]
     if len(conn_bones) != len(trans_bones):
-        raise ValueError(f"the .connect has {len(conn_bones)} bones but the {what} has {len(trans_bones)}")
+        extra = "; ".join(filter(None, (_listed(only_theirs, f"only in the {what}"),
+                                        _listed(only_ours, f"only in the {first}"))))
+        raise ValueError(f"the {first} has {len(conn_bones)} bones but the {what} has {len(trans_bones)}"
+                         + (f" ({extra})" if extra else "") + f"; {fix}")
     for i, (a, b) in enumerate(zip(conn_bones, trans_bones)):
-        if not a.same_segment(b, tol=1e-3):
-            raise ValueError(f"root order differs at bone {i}: the .connect has {a.label} "
-                             f"({_coords(a)}), the {what} has {b.label} ({_coords(b)})")
+        if a.same_segment(b, tol=1e-3):
+            continue
+        if not any(b is x for x in only_theirs):  # b is another bone of ours: the same bones, listed in another order
+            j = next(k for k, c in enumerate(conn_bones) if c.same_segment(b, tol=1e-3))
+            raise ValueError(f"the bones are listed in other orders: bone {i} is {_named(a)} in the {first} but "
+                             f"{_named(b)} in the {what} (the {first}'s bone {j}); list them in the {first}'s "
+                             f"root order, or {fix}")
+        moved = max(np.abs(a.proximal - b.proximal).max(), np.abs(a.distal - b.distal).max())
+        how = (f"its joints moved by up to {moved:g} voxels" if a.name == b.name and a.name else
+               f"the {what} has {_named(b)} there, which the {first} does not have")
+        raise ValueError(f"bone {i} differs: the {first} has {_named(a)}, {how} ({_coords(b)}); {fix}")
+
+
+def _named(b) -> str:
+    return f"{b.label} ({_coords(b)})" if b.name else f"bone {_coords(b)}"
+
+
+def _listed(bones, where: str) -> str:
+    if not bones:
+        return ""
+    names = ", ".join(_named(b) for b in bones[:3]) + (f" and {len(bones) - 3} more" if len(bones) > 3 else "")
+    return f"{names} {'is' if len(bones) == 1 else 'are'} {where}"
 
 
 def _coords(b) -> str:

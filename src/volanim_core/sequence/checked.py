@@ -64,7 +64,17 @@ class Store:
 
         if not 0 <= index < self.frames:
             raise FormatError(self.path, f"has no frame at index {index} (it has {self.frames})")
-        zyx = np.asarray(zarr.open_array(str(self.path / "0"), mode="r")[index])
+        array = zarr.open_array(str(self.path / "0"), mode="r")
+        try:
+            zyx = np.asarray(array[index])
+        except MemoryError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - zarr's codecs raise RuntimeError, ValueError, ... for a bad shard
+            shard = f"0/c/{index // (array.shards or array.chunks)[0]}/"
+            raise FormatError(self.path, f"frame {self.numbers[index]} (index {index}): its shard {shard} cannot be "
+                                         f"decoded ({type(exc).__name__}: {exc}): the file was damaged or changed "
+                                         "after it was written; rerun `volanim sequence` with --force to make "
+                                         "it again") from exc
         rec = self.done.get(index)
         if verify and rec is not None and rec.get("region") is not None:
             region = tuple(slice(a, b) for a, b in rec["region"])

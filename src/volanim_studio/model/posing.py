@@ -190,7 +190,7 @@ class PoseState:
         """Take a ``.trans`` frame as the pose (its bones must be the loaded ones, in root order); a load,
         not an edit: the history starts after it."""
         trans = io.read_trans(path).on_grid(self.doc.bones.geometry)  # a frame posed on another grid too
-        check_root_order(root_bones(self.doc.bones), trans.bones, ".trans")
+        check_root_order(root_bones(self.doc.bones), trans.bones, ".trans", "project's .bones")
         self.doc.loading(lambda: self._write(*self._from_matrices(trans.matrices)))
 
     def save_trans(self, path) -> None:

@@ -26,8 +26,10 @@ def test_a_sphere_fills_the_voxels_whose_centres_are_inside():
 
 
 def test_an_open_mesh_and_a_flat_one_are_refused():
-    with pytest.raises(ValueError, match="not closed"):
-        voxelize(pv.Plane())
+    with pytest.raises(ValueError, match=r"no volume: its \d+ points are flat along z"):
+        voxelize(pv.Plane())  # checked before its open edges (#89)
+    with pytest.raises(ValueError, match=r"not closed \(\d+ open edges, one from \("):
+        voxelize(pv.Sphere().remove_cells([0]))  # names where one of them is
     with pytest.raises(ValueError, match="no faces"):
         voxelize(pv.PolyData(np.random.default_rng(0).random((5, 3))))
 
