@@ -158,6 +158,8 @@ def autorig_cases() -> list[Case]:
     two[5:15, 5:15, 5:15] = two[25:35, 25:35, 25:35] = 1
     sheet = np.zeros((40, 40, 20), np.uint8)
     sheet[5:35, 5:35, 10] = 1
+    rod = np.zeros((30, 30, 60), np.uint8)
+    rod[13:17, 13:17, 5:55] = 1
 
     def case(name, mskel, says):
         return Case(f"autorig: {name}", "cli:autorig", {"m.mskel": mskel}, "autorig {d}/m.mskel -o {d}/m.bones",
@@ -166,7 +168,9 @@ def autorig_cases() -> list[Case]:
     bend = ("nothing to bend", "draw the bones in the studio")
     return [case("two points", b"# volanim mskel 1\n# metric: euclid\n10 10 10 3 1\n11 10 10 3 1\n", bend),
             case("two separate boxes", _mskel(two), ("2 pieces", "rig each body separately")),
-            case("a thin sheet", _mskel(sheet), bend)]
+            case("a thin sheet", _mskel(sheet), bend),
+            Case("autorig: a rod 4 voxels wide (thinned away whole by scikit-image)", "cli:autorig",
+                 {"m.mskel": _mskel(rod)}, "autorig {d}/m.mskel -o {d}/m.bones", "accept")]
 
 
 def mesh_cases() -> list[Case]:

@@ -6,7 +6,8 @@
                   (the frog's tissues: closing grows it by over POROUS) has gaps up to PORE x its
                   thickest radius closed too, and becomes one body whose thickness means something
       --thin-->   scikit-image's 3-D thinning: a curve, radius = the solid's distance
-                  transform (a flat torso is a curve, not the medial sheet voxels give)
+                  transform (a flat torso is a curve, not the medial sheet voxels give); a rod it
+                  removes whole (even widths, scikit-image#3757) is thinned again one voxel wider
       --link-->   an edge where two curve balls overlap: the segment between their centres
                   lies inside the body (every point of it is inside one ball or the other)
       --bridge--> a piece cut off by a small gap (a mesh made of parts, like the ant's legs)
@@ -263,7 +264,6 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     """
     import edt
     from scipy import ndimage
-    from skimage.morphology import skeletonize as thin
 
     from volanim_core.rig._curve_kernels import paint_balls
 
@@ -294,14 +294,56 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     grid = ndimage.binary_fill_holes(grid)
     if step is not None:
         step()
-    curve = thin(grid)
     dist = edt.edt(grid)
-    if not curve.any():  # Lee's thinning removes a box or a flat sheet whole: keep each piece's deepest voxel,
-        labels, pieces = ndimage.label(grid)  # so two boxes are two pieces and one is a ball (a numpy error was)
-        deepest = np.array(ndimage.maximum_position(dist, labels, range(1, pieces + 1)), np.int64).reshape(-1, 3)
-        curve[tuple(deepest.T)] = True
+    curve = _thin(grid, dist)
     idx = np.argwhere(curve)
     return (idx - pad) * h + lo, dist[curve] * h, Body(grid, lo, h, pad, painted, porous)
+
+
+def _thin(grid: np.ndarray, dist: np.ndarray) -> np.ndarray:
+    """Lee's 3-D thinning of ``grid``, mended where scikit-image removes a whole piece: a bar of even width
+    (scikit-image#3757: a 4 x 4 rod leaves nothing), a box, a flat sheet. Such a piece that is long (a rod, a
+    tail: its length over twice its width) is thinned again grown by one voxel along one or more axes, which
+    changes its widths' parity; any other piece keeps its deepest voxel, a ball (a box has nothing to bend),
+    so two boxes are still two pieces."""
+    from scipy import ndimage
+    from skimage.morphology import skeletonize as thin
+
+    curve = thin(grid).astype(bool)
+    labels, _ = ndimage.label(grid)
+    kept = set(np.unique(labels[curve]).tolist())
+    for piece, box in enumerate(ndimage.find_objects(labels), 1):
+        if piece in kept:
+            continue
+        mask = labels[box] == piece
+        line = _thin_grown(mask) if _long(mask) else None
+        if line is None:
+            line = np.zeros_like(mask)
+            line[np.unravel_index(np.argmax(np.where(mask, dist[box], 0)), mask.shape)] = True
+        curve[box] |= line
+    return curve
+
+
+def _long(mask: np.ndarray) -> bool:
+    """A piece whose longest principal spread is over twice its next: a rod, not a box or a sheet."""
+    spread = np.sort(np.linalg.eigvalsh(np.cov(np.argwhere(mask).T.astype(float)))) if mask.sum() > 3 else None
+    return spread is not None and spread[2] > 4 * max(spread[1], 0.25)
+
+
+def _thin_grown(mask: np.ndarray) -> np.ndarray | None:
+    """The thinning of ``mask`` grown by one voxel along x, y, z or two or three of them (the first that leaves
+    a curve), cut back to ``mask``; None if none does."""
+    from skimage.morphology import skeletonize as thin
+
+    padded = np.pad(mask, 1)
+    for axes in ((0,), (1,), (2,), (0, 1), (0, 2), (1, 2), (0, 1, 2)):
+        grown = padded.copy()
+        for axis in axes:
+            grown[(slice(None),) * axis + (slice(1, None),)] |= grown[(slice(None),) * axis + (slice(None, -1),)]
+        line = thin(grown).astype(bool)[1:-1, 1:-1, 1:-1] & mask
+        if line.any():
+            return line
+    return None
 
 
 def curve_tree(skeleton: Skeleton, *, spur: float = SPUR, step=None) -> CurveTree:

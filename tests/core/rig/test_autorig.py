@@ -133,6 +133,19 @@ def test_what_cannot_be_rigged_is_refused_with_where():
         autorig(skel, thinness=99.0)
 
 
+@pytest.mark.parametrize("width", [4, 5, 6])
+def test_a_square_rod_of_any_width_is_rigged_end_to_end(width):
+    """scikit-image's thinning removes a bar of even width whole (scikit-image#3757): a 4- or 6-voxel rod
+    was refused as 'nothing to bend'. It is one bone from end to end, as the 5-voxel rod is."""
+    rod = np.zeros((30, 30, 70), bool)
+    rod[12:12 + width, 12:12 + width, 8:62] = True
+    bones = autorig(skeletonize(rod)).bones
+    z = sorted(p[2] for p in bones.joints.values())
+    assert len(bones.bones) >= 1 and z[0] <= 12 and z[-1] >= 57, bones.joints
+    for p in bones.joints.values():  # on the rod's axis, not at its side
+        assert np.allclose(p[:2], 12 + (width - 1) / 2, atol=1.0), bones.joints
+
+
 def _mean_error(proposal, reference):
     assert [b.name for b in proposal.bones] == [b.name for b in reference.bones]
     return np.mean([np.linalg.norm(proposal.joints[k] - v) for k, v in reference.joints.items()])
