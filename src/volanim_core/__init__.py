@@ -19,6 +19,7 @@ cli/. The modules beside them:
                            surface (numba kernels in _face_kernels.py)
     memo.py .............. a few recent results kept by a hash of their inputs
     parallel.py .......... where many tasks run: this process, a spawn pool, or a Dask cluster
+    cluster_config.py .... a Dask cluster started from a file (dask-ctl's spec): --cluster-config
     volume.py ............ the old pipeline's volume tools as pure functions, and the value helpers
     mannequin_body.py .... the mannequin's analytic body: bones and a tapered capsule per bone
     posed_truth.py ....... the mannequin's true shape in any pose (what volanim compare scores against)

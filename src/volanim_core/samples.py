@@ -48,7 +48,8 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 #: placed on it as Slicer markups (``ant.mrk.json``) and a gait (``ant.keys``): :mod:`volanim_core.ant_sample`.
 #: ``rabbit``, ``spot`` and ``bob`` copy closed meshes other projects ship (trimesh's test rabbit, MIT; Keenan
 #: Crane's Spot the cow and Bob, CC0, as geometry-central's test assets): creatures nobody templated.
-FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob")
+FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster")
+CLUSTER_FILES = ("local", "slurm", "pbs", "kubernetes")  # cluster-NAME.yaml: --cluster-config templates
 MESH_SAMPLES = ("rabbit", "spot", "bob")
 
 CT_SPACING, CT_ORIGIN = (0.7, 0.7, 2.5), (-56.0, -35.0, -1150.0)  # a CT's voxels (mm), somewhere in a scanner
@@ -339,6 +340,11 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         written = [folder / f"{name}.ply", folder / f"{name}.ply.LICENSE"]
         for src, dst in zip((mesh, mesh.with_name(f"{name}.ply.LICENSE")), written):
             atomic_write_bytes(dst, src.read_bytes())
+        return written
+    if name == "cluster":  # files to start a Dask cluster from (--cluster-config), to edit (docs: cluster.md)
+        written = [folder / f"cluster-{kind}.yaml" for kind in CLUSTER_FILES]
+        for dst in written:
+            atomic_write_bytes(dst, (Path(__file__).resolve().parent / "sample_data" / dst.name).read_bytes())
         return written
     if name == "walk":
         clip = walk_clip()

@@ -8,6 +8,7 @@ import math
 import re
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -217,15 +218,49 @@ def stop_exclusive(b: Bounds) -> str:
     return " ".join(str(int(v)) for v in (*b.lo, *(h + 1 for h in b.hi)))
 
 
+def add_pool(p, verb: str) -> None:
+    """``--workers``, ``--scheduler`` and ``--cluster-config``: where ``verb`` runs (one of them)."""
+    pool = p.add_mutually_exclusive_group()
+    pool.add_argument("--workers", type=positive_int, help="local worker processes (default: every core)")
+    pool.add_argument("--scheduler", metavar="tcp://HOST:PORT", help=f"{verb} on this Dask cluster instead")
+    pool.add_argument("--cluster-config", metavar="FILE.yaml",
+                      help=f"{verb} on a Dask cluster this file starts (dask-ctl's spec: module, class, kwargs; "
+                      "e.g. dask_jobqueue's SLURMCluster), closed at the end; see docs/tutorials/cluster.md")
+
+
 def local_workers(args) -> int | None:
-    """``--workers`` (default: every core), or None with ``--scheduler``: then the wait to reach it (up to
-    Dask's connect timeout, 30 s by default) is announced first, as nothing else is printed meanwhile."""
-    if args.scheduler:
-        print(f"connecting to the Dask scheduler at {args.scheduler} ...", file=sys.stderr, flush=True)
+    """``--workers`` (default: every core), or None on a Dask cluster (``--scheduler``, ``--cluster-config``)."""
+    if args.scheduler or args.cluster_config:
         return None
     from volanim_core.parallel import default_workers
 
     return default_workers() if args.workers is None else args.workers
+
+
+@contextmanager
+def dask_scheduler(args):
+    """A ``distributed.Client`` of ``--scheduler``'s cluster or of the one ``--cluster-config`` starts, its
+    dashboard said on stderr, closed on leaving (a started cluster too); None for local workers. The wait to
+    reach a scheduler (up to Dask's connect timeout, 30 s by default) is announced first, as nothing else is
+    printed meanwhile."""
+    def say(text):
+        print(text, file=sys.stderr, flush=True)
+
+    if args.cluster_config:
+        from volanim_core.cluster_config import started_cluster
+
+        with started_cluster(args.cluster_config, say=say) as client:
+            yield client
+    elif args.scheduler:
+        from volanim_core.cluster_config import dashboard
+        from volanim_core.parallel import dask_client
+
+        say(f"connecting to the Dask scheduler at {args.scheduler} ...")
+        with dask_client(args.scheduler) as client:
+            say(f"connected to {args.scheduler}{dashboard(client)}")
+            yield client
+    else:
+        yield None
 
 
 class FrameProgress:

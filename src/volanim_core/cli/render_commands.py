@@ -8,12 +8,13 @@ import sys
 from ._common import (
     FrameProgress,
     add_command,
+    add_pool,
     ascii_int,
     checked_by,
+    dask_scheduler,
     finite_float,
     local_workers,
     positive_float,
-    positive_int,
 )
 
 EXAMPLE = (
@@ -81,8 +82,9 @@ def _render(args):
         io.write_transfer_function(args.save_tf, transfer_of(settings))
         print(f"wrote {args.save_tf} (the {'--tf' if args.tf else preset + ' preset'}'s transfer function)")
     workers = local_workers(args)
-    rep = render(inputs, settings, args.output, on=RunOn(workers=workers or 1, scheduler=args.scheduler), fps=args.fps,
-                 force=args.force, keep_frames=args.keep_frames, dims=args.dims, on_frame=FrameProgress())
+    with dask_scheduler(args) as scheduler:
+        rep = render(inputs, settings, args.output, on=RunOn(workers=workers or 1, scheduler=scheduler), fps=args.fps,
+                     force=args.force, keep_frames=args.keep_frames, dims=args.dims, on_frame=FrameProgress())
     print(file=sys.stderr)
     print(f"wrote {rep.out}: {rep.frames} frame{'s' if rep.frames != 1 else ''} of {w}x{h} ({args.style}, {preset} "
           f"colours), {rep.drawn} drawn, {rep.skipped} already there; {rep.workers}; {rep.seconds:.1f} s"
@@ -129,9 +131,7 @@ def register(sub) -> None:
     p.add_argument("--fps", type=positive_float, help="movie frame rate (default: the sequence's, else 24)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",
                    help="which frames (counted from 0)")
-    pool = p.add_mutually_exclusive_group()
-    pool.add_argument("--workers", type=positive_int, help="local worker processes (default: every core)")
-    pool.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="draw on this Dask cluster instead")
+    add_pool(p, "draw")
     p.add_argument("--mapper", choices=MAPPERS, default="auto",
                    help="volume style: cpu (the fixed-point ray caster), gpu (VTK's smart mapper) or auto (the "
                    "faster of the two on this data, timed once before the run)")

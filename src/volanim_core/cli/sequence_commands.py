@@ -11,8 +11,10 @@ from ._common import (
     add_command,
     add_dims,
     add_joints,
+    add_pool,
     ascii_int,
     checked_by,
+    dask_scheduler,
     joints_of,
     load_scan,
     load_source,
@@ -62,9 +64,10 @@ def _sequence(args):
     workers = local_workers(args)
     settings = SequenceSettings(mode=args.mode, source=source, source_geometry=source_geometry, kernel=args.kernel,
                                 padding=args.padding, fps=args.fps, every_frame_as=args.every_frame_as)
-    on = RunOn(workers=workers, scheduler=args.scheduler, threads_per_worker=args.threads_per_worker)
-    rep = run_sequence(conn, frames, args.output, settings, on=on, existing="redo" if args.force else "resume",
-                       on_frame=FrameProgress())
+    with dask_scheduler(args) as scheduler:
+        on = RunOn(workers=workers, scheduler=scheduler, threads_per_worker=args.threads_per_worker)
+        rep = run_sequence(conn, frames, args.output, settings, on=on, existing="redo" if args.force else "resume",
+                           on_frame=FrameProgress())
     print(file=sys.stderr)
     print(format_report(rep))
     from volanim_core.sequence.store import ome_scale
@@ -189,9 +192,7 @@ def register(sub) -> None:
     p.add_argument("--every-frame-as", metavar="DIR/NAME.%%04d.vti",
                    type=checked_by("volanim_core.sequence.task:check_frame_pattern", "--every-frame-as {text!r} "),
                    help="also write each frame as a file (.vti, .nrrd, .vol, .VOL; %%04d = frame number)")
-    where = p.add_mutually_exclusive_group()
-    where.add_argument("--workers", type=positive_int, help="local worker processes (default: every core)")
-    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="run on this Dask cluster instead")
+    add_pool(p, "run")
     p.add_argument("--threads-per-worker", type=positive_int, default=1, help="numba threads per worker (default 1)")
     p.add_argument("--force", action="store_true", help="recompute every frame (and replace another sequence)")
     p.add_argument("--fps", type=positive_float, default=24.0, help="frame rate recorded in the store (default 24)")
