@@ -21,6 +21,7 @@ from volanim_core.rig.bones import Bone, BoneSkeleton
 SKIN, FAT, MUSCLE_A, MUSCLE_B, BONE, SKULL, BRAIN = 210, 90, 130, 165, 250, 235, 110
 MANNEQUIN_SHAPE = (160, 100, 300)
 LARGE_SHAPE = (290, 169, 940)  # the thesis's half-size Visible Human
+FULL_SHAPE = (580, 338, 1880)  # the thesis's full Visible Human grid: 368 M voxels
 MID_X = (MANNEQUIN_SHAPE[0] - 1) / 2  # 79.5: the volume's mid-plane, the studio's default symmetry plane
 
 

@@ -24,12 +24,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.mannequin_body import LARGE_SHAPE, MANNEQUIN_SHAPE, capsule_boxes, mannequin_bones_at, paint_mannequin
+from volanim_core.mannequin_body import (
+    FULL_SHAPE,
+    LARGE_SHAPE,
+    MANNEQUIN_SHAPE,
+    capsule_boxes,
+    mannequin_bones_at,
+    paint_mannequin,
+)
 from volanim_core.samples import TISSUE_COLOURS, Sample
 
-POSABLE = ("mannequin", "mannequin-large", "mannequin-colour")
+POSABLE = ("mannequin", "mannequin-large", "mannequin-full", "mannequin-colour")
 _SCALES = {"mannequin": np.ones(3), "mannequin-colour": np.ones(3),
-           "mannequin-large": np.array(LARGE_SHAPE, float) / MANNEQUIN_SHAPE}
+           "mannequin-large": np.array(LARGE_SHAPE, float) / MANNEQUIN_SHAPE,
+           "mannequin-full": np.array(FULL_SHAPE, float) / MANNEQUIN_SHAPE}
 
 
 def posed_sample(name: str, matrices: np.ndarray, progress=None) -> Sample:

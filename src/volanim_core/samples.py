@@ -3,6 +3,7 @@
     mannequin()  (160, 100, 300) uint8  layered humanoid + BoneSkeleton + part labels
     mannequin_colour()  (160, 100, 300, 3) uint8  the same body in anatomical colours (RGB)
     mannequin_large()  (290, 169, 940) uint8  the same body at half-size Visible Human scale
+    mannequin_full()  (580, 338, 1880) uint8  the same body on the full Visible Human grid (368 M voxels)
     aliascube()  (128, 128, 128) uint8  107^3 checkerboard of 50 / 250 (thesis Table 5.2)
     frog()       (500, 470, 136) uint8  tissue labels from pyvista's wheel (offline),
                                          with a two-bone principal-axis chain
@@ -27,6 +28,7 @@ from volanim_core.mannequin_body import (  # noqa: F401 -- the body's names are 
     BONE,
     BRAIN,
     FAT,
+    FULL_SHAPE,
     LARGE_SHAPE,
     MANNEQUIN_SHAPE,
     MID_X,
@@ -51,6 +53,8 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster")
 CLUSTER_FILES = ("local", "slurm", "pbs", "kubernetes")  # cluster-NAME.yaml: --cluster-config templates
 MESH_SAMPLES = ("rabbit", "spot", "bob")
+#: Samples too large for ``samples all`` (minutes and gigabytes to make): asked for by name only.
+BY_NAME_ONLY = ("mannequin-full",)
 
 CT_SPACING, CT_ORIGIN = (0.7, 0.7, 2.5), (-56.0, -35.0, -1150.0)  # a CT's voxels (mm), somewhere in a scanner
 #: Hounsfield units a CT of the mannequin's tissues would read (air: -1000).
@@ -132,6 +136,13 @@ def mannequin_large(progress=None) -> Sample:
     mannequin's, scaled. ``progress(done, total)`` counts body parts (~2 s in all).
     """
     return _mannequin(np.array(LARGE_SHAPE, float) / MANNEQUIN_SHAPE, "mannequin-large", progress)
+
+
+def mannequin_full(progress=None) -> Sample:
+    """The mannequin on the thesis's full Visible Human grid, 580 x 338 x 1880 voxels (368 M): the body of
+    :func:`mannequin_large` sampled twice as finely along each axis, for runs at the thesis's target size
+    (`volanim sequence` on a cluster). ``progress(done, total)`` counts body parts."""
+    return _mannequin(np.array(FULL_SHAPE, float) / MANNEQUIN_SHAPE, "mannequin-full", progress)
 
 
 def part_connectivity(sample: Sample, min_thinness: float = 0.5, progress=None):
@@ -259,9 +270,10 @@ def _deepest_near(mask: np.ndarray, target, radius: float = 60.0, step: int = 4)
 def load(name: str) -> Sample:
     """A demo dataset by name: one of :data:`~volanim_core.samples.NAMES`."""
     makers = {"mannequin": mannequin, "mannequin-colour": mannequin_colour, "mannequin-large": mannequin_large,
+              "mannequin-full": mannequin_full,
               "aliascube": aliascube, "frog": frog, "curved-tube": curved_tube}
     if name not in makers:
-        raise ValueError(f"unknown sample {name!r}; choose one of {', '.join(NAMES)}")
+        raise ValueError(f"unknown sample {name!r}; choose one of {', '.join(NAMES + BY_NAME_ONLY)}")
     return makers[name]()
 
 
@@ -352,8 +364,9 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         for src, dst in zip((clip, clip.with_name(f"{clip.name}.LICENSE")), written):
             atomic_write_bytes(dst, src.read_bytes())
         return written
-    # mannequin-large: the body is the first 20 %, its .connect's skeleton the rest
-    sample = mannequin_large(stage(progress, 0, 20)) if name == "mannequin-large" else load(name)
+    # the large mannequins: the body is the first 20 %, its .connect's skeleton the rest
+    big = {"mannequin-large": mannequin_large, "mannequin-full": mannequin_full}
+    sample = big[name](stage(progress, 0, 20)) if name in big else load(name)
     written = [folder / f"{name}.VOL"]
     write_raw(written[0], sample.volume)
     if sample.bones is not None:
@@ -363,7 +376,7 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
     if name == "mannequin":  # keyframes for `volanim keys`: the left arm waves once, the spine leans
         written.append(folder / f"{name}.keys")
         write_mannequin_keys(written[-1], sample.bones)
-    if name == "mannequin-large":  # ready to reconstruct at the thesis's scale: its Table 2.2 skeleton
+    if name in big:  # ready to reconstruct at the thesis's scale: its Table 2.2 skeleton
         from volanim_core.io import write_connect
 
         written.append(folder / f"{name}.connect")

@@ -31,6 +31,20 @@ def test_at_identity_the_truth_is_mannequin_large_voxel_for_voxel():
     _check_identity("mannequin-large", samples.mannequin_large())
 
 
+@pytest.mark.slow
+def test_mannequin_full_is_the_large_body_on_the_full_visible_human_grid_and_its_truth_at_identity():
+    """#87: the thesis's full grid, 580 x 338 x 1880 (368 M voxels), the same body sampled twice as finely along
+    each axis as mannequin-large: 8x its voxels (within 1 %), its bones at twice the coordinates."""
+    full, large = samples.mannequin_full(), samples.mannequin_large()
+    assert full.volume.shape == (580, 338, 1880) and full.volume.dtype == np.uint8
+    ratio = np.count_nonzero(full.volume) / np.count_nonzero(large.volume)
+    assert abs(ratio - 8) < 0.08, ratio
+    for name, at in large.bones.joints.items():
+        assert np.allclose(full.bones.joints[name], 2 * at, atol=1.5), name
+    del large
+    _check_identity("mannequin-full", full)
+
+
 def test_a_posed_part_is_its_rest_part_moved_whole():
     """A forearm bent 90 degrees about y at the elbow: each of its voxels is a rest forearm voxel turned about
     the elbow, and the hand goes with it; the other side of the body does not move."""

@@ -219,7 +219,7 @@ def register(sub) -> None:
                     _compare)
     p.add_argument("ours", help="the posed volume (a reconstruction)")
     p.add_argument("truth", nargs="?", help="the true posed volume on the same voxel grid (samples NAME --pose)")
-    p.add_argument("--sample", choices=("mannequin", "mannequin-large", "mannequin-colour"),
+    p.add_argument("--sample", choices=("mannequin", "mannequin-large", "mannequin-full", "mannequin-colour"),
                    help="make the truth here: this mannequin posed by --pose")
     p.add_argument("--pose", metavar="TRANS", help="the .trans the volume was posed with (joints: where blobs are)")
     p.add_argument("--bones", help="the .bones of --pose (default: the sample's): blobs named by joint and bone")

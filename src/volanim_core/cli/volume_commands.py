@@ -425,7 +425,7 @@ def register(sub) -> None:
                     "Write a demo dataset: mannequin (-colour, -large, -ct as DICOM), aliascube, frog, the walk clip, "
                     "the ant mesh, or all.",
                     "volanim samples all -o .", _samples)
-    p.add_argument("name", choices=(*samples.NAMES, *samples.FILE_SAMPLES, "all"))
+    p.add_argument("name", choices=(*samples.NAMES, *samples.FILE_SAMPLES, *samples.BY_NAME_ONLY, "all"))
     p.add_argument("--pose", metavar="TRANS", help="a mannequin's true shape in this pose (a .trans of its bones): "
                    "each body part moved whole by its bone, the volume to compare a reconstruction with "
                    "(volanim compare); -o then names that volume: samples mannequin --pose arm.trans -o truth.vti")
