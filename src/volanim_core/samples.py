@@ -53,6 +53,7 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster")
 CLUSTER_FILES = ("local", "slurm", "pbs", "kubernetes")  # cluster-NAME.yaml: --cluster-config templates
 MESH_SAMPLES = ("rabbit", "spot", "bob")
+SAMPLE_DATA = Path(__file__).resolve().parent / "sample_data"  # package data: the clip, meshes, cluster files
 #: Samples too large for ``samples all`` (minutes and gigabytes to make): asked for by name only.
 BY_NAME_ONLY = ("mannequin-full",)
 
@@ -277,9 +278,19 @@ def load(name: str) -> Sample:
     return makers[name]()
 
 
+def _copy_package_data(folder: Path, names: list[str]) -> list[Path]:
+    """Files of ``sample_data/`` (package data) copied into ``folder``, each written atomically."""
+    from volanim_core.io.atomic import atomic_write_bytes
+
+    written = [folder / n for n in names]
+    for dst in written:
+        atomic_write_bytes(dst, (SAMPLE_DATA / dst.name).read_bytes())
+    return written
+
+
 def walk_clip() -> Path:
     """The bundled motion-capture walk (``walk.bvh``, package data; its MIT licence is beside it)."""
-    return Path(__file__).resolve().parent / "sample_data" / "walk.bvh"
+    return SAMPLE_DATA / "walk.bvh"
 
 
 def write_mannequin_ct(folder: str | Path, progress=None) -> list[Path]:
@@ -348,22 +359,11 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         atomic_write_bytes(written[0], Path(examples.antfile).read_bytes())
         return written + write_ant_rig(folder)  # its joints as Slicer markups, and a gait
     if name in MESH_SAMPLES:
-        mesh = Path(__file__).resolve().parent / "sample_data" / f"{name}.ply"
-        written = [folder / f"{name}.ply", folder / f"{name}.ply.LICENSE"]
-        for src, dst in zip((mesh, mesh.with_name(f"{name}.ply.LICENSE")), written):
-            atomic_write_bytes(dst, src.read_bytes())
-        return written
+        return _copy_package_data(folder, [f"{name}.ply", f"{name}.ply.LICENSE"])
     if name == "cluster":  # files to start a Dask cluster from (--cluster-config), to edit (docs: cluster.md)
-        written = [folder / f"cluster-{kind}.yaml" for kind in CLUSTER_FILES]
-        for dst in written:
-            atomic_write_bytes(dst, (Path(__file__).resolve().parent / "sample_data" / dst.name).read_bytes())
-        return written
+        return _copy_package_data(folder, [f"cluster-{kind}.yaml" for kind in CLUSTER_FILES])
     if name == "walk":
-        clip = walk_clip()
-        written = [folder / clip.name, folder / f"{clip.name}.LICENSE"]
-        for src, dst in zip((clip, clip.with_name(f"{clip.name}.LICENSE")), written):
-            atomic_write_bytes(dst, src.read_bytes())
-        return written
+        return _copy_package_data(folder, [walk_clip().name, f"{walk_clip().name}.LICENSE"])
     # the large mannequins: the body is the first 20 %, its .connect's skeleton the rest
     big = {"mannequin-large": mannequin_large, "mannequin-full": mannequin_full}
     sample = big[name](stage(progress, 0, 20)) if name in big else load(name)

@@ -170,11 +170,10 @@ def _png_depth(path: Path) -> tuple[int, int] | None:
     return head[24], head[25]
 
 
-def _refuse_16_bit_colour_png(path: Path) -> None:
-    """Refuse a 16-bit PNG with colour or alpha: Pillow, which reads the slices, keeps only the high byte of
-    each of its channels (a CT of values 0..6000 came in as 0..23, silently). Grey 16-bit PNGs and 16-bit
-    TIFFs of any kind are read in full."""
-    depth = _png_depth(path)
+def _refuse_16_bit_colour_png(path: Path, depth: tuple[int, int] | None) -> None:
+    """Refuse a 16-bit PNG with colour or alpha (``depth``: :func:`_png_depth`'s): Pillow, which reads the slices,
+    keeps only the high byte of each of its channels (a CT of values 0..6000 came in as 0..23, silently). Grey
+    16-bit PNGs and 16-bit TIFFs of any kind are read in full."""
     if depth is not None and depth[0] == 16 and depth[1] != 0:
         kind = _PNG_COLOUR_TYPES.get(depth[1], f"colour type {depth[1]}")
         raise FormatError(path, f"a 16-bit {kind} PNG: the image library volanim reads slices with (Pillow) keeps "
@@ -195,10 +194,10 @@ def _keyed_transparency(path: Path) -> bool:
         return False
 
 
-def _refuse_keyed_grey16(path: Path, img: np.ndarray) -> None:
+def _refuse_keyed_grey16(path: Path, depth: tuple[int, int] | None, img: np.ndarray) -> None:
     """A 16-bit grey PNG whose tRNS chunk keys one value as transparent: refused where a pixel has it (as an
     alpha channel with a transparent pixel is), read as it is where none has."""
-    if _png_depth(path) != (16, 0):
+    if depth != (16, 0):
         return
     from PIL import Image
 
@@ -219,14 +218,15 @@ def read_slice(path: Path, *, colour: bool | None = False, expect=None) -> np.nd
     """
     import imageio.v3 as iio  # not skimage.io.imread: it moves the axes of a grey+alpha image 3 or 4 rows high
 
-    _refuse_16_bit_colour_png(path)
+    depth = _png_depth(path)  # the PNG's header, read once for both checks
+    _refuse_16_bit_colour_png(path, depth)
     try:
         # a palette (or grey, RGB) image with a tRNS chunk: its transparency is read as alpha, which PIL's
         # plain conversion drops (a mask's transparent background came in as opaque colour)
         img = np.asarray(iio.imread(path, mode="RGBA") if _keyed_transparency(path) else iio.imread(path))
     except Exception as exc:  # imageio/PIL raise many types
         raise FormatError(path, f"cannot read image: {exc}") from exc
-    _refuse_keyed_grey16(path, img)
+    _refuse_keyed_grey16(path, depth, img)
     if img.ndim == 3 and img.shape[2] in (2, 4):  # grey+alpha or RGBA
         img = _without_alpha(img, path)
     is_rgb = img.ndim == 3 and img.shape[2] == 3

@@ -18,6 +18,9 @@ def check_root_order(conn_bones, trans_bones, what: str = ".trans", first: str =
     """Raise ValueError saying how two files' bones differ: the bones only one of them has, two bones listed in
     other orders, or the first bone whose joints moved (by how much), and what to do. The caller names the
     files (the CLI's error prefix, or ``what``/``first``)."""
+    if len(conn_bones) == len(trans_bones) and all(a.same_segment(b, tol=1e-3)
+                                                    for a, b in zip(conn_bones, trans_bones)):
+        return  # the usual answer, once per frame of a clip: the pairwise search below is for saying what differs
     fix = (f"the {what} was written for another bone skeleton: write the frames from the bones of this "
            f"{first} (volanim pose, keys or bvh2trans with its .bones)")
     only_theirs = [b for b in trans_bones if not any(b.same_segment(a, tol=1e-3) for a in conn_bones)]
