@@ -20,6 +20,14 @@ overhead (the target) is estimated from all rounds of the three datasets togethe
 7 rounds still move by +-5 points from run to run (a neighbour's burst in two of them).
 
     .venv/bin/python benchmarks/bench_sequence.py [FRAMES]    # FRAMES: the same count for every dataset
+    .venv/bin/python benchmarks/bench_sequence.py --scale [FRAMES]   # the cost curve (#87), below
+
+``--scale``: the walking mannequin on a quarter, half and the whole of the thesis's full Visible Human
+grid (5.8 M, 46 M, 368 M voxels), the same walk frames at each, sampled mode, on a fresh Dask LocalCluster
+of 1 and of 2 workers (fresh, so a worker's peak RSS is this run's). Reported per size: the voxels a frame
+is made in (its own grid, not the walk's shared one), a worker's seconds per frame and per M voxels, the
+2-worker throughput, peak RSS per worker and the store's bytes per frame. Linear in voxels is the goal:
+seconds per M voxels within 1.3x of the quarter size's.
 """
 
 from __future__ import annotations
@@ -222,5 +230,74 @@ def main() -> None:
     print(table(ext, ["workers", "s per frame", "100 frames take", "GB per worker"]))
 
 
+def _scaled_case(fraction: float, n: int):
+    """The walking mannequin on ``fraction`` of the full Visible Human grid (the sample's own body painted
+    on that grid, its ground-truth skeleton), the walk's frames 0, 10, ... as at every size."""
+    from volanim_core import samples
+    from volanim_core.mannequin_body import FULL_SHAPE, MANNEQUIN_SHAPE
+    from volanim_core.sequence.frames import frames_from_files
+
+    s = samples._mannequin(np.array(FULL_SHAPE, float) * fraction / MANNEQUIN_SHAPE, f"mannequin x{fraction:g}")
+    conn = samples.part_connectivity(s, 0.5)
+    frames = frames_from_files(conn, [samples.walk_clip()], bones=s.bones, frames=slice(0, 10 * n, 10))
+    return s, conn, frames
+
+
+def _on_cluster(conn, frames, source, folder: Path, workers: int) -> dict:
+    from distributed import Client, LocalCluster
+
+    from volanim_core.parallel import RunOn
+    from volanim_core.sequence.run import SequenceSettings, run_sequence
+
+    out = folder / "scale.zarr"
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None, memory_limit=0) as cluster, Client(cluster) as client:
+        rep = run_sequence(conn, frames, out, SequenceSettings(mode="sampled", source=source),
+                           on=RunOn(scheduler=client), existing="redo")
+    size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    shutil.rmtree(out)
+    regions = [int(np.prod([b - a for a, b in r["region"]])) for r in rep.records]
+    return {"seconds": float(np.median([r["seconds"] for r in rep.records])), "wall": rep.seconds,
+            "steady": steady_rate(rep.records), "peak": max(r["peak_rss"] for r in rep.records),
+            "size": size / len(frames), "voxels": float(np.mean(regions)),
+            "filled": float(np.mean([r["filled"] for r in rep.records])),
+            "overdraw": float(np.mean([r.get("overdraw", 0.0) for r in rep.records]))}
+
+
+def scale_curve(n: int) -> None:
+    import gc
+
+    rows, per_voxel = [], {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for fraction in (0.25, 0.5, 1.0):
+            t0 = time.perf_counter()
+            sample, conn, frames = _scaled_case(fraction, n)
+            made = time.perf_counter() - t0
+            got = {w: _on_cluster(conn, frames, sample.volume, Path(tmp), w) for w in (1, 2)}
+            one, two = got[1], got[2]
+            per_voxel[fraction] = one["seconds"] / (one["voxels"] / 1e6)
+            rows.append([f"{fraction:g}", "x".join(map(str, sample.volume.shape)), f"{len(conn):,}", f"{n}",
+                         f"{one['voxels'] / 1e6:.0f}", f"{one['filled'] / 1e6:.1f}", f"{one['seconds']:.2f}",
+                         f"{1000 * per_voxel[fraction]:.1f}", f"{one['overdraw']:.1f}", f"{two['steady']:.3f}",
+                         f"{two['seconds']:.2f}",
+                         f"{one['peak'] / 2**30:.2f} / {two['peak'] / 2**30:.2f}", f"{one['size'] / 2**20:.2f}",
+                         f"{made:.0f}"])
+            del sample, conn, frames
+            gc.collect()
+    base = per_voxel[0.25]
+    for row, fraction in zip(rows, per_voxel):
+        row.insert(8, f"{per_voxel[fraction] / base:.2f}")
+    print(f"\nsequence cost curve (#87): the walking mannequin, {n} walk frames a size, sampled mode, a fresh Dask "
+          "LocalCluster of 1 and of 2 workers (1 thread each) per size; a frame's voxels: its own grid")
+    print(table(rows, ["size (of full)", "body grid", "spheres", "frames", "M voxels a frame", "M filled",
+                       "1 worker s/frame (median)", "ms per M voxels", "vs quarter (<= 1.3)", "overdraw",
+                       "2 workers f/s (steady)", "2 workers s/frame a worker", "peak GB a worker (1 / 2)",
+                       "store MB a frame", "body + skeleton s"]))
+
+
 if __name__ == "__main__":
-    main()
+    if "--scale" in sys.argv:
+        args = [a for a in sys.argv[1:] if a != "--scale"]
+        scale_curve(int(args[0]) if args else 6)
+    else:
+        main()

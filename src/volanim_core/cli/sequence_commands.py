@@ -81,6 +81,21 @@ def _sequence(args):
     print(f"wrote {args.output}: {len(frames)} frames of {'x'.join(map(str, rep.bounds.shape))} ({rep.dtype}), "
           f"origin {rep.bounds.lo}; {rep.computed} made, {rep.skipped} already complete; {rep.workers}; "
           f"{rep.seconds:.1f} s")
+    print(cost_line(rep, args.output))
+
+
+def cost_line(rep, store) -> str:
+    """What a frame cost and what the store holds (#87: a user sizing a cluster run reads this line)."""
+    from pathlib import Path
+
+    from volanim_core.limits import human_bytes
+
+    recs = rep.records
+    size = sum(p.stat().st_size for p in Path(store).rglob("*") if p.is_file())
+    per = f"{rep.seconds / rep.computed:.2f} s a frame made this run; " if rep.computed else ""
+    per += (f"a frame {sum(r['seconds'] for r in recs) / len(recs):.2f} s on its worker (mean), worker peak "
+            f"{human_bytes(max(r['peak_rss'] for r in recs))}; " if recs else "")
+    return f"{per}store {human_bytes(size)}, {human_bytes(size / max(len(rep.records), 1))} a frame"
 
 
 def _crumble(args):

@@ -114,7 +114,7 @@ def _zarr_inputs(path: Path, frames: slice) -> RenderInputs:
     else:
         vmax = float(np.iinfo(dtype).max) if dtype.kind in "ui" else 1.0
         if dtype.itemsize > 1 or dtype.kind == "f":
-            vmax = float(np.max(seq.read_frame(indices[len(indices) // 2])))  # a middle frame's brightest voxel
+            vmax = float(np.max(seq.read_part(indices[len(indices) // 2])[0]))  # a middle frame's brightest voxel
     scale = seq.seconds_per_frame
     refs = [FrameRef(str(resolved(path)), i, int(numbers[i])) for i in indices]
     boxes = None
@@ -217,14 +217,15 @@ def render_task(job: RenderJob | None, ref: FrameRef) -> tuple[int, np.ndarray]:
 def read_frame(ref: FrameRef, dims=None, colour: bool = True) -> tuple[np.ndarray, tuple]:
     """One input frame as ``(volume [x, y, z], origin in voxels)``. A colour sequence's frame is its
     colours ``[x, y, z, 3]`` (its indices through its palette), or with ``colour=False`` its indices
-    (what a user's transfer function over the palette reads: ``render --tf``)."""
+    (what a user's transfer function over the palette reads: ``render --tf``). A sequence's frame is its
+    recorded region placed at its corner, never the shared grid (a full-size walk's holds 31.5 G voxels)."""
     if ref.index >= 0:
         from volanim_core.sequence.checked import read_store
 
         seq = read_store(ref.path)
-        if colour and seq.palette is not None:
-            return seq.read_colour(ref.index), seq.origin_xyz
-        return seq.read_frame(ref.index), seq.origin_xyz
+        part, corner = seq.read_colour_part(ref.index) if colour and seq.palette is not None else \
+            seq.read_part(ref.index)
+        return part, tuple(o + c for o, c in zip(seq.origin_xyz, corner))
     volume, origin, *_ = _read(ref.path, dims)
     return volume, origin
 

@@ -8,7 +8,8 @@
     OUT.zarr/volanim-frames.jsonl  --> the finished frames' records (index, sha256, region, box, ...)
                           |
                           v
-    Store (frozen) --read_frame(index)--> the frame, its sha256 compared with its record's
+    Store (frozen) --read_part(index)--> the frame's recorded region and its corner, its sha256 compared
+                   --read_frame(index)--> the frame on the whole shared grid (when that fits in memory)
 
 Every check refuses with a FormatError naming the store's file and, for the manifest, its line.
 The fault corpus found 29 crashes and 9 memory blow-ups where this metadata was indexed unchecked
@@ -55,18 +56,37 @@ class Store:
         return len(self.numbers)
 
     def read_frame(self, index: int, verify: bool = True) -> np.ndarray:
-        """Frame ``index`` as ``[x, y, z]``; with ``verify``, refused unless it hashes to its record's
-        sha256 (a missing or swapped shard, a changed file). Returns the frame; frames recorded before
-        regions were recorded (no ``"region"``) cannot be verified and are returned as read."""
+        """Frame ``index`` as ``[x, y, z]`` on the whole shared grid (refused naming the store when that grid
+        does not fit in memory: :meth:`read_part` reads only the frame's body); with ``verify``, refused unless
+        it hashes to its record's sha256 (a missing or swapped shard, a changed file)."""
+        checked_grid(self.path, self.shape_zyx[::-1], self.dtype.itemsize, what="the sequence's shared grid")
+        part, corner = self.read_part(index, verify)
+        whole = np.zeros(self.shape_zyx[::-1], self.dtype)
+        whole[tuple(slice(c, c + n) for c, n in zip(corner, part.shape))] = part
+        return whole
+
+    def read_part(self, index: int, verify: bool = True) -> tuple[np.ndarray, tuple[int, int, int]]:
+        """Frame ``index``'s recorded region as ``[x, y, z]`` and its corner ``(x, y, z)`` in the grid's voxels;
+        outside the region the frame is empty. A walk's shared grid is mostly empty (the full-size walk's is
+        31.5 G voxels, a frame's region 0.4 G): renders and viewers read this. With ``verify``, refused unless it
+        hashes to its record's sha256. A frame recorded before regions were (no ``"region"``) is read whole and
+        cannot be verified; an empty frame is one empty voxel at the corner."""
         import zarr
 
         from .store import frame_checksum
 
         if not 0 <= index < self.frames:
             raise FormatError(self.path, f"has no frame at index {index} (it has {self.frames})")
+        rec = self.done.get(index)
+        known = rec is not None and rec.get("region") is not None
+        region = tuple(slice(a, b) for a, b in rec["region"]) if known else \
+            tuple(slice(0, n) for n in self.shape_zyx)
+        sizes = [s.stop - s.start for s in region]
+        if min(sizes) > 0:  # a region that does not fit in memory is refused before zarr allocates it
+            checked_grid(self.path, sizes[::-1], self.dtype.itemsize, what=f"frame {self.numbers[index]}'s region")
         array = zarr.open_array(str(self.path / "0"), mode="r")
         try:
-            zyx = np.asarray(array[index])
+            zyx = np.asarray(array[(index, *region)])
         except MemoryError:
             raise
         except Exception as exc:  # noqa: BLE001 - zarr's codecs raise RuntimeError, ValueError, ... for a bad shard
@@ -75,20 +95,26 @@ class Store:
                                          f"decoded ({type(exc).__name__}: {exc}): the file was damaged or changed "
                                          "after it was written; rerun `volanim sequence` with --force to make "
                                          "it again") from exc
-        rec = self.done.get(index)
-        if verify and rec is not None and rec.get("region") is not None:
-            region = tuple(slice(a, b) for a, b in rec["region"])
-            if frame_checksum(zyx[region], region) != rec["sha256"]:
-                raise FormatError(self.path, f"frame {self.numbers[index]} (index {index}) does not match its "
-                                  f"sha256 in {FRAMES_FILE}: its shard in 0/ is missing or was changed; "
-                                  "rerun `volanim sequence` with --force to make it again")
-        return zyx.T
+        if verify and known and frame_checksum(zyx, region) != rec["sha256"]:
+            raise FormatError(self.path, f"frame {self.numbers[index]} (index {index}) does not match its "
+                              f"sha256 in {FRAMES_FILE}: its shard in 0/ is missing or was changed; "
+                              "rerun `volanim sequence` with --force to make it again")
+        if not zyx.size:
+            return np.zeros((1, 1, 1), self.dtype), (0, 0, 0)
+        return zyx.T, tuple(int(s.start) for s in region[::-1])
 
     def read_colour(self, index: int) -> np.ndarray:
         """A colour sequence's frame ``index`` as ``[x, y, z, 3]`` colours: its indices through its palette."""
         if self.palette is None:
             raise ValueError(f"{self.path} is not a colour sequence (it has no palette)")
         return self.palette[self.read_frame(index)]
+
+    def read_colour_part(self, index: int) -> tuple[np.ndarray, tuple[int, int, int]]:
+        """:meth:`read_part` of a colour sequence, in colours ``[x, y, z, 3]``."""
+        if self.palette is None:
+            raise ValueError(f"{self.path} is not a colour sequence (it has no palette)")
+        part, corner = self.read_part(index)
+        return self.palette[part], corner
 
     def verified(self, index: int) -> bool:
         """Whether :meth:`read_frame` can verify this frame (its record has the region it hashed)."""
@@ -180,7 +206,10 @@ def _read_store(path: Path) -> Store:
     _need(array_file, dtype in DTYPES, f"\"data_type\" must be one of {', '.join(DTYPES)}, got {dtype!r}")
     _need(array_file, palette is None or dtype == "uint8", f"a colour sequence's \"data_type\" is uint8 (palette "
           f"indices), got {dtype!r}")
-    z, y, x = checked_grid(array_file, shape[:0:-1], np.dtype(dtype).itemsize, what="\"shape\"")[::-1]
+    # the shared grid need not fit in memory (a full-size walk's is 31.5 G voxels): a frame's region must,
+    # checked where it is read (Store.read_part); the whole grid only where it is asked for (read_frame)
+    z, y, x = checked_grid(array_file, shape[:0:-1], np.dtype(dtype).itemsize, what="\"shape\"",
+                           allocate=False)[::-1]
     for where, chunks in _chunk_shapes(array):
         _need(array_file, isinstance(chunks, list) and len(chunks) == 4 and all(
             _int(c) and 1 <= c <= min(MAX_AXIS, 2 * max(n, 128)) for c, n in zip(chunks, [1, z, y, x])),

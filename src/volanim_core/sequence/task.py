@@ -14,13 +14,13 @@ so each worker computes them once per DT scale and keeps them.
 from __future__ import annotations
 
 import os
-import resource
 import socket
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from volanim_core.limits import peak_rss
 from volanim_core.rig.connectivity import Connectivity
 from volanim_core.volume import Bounds, tight_bounds
 
@@ -128,11 +128,12 @@ def reconstruct_frame(payload: Payload | None, index: int, spec: FrameSpec, grid
     return frame_record(  # its checksum and the region it hashed: a reader verifies the frame
         index, spec.number, part, region, filled=int(s["filled"]),
         box=None if box is None else _in_grid(box, grid.lo), clipped=int(s.get("clipped", 0)),
+        overdraw=round(float(s.get("overdraw", 0.0)), 3),  # voxel writes a filled voxel: the kernel's cost
         hotspot_max=int(s["hotspot_max"]) if "hotspot_max" in s else None,
         dt_scale=round(float(np.mean(spec.dt_scale)), 6), crumble=spec.crumble,
         seconds=round(time.perf_counter() - t0, 4), finished=round(time.time(), 4),
         worker=f"{socket.gethostname()}:{os.getpid()}",
-        peak_rss=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+        peak_rss=peak_rss())
 
 
 def _in_grid(box, lo) -> list[list[int]]:

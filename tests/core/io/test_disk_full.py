@@ -57,3 +57,10 @@ def test_every_writer_on_a_full_disk_raises_and_keeps_the_old_file(tmp_path):
     assert seq["raised"] and "s.zarr" in seq["raised"] and 0 <= seq["recorded"] < seq["frames"], seq
     assert seq["recorded_verify"] and seq["skipped_on_resume"] == seq["recorded"], seq
     assert seq["resumed_equal"], seq
+    # #87: the room it needs, from the frames it wrote (a walk's frame compresses ~10^4 x below its grid's bytes:
+    # "up to 433 MB" was said for a store that needed 0.5 MB more)
+    said = re.search(r"about ([\d.]+) (bytes|KB|MB|GB) more \((\d+) frames", seq["raised"])
+    assert said and int(said[3]) == seq["frames"] - seq["recorded"], seq
+    more = float(said[1]) * 1024 ** ["bytes", "KB", "MB", "GB"].index(said[2])
+    needed = seq["store_bytes"] * (seq["frames"] - seq["recorded"]) / seq["frames"]
+    assert 0.7 < more / needed < 1.4, (more, needed)

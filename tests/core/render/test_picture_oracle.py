@@ -180,3 +180,38 @@ def test_view_screenshot_frames_a_bone_volume_in_bone_colours(tmp_path, files):
     check("front", "view --screenshot", image, cam, vol > 0, (100.0, 0.0, 0.0), 1.0, "surface")
     lit = image[foreground(image)]
     assert np.ptp(lit.astype(int), axis=0).max() > 60 and np.abs(lit[:, 0].astype(int) - lit[:, 2]).max() > 40
+
+
+@pytest.mark.slow  # the full tier: make test keeps its time (#87)
+def test_a_sequence_whose_shared_grid_does_not_fit_in_memory_is_drawn_from_its_frames_regions(tmp_path,
+                                                                                              monkeypatch):
+    """#87: a full-size walk's shared grid is 31.5 G voxels, a frame's body 0.4 G. The store could not be
+    rendered (its grid was refused as too large for memory, or would have been allocated whole for every
+    frame). Here the grid is 20x the voxel limit, each frame's region 0.8 of it; every picture is the
+    ball the frame holds, drawn where it is, against the ball computed here."""
+    frames, shape, r = 4, (2000, 80, 80), 30  # x, y, z
+    path = tmp_path / "long-walk.zarr"
+    store.create(path, shape[::-1], frames, np.uint8, (100, -50, 7), {"key": "t", "mode": "binary",
+                 "frames": frames, "numbers": list(range(frames))}, fps=12.0)
+    arr = store.open_frames(path, "r+")
+    zz, yy, xx = np.mgrid[:80, :80, :80]  # a frame's region: 80 voxels of x, written alone as the task does
+    balls = []
+    for i in range(frames):
+        x0 = 1500 + 100 * i  # near the grid's far end: a region read at the wrong place is empty
+        part = ((xx - 40) ** 2 + (yy - 40) ** 2 + (zz - 40) ** 2 <= r * r).astype(np.uint8)
+        region = (slice(0, 80), slice(0, 80), slice(x0, x0 + 80))
+        arr[(i, *region)] = part
+        corner = np.array([100 + x0, -50, 7])  # the region's corner in world voxels (the store's origin + x0)
+        box = [(corner + 40 - r).tolist(), (corner + 40 + r).tolist()]  # recorded in world voxels, as the task does
+        store.record(path, store.frame_record(i, i, part, region, filled=int(part.sum()), box=box))
+        balls.append((part.T > 0, tuple(corner)))  # the mask [x, y, z] and where it is
+    monkeypatch.setenv("VOLANIM_MAX_VOXELS", str(shape[0] * shape[1] * shape[2] // 20))
+    inputs = open_inputs([path])
+    for camera in (None, "follow"):
+        cam, inputs = place_camera(inputs, "front", camera, aspect=SIZE[0] / SIZE[1])
+        render(inputs, RenderSettings(cam, preset="binary", vmax=1, size=SIZE), tmp_path / f"pics-{camera}",
+               on=RunOn(workers=1))
+        for ref, (mask, corner) in zip(inputs.frames, balls):
+            image = iio.imread(tmp_path / f"pics-{camera}" / f"frame.{ref.number:04d}.png")[..., :3]
+            check(f"frame {ref.number}", f"sequence, grid 20x the limit ({camera or 'union'})", image,
+                  ref.camera or cam, mask, corner, 1.0, "surface")

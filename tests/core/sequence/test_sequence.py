@@ -4,6 +4,7 @@ after a kill -9, and each frame equal to the single-frame reconstruction placed 
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -18,6 +19,7 @@ from volanim_core import io
 from volanim_core.cli import main
 from volanim_core.errors import FormatError
 from volanim_core.io.frame_files import write_frames
+from volanim_core.limits import human_bytes
 from volanim_core.parallel import RunOn
 from volanim_core.reconstruct.engine import reconstruct
 from volanim_core.samples import mannequin_bones
@@ -107,6 +109,20 @@ def test_an_isolated_run_makes_its_frames_in_a_worker_process_and_the_same_frame
     assert [r["sha256"] for r in here.records] == [r["sha256"] for r in away.records]
 
 
+@pytest.mark.slow  # a spawned worker's start-up (8 s): the full tier
+def test_a_worker_reports_its_own_peak_memory_not_its_parents(tmp_path, conn, walk):
+    """#87: each frame's ``peak_rss`` came from ``getrusage``, whose maximum survives ``exec``: a spawned worker
+    reported the RSS of the process that started it. Measured with the full-size mannequin held by its
+    parent, every worker "peaked" at 4.47 GB. Here the parent holds 1.5 GB; a worker making small frames
+    holds a few hundred MB."""
+    held = np.ones(1_500_000_000, np.uint8)  # touched: resident in this process
+    rep = run_sequence(conn, walk[:2], tmp_path / "w.zarr", SequenceSettings(mode="binary"),
+                       on=RunOn(workers=1, isolate=True))
+    assert held[-1] == 1 and rep.workers == "1 local worker"
+    peaks = [r["peak_rss"] for r in rep.records]
+    assert all(50 * 2**20 < p < 1_000_000_000 for p in peaks), peaks
+
+
 def test_frames_per_task_makes_tasks_of_the_length_asked_from_the_frames_timed_so_far():
     assert frames_per_task([], DASK_TASK_SECONDS) == 1  # nothing timed yet
     assert frames_per_task([0.03] * 5, 0.0) == 1  # a local pool: a task costs microseconds
@@ -129,6 +145,10 @@ def test_every_frame_is_the_single_frame_reconstruction_placed_in_the_shared_gri
         placed[at[0]:at[0] + alone.volume.shape[0], at[1]:at[1] + alone.volume.shape[1],
                at[2]:at[2] + alone.volume.shape[2]] = alone.volume
         assert np.array_equal(read_store(tmp_path / "s.zarr").read_frame(i), placed), f"frame {i}"
+        # what renders read (#87): the frame's own region at its corner, holding every filled voxel
+        part, corner = read_store(tmp_path / "s.zarr").read_part(i)
+        assert part.size < placed.size and part.sum(dtype=np.int64) == placed.sum(dtype=np.int64), f"frame {i}"
+        assert np.array_equal(part, placed[tuple(slice(c, c + n) for c, n in zip(corner, part.shape))]), f"frame {i}"
     assert rep.records[-1]["filled"] < rep.records[0]["filled"] / 2  # melting
     # OME-Zarr (NGFF 0.5) metadata a viewer reads: axes t, z, y, x and the origin as a translation
     import zarr
@@ -204,6 +224,10 @@ def test_cli_prints_the_table_writes_per_frame_files_and_refuses_another_plan(tm
     assert main(args) == 0
     text = capsys.readouterr().out
     assert "loss %" in text and "wrote" in text and "2 made, 0 already complete" in text
+    size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())  # #87: the cost said at the end
+    said = re.search(r"s a frame made this run; a frame [\d.]+ s on its worker \(mean\), worker peak .+; store "
+                     r"(.+), .+ a frame", text)
+    assert said and said[1] == human_bytes(size), text
     vol, placed, _ = io.read_scan(tmp_path / "f" / "w.0020.nrrd")
     origin = placed.origin  # the geometry's origin: where voxel [0, 0, 0] is
     assert np.array_equal(vol, read_store(out).read_frame(1))
