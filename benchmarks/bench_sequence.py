@@ -171,7 +171,8 @@ def main() -> None:
     count = int(sys.argv[1]) if len(sys.argv) > 1 else None
     rows, large, every_round = [], None, []
     with tempfile.TemporaryDirectory() as tmp, LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None) as cluster, \
+            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+            dashboard_address="127.0.0.1:0") as cluster, \
             Client(cluster) as client:
         folder = Path(tmp)
         for make, n in CASES:
@@ -251,7 +252,7 @@ def _on_cluster(conn, frames, source, folder: Path, workers: int) -> dict:
 
     out = folder / "scale.zarr"
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=None, memory_limit=0) as cluster, Client(cluster) as client:
+                      dashboard_address="127.0.0.1:0", memory_limit=0) as cluster, Client(cluster) as client:
         rep = run_sequence(conn, frames, out, SequenceSettings(mode="sampled", source=source),
                            on=RunOn(scheduler=client), existing="redo")
     size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())

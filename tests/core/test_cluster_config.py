@@ -102,7 +102,8 @@ def test_a_sequence_on_a_cluster_config_equals_one_worker_s(tmp_path, capsys):
     ("version: 1\nmodule: volanim_no_such_module\nclass: SLURMCluster\n",
      "cannot be imported.*pip install volanim_no_such_module"),
     ("version: 1\nmodule: distributed\nclass: LocalClustr\n", "module distributed has no class 'LocalClustr'"),
-    ("version: 1\nmodule: distributed\nclass: LocalCluster\nkwargs: {n_wrkers: 2}\n",
+    ("version: 1\nmodule: distributed\nclass: LocalCluster\n"
+     "kwargs: {n_wrkers: 2, dashboard_address: '127.0.0.1:0'}\n",
      "distributed.LocalCluster refused its kwargs.*n_wrkers"),
 ])
 def test_a_bad_cluster_file_is_refused_naming_the_file_and_what_to_write(tmp_path, capsys, text, says):
