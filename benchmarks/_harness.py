@@ -15,18 +15,12 @@ import subprocess
 import sys
 import time
 
+from volanim_core.limits import peak_rss  # VmHWM: a spawned child's own peak
+
 
 def rss_bytes() -> int:
     with open("/proc/self/statm") as fh:
         return int(fh.read().split()[1]) * resource.getpagesize()
-
-
-def _peak_rss() -> int:
-    with open("/proc/self/status") as fh:
-        for line in fh:
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) * 1024
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
 def _reset_peak() -> None:
@@ -45,7 +39,7 @@ def child(cases: dict, loader, case: str, dataset: str, repeats: int) -> None:
     _reset_peak()
     before = rss_bytes()
     fn(data)
-    peak = _peak_rss() - before
+    peak = peak_rss() - before
     times = []
     for _ in range(repeats):
         t0 = time.perf_counter()

@@ -44,6 +44,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).parent))
 from _harness import table  # noqa: E402
 
+from volanim_core.sequence.store import bytes_on_disk  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -115,7 +117,7 @@ def run(case, folder: Path, **where) -> dict:
     rep = run_sequence(conn, frames, out, SequenceSettings(mode="sampled", source=source), on=RunOn(**where),
                        existing="redo")
     helpers = _helper_cpu() - before
-    size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    size = bytes_on_disk(out)
     shutil.rmtree(out)
     return {"fps": len(frames) / rep.seconds, "steady": steady_rate(rep.records),
             "peak": max(r["peak_rss"] for r in rep.records), "size": size,
@@ -255,7 +257,7 @@ def _on_cluster(conn, frames, source, folder: Path, workers: int) -> dict:
                       dashboard_address="127.0.0.1:0", memory_limit=0) as cluster, Client(cluster) as client:
         rep = run_sequence(conn, frames, out, SequenceSettings(mode="sampled", source=source),
                            on=RunOn(scheduler=client), existing="redo")
-    size = sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    size = bytes_on_disk(out)
     shutil.rmtree(out)
     regions = [int(np.prod([b - a for a, b in r["region"]])) for r in rep.records]
     return {"seconds": float(np.median([r["seconds"] for r in rep.records])), "wall": rep.seconds,

@@ -19,7 +19,6 @@ store's own manifest), with the same frames made by one worker (`--workers 1`):
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import shutil
@@ -33,15 +32,14 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).parent))
 from _harness import table  # noqa: E402
 
+from volanim_core.sequence.store import bytes_on_disk, finished  # noqa: E402
+
 VOLANIM = [sys.executable, "-m", "volanim_core"]
 
 
 def manifest(store: Path) -> dict[int, dict]:
-    file = store / "volanim-frames.jsonl"
-    if not file.exists():
-        return {}
-    recs = [json.loads(line) for line in file.read_text().splitlines() if line.strip()]
-    return {r["index"]: r for r in recs}
+    """The frames recorded complete, read as `volanim sequence` reads them (a line being written is skipped)."""
+    return finished(store)
 
 
 def sequence_args(folder: Path, name: str, frames: int, out: Path) -> list[str]:
@@ -61,10 +59,15 @@ def wait_for(store: Path, count: int, proc: subprocess.Popen) -> dict[int, dict]
         time.sleep(0.2)
 
 
-def run(args: list[str], log: Path, **kw) -> subprocess.CompletedProcess:
+def run(args: list[str], log: Path) -> subprocess.CompletedProcess:
     with open(log, "w") as fh:
-        out = subprocess.run(args, stdout=fh, stderr=subprocess.STDOUT, text=True, **kw)
-    return out
+        return subprocess.run(args, stdout=fh, stderr=subprocess.STDOUT, text=True)
+
+
+def start(args: list[str], log: Path) -> subprocess.Popen:
+    """The run in a process group of its own (a kill reaches its LocalCluster too), its output to ``log``."""
+    with open(log, "w") as fh:  # the child keeps its own copy of the descriptor
+        return subprocess.Popen(args, stdout=fh, stderr=subprocess.STDOUT, start_new_session=True)
 
 
 def same(store: Path, ref: dict[int, dict]) -> str:
@@ -75,8 +78,7 @@ def same(store: Path, ref: dict[int, dict]) -> str:
 
 def worker_killed(folder, name, frames, cluster, ref, logs) -> list:
     out = folder / "worker.zarr"
-    proc = subprocess.Popen([*sequence_args(folder, name, frames, out), "--cluster-config", str(cluster)],
-                            stdout=open(logs / "worker.log", "w"), stderr=subprocess.STDOUT, start_new_session=True)
+    proc = start([*sequence_args(folder, name, frames, out), "--cluster-config", str(cluster)], logs / "worker.log")
     at = -(-3 * frames // 10)
     got = wait_for(out, at, proc)
     victim = int(max(got.values(), key=lambda r: r["finished"])["worker"].rsplit(":", 1)[1])
@@ -94,8 +96,7 @@ def worker_killed(folder, name, frames, cluster, ref, logs) -> list:
 def client_killed(folder, name, frames, cluster, ref, logs) -> list:
     out = folder / "client.zarr"
     args = [*sequence_args(folder, name, frames, out), "--cluster-config", str(cluster)]
-    proc = subprocess.Popen(args, stdout=open(logs / "client-1.log", "w"), stderr=subprocess.STDOUT,
-                            start_new_session=True)
+    proc = start(args, logs / "client-1.log")
     at = -(-6 * frames // 10)
     wait_for(out, at, proc)
     os.killpg(proc.pid, signal.SIGKILL)  # the client and its LocalCluster: every process of the run
@@ -118,7 +119,7 @@ ls "{disk}/walk.zarr/volanim-frames.jsonl" > /dev/null 2>&1 && wc -l < "{disk}/w
     > "{logs}/disk-kept.txt"
 mount -o remount,size={large} "{disk}" || exit 91
 "$@" > "{logs}/disk-2.log" 2>&1; echo "second exit $?" >> "{logs}/disk-2.log"
-cp "{disk}/walk.zarr/volanim-frames.jsonl" "{logs}/disk-frames.jsonl"
+mkdir -p "{logs}/disk-store" && cp "{disk}/walk.zarr/volanim-frames.jsonl" "{logs}/disk-store/"
 """
 
 
@@ -135,19 +136,14 @@ def disk_filled(folder, name, frames, cluster, ref, logs, frame_bytes: int) -> l
     kept = int((logs / "disk-kept.txt").read_text()) if (logs / "disk-kept.txt").exists() else 0
     second = (logs / "disk-2.log").read_text()
     resumed = re.search(r"(\d+) made, (\d+) already complete", second)
-    got = {}
-    for line in (logs / "disk-frames.jsonl").read_text().splitlines() if (logs / "disk-frames.jsonl").exists() else []:
-        r = json.loads(line)
-        got[r["index"]] = r
-    equal = sum(got.get(i, {}).get("sha256") == r["sha256"] for i, r in ref.items())
     return ["disk", f"a {small / 2**20:.1f} MB tmpfs, then remounted at {8 * small / 2**20:.1f} MB",
             f"{out.returncode} ({first.splitlines()[-1] if first else '?'})",
             f"said: {said[0].strip() if said else '(nothing)'}; {kept} frames kept; rerun: "
-            f"{resumed[0] if resumed else second[-300:]}", f"{equal}/{len(ref)}"]
+            f"{resumed[0] if resumed else second[-300:]}", same(logs / "disk-store", ref)]
 
 
 def main() -> None:
-    argv = [a for a in sys.argv[1:]]
+    argv = sys.argv[1:]
     name = "mannequin-large" if "--size" in argv and argv[argv.index("--size") + 1] == "large" else "mannequin-full"
     if "--size" in argv:
         del argv[argv.index("--size"):argv.index("--size") + 2]
@@ -171,7 +167,7 @@ def main() -> None:
             sys.exit((logs / "one.log").read_text()[-2000:])
         one_s = time.perf_counter() - t0
         ref = manifest(ref_store)
-        frame_bytes = sum(p.stat().st_size for p in ref_store.rglob("*") if p.is_file()) // frames
+        frame_bytes = bytes_on_disk(ref_store) // frames
         shutil.rmtree(ref_store)
         cluster = folder / "cluster-local.yaml"
         rows = [worker_killed(folder, name, frames, cluster, ref, logs),

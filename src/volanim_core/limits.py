@@ -29,29 +29,30 @@ def max_voxels() -> int:
     return int(env) if env.isascii() and env.isdigit() else DEFAULT_MAX_VOXELS
 
 
-def available_bytes() -> int | None:
-    """Memory available to a new allocation (Linux ``MemAvailable``), or None when unknown."""
+def _proc_bytes(file: str, key: str) -> int | None:
+    """A ``KEY: N kB`` line of a Linux ``/proc`` file, in bytes; None where there is none."""
     try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
+        with open(file, encoding="ascii") as fh:
             for line in fh:
-                if line.startswith("MemAvailable:"):
+                if line.startswith(key):
                     return int(line.split()[1]) * 1024
     except (OSError, ValueError, IndexError):
         pass
     return None
 
 
+def available_bytes() -> int | None:
+    """Memory available to a new allocation (Linux ``MemAvailable``), or None when unknown."""
+    return _proc_bytes("/proc/meminfo", "MemAvailable:")
+
+
 def peak_rss() -> int:
     """This process's peak resident memory in bytes: Linux ``VmHWM``, the peak of its own address space.
     ``getrusage``'s ``ru_maxrss`` survives ``exec``: a spawned worker reported the RSS its parent had when it
     was started (4.5 GB for a 1-2 GB worker whose parent had just made the full-size mannequin)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
+    peak = _proc_bytes("/proc/self/status", "VmHWM:")
+    if peak is not None:
+        return peak
     import resource
     import sys
 

@@ -86,16 +86,14 @@ def _sequence(args):
 
 def cost_line(rep, store) -> str:
     """What a frame cost and what the store holds (#87: a user sizing a cluster run reads this line)."""
-    from pathlib import Path
-
     from volanim_core.limits import human_bytes
+    from volanim_core.sequence.store import bytes_on_disk
 
-    recs = rep.records
-    size = sum(p.stat().st_size for p in Path(store).rglob("*") if p.is_file())
-    per = f"{rep.seconds / rep.computed:.2f} s a frame made this run; " if rep.computed else ""
-    per += (f"a frame {sum(r['seconds'] for r in recs) / len(recs):.2f} s on its worker (mean), worker peak "
-            f"{human_bytes(max(r['peak_rss'] for r in recs))}; " if recs else "")
-    return f"{per}store {human_bytes(size)}, {human_bytes(size / max(len(rep.records), 1))} a frame"
+    recs, size = rep.records, bytes_on_disk(store)  # every frame of the store: a resumed run's too
+    made = f"{rep.seconds / rep.computed:.2f} s a frame made this run; " if rep.computed else ""
+    worker = (f"a frame {sum(r['seconds'] for r in recs) / len(recs):.2f} s on its worker (mean), worker peak "
+              f"{human_bytes(max(r['peak_rss'] for r in recs))}; ")
+    return f"{made}{worker}store {human_bytes(size)}, {human_bytes(size / len(recs))} a frame"
 
 
 def _crumble(args):

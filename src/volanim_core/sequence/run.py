@@ -222,14 +222,13 @@ def run_sequence(conn: Connectivity, frames: list[FrameSpec], out, settings: Seq
 
     def room_left() -> str:
         left = len(frames) - len(records)
-        most = f"at most {left * frame_bytes:,} bytes uncompressed"
+        most = f"{left * frame_bytes:,} bytes ({left} frames of at most {frame_bytes:,})"
         if not records:
-            return f"up to {left * frame_bytes:,} bytes ({left} frames of at most {frame_bytes:,})"
+            return f"up to {most}"
         # a walk's frame is mostly empty and compressed: the frames on disk say what the rest will take
-        written = sum(f.stat().st_size for f in (out / "0").rglob("*") if f.is_file())
-        each = written / len(records)
+        each = store.bytes_on_disk(out / "0") / len(records)
         return (f"about {human_bytes(left * each)} more ({left} frames of about {human_bytes(each)}, as the "
-                f"{len(records)} written; {most})")
+                f"{len(records)} written; at most {most} uncompressed)")
 
     full_disk = naming_the_output(out, "the sequence store (its finished frames are kept: run again with room)",
                                   room_left)

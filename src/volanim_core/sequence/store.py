@@ -164,6 +164,11 @@ def finished(path: str | Path) -> dict[int, dict]:
     return out
 
 
+def bytes_on_disk(path: str | Path) -> int:
+    """What a store (or one of its folders, e.g. ``0`` for the frames alone) takes on disk, in bytes."""
+    return sum(f.stat().st_size for f in Path(path).rglob("*") if f.is_file())
+
+
 def record(path: str | Path, *recs: dict) -> None:
     """Append finished frames (a task's): one write, then one fsync (called by the driver only)."""
     line = b"".join((json.dumps(rec, separators=(",", ":")) + "\n").encode() for rec in recs)
