@@ -22,6 +22,8 @@ INLINED = {
     "volanim_core.reconstruct._whole_kernels._joins",
     "volanim_core.reconstruct._whole_kernels._next_to",
     "volanim_core.reconstruct._kernels._sample",
+    "volanim_core.reconstruct._kernels.row_run",
+    "volanim_core.reconstruct._kernels.slice_cuts",
     "volanim_core.reconstruct._label_kernels._root",
     "volanim_core.reconstruct._label_kernels.group_starts",
     "volanim_core.rig._attach_kernels._path_inside",
