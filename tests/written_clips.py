@@ -1,10 +1,35 @@
-"""BVH clips written for tests where no real clip with a licence we can ship is on hand (an elephant, an
+"""BVH (and one glTF) clips written for tests where no real clip with a licence we can ship is on hand (an elephant, an
 insect): a hierarchy of ``(joint, parent, offset)`` and each frame's channels, as rigging tools write them
 (the root: position then ZXY rotation; every other joint: ZXY rotation)."""
 
 from __future__ import annotations
 
+import base64
+import json
+
 import numpy as np
+
+
+def tiny_gltf(times=(0.0, 1.0), quats=((0, 0, 0, 1), (0, 0, 0.7071068, 0.7071068)), interpolation="LINEAR",
+              count=None, **override) -> bytes:
+    """A three-joint glTF clip as exporters write one: a root, an arm one unit up and its hand one more, the
+    arm turned by the keys (data in a data: URI). ``count`` claims that many keys; ``override`` replaces
+    top-level entries (``nodes``, ``buffers``, ``animations``)."""
+    t, q = np.asarray(times, np.float32), np.asarray(quats, np.float32)
+    data = t.tobytes() + q.tobytes()
+    doc = {"asset": {"version": "2.0"},
+           "nodes": [{"name": "root", "children": [1]}, {"name": "arm", "translation": [0, 1, 0], "children": [2]},
+                     {"name": "hand", "translation": [0, 1, 0]}],
+           "buffers": [{"byteLength": len(data),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+           "bufferViews": [{"buffer": 0, "byteLength": t.nbytes},
+                           {"buffer": 0, "byteOffset": t.nbytes, "byteLength": q.nbytes}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": count or len(t), "type": "SCALAR"},
+                         {"bufferView": 1, "componentType": 5126, "count": count or len(q), "type": "VEC4"}],
+           "animations": [{"name": "turn", "channels": [{"sampler": 0, "target": {"node": 1, "path": "rotation"}}],
+                           "samplers": [{"input": 0, "output": 1, "interpolation": interpolation}]}]}
+    doc.update(override)
+    return json.dumps(doc).encode()
 
 
 def write_bvh(path, joints, channels, frames: int, end=(0, -1, 0), frame_time: float = 1 / 30) -> None:

@@ -50,7 +50,8 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 #: placed on it as Slicer markups (``ant.mrk.json``) and a gait (``ant.keys``): :mod:`volanim_core.ant_sample`.
 #: ``rabbit``, ``spot`` and ``bob`` copy closed meshes other projects ship (trimesh's test rabbit, MIT; Keenan
 #: Crane's Spot the cow and Bob, CC0, as geometry-central's test assets): creatures nobody templated.
-FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster")
+#: ``fox`` copies Khronos' glTF sample Fox (CC BY 4.0): a real animal's clips (Survey, Walk, Run) in glTF.
+FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster", "fox")
 CLUSTER_FILES = ("local", "slurm", "pbs", "kubernetes")  # cluster-NAME.yaml: --cluster-config templates
 MESH_SAMPLES = ("rabbit", "spot", "bob")
 SAMPLE_DATA = Path(__file__).resolve().parent / "sample_data"  # package data: the clip, meshes, cluster files
@@ -364,6 +365,8 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         return _copy_package_data(folder, [f"cluster-{kind}.yaml" for kind in CLUSTER_FILES])
     if name == "walk":
         return _copy_package_data(folder, [walk_clip().name, f"{walk_clip().name}.LICENSE"])
+    if name == "fox":
+        return _copy_package_data(folder, ["Fox.glb", "Fox.glb.LICENSE"])
     # the large mannequins: the body is the first 20 %, its .connect's skeleton the rest
     big = {"mannequin-large": mannequin_large, "mannequin-full": mannequin_full}
     sample = big[name](stage(progress, 0, 20)) if name in big else load(name)

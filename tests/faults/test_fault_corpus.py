@@ -19,6 +19,7 @@ from .cases import HOSTILE_NUMBERS, hand_written, mutated
 from .round2_cases import round2_cases
 from .round3_cases import round3_cases
 from .round4_cases import round4_cases
+from .round5_cases import round5_cases
 from .run import run_corpus, table
 from .scan_cases import scan_cases
 from .store_cases import store_cases
@@ -31,8 +32,7 @@ def corpus():
     draw = random.Random(2026)
     drawn = {(draw.choice(KINDS), draw.randrange(41), draw.choice(HOSTILE_NUMBERS)) for _ in range(60)}
     cases = hand_written() + scan_cases() + store_cases() + round2_cases() + round3_cases() + round4_cases() + \
-        sweep + [mutated(*m)
-                                                                                      for m in sorted(drawn)]
+        round5_cases() + sweep + [mutated(*m) for m in sorted(drawn)]
     seen, unique = set(), []
     for c in cases:  # a drawn mutation may repeat a swept one
         key = (c.target, c.name)

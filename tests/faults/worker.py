@@ -63,6 +63,7 @@ def readers() -> dict:
     from volanim_core import io
     from volanim_core.geometry import IDENTITY
     from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.clip_files import read_clip
     from volanim_core.io.marker_files import read_c3d
     from volanim_core.io.mesh_files import read_mesh
     from volanim_core.io.palette_files import read_alpha_map, read_palette
@@ -72,7 +73,7 @@ def readers() -> dict:
 
     return {"read_volume": io.read_volume, "read_mskel": io.read_mskel, "read_bones": io.read_bones,
             "read_connections": io.read_connections, "read_connect": io.read_connect, "read_trans": io.read_trans,
-            "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh,
+            "read_tskel": io.read_tskel, "read_project": read_project, "read_bvh": read_bvh, "read_clip": read_clip,
             "read_camera": io.read_camera, "read_transfer_function": io.read_transfer_function,
             "read_mesh": read_mesh, "read_palette": read_palette, "read_alpha_map": read_alpha_map,
             "read_sequence": read_sequence, "read_markups": lambda p: read_markups(p, IDENTITY),
@@ -97,6 +98,8 @@ CHECKS = {
     "c3d_qualisys": lambda r: len(r[0]) == 55 and r[1].shape == (340, 55, 3) and r[2] == 200.0,
     "shape_8_6_4": lambda r: tuple(r.shape) == (8, 6, 4) and int(r.max()) == 300,
     "ct_6000": lambda r: tuple(r.shape) == (6, 5, 2) and r.dtype == np.uint16 and int(r.max()) == 6000,
+    "gltf_arm_turned": lambda r: r.names == ["root", "arm", "hand"] and r.frames == 31
+    and np.allclose(r.forward_kinematics()[1][-1, 2], [-1, 1, 0], atol=1e-5),
     "two_frames": lambda r: len(r) == 2 and r[0].shape == (6, 5, 4) and int(r[1].max()) == 2,
 }
 

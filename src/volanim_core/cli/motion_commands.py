@@ -11,7 +11,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.io import read_bones, read_connect, read_trans, write_tskel
-from volanim_core.io.bvh_files import read_bvh
+from volanim_core.io.clip_files import clip_animations, read_clip
 from volanim_core.io.frame_files import write_frames
 from volanim_core.io.mapping_files import format_mapping, read_mapping
 from volanim_core.motion.plausible import check_clip, refuse_failed
@@ -69,7 +69,7 @@ def axis_or_auto(text: str) -> str:
 
 def _bvh2trans(args):
     bones = read_bones(args.bones).on_cubes()
-    motion = read_bvh(args.clip)
+    motion = read_clip(args.clip, args.animation)
     mapping = None
     if args.map:
         mapping = read_mapping(args.map)
@@ -81,6 +81,10 @@ def _bvh2trans(args):
                          f"selects no frame of {motion.frames}")
     used = {retarget.bones.bones[b].label: motion.names[k] for b, k in retarget.mapping.items()}
     report = retarget.report
+    if motion.animation is not None:
+        names = clip_animations(args.clip)
+        print(f"# animation: {motion.animation!r}" + (f" (the file has {', '.join(map(repr, names))}: --animation "
+                                                     "NAME picks another)" if len(names) > 1 else ""))
     print(f"# the clip's figure: {report['kind'].kind}: {report['kind'].reason}")
     print(f"# naming scheme: {report['scheme']}; each line says what placed it (name, shape or both)")
     print(format_mapping(used, bones, report["how"]), end="")
@@ -231,7 +235,8 @@ def register(sub) -> None:
 
     p = add_command(sub, "bvh2trans", "Motion capture onto the bone skeleton: one .trans (and .tskel) per frame.",
                     "volanim bvh2trans walk.bvh --bones mannequin.bones --frames 0:200:10 -o walk/", _bvh2trans)
-    p.add_argument("clip", help="a .bvh motion-capture clip")
+    p.add_argument("clip", help="a motion clip: .bvh, or glTF 2.0 (.glb, .gltf, .vrma)")
+    p.add_argument("--animation", help="glTF: which of the file's animations, by name or number (default the first)")
     p.add_argument("--bones", required=True, help="our .bones file")
     p.add_argument("--map", help="BONE BVH_JOINT per line (default: suggested from the names; printed)")
     p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")

@@ -48,7 +48,8 @@ def _sequence(args):
     conn = joints_of(args, read_connect(args.connect))
     bones = read_bones(args.bones) if args.bones else None
     frames = frames_from_files(conn, args.frames, bones=bones, mapping=read_mapping(args.map) if args.map else None,
-                               frames=args.range, up=args.up, forward=args.forward, check=not args.no_check)
+                               frames=args.range, up=args.up, forward=args.forward, check=not args.no_check,
+                               animation=args.animation)
     if not args.crumble and (args.acceleration or args.heap != "keep"):
         raise ValueError("--acceleration and --heap shape a crumble: give --crumble N")
     if args.melt and args.teleport:
@@ -193,7 +194,8 @@ def register(sub) -> None:
     p = add_command(sub, "sequence", "Reconstruct many frames into one OME-Zarr time series (t, z, y, x): one grid "
                     "for all frames, resumable, on all local cores or a Dask cluster.", EXAMPLE, _sequence)
     p.add_argument("connect", help="the .connect every frame uses")
-    p.add_argument("frames", nargs="+", help=".trans or .tskel files (numbered NAME.0000.trans ...), or one .bvh")
+    p.add_argument("frames", nargs="+", help=".trans or .tskel files (numbered NAME.0000.trans ...), or one clip "
+                                             "(.bvh, glTF .glb/.gltf/.vrma)")
     p.add_argument("--source", help="rest-pose volume, grey or colour (needed for --mode sampled; a colour one "
                                     "makes a colour sequence: palette indices, the palette in the store)")
     add_dims(p)  # --dims for a headerless .vol source, --series for a DICOM folder of several
@@ -219,6 +221,7 @@ def register(sub) -> None:
     _fall_options(p, "crumble: ", down="teleport/crumble: ")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
+    p.add_argument("--animation", help="glTF: which of the clip's animations, by name or number (default the first)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",
                    help="BVH: which frames")
     p.add_argument("--up", default="auto", help="BVH: the clip's up axis (default detected)")

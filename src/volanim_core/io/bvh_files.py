@@ -53,6 +53,7 @@ class Motion:
     frame_time: float
     values: np.ndarray  # (F, C) float64, C = total channel count
     end_sites: dict[int, np.ndarray] = field(default_factory=dict)  # joint -> End Site offset
+    animation: str | None = None  # which of the file's animations (glTF holds several; BVH one: None)
 
     def __post_init__(self) -> None:
         """A Motion made in code is held to what a file is (ValueError): the API took NaN values, a joint

@@ -66,6 +66,12 @@ PRESETS = (
         "SPINE": ("Spine", "Spine1"), "NECK": ("Neck",), "HEAD": ("Head",), "CLAVICLE": ("{S}Clavicle",),
         "UPPERARM": ("{S}UpperArm",), "FOREARM": ("{S}Forearm",), "HAND": ("{S}Hand",), "THIGH": ("{S}Thigh",),
         "SHIN": ("{S}Calf",), "FOOT": ("{S}Foot",), "TOE": ("{S}Toe0", "{S}Toe")}),
+    # VRM's humanoid bones (VRM animations, .vrma), as Unity's Humanoid names them
+    Preset("VRM / Unity humanoid", ("Left", "Right"), {
+        "SPINE": ("spine", "chest", "upperChest"), "NECK": ("neck",), "HEAD": ("head",),
+        "CLAVICLE": ("{S}Shoulder",), "UPPERARM": ("{S}UpperArm",), "FOREARM": ("{S}LowerArm",),
+        "HAND": ("{S}Hand",), "THIGH": ("{S}UpperLeg",), "SHIN": ("{S}LowerLeg",), "FOOT": ("{S}Foot",),
+        "TOE": ("{S}Toes",)}),
     Preset("volanim L_/R_", ("L_", "R_"), {
         **{p: ("{S}" + p,) for p in SIDED}, "SPINE": ("SPINE",), "NECK": ("NECK",), "HEAD": ("HEAD",)}),
 )

@@ -2,7 +2,7 @@
 
     .trans files          the matrices, checked against the .connect's bones
     .tskel files          the matrices; its points must be the .connect's (else refused)
-    a .bvh clip           retargeted onto --bones (optionally --map), --frames START:STOP:STEP
+    a clip (.bvh, glTF)   retargeted onto --bones (optionally --map, --animation), --frames START:STOP:STEP
     effects after them    melt, teleport, crumble (``effects.py``)
 
 Each frame is a :class:`FrameSpec`: a number (for file names and the manifest),
@@ -53,17 +53,22 @@ class FrameSpec:
 
 
 def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, frames=slice(None),
-                      up: str = "auto", forward: str = "auto", check: bool = True) -> list[FrameSpec]:
-    """FrameSpecs from ``.trans``/``.tskel`` files or one ``.bvh`` (needs ``bones``: a BoneSkeleton)."""
+                      up: str = "auto", forward: str = "auto", check: bool = True,
+                      animation: str | None = None) -> list[FrameSpec]:
+    """FrameSpecs from ``.trans``/``.tskel`` files or one clip (``.bvh``, glTF: needs ``bones``, a
+    BoneSkeleton; ``animation`` picks one of a glTF file's)."""
     from volanim_core import io
+    from volanim_core.io.clip_files import is_clip
 
     paths = [Path(p) for p in paths]
     if not paths:
-        raise ValueError("no frames given: name .trans or .tskel files, or a .bvh clip")
-    if any(p.suffix.lower() == ".bvh" for p in paths):
+        raise ValueError("no frames given: name .trans or .tskel files, or a clip (.bvh, .glb, .gltf)")
+    if any(is_clip(p) for p in paths):
         if len(paths) != 1:
-            raise ValueError("give one .bvh clip, or .trans/.tskel files, not both")
-        return _from_bvh(conn, paths[0], bones, mapping, frames, up, forward, check)
+            raise ValueError("give one clip (.bvh, .glb, .gltf), or .trans/.tskel files, not both")
+        return _from_clip(conn, paths[0], bones, mapping, frames, up, forward, check, animation)
+    if animation is not None:
+        raise ValueError("--animation picks one of a glTF clip's animations; these frames are .trans/.tskel files")
     check_complete(paths)
     numbers = [frame_number(p) for p in paths]
     if None in numbers or len(set(numbers)) != len(numbers):
@@ -82,7 +87,7 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
                                      "one connectivity; pass the .trans frames (or the matching .connect)")
             mats, bones_of = t.matrices, t.bones
         else:
-            raise ValueError(f"{p}: a frame must be a .trans, .tskel or .bvh file")
+            raise ValueError(f"{p}: a frame must be a .trans or .tskel file, or a clip (.bvh, .glb, .gltf, .vrma)")
         try:
             check_root_order(conn.bones, bones_of, p.name)
         except ValueError as exc:
@@ -91,16 +96,16 @@ def frames_from_files(conn: Connectivity, paths, *, bones=None, mapping=None, fr
     return out
 
 
-def _from_bvh(conn, path: Path, bones, mapping, frames, up, forward, check) -> list[FrameSpec]:
-    from volanim_core.io.bvh_files import read_bvh
+def _from_clip(conn, path: Path, bones, mapping, frames, up, forward, check, animation) -> list[FrameSpec]:
+    from volanim_core.io.clip_files import read_clip
     from volanim_core.motion.retarget import Retarget, check_mapping_file
     from volanim_core.rig.pose import root_bones
 
     if bones is None:
-        raise ValueError(f"{path.name}: a BVH clip needs the bone skeleton it drives (--bones MODEL.bones)")
+        raise ValueError(f"{path.name}: a clip needs the bone skeleton it drives (--bones MODEL.bones)")
     bones = bones.on_grid(conn.geometry)  # bones drawn on another grid land where they were drawn
     check_root_order(conn.bones, root_bones(bones), ".bones")
-    motion = read_bvh(path)
+    motion = read_clip(path, animation)
     if mapping is not None:
         check_mapping_file(path, mapping, bones, motion)
     retarget = Retarget.build(bones, motion, mapping, up=up, forward=forward)

@@ -295,14 +295,14 @@ def _data_file(data: dict, path, key: str, read):
 
 def _read_clip(clip: dict, bones) -> dict:
     """A timeline clip's file(s), read as :meth:`Timeline.restore` takes them."""
-    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.clip_files import read_clip
     from volanim_core.io.frame_files import read_frames
 
     from .timeline import retarget_clip
 
     try:
         if clip["kind"] == "bvh":
-            motion = read_bvh(clip["path"])
+            motion = read_clip(clip["path"], clip.get("animation"))
             return {"motion": motion, "built": retarget_clip(clip["path"], bones, motion, clip.get("mapping"),
                                                               clip.get("up", "auto"), clip.get("forward", "auto"))}
         return {"frames": read_frames(clip["path"], bones)}

@@ -1,7 +1,8 @@
 """The animation on the timeline: a loaded clip or pose keys; the current frame drives the pose. Qt-free.
 
     settings.current_frame --> Timeline.show_frame --> pose.show(matrices) (not an edit: no undo)
-    clip:  a BVH retargeted onto the bones, or a folder of .trans frames (takes precedence)
+    clip:  a clip (BVH, or one animation of a glTF file) retargeted onto the bones, or a folder of .trans
+           frames (takes precedence)
     keys:  frame -> KeyPose, slerped (volanim_core.motion.keyframes); set / delete are undoable
     doc.events.timeline  whenever the clip, the keys, ease or the length change
 
@@ -17,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from volanim_core.io.bvh_files import Motion, read_bvh
+from volanim_core.io.bvh_files import Motion
+from volanim_core.io.clip_files import read_clip
 from volanim_core.io.frame_files import frame_number, read_frames
 from volanim_core.motion.keyframes import interpolate
 from volanim_core.motion.retarget import Retarget, check_mapping_file
@@ -43,12 +45,13 @@ class Clip:
     name: str
     matrices: np.ndarray  # (F, B, 4, 4)
     fps: float
-    path: str  # the .bvh, or the folder of .trans
+    path: str  # the clip (.bvh, .glb, ...), or the folder of .trans
     frames: list[int] = field(default_factory=list)  # frame numbers (of the files; BVH: 0..F-1)
     motion: Motion | None = None  # BVH only: kept to retarget again when the bones change
     mapping: dict[str, str] | None = None
     up: str = "auto"
     forward: str = "auto"
+    animation: str | None = None  # which of a glTF file's animations (None: a BVH's one)
 
     @property
     def kind(self) -> str:
@@ -178,25 +181,26 @@ class Timeline:
 
     # ---------------------------------------------------------------- clips
     def load_bvh(self, path, mapping: dict[str, str] | None = None, up: str = "auto", forward: str = "auto",
-                 motion: Motion | None = None, built=None) -> Retarget:
-        """Retarget a BVH clip onto the bones and put it on the timeline (FormatError names the file).
-        A load, not an edit: the history starts after it. ``built``: see :meth:`_retarget`."""
-        return self.doc.loading(lambda: self._retarget(path, mapping, up, forward, motion, built))
+                 motion: Motion | None = None, built=None, animation: str | None = None) -> Retarget:
+        """Retarget a clip (BVH, or ``animation`` of a glTF file: None the first) onto the bones and put it on
+        the timeline (FormatError names the file). A load, not an edit: the history starts after it.
+        ``built``: see :meth:`_retarget`."""
+        return self.doc.loading(lambda: self._retarget(path, mapping, up, forward, motion, built, animation))
 
-    def _retarget(self, path, mapping, up, forward, motion, built=None) -> Retarget:
+    def _retarget(self, path, mapping, up, forward, motion, built=None, animation=None) -> Retarget:
         """:meth:`load_bvh` without touching the history (the bones changed: the clip follows them).
         ``built``: :func:`retarget_clip`'s ``(bones, Retarget, matrices)`` made in a worker, used when
         its bones are the document's."""
         if not len(self.doc.bones):
             raise ValueError("build or open the bone skeleton first: the clip drives its bones")
         if built is None or built[0] != self.doc.bones:
-            motion = read_bvh(path) if motion is None else motion
+            motion = read_clip(path, animation) if motion is None else motion
             built = retarget_clip(path, self.doc.bones, motion, mapping, up, forward)
         _, r, matrices = built
         motion = r.motion
         used = {self.doc.bones.bones[b].label: motion.names[k] for b, k in r.mapping.items()}
         self._put_clip(Clip(Path(path).stem, matrices, motion.fps, str(path), list(range(motion.frames)),
-                            motion, used, r.up, r.forward))
+                            motion, used, r.up, r.forward, motion.animation))
         return r
 
     def load_trans(self, paths, frames=None) -> Clip:
@@ -269,6 +273,8 @@ class Timeline:
         c = self.clip
         if c is not None:
             data["clip"] = {"kind": c.kind, "path": c.path, "mapping": c.mapping, "up": c.up, "forward": c.forward}
+            if c.animation is not None:
+                data["clip"]["animation"] = c.animation
         return data
 
     @staticmethod
@@ -294,11 +300,12 @@ class Timeline:
             mapping = clip.get("mapping") if isinstance(clip, dict) else None
             if (not isinstance(clip, dict) or clip.get("kind") not in ("bvh", "trans")
                     or not isinstance(clip.get("path"), str)
-                    or not all(isinstance(clip.get(k, "auto"), str) for k in ("up", "forward"))
+                    or not all(isinstance(clip.get(k, "auto"), str) for k in ("up", "forward", "animation"))
                     or (mapping is not None and not (isinstance(mapping, dict) and all(
                         isinstance(k, str) and isinstance(v, str) for k, v in mapping.items())))):
                 raise ValueError(f"{where}: \"timeline\": \"clip\" must be {{\"kind\": \"bvh\" or \"trans\", "
-                                 "\"path\": FILE, \"mapping\": {BONE: JOINT}, \"up\": AXIS, \"forward\": AXIS}")
+                                 "\"path\": FILE, \"mapping\": {BONE: JOINT}, \"up\": AXIS, \"forward\": AXIS, "
+                                 "\"animation\": NAME (glTF)}")
         return {"keys": parsed, "ease": ease, "length": length, "fps": float(fps), "clip": clip}
 
     def restore(self, parsed: dict, where: str) -> list[str]:
@@ -314,7 +321,7 @@ class Timeline:
                 raise ValueError(read["error"])
             if clip["kind"] == "bvh":
                 self.load_bvh(clip["path"], clip.get("mapping"), clip.get("up", "auto"), clip.get("forward", "auto"),
-                              motion=read.get("motion"), built=read.get("built"))
+                              motion=read.get("motion"), built=read.get("built"), animation=clip.get("animation"))
             else:
                 self.load_trans(clip["path"], frames=read.get("frames"))
         except (OSError, ValueError) as exc:

@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 from PySide6.QtCore import QTimer
-from PySide6.QtWidgets import QDialog, QFileDialog
+from PySide6.QtWidgets import QDialog, QFileDialog, QInputDialog
 
 from volanim_core import io
-from volanim_core.io.bvh_files import read_bvh
+from volanim_core.io.clip_files import CLIP_FILTER, clip_animations, read_clip
 from volanim_core.io.frame_files import read_frames, write_frames
 from volanim_core.reconstruct.scan import scan_frames, scan_summary, worst_first
 from volanim_core.render.views import Camera
@@ -51,7 +51,7 @@ class TimelineController(Controller):
 
     # ------------------------------------------------------------ wiring
     def fill_menu(self, menu, action) -> None:
-        action("Load BVH clip…", lambda: self.load_bvh_dialog(), menu=menu)
+        action("Load clip (BVH, glTF)…", lambda: self.load_bvh_dialog(), menu=menu)
         action("Load .trans frames…", lambda: self.load_trans_dialog(), menu=menu)
         action("Unload clip", lambda: self.doc.timeline.unload(), menu=menu)
         menu.addSeparator()
@@ -199,12 +199,30 @@ class TimelineController(Controller):
         if path:
             (self.export_keys if save else self.import_keys)(path)
 
-    def load_bvh(self, path, *, ask=None) -> Worker | None:
-        """Read a clip in the reader thread (#61: no file is read on the GUI thread), then let the user
-        confirm the mapping (``ask(dialog) -> bool``; None: the suggestions) and retarget it onto the bones.
-        The reader's worker, or None while another file is being read (said)."""
+    def load_bvh(self, path, *, ask=None, pick=None) -> Worker | None:
+        """Read a clip (BVH; glTF: each of its animations) in the reader thread (#61: no file is read on the
+        GUI thread), let the user pick one of a glTF file's animations (``pick(names) -> name or None``; None:
+        the first) and confirm the mapping (``ask(dialog) -> bool``; None: the suggestions), then retarget it
+        onto the bones. The reader's worker, or None while another file is being read (said)."""
         self.stop()
-        return self.read_then(path, lambda progress: read_bvh(path), lambda motion: self._retarget(path, motion, ask))
+        return self.read_then(path, lambda progress: [read_clip(path, k) if k else read_clip(path)
+                                                      for k in range(len(clip_animations(path)))],
+                              lambda motions: self._picked(path, motions, ask, pick))
+
+    def _picked(self, path, motions, ask, pick) -> None:
+        motion = motions[0]
+        if len(motions) > 1 and pick is not None:
+            name = pick([m.animation for m in motions])
+            if name is None:
+                return
+            motion = next(m for m in motions if m.animation == name)
+        self._retarget(path, motion, ask)
+
+    def pick_animation(self, path, names: list[str]) -> str | None:
+        """The animation of a glTF file to load, asked in a list (None: cancelled)."""
+        name, ok = QInputDialog.getItem(self.window, "Pick an animation",
+                                        f"{Path(path).name} holds {len(names)} animations:", names, 0, False)
+        return name if ok else None
 
     def _retarget(self, path, motion, ask) -> None:
         """The mapping asked (``ask``), the clip retargeted in the reader thread (#83 item 13: 70 ms of
@@ -221,21 +239,24 @@ class TimelineController(Controller):
                                 lambda built: self._put_clip(path, mapping, up, forward, motion, built))
 
     def _put_clip(self, path, mapping, up, forward, motion, built) -> None:
-        r = self.attempt("Load BVH", lambda: self.doc.timeline.load_bvh(path, mapping, up, forward, motion, built))
+        r = self.attempt("Load clip", lambda: self.doc.timeline.load_bvh(path, mapping, up, forward, motion, built,
+                                                                          motion.animation))
         if r is FAILED:
             return
         absorbed = r.absorbed_degrees()
         worst = max(absorbed, key=absorbed.get) if absorbed else None
-        self.doc.message(f"{Path(path).name}: {motion.frames} frames at {motion.fps:.4g} fps on {len(r.mapping)} of "
-                         f"{len(self.doc.bones)} bones (up {r.up}, facing {r.forward})"
+        which = f" ({motion.animation})" if motion.animation is not None else ""
+        self.doc.message(f"{Path(path).name}{which}: {motion.frames} frames at {motion.fps:.4g} fps on "
+                         f"{len(r.mapping)} of {len(self.doc.bones)} bones (up {r.up}, facing {r.forward})"
                          + (f"; largest rest difference {absorbed[worst]:.0f}° at {worst}" if worst else "")
                          + ". Space plays, arrows step.")
 
     def load_bvh_dialog(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self.window, "Load a motion-capture clip", self.folder(),
-                                              "BVH clips (*.bvh *.BVH);;All files (*)")
+        path, _ = QFileDialog.getOpenFileName(self.window, "Load a motion clip", self.folder(),
+                                              f"{CLIP_FILTER};;All files (*)")
         if path:
-            self.load_bvh(path, ask=lambda d: d.exec() == QDialog.Accepted)
+            self.load_bvh(path, ask=lambda d: d.exec() == QDialog.Accepted,
+                          pick=lambda names: self.pick_animation(path, names))
 
     def load_trans(self, folder) -> Worker | None:
         """Read a folder of ``.trans`` frames in the reader thread (1064 files: about 1.5 s), then put them

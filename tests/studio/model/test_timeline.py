@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from paths import WALK  # WALK: the real clip, bundled with its MIT licence
+from paths import FOX, WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core import samples
 from volanim_core.errors import FormatError
 from volanim_core.io.frame_files import write_frames
@@ -107,6 +107,16 @@ def test_a_project_keeps_keys_options_and_the_clip(doc, tmp_path):
     other = Document()
     apply_project(other, read_project(tmp_path / "walk.volanim"), tmp_path / "walk.volanim")
     assert other.timeline.clip is not None and other.timeline.frame_count == 1064
+
+
+def test_one_animation_of_a_gltf_file_is_the_clip_and_the_project_keeps_which(doc, tmp_path):
+    doc.timeline.load_bvh(FOX, animation="Walk")  # Khronos' Fox: Survey, Walk, Run
+    assert (doc.timeline.clip.animation, doc.timeline.frame_count, doc.timeline.frame_rate) == ("Walk", 18, 24.0)
+    doc.write_project(tmp_path / "fox.volanim")
+    other = Document()
+    apply_project(other, read_project(tmp_path / "fox.volanim"), tmp_path / "fox.volanim")
+    assert other.timeline.clip.animation == "Walk" and other.timeline.frame_count == 18
+    assert np.allclose(other.timeline.matrices([9]), doc.timeline.matrices([9]))
 
 
 def test_a_missing_clip_is_a_warning_and_a_bad_timeline_names_the_project(doc, tmp_path):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-from paths import ASSETS, WALK  # WALK: the real clip, bundled with its MIT licence
+from paths import ASSETS, FOX, WALK  # WALK: the real clip, bundled with its MIT licence
 from runnable import run_in_process
 from volanim_core import io
 from volanim_studio.model.interaction import Mode
@@ -33,6 +33,24 @@ def rigged(qtbot, window):
     assert window.files.open_bones(ASSETS / "mannequin.bones")
     assert window.files.open_connect(ASSETS / "mannequin.0.50.connect")
     return window
+
+
+def test_a_gltf_file_s_animations_are_offered_and_the_picked_one_plays(qtbot, rigged):
+    w, offered = rigged, []
+
+    def pick(names):
+        offered.append(names)
+        return "Run"
+
+    assert w.timeline.load_bvh(FOX, ask=lambda dialog: True, pick=pick) is not None
+    qtbot.waitUntil(lambda: w.doc.timeline.clip is not None, timeout=JOB_TIMEOUT_MS)
+    assert offered == [["Survey", "Walk", "Run"]]
+    assert (w.doc.timeline.clip.animation, w.doc.timeline.frame_count) == ("Run", 28)
+    assert "Fox.glb (Run): 28 frames at 24 fps" in w.statusBar().currentMessage()
+    before = w.doc.timeline.clip
+    assert w.timeline.load_bvh(FOX, ask=lambda dialog: True, pick=lambda names: None) is not None
+    qtbot.waitUntil(lambda: not w.readers.busy, timeout=JOB_TIMEOUT_MS)
+    assert w.doc.timeline.clip is before  # cancelled in the list: nothing loaded
 
 
 def test_load_the_walk_through_the_mapping_dialog_and_step_with_the_keys(qtbot, rigged):
@@ -602,3 +620,22 @@ def test_every_picture_drawn_while_playing_is_one_whole_frame_with_its_bones(qtb
           f"(voxels on drawn pixels, drawn pixels on voxels): {[tuple(round(x, 3) for x in g) for g in grabs]}")
     assert min(on_body) >= 0.9
     assert min(g[0] for g in grabs) >= 0.9 and min(g[1] for g in grabs) >= 0.9  # another frame: ~0.65
+
+
+def test_the_animation_list_is_a_real_dialog_that_returns_the_chosen_name(qtbot, rigged):
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication, QInputDialog
+
+    seen = []
+
+    def choose():  # whatever it finds, the dialog is closed: a failed check must not leave the test waiting
+        dialog = QApplication.activeModalWidget()
+        seen.append(dialog.comboBoxItems() if isinstance(dialog, QInputDialog) else dialog)
+        dialog.setTextValue("Walk")
+        dialog.accept()
+
+    QTimer.singleShot(0, choose)
+    assert rigged.timeline.pick_animation(FOX, ["Survey", "Walk", "Run"]) == "Walk"
+    assert seen == [["Survey", "Walk", "Run"]]
+    QTimer.singleShot(0, lambda: QApplication.activeModalWidget().reject())
+    assert rigged.timeline.pick_animation(FOX, ["Survey", "Walk", "Run"]) is None
