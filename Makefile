@@ -2,9 +2,10 @@
 PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
-# What a virtual display and Qt's xcb platform plugin need on Debian; checked
-# one by one so a machine that has them all needs neither root nor network.
-APT_PACKAGES := xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxcb-keysyms1 \
+# What a virtual display and Qt's xcb platform plugin need on Debian, and the
+# Open Asset Import Library (FBX clips); checked one by one so a machine that
+# has them all needs neither root nor network.
+APT_PACKAGES := libassimp5 xvfb xauth libxcb-cursor0 libxkbcommon-x11-0 libxcb-icccm4 libxcb-keysyms1 \
 	libxcb-image0 libxcb-render-util0 libxcb-xinerama0 libxcb-shape0 libxcb-randr0 \
 	libxcb-xfixes0 libxcb-xkb1 libxkbcommon0 libegl1 libgl1 libglx-mesa0 libgl1-mesa-dri \
 	libfontconfig1 libdbus-1-3 libgomp1
@@ -19,8 +20,13 @@ $(VENV)/.installed: pyproject.toml
 	$(PY) -m volanim_core warmup  # every numba kernel compiled now, not on a user's first scan (#61)
 	touch $@
 
+# The Khronos glTF validator (its own JavaScript build, from npm) checks the .glb files export-gltf writes.
+GLTF_VALIDATOR := gltf-validator@2.0.0-dev.3.10
+
 $(VENV)/.installed-test: $(VENV)/.installed
 	$(PY) -m pip install -q -e '.[test]'
+	@command -v npm >/dev/null || { echo "npm is missing (the glTF validator's tests need it): sudo apt-get install npm"; exit 1; }
+	npm install --silent --no-audit --no-fund --prefix $(VENV)/npm $(GLTF_VALIDATOR)
 	touch $@
 
 install: $(VENV)/.installed
@@ -33,7 +39,7 @@ system-deps:
 		echo "installing Debian packages: $$missing"; \
 		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
 	else \
-		echo "missing Debian packages for the virtual display; run:"; \
+		echo "missing Debian packages (the virtual display, assimp for FBX); run:"; \
 		echo "  sudo apt-get install -y $$missing"; exit 1; \
 	fi
 

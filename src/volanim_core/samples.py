@@ -51,7 +51,9 @@ NAMES = ("mannequin", "mannequin-colour", "mannequin-large", "aliascube", "frog"
 #: ``rabbit``, ``spot`` and ``bob`` copy closed meshes other projects ship (trimesh's test rabbit, MIT; Keenan
 #: Crane's Spot the cow and Bob, CC0, as geometry-central's test assets): creatures nobody templated.
 #: ``fox`` copies Khronos' glTF sample Fox (CC BY 4.0): a real animal's clips (Survey, Walk, Run) in glTF.
-FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster", "fox")
+#: ``huesitos`` copies assimp's FBX test model of that name (BSD): a branching rig's clip as Blender writes FBX,
+#: and a map of it onto the mannequin's spine and arms.
+FILE_SAMPLES = ("walk", "mannequin-ct", "ant", "rabbit", "spot", "bob", "cluster", "fox", "huesitos")
 CLUSTER_FILES = ("local", "slurm", "pbs", "kubernetes")  # cluster-NAME.yaml: --cluster-config templates
 MESH_SAMPLES = ("rabbit", "spot", "bob")
 SAMPLE_DATA = Path(__file__).resolve().parent / "sample_data"  # package data: the clip, meshes, cluster files
@@ -367,6 +369,8 @@ def write_sample(name: str, folder: str | Path, progress=None) -> list[Path]:
         return _copy_package_data(folder, [walk_clip().name, f"{walk_clip().name}.LICENSE"])
     if name == "fox":
         return _copy_package_data(folder, ["Fox.glb", "Fox.glb.LICENSE"])
+    if name == "huesitos":
+        return _copy_package_data(folder, ["huesitos.fbx", "huesitos.fbx.LICENSE", "huesitos.mannequin.map"])
     # the large mannequins: the body is the first 20 %, its .connect's skeleton the rest
     big = {"mannequin-large": mannequin_large, "mannequin-full": mannequin_full}
     sample = big[name](stage(progress, 0, 20)) if name in big else load(name)

@@ -1,18 +1,19 @@
-"""Fault cases of the fifth round (#88): glTF clips. A truncated GLB, a buffer file that is not there, NaN
+"""Fault cases of the fifth round (#88): glTF and FBX clips. A truncated GLB, a buffer file that is not there, NaN
 keys, a count of keys the buffer does not hold, key times that span years, nodes that loop, a file with no
-animation, and an FBX file (not read yet: the refusal says how to bring the clip). Real bytes where they
-exist: Khronos' Fox cut short; the rest are small glTF documents written here, as exporters write them."""
+animation; FBX files cut short, empty (assimp aborts the process on it: refused before assimp sees it) and
+holding a box but no skeleton. Real bytes where they exist: Khronos' Fox and assimp's huesitos cut short,
+assimp's box; the rest are small glTF documents written here, as exporters write them."""
 
 from __future__ import annotations
 
-from paths import ASSETS, FOX
+from paths import ASSETS, FBX, FOX, HUESITOS
 from written_clips import tiny_gltf as gltf
 
 from .cases import Case
 
 
 def round5_cases() -> list[Case]:
-    fox = FOX.read_bytes()
+    fox, huesitos = FOX.read_bytes(), HUESITOS.read_bytes()
     bones = (ASSETS / "mannequin.bones").read_bytes()
     loop = [{"name": "a", "children": [1]}, {"name": "b", "children": [0]}]
 
@@ -33,8 +34,16 @@ def round5_cases() -> list[Case]:
         clip("no animation", gltf(animations=[]), ("has no animation",)),
         clip("a zero quaternion", gltf(quats=((0, 0, 0, 0), (0, 0, 0, 1))), ("zero quaternion",)),
         clip("an arm turned 90 degrees", gltf(), expect="accept", check="gltf_arm_turned"),
-        Case("fbx: any FBX clip (not read yet)", "read_clip", {"c.fbx": b"Kaydara FBX Binary  \x00"}, "c.fbx",
-             says=("export the clip as glTF",)),
+        Case("fbx: a file cut short", "read_clip", {"c.fbx": huesitos[:60_000]}, "c.fbx",
+             says=("assimp can read: FBX-Tokenize",)),
+        Case("fbx: its magic only", "read_clip", {"c.fbx": b"Kaydara FBX Binary  \x00"}, "c.fbx",
+             says=("assimp can read",)),
+        Case("fbx: an empty file (assimp aborts the process on it)", "read_clip", {"c.fbx": b""}, "c.fbx",
+             says=("is no FBX file (0 bytes)",)),
+        Case("fbx: a box with no skeleton", "read_clip", {"c.fbx": (FBX / "box.fbx").read_bytes()}, "c.fbx",
+             says=("no skeleton",)),
+        Case("bvh2trans: an FBX cut short", "cli:bvh2trans", {"c.fbx": huesitos[:60_000], "m.bones": bones},
+             "bvh2trans {d}/c.fbx --bones {d}/m.bones -o {d}/out", says=("FBX-Tokenize",)),
         Case("bvh2trans: a GLB cut short", "cli:bvh2trans", {"Fox.glb": fox[:100_000], "m.bones": bones},
              "bvh2trans {d}/Fox.glb --bones {d}/m.bones -o {d}/out", says=("truncated",)),
     ]

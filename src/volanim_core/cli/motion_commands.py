@@ -1,6 +1,6 @@
 """Motion subcommands: keys (keyframes -> one .trans per frame, the studio's timeline), bvh2trans (motion
-capture -> one .trans per frame), trans2tskel, trans2bvh (back to an animation package), trans2positions and
-positions2trans (joint positions per frame, as a CSV)."""
+capture -> one .trans per frame), export-gltf (the posed body as an animated glTF), trans2tskel, trans2bvh
+(back to an animation package), trans2positions and positions2trans (joint positions per frame, as a CSV)."""
 
 from __future__ import annotations
 
@@ -68,6 +68,18 @@ def axis_or_auto(text: str) -> str:
 
 
 def _bvh2trans(args):
+    bones, motion, retarget, frames = _retargeted(args)
+    conn = read_connect(args.connect) if args.connect else None
+    mats = retarget.matrices(args.frames)
+    write_frames(args.output, Path(args.clip).stem, bones, mats, frames, connect=conn,
+                 progress=TextProgress(f"writing {len(frames)} frames"))
+    print(f"wrote {len(frames)} frames ({motion.fps:.1f} fps in the clip; up {retarget.up}, forward "
+          f"{retarget.forward}; scale {retarget.scale:.3g} voxels per BVH unit) -> {args.output}")
+
+
+def _retargeted(args):
+    """``args.clip`` onto ``args.bones`` as bvh2trans does it, the mapping and checks printed (refused when
+    they fail, unless ``--no-check``): ``(bones, motion, retarget, frames)``."""
     bones = read_bones(args.bones).on_cubes()
     motion = read_clip(args.clip, args.animation)
     mapping = None
@@ -103,12 +115,37 @@ def _bvh2trans(args):
         print(f"# {c.line(sampled)}")
     if not args.no_check:
         refuse_failed(args.clip, checks, used)
-    conn = read_connect(args.connect) if args.connect else None
-    mats = retarget.matrices(args.frames)
-    write_frames(args.output, Path(args.clip).stem, bones, mats, frames, connect=conn,
-                 progress=TextProgress(f"writing {len(frames)} frames"))
-    print(f"wrote {len(frames)} frames ({motion.fps:.1f} fps in the clip; up {retarget.up}, forward "
-          f"{retarget.forward}; scale {retarget.scale:.3g} voxels per BVH unit) -> {args.output}")
+    return bones, motion, retarget, frames
+
+
+def _export_gltf(args):
+    from volanim_core.io.clip_files import is_clip
+    from volanim_core.io.frame_files import read_frames
+    from volanim_core.render.skinned_body import export_gltf
+    from volanim_core.rig.pose import root_bones
+    from volanim_core.rig.tskel_tools import check_root_order
+
+    conn = read_connect(args.connect)
+    if len(args.clip) == 1 and is_clip(args.clip[0]):
+        args.clip = args.clip[0]
+        bones, motion, retarget, frames = _retargeted(args)
+        mats, fps = retarget.matrices(args.frames), args.fps or motion.fps
+        name = motion.animation or Path(args.clip).stem
+    else:
+        bones = read_bones(args.bones).on_cubes()
+        mats, paths = read_frames(args.clip, bones, progress=TextProgress("reading frames"))
+        mats, fps, name = mats[args.frames], args.fps or 24.0, Path(args.clip[0]).stem.split(".")[0]
+        if not len(mats):
+            raise ValueError(f"--frames selects no frame of the {len(paths)} .trans files")
+    try:
+        check_root_order(conn.bones, root_bones(bones), ".bones", ".connect")
+    except ValueError as exc:
+        raise FormatError(args.connect, str(exc)) from None
+    held = export_gltf(conn, mats, fps, args.output, name, args.triangles, args.blend,
+                       TextProgress("exporting glTF"))
+    how = "its ownership" if conn.ownership is not None else "the rest spheres (the rig has no ownership)"
+    print(f"wrote {args.output}: the body ({held['triangles']:,} triangles, {held['vertices']:,} vertices) skinned "
+          f"to {held['joints']} joints by {how}, {held['frames']} frames at {fps:g} fps")
 
 
 def _trans2tskel(args):
@@ -235,8 +272,9 @@ def register(sub) -> None:
 
     p = add_command(sub, "bvh2trans", "Motion capture onto the bone skeleton: one .trans (and .tskel) per frame.",
                     "volanim bvh2trans walk.bvh --bones mannequin.bones --frames 0:200:10 -o walk/", _bvh2trans)
-    p.add_argument("clip", help="a motion clip: .bvh, or glTF 2.0 (.glb, .gltf, .vrma)")
-    p.add_argument("--animation", help="glTF: which of the file's animations, by name or number (default the first)")
+    p.add_argument("clip", help="a motion clip: .bvh, glTF 2.0 (.glb, .gltf, .vrma) or .fbx")
+    p.add_argument("--animation",
+                   help="glTF, FBX: which of the file's animations, by name or number (default: the first)")
     p.add_argument("--bones", required=True, help="our .bones file")
     p.add_argument("--map", help="BONE BVH_JOINT per line (default: suggested from the names; printed)")
     p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
@@ -248,6 +286,29 @@ def register(sub) -> None:
     p.add_argument("--no-check", action="store_true",
                    help="write the frames even when the retargeted figure fails the plausibility checks")
     p.add_argument("-o", "--output", required=True, help="folder for NAME.0000.trans, ...")
+
+    p = add_command(sub, "export-gltf", "The posed body for any glTF viewer: the rest body's surface skinned to "
+                    "the bones and a clip (or .trans frames) as its animation, one .glb.",
+                    ("volanim export-gltf mannequin.0.50.connect walk.bvh --bones mannequin.bones --frames 0:200:5 "
+                     "-o walk.glb",
+                     "volanim export-gltf mannequin.0.50.connect wave/ --bones mannequin.bones --fps 24 -o wave.glb"),
+                    _export_gltf)
+    p.add_argument("connect", help="the rig: a .connect (its ownership, NAME.owners.nrrd, skins the body)")
+    p.add_argument("clip", nargs="+", help="a motion clip (.bvh, .glb, .gltf, .vrma, .fbx), retargeted as bvh2trans "
+                                           "does; or .trans frames (files or a folder)")
+    p.add_argument("--bones", required=True, help="our .bones file (the rig's bones, in its root order)")
+    p.add_argument("--animation", help="glTF, FBX: which of the clip's animations (default: the first)")
+    p.add_argument("--map", help="a clip: BONE BVH_JOINT per line (default: suggested from the names)")
+    p.add_argument("--frames", type=parse_frames, default=slice(None), metavar="START:STOP:STEP")
+    p.add_argument("--up", type=axis_or_auto, default="auto", help="a clip's up axis (default: detected)")
+    p.add_argument("--forward", type=axis_or_auto, default="auto", help="a clip's forward axis (default: detected)")
+    p.add_argument("--no-check", action="store_true", help="a clip: export even when the plausibility checks fail")
+    p.add_argument("--fps", type=positive_float, help="frames per second (default: the clip's; .trans frames: 24)")
+    p.add_argument("--triangles", type=positive_int, default=200_000,
+                   help="at most this many triangles (default 200000: what a web viewer takes)")
+    p.add_argument("--blend", type=positive_float, default=2.0,
+                   help="voxels over which a vertex near a joint blends its bones (default 2)")
+    p.add_argument("-o", "--output", required=True, help="the .glb to write")
 
     p = add_command(sub, "trans2bvh", "Our bones and their frames as a BVH clip, to refine in an animation package "
                     "(Blender, Maya) and bring back with bvh2trans.",

@@ -195,7 +195,7 @@ def register(sub) -> None:
                     "for all frames, resumable, on all local cores or a Dask cluster.", EXAMPLE, _sequence)
     p.add_argument("connect", help="the .connect every frame uses")
     p.add_argument("frames", nargs="+", help=".trans or .tskel files (numbered NAME.0000.trans ...), or one clip "
-                                             "(.bvh, glTF .glb/.gltf/.vrma)")
+                                             "(.bvh, glTF .glb/.gltf/.vrma, .fbx)")
     p.add_argument("--source", help="rest-pose volume, grey or colour (needed for --mode sampled; a colour one "
                                     "makes a colour sequence: palette indices, the palette in the store)")
     add_dims(p)  # --dims for a headerless .vol source, --series for a DICOM folder of several
@@ -221,7 +221,8 @@ def register(sub) -> None:
     _fall_options(p, "crumble: ", down="teleport/crumble: ")
     p.add_argument("--bones", help="a BVH frame source needs the .bones it drives")
     p.add_argument("--map", help="BVH: BONE BVH_JOINT per line (default: suggested)")
-    p.add_argument("--animation", help="glTF: which of the clip's animations, by name or number (default the first)")
+    p.add_argument("--animation",
+                   help="glTF, FBX: which of the clip's animations, by name or number (default the first)")
     p.add_argument("--frames", dest="range", type=parse_frames, default=slice(None), metavar="START:STOP:STEP",
                    help="BVH: which frames")
     p.add_argument("--up", default="auto", help="BVH: the clip's up axis (default detected)")

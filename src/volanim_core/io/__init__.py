@@ -19,7 +19,10 @@ for a bad file; all writers are atomic.
       keys_files.py ....... .keys (keyframes)
       bvh_files.py ........ BVH clips read (the clip's own hierarchy and forward kinematics); bvh_export.py: written
       gltf_files.py ....... glTF 2.0 clips (.glb .gltf .vrma): a skeleton and one animation, read as a BVH Motion
-      clip_files.py ....... a clip read by its kind (BVH, glTF): what every command and the studio call
+      fbx_files.py ........ FBX clips through assimp (impasse), read as a Motion by the glTF rules
+      gltf_export.py ...... an animated, skinned .glb written from arrays (what: render/skinned_body.py)
+      clip_bake.py ........ what the glTF and FBX readers share: key sampling, frame times, world matrices -> Motion
+      clip_files.py ....... a clip read by its kind (BVH, glTF, FBX): what every command and the studio call
       mapping_files.py .... BONE BVH_JOINT mapping files
       positions_files.py .. joint positions per frame (CSV)
       marker_files.py ..... C3D marker data and marker maps; c3d_layout.py: a C3D file checked before ezc3d

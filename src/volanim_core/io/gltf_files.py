@@ -35,17 +35,15 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.io.bvh_files import MAX_JOINTS, MAX_VALUE, Motion
+from volanim_core.io.clip_bake import bake_motion, frame_times, quaternion_matrices, sample_keys
 from volanim_core.io.files import parse_json, regular_file_bytes
 from volanim_core.limits import available_bytes, human_bytes
 
 MAX_GLTF_BYTES = 1 << 30
-MAX_FRAMES = 1_000_000  # nine hours at 30 frames a second: key times past that are no clip (1e30 s froze the read)
-BAKED_RATE, SAMPLED_RATE = 24.0, 30.0
 _GLB_JSON, _GLB_BIN = 0x4E4F534A, 0x004E4942
 _COMPONENTS = {5120: (np.int8, 127.0), 5121: (np.uint8, 255.0), 5122: (np.int16, 32767.0),
                5123: (np.uint16, 65535.0), 5125: (np.uint32, None), 5126: (np.float32, None)}
 _WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
-_ROOT_CHANNELS = ["xposition", "yposition", "zposition", "zrotation", "xrotation", "yrotation"]
 
 
 @dataclass
@@ -237,19 +235,7 @@ def _times(g: Gltf, anim: dict) -> tuple[np.ndarray, float]:
     inputs = [g.accessor(s.get("input"))[:, 0] for s in anim.get("samplers", [])]
     if not inputs:
         raise g.fail("its animation has no samplers")
-    for t in inputs:
-        if len(t) > 1 and not (np.diff(t) > 0).all():
-            raise g.fail("an animation sampler's key times do not increase (glTF requires strictly increasing)")
-    t0, t1 = min(t[0] for t in inputs), max(t[-1] for t in inputs)
-    step = np.median(np.diff(max(inputs, key=len))) if max(map(len, inputs)) > 1 else 0.0
-    rate = 1.0 / step if step > 0 and 1.0 / step >= 0.99 * BAKED_RATE else SAMPLED_RATE
-    rate = float(np.round(rate)) if abs(rate - np.round(rate)) < 1e-3 else rate  # float32 key times: 23.99999994
-    span = (t1 - t0) * rate
-    if span >= MAX_FRAMES:
-        raise g.fail(f"its keys span {t1 - t0:,.6g} s: {span:,.0f} frames at {rate:g} a second; a clip has at most "
-                     f"{MAX_FRAMES:,} (are its key times in seconds?)")
-    n = int(np.floor(span + 1e-6)) + 1
-    return t0 + np.arange(n) / rate, rate
+    return frame_times(inputs, g.fail)
 
 
 def _sample(g: Gltf, sampler: dict, times: np.ndarray, rotation: bool) -> np.ndarray:
@@ -260,42 +246,7 @@ def _sample(g: Gltf, sampler: dict, times: np.ndarray, rotation: bool) -> np.nda
     if how not in ("LINEAR", "STEP", "CUBICSPLINE") or len(v) != len(t) * (3 if cubic else 1):
         raise g.fail(f"a sampler ({how}) has {len(t)} key times and {len(v)} values")
     tangent_in, v, tangent_out = (v[0::3], v[1::3], v[2::3]) if cubic else (None, v, None)
-    if len(t) == 1:
-        return np.repeat(v[:1], len(times), 0)
-    i = np.clip(np.searchsorted(t, times, "right") - 1, 0, len(t) - 2)
-    dt = t[i + 1] - t[i]
-    u = np.clip((times - t[i]) / dt, 0.0, 1.0)[:, None]
-    a, b = v[i], v[i + 1]
-    if how == "STEP":
-        return np.where(u >= 1.0, b, a)
-    if cubic:
-        u2, u3 = u * u, u * u * u
-        out = ((2 * u3 - 3 * u2 + 1) * a + (u3 - 2 * u2 + u) * dt[:, None] * tangent_out[i]
-               + (-2 * u3 + 3 * u2) * b + (u3 - u2) * dt[:, None] * tangent_in[i + 1])
-    elif rotation:  # spherical, the short way round
-        b = np.where((a * b).sum(1, keepdims=True) < 0, -b, b)
-        cos = np.clip((a * b).sum(1, keepdims=True), -1.0, 1.0)
-        angle = np.arccos(cos)
-        sin = np.sin(angle)
-        near = sin < 1e-9
-        wa = np.where(near, 1 - u, np.sin((1 - u) * angle) / np.where(near, 1, sin))
-        wb = np.where(near, u, np.sin(u * angle) / np.where(near, 1, sin))
-        out = wa * a + wb * b
-    else:
-        out = (1 - u) * a + u * b
-    return out
-
-
-def quaternion_matrices(q: np.ndarray) -> np.ndarray:
-    """``(n, 3, 3)`` rotations of glTF quaternions ``(x, y, z, w)``, normalised first."""
-    q = np.asarray(q, np.float64).reshape(-1, 4)
-    norm = np.linalg.norm(q, axis=1, keepdims=True)
-    if (norm < 1e-12).any():
-        raise ValueError("a zero quaternion is no rotation")
-    x, y, z, w = (q / norm).T
-    return np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w),
-                     2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
-                     2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], 1).reshape(-1, 3, 3)
+    return sample_keys(t, v, times, how, rotation, tangent_in, tangent_out)
 
 
 def _rest_local(g: Gltf, node: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray] | np.ndarray:
@@ -367,24 +318,6 @@ def _world(parent: np.ndarray, nodes: list[int], local: np.ndarray) -> np.ndarra
     return world
 
 
-def _rotations(m: np.ndarray) -> np.ndarray:
-    """The rotation of each ``(..., 3, 3)`` matrix without its scale (the polar factor)."""
-    u, _, vt = np.linalg.svd(m)
-    r = u @ vt
-    flip = np.linalg.det(r) < 0  # a mirroring scale: keep a proper rotation
-    u[flip, :, 2] *= -1
-    return np.where(flip[..., None, None], u @ vt, r)
-
-
-def zxy_degrees(r: np.ndarray) -> np.ndarray:
-    """Intrinsic Z X Y Euler degrees of rotations ``(n, 3, 3)``: ``euler_matrices("ZXY", out)`` gives them back."""
-    x = np.arcsin(np.clip(r[:, 2, 1], -1.0, 1.0))
-    locked = np.abs(r[:, 2, 1]) > 1 - 1e-12
-    z = np.where(locked, np.arctan2(r[:, 1, 0], r[:, 0, 0]), np.arctan2(-r[:, 0, 1], r[:, 1, 1]))
-    y = np.where(locked, 0.0, np.arctan2(-r[:, 2, 0], r[:, 2, 2]))
-    return np.degrees(np.unwrap(np.stack([z, x, y], 1), axis=0))
-
-
 def read_gltf(path: str | Path, animation: str | int | None = None) -> Motion:
     """One animation of a glTF 2.0 file as a :class:`Motion` (see the module's "Decided here"); FormatError
     naming the file for anything it cannot read."""
@@ -398,33 +331,9 @@ def read_gltf(path: str | Path, animation: str | int | None = None) -> Motion:
     pick = [nodes.index(j) for j in joints]
     rest = _world(parent, nodes, _locals(g, anim, nodes, None))[:, pick]
     world = _world(parent, nodes, _locals(g, anim, nodes, times))[:, pick]
-    turn = _rotations(world[..., :3, :3]) @ np.swapaxes(_rotations(rest[..., :3, :3]), -1, -2)
-    pos, rest_pos = world[..., :3, 3], rest[0, :, :3, 3]
     jparent = [next((joints.index(a) for a in _ancestors(parent, j) if a in joints), -1) for j in joints]
-    size = max(float(np.ptp(rest_pos, axis=0).max()), 1e-9)
-    offsets, channels, columns = np.zeros((len(joints), 3)), [], []
-    for k, p in enumerate(jparent):
-        if p < 0:
-            offsets[k] = rest_pos[k]
-            channels.append(list(_ROOT_CHANNELS))
-            columns += [pos[:, k] - rest_pos[k], zxy_degrees(turn[:, k])]
-            continue
-        offsets[k] = rest_pos[k] - rest_pos[p]
-        local = (np.swapaxes(turn[:, p], -1, -2) @ (pos[:, k] - pos[:, p])[..., None])[..., 0]
-        stretch = bool(np.abs(local - offsets[k]).max() > 1e-6 * size)
-        channels.append(_ROOT_CHANNELS[:3] * stretch + _ROOT_CHANNELS[3:])
-        columns += [local] * stretch + [zxy_degrees(np.swapaxes(turn[:, p], -1, -2) @ turn[:, k])]
-    names = _unique([g.doc["nodes"][j].get("name") or f"node{j}" for j in joints])
+    names = [g.doc["nodes"][j].get("name") or f"node{j}" for j in joints]
     try:
-        return Motion(names, np.asarray(jparent), offsets, channels, 1.0 / rate, np.hstack(columns), animation=name)
+        return bake_motion(names, jparent, rest[0], world, rate, name)
     except ValueError as exc:
         raise g.fail(f"animation {name!r}: {exc}") from None
-
-
-def _unique(names: list[str]) -> list[str]:
-    seen: dict[str, int] = {}
-    out = []
-    for n in names:
-        seen[n] = seen.get(n, 0) + 1
-        out.append(n if seen[n] == 1 else f"{n}_{seen[n]}")
-    return out

@@ -9,6 +9,7 @@
     scene.py ........ RenderSettings, presets, the off-screen Renderer, cut-aways
     movie.py ........ many frames to pictures and a movie: inputs, one plotter per worker, resumable PNGs
     quicklook.py .... `volanim view` and the studio's View window
+    skinned_body.py . the rest body's surface skinned to the bones, a clip as its animation: `export-gltf`
     slices.py, slice_view.py  `view --slices`
 
 pyvista and VTK are imported inside the functions that need them, so importing

@@ -1,7 +1,7 @@
 """The animation on the timeline: a loaded clip or pose keys; the current frame drives the pose. Qt-free.
 
     settings.current_frame --> Timeline.show_frame --> pose.show(matrices) (not an edit: no undo)
-    clip:  a clip (BVH, or one animation of a glTF file) retargeted onto the bones, or a folder of .trans
+    clip:  a clip (BVH, or one animation of a glTF or FBX file) retargeted onto the bones, or a folder of .trans
            frames (takes precedence)
     keys:  frame -> KeyPose, slerped (volanim_core.motion.keyframes); set / delete are undoable
     doc.events.timeline  whenever the clip, the keys, ease or the length change
@@ -182,7 +182,7 @@ class Timeline:
     # ---------------------------------------------------------------- clips
     def load_bvh(self, path, mapping: dict[str, str] | None = None, up: str = "auto", forward: str = "auto",
                  motion: Motion | None = None, built=None, animation: str | None = None) -> Retarget:
-        """Retarget a clip (BVH, or ``animation`` of a glTF file: None the first) onto the bones and put it on
+        """Retarget a clip (BVH, or ``animation`` of a glTF or FBX file: None the first) onto the bones and put it on
         the timeline (FormatError names the file). A load, not an edit: the history starts after it.
         ``built``: see :meth:`_retarget`."""
         return self.doc.loading(lambda: self._retarget(path, mapping, up, forward, motion, built, animation))

@@ -51,7 +51,7 @@ class TimelineController(Controller):
 
     # ------------------------------------------------------------ wiring
     def fill_menu(self, menu, action) -> None:
-        action("Load clip (BVH, glTF)…", lambda: self.load_bvh_dialog(), menu=menu)
+        action("Load clip (BVH, glTF, FBX)…", lambda: self.load_bvh_dialog(), menu=menu)
         action("Load .trans frames…", lambda: self.load_trans_dialog(), menu=menu)
         action("Unload clip", lambda: self.doc.timeline.unload(), menu=menu)
         menu.addSeparator()

@@ -165,7 +165,7 @@ class TimelinePanel(QWidget):
         elif tl.keys:
             text = f"keyed: {tl.frame_count} frames · {tl.frame_rate:.4g} fps" + (" · key" if f in tl.keys else "")
         else:
-            text = "no animation: load a clip (BVH, glTF) or .trans frames, or set keys"
+            text = "no animation: load a clip (BVH, glTF, FBX) or .trans frames, or set keys"
         p = self.doc.preview
         if self.doc.settings.playing and p is not None and p.frame is not None and p.frame != f:
             # frames are dropped to keep up; the body and its bones are the same frame, which is said

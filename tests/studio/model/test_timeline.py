@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from paths import FOX, WALK  # WALK: the real clip, bundled with its MIT licence
+from paths import FOX, HUESITOS, WALK  # WALK: the real clip, bundled with its MIT licence
 from volanim_core import samples
 from volanim_core.errors import FormatError
 from volanim_core.io.frame_files import write_frames
@@ -117,6 +117,20 @@ def test_one_animation_of_a_gltf_file_is_the_clip_and_the_project_keeps_which(do
     apply_project(other, read_project(tmp_path / "fox.volanim"), tmp_path / "fox.volanim")
     assert other.timeline.clip.animation == "Walk" and other.timeline.frame_count == 18
     assert np.allclose(other.timeline.matrices([9]), doc.timeline.matrices([9]))
+
+
+def test_an_fbx_clip_drives_the_bones_its_map_names_and_leaves_the_others_at_rest(doc):
+    arms = {"SPINE": "Bone.001", "L_UPPERARM": "Bone.004", "L_FOREARM": "Bone.005", "L_HAND": "Bone.006",
+            "R_UPPERARM": "Bone.003", "R_FOREARM": "Bone.007", "R_HAND": "Bone.008"}
+    doc.timeline.load_bvh(HUESITOS, mapping=arms)  # assimp's huesitos.fbx: a trunk forking into two arms
+    tl = doc.timeline
+    assert (tl.clip.animation, tl.frame_count, tl.frame_rate) == ("Armature|Action", 40, 25.0)
+    m = tl.matrices([20])[0]
+    arm_turn = m[arm(doc), :3, :3] @ np.linalg.inv(m[doc.bones.index("SPINE"), :3, :3])
+    assert not np.allclose(arm_turn, np.eye(3), atol=1e-2)  # the arm swings against the spine
+    assert not np.allclose(m[doc.bones.index("SPINE")], np.eye(4), atol=1e-2)  # the trunk leans the spine
+    for leg in ("L_THIGH", "R_THIGH", "L_SHIN"):  # what the map leaves out stays at rest
+        assert np.allclose(m[doc.bones.index(leg)], np.eye(4))
 
 
 def test_a_missing_clip_is_a_warning_and_a_bad_timeline_names_the_project(doc, tmp_path):
