@@ -30,7 +30,7 @@ import numpy as np
 
 from volanim_core.io.gltf_export import JointAnimation, SkinnedMesh, write_glb
 from volanim_core.isosurface import flying_edges
-from volanim_core.progress import ProgressFn, stage
+from volanim_core.progress import CancelFn, ProgressFn, Reporter
 from volanim_core.rig.connectivity import Connectivity
 
 MAX_TRIANGLES = 200_000
@@ -155,26 +155,29 @@ def joint_animation(conn: Connectivity, frames: np.ndarray, fps: float, name: st
 
 
 def export_gltf(conn: Connectivity, frames: np.ndarray, fps: float, path, name: str = "clip",
-                max_triangles: int = MAX_TRIANGLES, blend: float = BLEND, progress: ProgressFn | None = None
-                ) -> dict:
+                max_triangles: int = MAX_TRIANGLES, blend: float = BLEND, progress: ProgressFn | None = None,
+                cancel: CancelFn | None = None) -> dict:
     """Write ``path`` (``.glb``): the rest body skinned to ``conn``'s bones, moved by ``frames`` (``(F, B, 4,
-    4)`` row-vector matrices of the rig's voxels, as ``.trans`` files hold) at ``fps``. What it holds."""
+    4)`` row-vector matrices of the rig's voxels, as ``.trans`` files hold) at ``fps``. What it holds.
+    ``cancel()`` True between stages raises Cancelled, nothing written."""
     frames = np.asarray(frames, np.float64)
     if frames.ndim != 4 or frames.shape[1:] != (len(conn.bones), 4, 4) or not len(frames):
         raise ValueError(f"frames must be (F, {len(conn.bones)}, 4, 4) matrices of the rig's bones, "
                          f"got {frames.shape}")
+    report = Reporter(progress, cancel)
     anim = joint_animation(conn, frames, fps, name)
     labels, origin = body_labels(conn)
-    stage(progress, 0, 10)(1, 1)
+    report(10, 100)
     vertices, normals, tris = body_surface(labels, origin, max_triangles)
-    stage(progress, 10, 60)(1, 1)
+    report(60, 100)
     joints, weights = skin_weights(vertices, labels, origin, len(conn.bones), blend)
-    stage(progress, 60, 90)(1, 1)
+    report(90, 100)
     axes = scene_axes(conn, vertices)
     scene = vertices @ axes[:3, :3].T + axes[:3, 3]
     turned = normals @ axes[:3, :3].T
     turned /= np.maximum(np.linalg.norm(turned, axis=1, keepdims=True), 1e-12)
     write_glb(path, SkinnedMesh(scene, turned, tris, joints, weights), anim, axes)
-    stage(progress, 90, 100)(1, 1)
+    if progress is not None:  # written: a Cancel now comes too late to be honoured
+        progress(100, 100)
     return {"vertices": len(vertices), "triangles": len(tris), "joints": len(conn.bones), "frames": len(frames),
             "axes": axes}

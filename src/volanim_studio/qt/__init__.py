@@ -6,6 +6,7 @@ files_controller.py ... open/save volumes, skeletons, bones, connectivity, proje
 preview_controller.py . live and full previews, compare, export, poses (.trans/.tskel)
 connect_controller.py . the Connect menu: auto-connect and mirror
 timeline_controller.py  load clips, play, step, key, scan for breakage, export frames
+export_controller.py .. File → Export animated glTF: the posed body for any glTF viewer, in the worker
 naming_controller.py .. F2 names a joint, Ctrl+F2 a whole chain
 session_controller.py . autosave, crash recovery, the unsaved marker and "Save changes?"
 worker.py ............. JobRunner/Worker: background jobs with progress, Cancel, clean shutdown

@@ -33,6 +33,7 @@ from .bone_panel import BonePanel
 from .connect_controller import ConnectController
 from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
+from .export_controller import ExportController
 from .files_controller import FilesController
 from .gui_gc import collect_on_gui_thread
 from .interactor import close_interactor
@@ -114,6 +115,7 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
         self.timeline_panel = TimelinePanel(self.doc)
         self.timeline = TimelineController(self)
+        self.exporting = ExportController(self)
         timeline_dock = QDockWidget("Timeline", self)
         timeline_dock.setWidget(self.timeline_panel)
         timeline_dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable)
@@ -152,6 +154,7 @@ class MainWindow(QMainWindow):
         bar = self.menuBar()
         file = bar.addMenu("&File")
         self.files.fill_menu(file, self._action)
+        self.exporting.fill_menu(file, self._action)
         file.addSeparator()
         self._action("&Quit", self.close, "Ctrl+Q", menu=file)
         edit = bar.addMenu("&Edit")

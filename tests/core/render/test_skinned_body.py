@@ -19,6 +19,7 @@ import trimesh
 from paths import HUESITOS
 from their_gltf import accessor_values, load_theirs, their_positions, their_skinned_vertices
 from volanim_core import samples
+from volanim_core.errors import Cancelled
 from volanim_core.io.clip_files import read_clip
 from volanim_core.io.mapping_files import read_mapping
 from volanim_core.motion.retarget import Retarget
@@ -119,3 +120,11 @@ def test_a_frame_that_shears_is_refused_and_nothing_is_written(exported, tmp_pat
     with pytest.raises(ValueError, match="not a rigid motion"):
         export_gltf(conn, bad, 25.0, tmp_path / "bad.glb")
     assert not any(tmp_path.iterdir())
+
+
+def test_cancel_between_stages_writes_nothing(exported, tmp_path):
+    conn, frames, _, _ = exported
+    asked = []
+    with pytest.raises(Cancelled):
+        export_gltf(conn, frames, 25.0, tmp_path / "c.glb", cancel=lambda: asked.append(1) or len(asked) > 1)
+    assert len(asked) == 2 and not any(tmp_path.iterdir())  # the second stage's check: surface made, not written
