@@ -65,3 +65,19 @@ def test_a_bad_file_is_refused_naming_it_and_what_is_wrong(tmp_path, make, says)
     path.write_bytes(make(path))
     with pytest.raises(FormatError, match=str(path).replace(".", r"\.") + ": " + says):
         read_clip(path)
+
+
+def test_keys_that_are_nan_or_absurd_are_refused_naming_the_node(tmp_path):
+    """Whatever assimp hands over is checked before it becomes a Motion (no real FBX here carries such keys)."""
+    from types import SimpleNamespace
+
+    from volanim_core.io.fbx_files import _keys
+
+    path = tmp_path / "c.fbx"
+    for bad in (float("nan"), float("inf"), 1e30):
+        keys = [SimpleNamespace(time=0.0, value=[0.0, 0.0, 0.0]), SimpleNamespace(time=1.0, value=[bad, 0.0, 0.0])]
+        with pytest.raises(FormatError, match=r"c\.fbx: node 'Bone' has NaN, infinite or absurd keys"):
+            _keys(path, "Bone", keys, 3, 25.0)
+    keys = [SimpleNamespace(time=1.0, value=[0.0] * 3), SimpleNamespace(time=1.0, value=[0.0] * 3)]
+    with pytest.raises(FormatError, match="its key times do not increase"):
+        _keys(path, "Bone", keys, 3, 25.0)
