@@ -199,29 +199,80 @@ def thinned_radii(rest, posed, dt, sheet, pairs, floor):
     return out
 
 
+def _claims(labels, p, bone1):
+    """Whether label ``bone1`` claims the rest point ``p`` (labels' voxel coordinates): the 8 voxels around p,
+    weighted trilinearly (outside the array: 0), fill at least half of it with body, and p's nearest voxel is
+    bone1's or, when that voxel is outside the body, bone1's share of the 8 is the largest (a tie to the lower
+    label)."""
+    import math
+
+    base = [int(math.floor(v)) for v in p]
+    share: dict[int, float] = {}
+    for corner in np.ndindex(2, 2, 2):
+        k = [base[a] + corner[a] for a in range(3)]
+        w = 1.0
+        for a in range(3):
+            t = p[a] - base[a]
+            w *= t if corner[a] else 1.0 - t
+        inside = all(0 <= k[a] < labels.shape[a] for a in range(3))
+        v = int(labels[tuple(k)]) if inside else 0
+        if v:
+            share[v] = share.get(v, 0.0) + w
+    near = [int(math.floor(v + 0.5)) for v in p]
+    nearest = int(labels[tuple(near)]) if all(0 <= near[a] < labels.shape[a] for a in range(3)) else 0
+    if sum(share.values()) < 0.5 or nearest not in (0, bone1):
+        return False
+    if nearest == bone1:
+        return True
+    if share.get(bone1, 0.0) <= 0.0:
+        return False
+    return all(w < share[bone1] or (w == share[bone1] and v > bone1) for v, w in share.items() if v != bone1)
+
+
+def _thin(labels, k):
+    """A body voxel whose two face neighbours along some axis are both outside the body (or the array)."""
+    def body(j):
+        return all(0 <= j[a] < labels.shape[a] for a in range(3)) and labels[tuple(j)] != 0
+
+    for a in range(3):
+        lo, hi = list(k), list(k)
+        lo[a] -= 1
+        hi[a] += 1
+        if not body(lo) and not body(hi):
+            return True
+    return False
+
+
 def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     """The ownership warp (reconstruct/owned.py) voxel by voxel: each output voxel q of ``bounds`` is bone b's
-    (first in order) when ``round([q 1] @ inv(M_b))`` is a rest voxel owned by b; then each rest voxel of a turned
-    bone is written where it lands, rounded, if that is empty; then each empty voxel strictly
-    inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. Returns 1 + bone per voxel
-    ``[x, y, z]``."""
+    (first in order) when b claims the rest point ``[q 1] @ inv(M_b)`` (:func:`_claims`: the body's trilinear
+    share there at least half, b's the largest); a bone moved by whole voxels only reads its own voxel there.
+    Then each thin rest voxel (one voxel thick along an axis) of a turned bone is written where it lands,
+    rounded, if that is empty; then each empty voxel strictly inside a ball ``(centre, radius, bone)`` (in
+    order) is that ball's bone. Returns 1 + bone per voxel ``[x, y, z]``."""
     import math
 
     lo, hi = np.asarray(bounds[0]), np.asarray(bounds[1])
     out = np.zeros(tuple(hi - lo + 1), np.int64)
     for b, m in enumerate(matrices):
         inv = np.linalg.inv(m)
+        whole = np.array_equal(m[:3, :3], np.eye(3)) and np.array_equal(m[3, :3], np.round(m[3, :3]))
         for idx in np.ndindex(*out.shape):
             if out[idx]:
                 continue
             q = np.asarray(idx) + lo
-            k = np.array([int(math.floor(v + 0.5)) for v in (q @ inv[:3, :3] + inv[3, :3])]) - rest_lo
-            if (k >= 0).all() and (k < labels.shape).all() and labels[tuple(k)] == b + 1:
+            if whole:
+                k = q - np.round(m[3, :3]).astype(np.int64) - rest_lo
+                if (k >= 0).all() and (k < labels.shape).all() and labels[tuple(k)] == b + 1:
+                    out[idx] = b + 1
+            elif _claims(labels, q @ inv[:3, :3] + inv[3, :3] - rest_lo, b + 1):
                 out[idx] = b + 1
-    for b, m in enumerate(matrices):  # each turned bone's rest voxels pushed to where they land, if empty
+    for b, m in enumerate(matrices):  # each turned bone's thin rest voxels pushed to where they land, if empty
         if np.array_equal(m[:3, :3], np.eye(3)) and np.array_equal(m[3, :3], np.round(m[3, :3])):
             continue
         for k in np.argwhere(labels == b + 1):
+            if not _thin(labels, k):
+                continue
             p = k + rest_lo
             v = [p[0] * m[0, i] + p[1] * m[1, i] + p[2] * m[2, i] + m[3, i] for i in range(3)]  # the kernel's sums
             q = np.array([int(math.floor(x + 0.5)) for x in v]) - lo

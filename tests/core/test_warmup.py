@@ -29,6 +29,8 @@ INLINED = {
     "volanim_core.rig._attach_kernels._path_inside",
     "volanim_core.skeleton._kernels._relax",
     "volanim_core.reconstruct._owned_kernels._moved",
+    "volanim_core.reconstruct._owned_kernels._label",
+    "volanim_core.reconstruct._owned_kernels.claims_point",
     "volanim_core.rig._ownership_kernels.tube_depth",
     "volanim_core.rig._ownership_kernels.tube_distance",
 }

@@ -2,8 +2,9 @@
 
     Ownership (rig/ownership.py: rest labels, ball radii), matrices (B, 4, 4)
         --each bone's owned box moved by its matrix--> posed boxes; output grid (their union + padding, or bounds)
-        --K.warp_owners (each output voxel read from the rest voxel its bone brings it from)--> owner [z, y, x]
-        --K.splat_turned (each turned bone's rest voxels pushed to where they land, where still empty: a limb
+        --K.warp_owners (each output voxel read at the rest point its bone brings it from: the body's share
+                         there, trilinear, and the bone owning most of it)--> owner [z, y, x]
+        --K.splat_turned (each turned bone's thin rest voxels pushed to where they land, where still empty: a limb
                           one voxel thin that the read steps over stays in one piece)-->
         --K.close_joints (the ball at each bone's proximal joint, moved by the bone: empty voxels to the bone)-->
         --by mode--> binary (value), bone (owner), mottled (a colour per bone), hotspot (bones reaching a voxel),
@@ -48,15 +49,16 @@ SLAB = 32  # output slices per launch: the progress and cancel granularity
 
 def posed_boxes(own: Ownership, matrices: np.ndarray) -> np.ndarray:
     """``(B, 6)`` each bone's owned voxels' box once moved by its matrix, in rest-grid voxels (x1 < x0: owns
-    none): its hull's vertices moved (own.hulls()), one voxel wider for the rounding of a read."""
+    none): its hull's vertices moved (own.hulls()), two voxels wider: a read finds the bone among the 8 voxels
+    around its point, up to a voxel's diagonal away."""
     out = np.zeros((len(own.bones), 6), np.int64)
     out[:, :3] = 1
     for b, hull in enumerate(own.hulls()):
         if not len(hull):
             continue
         moved = hull @ matrices[b, :3, :3] + matrices[b, 3, :3]
-        out[b, :3] = np.floor(moved.min(0)) - 1
-        out[b, 3:] = np.ceil(moved.max(0)) + 1
+        out[b, :3] = np.floor(moved.min(0)) - 2
+        out[b, 3:] = np.ceil(moved.max(0)) + 2
     return out
 
 
@@ -119,6 +121,7 @@ def reconstruct_owned(
     local[:, 3:] = np.minimum(local[:, 3:], np.array([nx, ny, nz]) - 1)
     inv = np.ascontiguousarray(np.linalg.inv(matrices))
     rest_lo = np.asarray(own.origin, np.int64)
+    flags = own.flags()
     shifts = whole_voxel_shifts(matrices)
     # a bone whose posed box misses the grid adds nothing (a live update's box holds few): not splatted
     reaches = (boxes[:, 3:] >= lo).all(1) & (boxes[:, :3] <= np.asarray(grid.hi)).all(1)
@@ -135,14 +138,15 @@ def reconstruct_owned(
             slab = local.copy()
             slab[:, 2] = np.maximum(slab[:, 2] - z0, 0)
             slab[:, 5] = np.minimum(slab[:, 5] - z0, z1 - z0 - 1)
-            reads += K.warp_owners(own.labels, own.spans(), rest_lo, inv, shifts, turned, turned_spans[:, z0:z1],
-                                   slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
-                                   claims[z0:z1] if count else claims, count)
+            reads += K.warp_owners(own.labels, flags, own.spans(), rest_lo, inv, shifts, turned,
+                                   turned_spans[:, z0:z1], slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1],
+                                   row_hi[z0:z1], claims[z0:z1] if count else claims, count)
             report(z1, total)
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
         spans = own.spans()
         for b in np.flatnonzero((shifts[:, 3] == 0) & reaches):
-            K.splat_turned(own.labels, spans[b], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi, claims, count)
+            K.splat_turned(own.labels, flags, spans[b], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi,
+                           claims, count)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
         volume = _by_mode(owner, claims, mode, n_bones, value)
@@ -177,11 +181,11 @@ def _turned_spans(own: Ownership, matrices: np.ndarray, which: np.ndarray, lo: n
     which = np.flatnonzero(which)
     spans = np.empty((max(1, len(which)), *shape_zy, 2), np.int32)
     spans[..., 0], spans[..., 1] = shape_zy[1] * 0 + 2**30, -(2**30)
-    rest_spans = own.spans()
+    rest_spans, flags = own.spans(), own.flags()
     rest_lo = np.asarray(own.origin, np.int64)
     for k, b in enumerate(which):
         turned[b] = k
-        K.posed_row_spans(rest_spans[b], rest_lo, matrices[b], lo, spans[k])
+        K.posed_row_spans(flags, rest_spans[b], rest_lo, matrices[b], lo, spans[k])
     return turned, spans
 
 

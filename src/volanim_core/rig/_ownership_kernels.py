@@ -306,3 +306,32 @@ def speck_rings(pieces, specks, boxes):
                                     n += 1
         starts[k + 1] = n
     return starts, ring[:n]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def voxel_flags(labels, out):
+    """``out[x, y, z]`` (uint8, zeroed) for each voxel of ``labels`` ``[x, y, z]`` (outside the array: 0):
+    bit 1 (UNIFORM) when it and its 26 neighbours hold one label (0 or a bone): a sub-voxel read near it needs
+    no interpolation; bit 2 (THIN) when it is a body voxel whose two face neighbours along some axis are both
+    outside the body: a limb one voxel thick there."""
+    nx, ny, nz = labels.shape
+    for z in numba.prange(nz):
+        for y in range(ny):
+            for x in range(nx):
+                v = labels[x, y, z]
+                same = True
+                for dz in range(-1, 2):
+                    for dy in range(-1, 2):
+                        for dx in range(-1, 2):
+                            a, b, c = x + dx, y + dy, z + dz
+                            w = labels[a, b, c] if 0 <= a < nx and 0 <= b < ny and 0 <= c < nz else 0
+                            if w != v:
+                                same = False
+                flag = 1 if same else 0
+                if v != 0:
+                    out_x = (x == 0 or labels[x - 1, y, z] == 0) and (x == nx - 1 or labels[x + 1, y, z] == 0)
+                    out_y = (y == 0 or labels[x, y - 1, z] == 0) and (y == ny - 1 or labels[x, y + 1, z] == 0)
+                    out_z = (z == 0 or labels[x, y, z - 1] == 0) and (z == nz - 1 or labels[x, y, z + 1] == 0)
+                    if out_x or out_y or out_z:
+                        flag |= 2
+                out[x, y, z] = flag

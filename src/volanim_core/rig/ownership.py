@@ -40,6 +40,7 @@ from volanim_core.rig._ownership_kernels import (
     row_ends,
     row_spans,
     section_moments,
+    voxel_flags,
 )
 from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.rig.specks import join_specks
@@ -75,6 +76,7 @@ class Ownership:
     _coarse: dict = field(default_factory=dict, repr=False)
     _hulls: list | None = field(default=None, repr=False)
     _spans: np.ndarray | None = field(default=None, repr=False)
+    _flags: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.origin = tuple(int(v) for v in self.origin)
@@ -120,6 +122,17 @@ class Ownership:
             row_spans(self.labels, spans)
             self._spans = spans
         return self._spans
+
+    def flags(self) -> np.ndarray:
+        """``[x, y, z]`` uint8 beside :attr:`labels` (made once): bit 1 where a voxel and its 26 neighbours hold
+        one label (a posed read there needs no interpolation), bit 2 on a body voxel one voxel thick along some
+        axis (pushed forward too when its bone turns, so a thin limb stays whole): rig/_ownership_kernels."""
+        if self._flags is None:
+            # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
+            flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")
+            voxel_flags(self.labels, flags)
+            self._flags = flags
+        return self._flags
 
     def counts(self) -> np.ndarray:
         """Each bone's owned voxels."""
