@@ -201,7 +201,7 @@ def thinned_radii(rest, posed, dt, sheet, pairs, floor):
 
 def _claims(labels, p, bone1):
     """Whether label ``bone1`` claims the rest point ``p`` (labels' voxel coordinates): the 8 voxels around p,
-    weighted trilinearly (outside the array: 0), fill at least half of it with body, and p's nearest voxel is
+    weighted trilinearly (outside the array: 0), fill more than half of it with body, and p's nearest voxel is
     bone1's or, when that voxel is outside the body, bone1's share of the 8 is the largest (a tie to the lower
     label)."""
     import math
@@ -220,7 +220,7 @@ def _claims(labels, p, bone1):
             share[v] = share.get(v, 0.0) + w
     near = [int(math.floor(v + 0.5)) for v in p]
     nearest = int(labels[tuple(near)]) if all(0 <= near[a] < labels.shape[a] for a in range(3)) else 0
-    if sum(share.values()) < 0.5 or nearest not in (0, bone1):
+    if sum(share.values()) <= 0.5 or nearest not in (0, bone1):
         return False
     if nearest == bone1:
         return True
@@ -246,7 +246,7 @@ def _thin(labels, k):
 def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     """The ownership warp (reconstruct/owned.py) voxel by voxel: each output voxel q of ``bounds`` is bone b's
     (first in order) when b claims the rest point ``[q 1] @ inv(M_b)`` (:func:`_claims`: the body's trilinear
-    share there at least half, b's the largest); a bone moved by whole voxels only reads its own voxel there.
+    share there more than half, and p b's); a bone moved by whole voxels only reads its own voxel there.
     Then each thin rest voxel (one voxel thick along an axis) of a turned bone is written where it lands,
     rounded, if that is empty; then each empty voxel strictly inside a ball ``(centre, radius, bone)`` (in
     order) is that ball's bone. Returns 1 + bone per voxel ``[x, y, z]``."""

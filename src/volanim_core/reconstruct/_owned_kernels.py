@@ -2,7 +2,7 @@
 
     warp_owners(labels, flags, rest_lo, inv, boxes, out_lo, out, row_lo, row_hi, claims, count)
         every output voxel q, for each bone b whose posed box holds q (root order), at its rest point
-        p = [q 1] @ inv[b]: q is b's (the first such bone keeps it) when the body fills at least half of p
+        p = [q 1] @ inv[b]: q is b's (the first such bone keeps it) when the body fills more than half of p
         (trilinear over the 8 voxels around p) and p is b's (its nearest voxel's bone; outside the body, the
         largest share: :func:`claims_point`); a bone moved by whole voxels reads its own voxel, exactly
     close_joints(out, out_lo, centres, r2s, bones, row_lo, row_hi, claims)
@@ -106,7 +106,7 @@ def _label(labels, x, y, z, lx, ly, lz):
 @njit(cache=True, nogil=True, inline="always")
 def claims_point(labels, flags, px, py, pz, bone1, lx, ly, lz):
     """Whether label ``bone1`` claims rest point ``p`` (voxel coordinates of ``labels``). The body (labels > 0)
-    must fill at least half of p, trilinear over the 8 voxels around it; then p is the nearest voxel's bone, or,
+    must fill more than half of p, trilinear over the 8 voxels around it; then p is the nearest voxel's bone, or,
     where the nearest voxel is outside the body, the bone with the largest share of the 8 (a tie to the lower
     label, as the first bone in root order keeps a voxel). Where the nearest voxel's 26 neighbours hold its
     label too (``flags`` bit 1), all 8 do: no interpolation. A nearest voxel of another bone ends the read at
@@ -118,7 +118,10 @@ def claims_point(labels, flags, px, py, pz, bone1, lx, ly, lz):
         return False
     if inside and flags[rx, ry, rz] & 1:
         return v == bone1
-    if not inside and (rx < -1 or ry < -1 or rz < -1 or rx > lx or ry > ly or rz > lz):
+    # outside the body with no face neighbour in it: the corners it shares an axis with are outside, and the
+    # others (two or three axes off, each by at most half a voxel) weigh at most half: never more than half body
+    if (inside and v == 0 and not flags[rx, ry, rz] & 4) or (not inside and (
+            rx < -1 or ry < -1 or rz < -1 or rx > lx or ry > ly or rz > lz)):
         return False
     x0, y0, z0 = int(math.floor(px)), int(math.floor(py)), int(math.floor(pz))
     tx, ty, tz = px - x0, py - y0, pz - z0
@@ -134,9 +137,9 @@ def claims_point(labels, flags, px, py, pz, bone1, lx, ly, lz):
         body += w
         if c == bone1:
             mine += w
-        if v == bone1 and body >= 0.5:  # the nearest voxel is the bone's: half the body is all it needs
+        if v == bone1 and body > 0.5:  # the nearest voxel is the bone's: more than half body is all it needs
             return True
-    if body < 0.5:
+    if body <= 0.5:
         return False
     if v == bone1:
         return True

@@ -313,7 +313,8 @@ def voxel_flags(labels, out):
     """``out[x, y, z]`` (uint8, zeroed) for each voxel of ``labels`` ``[x, y, z]`` (outside the array: 0):
     bit 1 (UNIFORM) when it and its 26 neighbours hold one label (0 or a bone): a sub-voxel read near it needs
     no interpolation; bit 2 (THIN) when it is a body voxel whose two face neighbours along some axis are both
-    outside the body: a limb one voxel thick there."""
+    outside the body: a limb one voxel thick there; bit 4 (SKIN) when it is outside the body with a face
+    neighbour in it: only there can a point whose nearest voxel is outside be more than half body."""
     nx, ny, nz = labels.shape
     for z in numba.prange(nz):
         for y in range(ny):
@@ -334,4 +335,8 @@ def voxel_flags(labels, out):
                     out_z = (z == 0 or labels[x, y, z - 1] == 0) and (z == nz - 1 or labels[x, y, z + 1] == 0)
                     if out_x or out_y or out_z:
                         flag |= 2
+                elif ((x > 0 and labels[x - 1, y, z] != 0) or (x < nx - 1 and labels[x + 1, y, z] != 0)
+                      or (y > 0 and labels[x, y - 1, z] != 0) or (y < ny - 1 and labels[x, y + 1, z] != 0)
+                      or (z > 0 and labels[x, y, z - 1] != 0) or (z < nz - 1 and labels[x, y, z + 1] != 0)):
+                    flag |= 4
                 out[x, y, z] = flag

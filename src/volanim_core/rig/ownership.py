@@ -126,7 +126,8 @@ class Ownership:
     def flags(self) -> np.ndarray:
         """``[x, y, z]`` uint8 beside :attr:`labels` (made once): bit 1 where a voxel and its 26 neighbours hold
         one label (a posed read there needs no interpolation), bit 2 on a body voxel one voxel thick along some
-        axis (pushed forward too when its bone turns, so a thin limb stays whole): rig/_ownership_kernels."""
+        axis (pushed forward too when its bone turns, so a thin limb stays whole), bit 4 on an outside voxel with
+        a face neighbour in the body (only near those can a read be more than half body): rig/_ownership_kernels."""
         if self._flags is None:
             # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
             flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")

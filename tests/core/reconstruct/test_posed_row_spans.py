@@ -44,8 +44,9 @@ def test_a_bones_surface_gives_the_spans_of_all_its_voxels():
 
 
 def test_the_uniform_shortcut_changes_no_voxel():
-    """A read near a voxel whose 26 neighbours hold its label takes that label without interpolating, and rows
-    skip such voxels: the same body, voxel for voxel, as with the shortcut off (flags' bit 1 cleared)."""
+    """A read near a voxel whose 26 neighbours hold its label takes that label without interpolating, a read whose
+    nearest voxel is outside with no face neighbour in the body is refused at once, and rows skip uniform
+    voxels: the same body, voxel for voxel, as with every shortcut off (bit 1 cleared, bit 4 set everywhere)."""
     from dataclasses import replace
 
     from volanim_core.reconstruct.owned import reconstruct_owned
@@ -54,7 +55,7 @@ def test_the_uniform_shortcut_changes_no_voxel():
     s = samples.mannequin()
     own = ownership(s.mask, connect(skeletonize(s.mask, min_thinness=0.5), s.bones)[0])
     slow = replace(own)
-    slow._flags = np.asfortranarray(own.flags() & 2)
+    slow._flags = np.asfortranarray((own.flags() & 2) | 4)
     rng = np.random.default_rng(84)
     for trial in range(4):
         pose = {b.name: tuple(rng.uniform(-60, 60, 3)) for b in s.bones.bones}
