@@ -107,6 +107,15 @@ def zxy_degrees(r: np.ndarray) -> np.ndarray:
     return np.degrees(np.unwrap(np.stack([z, x, y], 1), axis=0))
 
 
+def ancestors(parent, k: int) -> list[int]:
+    """Node ``k``'s ancestors, nearest first (``parent[j]`` -1 for a root): both readers' trees."""
+    out = []
+    while parent[k] >= 0:
+        k = parent[k]
+        out.append(k)
+    return out
+
+
 def unique_names(names: list[str]) -> list[str]:
     """``names`` with repeats numbered (``Bone``, ``Bone_2``): a Motion's joints need distinct names."""
     seen: dict[str, int] = {}

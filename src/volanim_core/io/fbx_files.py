@@ -34,6 +34,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.io.bvh_files import MAX_JOINTS, MAX_VALUE, Motion
+from volanim_core.io.clip_bake import ancestors as _ancestors
 from volanim_core.io.clip_bake import bake_motion, frame_times, quaternion_matrices, sample_keys
 from volanim_core.io.files import regular_file_bytes
 from volanim_core.limits import available_bytes, human_bytes
@@ -104,14 +105,6 @@ def _tree(scene) -> tuple[list[str], list[int], np.ndarray]:
 
 def _owner(name: str) -> str:
     return name.split(HELPER)[0]
-
-
-def _ancestors(parent: list[int], k: int) -> list[int]:
-    out = []
-    while parent[k] >= 0:
-        k = parent[k]
-        out.append(k)
-    return out
 
 
 def _joints(path: Path, scene, anim, names: list[str], parent: list[int]) -> list[int]:

@@ -35,6 +35,7 @@ import numpy as np
 
 from volanim_core.errors import FormatError
 from volanim_core.io.bvh_files import MAX_JOINTS, MAX_VALUE, Motion
+from volanim_core.io.clip_bake import ancestors as _ancestors
 from volanim_core.io.clip_bake import bake_motion, frame_times, quaternion_matrices, sample_keys
 from volanim_core.io.files import parse_json, regular_file_bytes
 from volanim_core.limits import available_bytes, human_bytes
@@ -193,14 +194,6 @@ def _parents(g: Gltf) -> np.ndarray:
         if seen > len(nodes):
             raise g.fail(f"node {k} is in a cycle of children: the nodes must form trees")
     return parent
-
-
-def _ancestors(parent, k) -> list[int]:
-    out = []
-    while parent[k] >= 0:
-        k = parent[k]
-        out.append(k)
-    return out
 
 
 def _joints(g: Gltf, anim: dict, parent: np.ndarray) -> list[int]:
