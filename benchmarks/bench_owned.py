@@ -2,7 +2,7 @@
 and the ownership (once per rig) against the skeletonize it follows, same run, as ratios.
 
     body (frog, mannequin, mannequin-large) --skeletonize (timed)--> skeleton --connect (nearest)--> connectivity
-        --ownership (timed, rig/ownership.py)--> labels
+        --ownership and the tables every frame reads (flags, cells, thin, spans, hulls), timed--> labels
     one pose, frames alternated: reconstruct(method='spheres') vs reconstruct(method='owned'), bone mode
     goals: frame owned / spheres <= 1.0; ownership / skeletonize <= 1.0
 
@@ -31,17 +31,21 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--bodies", default="frog,mannequin,mannequin-large")
     args = parser.parse_args()
-    print("| body | skeletonize, s | ownership, s | ownership / skeletonize | sphere frame, s | owned frame, s | "
-          "owned / spheres (frame) | overdraw spheres / owned |\n|---|---|---|---|---|---|---|---|")
+    print("| body | skeletonize, s | ownership + its tables, s | ownership / skeletonize | sphere frame, s | "
+          "owned frame, s | owned / spheres (frame) | overdraw spheres / owned |\n|---|---|---|---|---|---|---|---|")
     for name in args.bodies.split(","):
         s = samples.load(name)
         t0 = time.perf_counter()
         skel = skeletonize(s.mask, **({} if name == "frog" else {"min_thinness": 0.5}))
         t_skel = time.perf_counter() - t0
         conn = connect(skel, s.bones)[0]
-        ownership(s.mask, conn)  # compiled
+        warm = ownership(s.mask, conn)  # compiled
+        for table in (warm.flags, warm.cells, warm.thin, warm.spans, warm.hulls):
+            table()
         t0 = time.perf_counter()
         own = ownership(s.mask, conn)
+        for table in (own.flags, own.cells, own.thin, own.spans, own.hulls):  # made once per rig, at the first frame
+            table()
         t_own = time.perf_counter() - t0
         frame = conn.with_ownership(own).posed(pose_matrices(s.bones, POSES[name]))
         for method in ("spheres", "owned"):

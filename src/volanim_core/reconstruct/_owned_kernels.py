@@ -26,75 +26,86 @@ import numba
 import numpy as np
 from numba import njit
 
+ZB = 4  # output slices a thread reads row by row (warp_owners)
+
 
 @njit(cache=True, nogil=True, parallel=True)
-def warp_owners(labels, flags, spans, rest_lo, inv, shifts, turned, turned_spans, boxes, out_lo, out, row_lo, row_hi,
-                claims, count):
+def warp_owners(labels, flags, spans, rest_lo, inv, shifts, turned, marks, cell, z_first, boxes, out_lo, out, row_lo,
+                row_hi, claims, count, threads):
     """``out`` ``[z, y, x]`` (zeroed): each voxel's owning bone + 1. ``labels`` ``[x, y, z]``: the rest owners,
     voxel ``[0, 0, 0]`` at rest voxel ``rest_lo``. ``boxes[b]``: bone b's posed box ``x0 y0 z0 x1 y1 z1`` in
-    output indices (empty when x1 < x0). A turned bone b reads only where ``turned_spans[turned[b], z, y]`` says its
-    voxels land on the row (:func:`posed_row_spans`, made for this slab's rows). ``row_lo/row_hi[z, y]``:
+    output indices (empty when x1 < x0). ``row_lo/row_hi[z, y]``:
     each row's span of written voxels. ``count``: also count every bone reaching a voxel in ``claims``
     (hotspot), else stop at the first. ``spans[b, y, z]``: bone b's first and last x on rest row (y, z) of
     ``labels``. ``shifts[b]``: ``dx dy dz 1`` when bone b moves by whole voxels only (its
-    voxels are read without rounding), else ``0 0 0 0``. ``flags``: Ownership.flags(). Returns the voxel-bone
-    reads."""
+    voxels are read without rounding), else ``0 0 0 0``. A turned bone b reads only in the output cubes (``cell``
+    voxels a side; the launch's first slice is the output's slice ``z_first``) that ``marks[turned[b]]`` holds
+    (:func:`posed_cells`). ``threads``: the launch's threads.
+    ``flags``: Ownership.flags(). Returns the voxel-bone reads."""
     nz, ny, nx = out.shape
     lx, ly, lz = labels.shape
     nb = inv.shape[0]
-    reads = np.zeros(nz, np.int64)
-    for z in numba.prange(nz):
+    nblocks = -(-nz // ZB)
+    reads = np.zeros(threads, np.int64)
+    # blocks of ZB slices dealt round the threads (a thread's share spread over the launch: a limb fills few
+    # slices), each block row by row: a turn about y lays an output row across the rest slices, and the same
+    # row of the block's next slice reads the same cache lines of the labels, a voxel along
+    for t in numba.prange(threads):
         n = 0
-        qz = z + out_lo[2]
-        for y in range(ny):
-            qy = y + out_lo[1]
-            lo_x, hi_x = nx, -1
-            for b in range(nb):
-                if z < boxes[b, 2] or z > boxes[b, 5] or y < boxes[b, 1] or y > boxes[b, 4]:
-                    continue
-                m = inv[b]
-                # the rest point of x = 0 and its step per x: a row is a straight line in the rest frame
-                bx = qy * m[1, 0] + qz * m[2, 0] + m[3, 0] - rest_lo[0]
-                by = qy * m[1, 1] + qz * m[2, 1] + m[3, 1] - rest_lo[1]
-                bz = qy * m[1, 2] + qz * m[2, 2] + m[3, 2] - rest_lo[2]
-                if shifts[b, 3] == 1:
-                    x0, x1 = boxes[b, 0], boxes[b, 3]
-                else:  # where the turned bone's voxels land on this row (posed_row_spans)
-                    x0 = max(boxes[b, 0], turned_spans[turned[b], z, y, 0])
-                    x1 = min(boxes[b, 3], turned_spans[turned[b], z, y, 1])
-                if shifts[b, 3] == 1:  # moved by whole voxels only (most bones of a pose: not at all): no rounding
-                    iy, iz = qy - shifts[b, 1] - rest_lo[1], qz - shifts[b, 2] - rest_lo[2]
-                    if iy < 0 or iz < 0 or iy >= ly or iz >= lz or x1 < x0:
-                        continue
-                    dx = out_lo[0] - shifts[b, 0] - rest_lo[0]
-                    x0, x1 = max(x0, spans[b, iy, iz, 0] - dx), min(x1, spans[b, iy, iz, 1] - dx)
-                    n += max(0, x1 - x0 + 1)
-                    for x in range(x0, x1 + 1):
-                        if labels[x + dx, iy, iz] == b + 1 and (count or out[z, y, x] == 0):
-                            if out[z, y, x] == 0:
-                                out[z, y, x] = b + 1
-                                lo_x = min(lo_x, x)
-                                hi_x = max(hi_x, x)
-                            if count:
-                                claims[z, y, x] += 1
-                    continue
-                for x in range(x0, x1 + 1):
-                    qx = x + out_lo[0]
-                    n += 1
-                    if not count and out[z, y, x] != 0:
-                        continue
-                    if not claims_point(labels, flags, bx + qx * m[0, 0], by + qx * m[0, 1], bz + qx * m[0, 2],
-                                        b + 1, lx, ly, lz):
-                        continue
-                    if out[z, y, x] == 0:
-                        out[z, y, x] = b + 1
-                        lo_x = min(lo_x, x)
-                        hi_x = max(hi_x, x)
-                    if count:
-                        claims[z, y, x] += 1
-            row_lo[z, y] = min(row_lo[z, y], lo_x)
-            row_hi[z, y] = max(row_hi[z, y], hi_x)
-        reads[z] = n
+        for k in range(t, nblocks, threads):
+            for y in range(ny):
+                qy = y + out_lo[1]
+                for z in range(k * ZB, min(nz, k * ZB + ZB)):
+                    qz = z + out_lo[2]
+                    lo_x, hi_x = nx, -1
+                    for b in range(nb):
+                        if z < boxes[b, 2] or z > boxes[b, 5] or y < boxes[b, 1] or y > boxes[b, 4]:
+                            continue
+                        m = inv[b]
+                        # the rest point of x = 0 and its step per x: a row is a straight line in the rest frame
+                        bx = qy * m[1, 0] + qz * m[2, 0] + m[3, 0] - rest_lo[0]
+                        by = qy * m[1, 1] + qz * m[2, 1] + m[3, 1] - rest_lo[1]
+                        bz = qy * m[1, 2] + qz * m[2, 2] + m[3, 2] - rest_lo[2]
+                        x0, x1 = boxes[b, 0], boxes[b, 3]
+                        # moved by whole voxels only (most bones of a pose: not at all): no rounding
+                        if shifts[b, 3] == 1:
+                            iy, iz = qy - shifts[b, 1] - rest_lo[1], qz - shifts[b, 2] - rest_lo[2]
+                            if iy < 0 or iz < 0 or iy >= ly or iz >= lz or x1 < x0:
+                                continue
+                            dx = out_lo[0] - shifts[b, 0] - rest_lo[0]
+                            x0, x1 = max(x0, spans[b, iy, iz, 0] - dx), min(x1, spans[b, iy, iz, 1] - dx)
+                            n += max(0, x1 - x0 + 1)
+                            for x in range(x0, x1 + 1):
+                                if labels[x + dx, iy, iz] == b + 1 and (count or out[z, y, x] == 0):
+                                    if out[z, y, x] == 0:
+                                        out[z, y, x] = b + 1
+                                        lo_x = min(lo_x, x)
+                                        hi_x = max(hi_x, x)
+                                    if count:
+                                        claims[z, y, x] += 1
+                            continue
+                        # the cubes of this row the turned bone can land in
+                        row = marks[turned[b], (z + z_first) // cell, y // cell]
+                        for c in range(x0 // cell, x1 // cell + 1):
+                            if row[c] == 0:
+                                continue
+                            for x in range(max(x0, c * cell), min(x1, c * cell + cell - 1) + 1):
+                                qx = x + out_lo[0]
+                                n += 1
+                                if not count and out[z, y, x] != 0:
+                                    continue
+                                if not claims_point(labels, flags, bx + qx * m[0, 0], by + qx * m[0, 1],
+                                                    bz + qx * m[0, 2], b + 1, lx, ly, lz):
+                                    continue
+                                if out[z, y, x] == 0:
+                                    out[z, y, x] = b + 1
+                                    lo_x = min(lo_x, x)
+                                    hi_x = max(hi_x, x)
+                                if count:
+                                    claims[z, y, x] += 1
+                    row_lo[z, y] = min(row_lo[z, y], lo_x)
+                    row_hi[z, y] = max(row_hi[z, y], hi_x)
+        reads[t] = n
     return reads.sum()
 
 
@@ -113,16 +124,17 @@ def claims_point(labels, flags, px, py, pz, bone1, lx, ly, lz):
     once: most reads of a bone's posed box fall in other bones' flesh."""
     rx, ry, rz = int(math.floor(px + 0.5)), int(math.floor(py + 0.5)), int(math.floor(pz + 0.5))
     inside = 0 <= rx < lx and 0 <= ry < ly and 0 <= rz < lz
+    f = flags[rx, ry, rz] if inside else 0
+    # outside the body with no face neighbour in it (bit 8, read before the labels: most refused reads need one
+    # line of memory): the corners it shares an axis with are outside, and the others (two or three axes off,
+    # each by at most half a voxel) weigh at most half: never more than half body
+    if f & 8 or (not inside and (rx < -1 or ry < -1 or rz < -1 or rx > lx or ry > ly or rz > lz)):
+        return False
     v = labels[rx, ry, rz] if inside else 0
     if v != 0 and v != bone1:
         return False
-    if inside and flags[rx, ry, rz] & 1:
+    if f & 1:
         return v == bone1
-    # outside the body with no face neighbour in it: the corners it shares an axis with are outside, and the
-    # others (two or three axes off, each by at most half a voxel) weigh at most half: never more than half body
-    if (inside and v == 0 and not flags[rx, ry, rz] & 4) or (not inside and (
-            rx < -1 or ry < -1 or rz < -1 or rx > lx or ry > ly or rz > lz)):
-        return False
     x0, y0, z0 = int(math.floor(px)), int(math.floor(py)), int(math.floor(pz))
     tx, ty, tz = px - x0, py - y0, pz - z0
     body = 0.0
@@ -208,70 +220,51 @@ def _moved(m, px, py, pz):
             px * m[0, 2] + py * m[1, 2] + pz * m[2, 2] + m[3, 2])
 
 
-@njit(cache=True, nogil=True)
-def posed_row_spans(flags, spans, rest_lo, m, out_lo, out):
-    """Where one turned bone's voxels land, row by row: ``out[z, y]`` (filled with ``(nx, -1)`` beforehand) widened
-    to hold every output voxel within ``REACH`` of a rest voxel of the bone moved by ``m`` (``[p 1] @ m``). A read
-    at ``inv(m) q`` can only find the bone's voxel among its 8 there (:func:`claims_point`). ``spans[y, z]``: the
-    bone's first and last x on each row of its rest labels (voxel ``[0, 0, 0]`` at ``rest_lo``). A voxel whose 26
-    neighbours are its own bone's (``flags`` bit 1) is skipped: its neighbours land around it, and a row's ends
-    come from the bone's surface (test_posed_row_spans checks the spans equal those of every voxel)."""
-    ly, lz = spans.shape[0], spans.shape[1]
-    nz, ny = out.shape[0], out.shape[1]
-    reach = 1.7321  # a voxel's diagonal, and a hair: the farthest a point lies from the 8 voxels around it
-    for iz in range(lz):
-        for iy in range(ly):
-            x0, x1 = spans[iy, iz, 0], spans[iy, iz, 1]
-            if x1 < x0:
-                continue
-            py, pz = iy + rest_lo[1], iz + rest_lo[2]
-            for ix in range(x0, x1 + 1):
-                if flags[ix, iy, iz] & 1:
-                    continue
-                px = ix + rest_lo[0]
-                vx, vy, vz = _moved(m, px, py, pz)
-                qx, qy, qz = vx - out_lo[0], vy - out_lo[1], vz - out_lo[2]
-                lo_x, hi_x = int(math.floor(qx - reach)), int(math.ceil(qx + reach))
-                for z in range(max(0, int(math.ceil(qz - reach))), min(nz - 1, int(math.floor(qz + reach))) + 1):
-                    for y in range(max(0, int(math.ceil(qy - reach))), min(ny - 1, int(math.floor(qy + reach))) + 1):
-                        if lo_x < out[z, y, 0]:
-                            out[z, y, 0] = lo_x
-                        if hi_x > out[z, y, 1]:
-                            out[z, y, 1] = hi_x
+@njit(cache=True, nogil=True, parallel=True)
+def posed_cells(cells, size, rest_lo, m, reach, out_lo, marks):
+    """Where one turned bone can be read: ``marks[kz, ky, kx]`` (uint8, an output cube of ``size`` voxels a side,
+    its first voxel ``size * (kx, ky, kz)`` of the output) set to 1 for every output cube within ``reach`` of a
+    rest cube of the bone (``cells``: lower corners / size, on the labels' grid, voxel ``[0, 0, 0]`` at
+    ``rest_lo``) moved by ``m`` (``[p 1] @ m``), its centre's reach taken. A read finds the bone only among the
+    8 voxels around its point, each within a voxel's diagonal of it; a voxel lies within half a cube's
+    diagonal of its cube's centre: ``reach`` is the sum, times the matrix's largest stretch."""
+    nz, ny, nx = marks.shape
+    h = (size - 1) / 2.0
+    for i in numba.prange(len(cells)):  # threads may set one mark at once: each writes the same 1
+        qx, qy, qz = _moved(m, cells[i, 0] * size + h + rest_lo[0], cells[i, 1] * size + h + rest_lo[1],
+                            cells[i, 2] * size + h + rest_lo[2])
+        qx, qy, qz = qx - out_lo[0], qy - out_lo[1], qz - out_lo[2]
+        x0, x1 = max(0, int(math.floor((qx - reach) / size))), min(nx - 1, int(math.floor((qx + reach) / size)))
+        y0, y1 = max(0, int(math.floor((qy - reach) / size))), min(ny - 1, int(math.floor((qy + reach) / size)))
+        z0, z1 = max(0, int(math.floor((qz - reach) / size))), min(nz - 1, int(math.floor((qz + reach) / size)))
+        for z in range(z0, z1 + 1):
+            for y in range(y0, y1 + 1):
+                for x in range(x0, x1 + 1):
+                    marks[z, y, x] = 1
 
 
 @njit(cache=True, nogil=True)
-def splat_turned(labels, flags, spans, rest_lo, m, bone, out_lo, out, row_lo, row_hi, claims, count):
-    """Each thin rest voxel of a turned bone (``flags`` bit 2: one voxel thick along some axis) written at its
-    posed place rounded, where no bone wrote yet. The inverse read alone can step over a limb one voxel thin
-    that a turn lays across the grid (the ant's legs came apart in single voxels); every such voxel pushed to
-    where it lands keeps the limb in one piece (two face neighbours land at most one voxel apart on each
-    axis). Thick flesh is left to the read: pushed too, its surface came back in stairs (the walk's Dice
+def splat_turned(voxels, rest_lo, m, bone, out_lo, out, row_lo, row_hi, claims, count):
+    """Each thin rest voxel of a turned bone (``voxels``: Ownership.thin(), one voxel thick along some axis)
+    written at its posed place rounded, where no bone wrote yet. The inverse read alone can step over a limb one
+    voxel thin that a turn lays across the grid (the ant's legs came apart in single voxels); every such voxel
+    pushed to where it lands keeps the limb in one piece (two face neighbours land at most one voxel apart on
+    each axis). Thick flesh is left to the read: pushed too, its surface came back in stairs (the walk's Dice
     0.9762 -> 0.9738). Returns the voxels written."""
-    ly, lz = spans.shape[0], spans.shape[1]
     nz, ny, nx = out.shape
     n = 0
-    for iz in range(lz):
-        for iy in range(ly):
-            x0, x1 = spans[iy, iz, 0], spans[iy, iz, 1]
-            if x1 < x0:
-                continue
-            py, pz = iy + rest_lo[1], iz + rest_lo[2]
-            for ix in range(x0, x1 + 1):
-                if labels[ix, iy, iz] != bone + 1 or not flags[ix, iy, iz] & 2:  # a span holds others' voxels too
-                    continue
-                px = ix + rest_lo[0]
-                # rounded on the rest grid first, then made an index: the same voxel whatever the output's box
-                vx, vy, vz = _moved(m, px, py, pz)
-                x = int(math.floor(vx + 0.5)) - out_lo[0]
-                y = int(math.floor(vy + 0.5)) - out_lo[1]
-                z = int(math.floor(vz + 0.5)) - out_lo[2]
-                if x < 0 or y < 0 or z < 0 or x >= nx or y >= ny or z >= nz or out[z, y, x] != 0:
-                    continue
-                out[z, y, x] = bone + 1
-                row_lo[z, y] = min(row_lo[z, y], x)
-                row_hi[z, y] = max(row_hi[z, y], x)
-                if count:
-                    claims[z, y, x] += 1
-                n += 1
+    for i in range(len(voxels)):
+        # rounded on the rest grid first, then made an index: the same voxel whatever the output's box
+        vx, vy, vz = _moved(m, voxels[i, 0] + rest_lo[0], voxels[i, 1] + rest_lo[1], voxels[i, 2] + rest_lo[2])
+        x = int(math.floor(vx + 0.5)) - out_lo[0]
+        y = int(math.floor(vy + 0.5)) - out_lo[1]
+        z = int(math.floor(vz + 0.5)) - out_lo[2]
+        if x < 0 or y < 0 or z < 0 or x >= nx or y >= ny or z >= nz or out[z, y, x] != 0:
+            continue
+        out[z, y, x] = bone + 1
+        row_lo[z, y] = min(row_lo[z, y], x)
+        row_hi[z, y] = max(row_hi[z, y], x)
+        if count:
+            claims[z, y, x] += 1
+        n += 1
     return n

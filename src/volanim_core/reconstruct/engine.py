@@ -33,6 +33,7 @@ from volanim_core.reconstruct._clip_kernels import count_outside
 
 # the plan's checks and geometry are this module's API too (callers import them from here)
 from volanim_core.reconstruct.plan import (  # noqa: F401
+    LAUNCH_SECONDS,
     MODES,
     OWNER,
     SNAP,
@@ -55,7 +56,6 @@ from volanim_core.volume import Bounds
 
 _MODE_CODE = {"binary": K.BINARY, "mottled": K.MOTTLED, "bone": K.BONE, "sampled": K.SAMPLED, "hotspot": K.HOTSPOT,
               OWNER: K.BONE}
-LAUNCH_SECONDS = 0.25  # aimed length of one parallel launch: the progress and cancel granularity
 CLIP_ROW_BUDGET = 4_000_000  # rows counted exactly per clipped sphere (radius ~1000); beyond, estimated
 
 

@@ -2,8 +2,10 @@
 
     Ownership (rig/ownership.py: rest labels, ball radii), matrices (B, 4, 4)
         --each bone's owned box moved by its matrix--> posed boxes; output grid (their union + padding, or bounds)
+        --K.posed_cells (each turned bone's rest cubes, Ownership.cells, moved)--> the output cubes it can land in
         --K.warp_owners (each output voxel read at the rest point its bone brings it from: the body's share
-                         there, trilinear, and the bone owning most of it)--> owner [z, y, x]
+                         there, trilinear, and the bone owning most of it; a turned bone only in its cubes;
+                         launches of ~LAUNCH_SECONDS, as the spheres')--> owner [z, y, x]
         --K.splat_turned (each turned bone's thin rest voxels pushed to where they land, where still empty: a limb
                           one voxel thin that the read steps over stays in one piece)-->
         --K.close_joints (the ball at each bone's proximal joint, moved by the bone: empty voxels to the bone)-->
@@ -36,15 +38,14 @@ import numba
 import numpy as np
 
 from volanim_core.geometry import Geometry
-from volanim_core.progress import CancelFn, Clock, ProgressFn, Reporter
+from volanim_core.progress import CancelFn, Clock, Pacer, ProgressFn, Reporter
 from volanim_core.reconstruct import _owned_kernels as K
-from volanim_core.reconstruct.plan import MODES, mottled_values, output_dtype
+from volanim_core.reconstruct._owned_kernels import ZB
+from volanim_core.reconstruct.plan import LAUNCH_SECONDS, MODES, mottled_values, output_dtype
 from volanim_core.reconstruct.result import Reconstruction
 from volanim_core.reconstruct.sampling import grid_to_source, sample_source
-from volanim_core.rig.ownership import Ownership
+from volanim_core.rig.ownership import CELL, Ownership
 from volanim_core.volume import Bounds
-
-SLAB = 32  # output slices per launch: the progress and cancel granularity
 
 
 def posed_boxes(own: Ownership, matrices: np.ndarray) -> np.ndarray:
@@ -125,7 +126,7 @@ def reconstruct_owned(
     shifts = whole_voxel_shifts(matrices)
     # a bone whose posed box misses the grid adds nothing (a live update's box holds few): not splatted
     reaches = (boxes[:, 3:] >= lo).all(1) & (boxes[:, :3] <= np.asarray(grid.hi)).all(1)
-    turned, turned_spans = _turned_spans(own, matrices, (shifts[:, 3] == 0) & reaches, lo, (nz, ny))
+    turned, marks = _turned_marks(own, matrices, (shifts[:, 3] == 0) & reaches, lo, (nz, ny, nx))
     nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
@@ -133,19 +134,20 @@ def reconstruct_owned(
     try:
         total = 2 * nz if mode == "sampled" else nz
         report(0, total)
-        for z0 in range(0, nz, SLAB):
-            z1 = min(nz, z0 + SLAB)
+        # a first, small launch measures the pace; the next ones last about LAUNCH_SECONDS each (engine's rule)
+        pacer = Pacer(first=max(nthreads * ZB * 2, nz // 16), least=nthreads * ZB, seconds=LAUNCH_SECONDS, clock=clock)
+        for z0, z1 in pacer.spans(nz):
             slab = local.copy()
             slab[:, 2] = np.maximum(slab[:, 2] - z0, 0)
             slab[:, 5] = np.minimum(slab[:, 5] - z0, z1 - z0 - 1)
-            reads += K.warp_owners(own.labels, flags, own.spans(), rest_lo, inv, shifts, turned,
-                                   turned_spans[:, z0:z1], slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1],
-                                   row_hi[z0:z1], claims[z0:z1] if count else claims, count)
+            reads += K.warp_owners(own.labels, flags, own.spans(), rest_lo, inv, shifts, turned, marks, CELL, z0, slab,
+                                   lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
+                                   claims[z0:z1] if count else claims, count, nthreads)
             report(z1, total)
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
-        spans = own.spans()
+        starts, thin = own.thin()
         for b in np.flatnonzero((shifts[:, 3] == 0) & reaches):
-            K.splat_turned(own.labels, flags, spans[b], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi,
+            K.splat_turned(thin[starts[b]:starts[b + 1]], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi,
                            claims, count)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
@@ -155,7 +157,7 @@ def reconstruct_owned(
             to_source = np.diag([float(own.factor)] * 3 + [1.0]) if source_geometry is None else \
                 own.geometry.index_map(source_geometry)
             maps = grid_to_source(inv, lo.astype(np.float64), to_source)
-            volume = sample_source(owner, source, maps, kernel, (row_lo, row_hi), nthreads, SLAB,
+            volume = sample_source(owner, source, maps, kernel, (row_lo, row_hi), nthreads, pacer.size,
                                    lambda done: report(nz + done, total))
     finally:
         numba.set_num_threads(previous)
@@ -173,20 +175,22 @@ def reconstruct_owned(
     return Reconstruction(xyz, tuple(int(v) for v in lo), stats, own.geometry.shifted(lo))
 
 
-def _turned_spans(own: Ownership, matrices: np.ndarray, which: np.ndarray, lo: np.ndarray, shape_zy):
-    """For each turned bone that reaches the grid (``which``: not moved by whole voxels), where its voxels land on
-    each output row: ``turned[b]`` its index in ``spans (T, nz, ny, 2)`` (0 for the others, whose entry is never
-    read)."""
+def _turned_marks(own: Ownership, matrices: np.ndarray, which: np.ndarray, lo: np.ndarray, shape_zyx):
+    """For each turned bone that reaches the grid (``which``: not moved by whole voxels), the output cubes
+    (:data:`CELL` a side) its reads can find it in: ``turned[b]`` its index in ``marks (T, cz, cy, cx)`` (0 for
+    the others, whose entry is never read). A read finds the bone among the 8 voxels around its point, a
+    voxel's diagonal away at most, and a voxel lies within half a cube's diagonal of its cube's centre."""
     turned = np.zeros(len(matrices), np.int64)
     which = np.flatnonzero(which)
-    spans = np.empty((max(1, len(which)), *shape_zy, 2), np.int32)
-    spans[..., 0], spans[..., 1] = shape_zy[1] * 0 + 2**30, -(2**30)
-    rest_spans, flags = own.spans(), own.flags()
+    marks = np.zeros((max(1, len(which)), *(-(-np.asarray(shape_zyx) // CELL))), np.uint8)
+    starts, cells = own.cells()
     rest_lo = np.asarray(own.origin, np.int64)
     for k, b in enumerate(which):
         turned[b] = k
-        K.posed_row_spans(flags, rest_spans[b], rest_lo, matrices[b], lo, spans[k])
-    return turned, spans
+        stretch = float(np.linalg.norm(matrices[b, :3, :3], 2))
+        reach = stretch * (CELL - 1 + 2) * np.sqrt(3) / 2 + 1e-6  # half the cube's diagonal, and a voxel's diagonal
+        K.posed_cells(cells[starts[b]:starts[b + 1]], CELL, rest_lo, matrices[b], reach, lo, marks[k])
+    return turned, marks
 
 
 def whole_voxel_shifts(matrices: np.ndarray) -> np.ndarray:

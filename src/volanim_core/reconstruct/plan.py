@@ -39,6 +39,8 @@ from volanim_core.volume import Bounds
 OWNER = "owner"
 SNAP = 2.0**20
 
+LAUNCH_SECONDS = 0.25  # aimed length of one parallel launch: the progress and cancel granularity
+
 
 @dataclass
 class FramePlan:

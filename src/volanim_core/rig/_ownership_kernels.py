@@ -314,7 +314,8 @@ def voxel_flags(labels, out):
     bit 1 (UNIFORM) when it and its 26 neighbours hold one label (0 or a bone): a sub-voxel read near it needs
     no interpolation; bit 2 (THIN) when it is a body voxel whose two face neighbours along some axis are both
     outside the body: a limb one voxel thick there; bit 4 (SKIN) when it is outside the body with a face
-    neighbour in it: only there can a point whose nearest voxel is outside be more than half body."""
+    neighbour in it: only there can a point whose nearest voxel is outside be more than half body; bit 8 (FAR) on
+    every other outside voxel."""
     nx, ny, nz = labels.shape
     for z in numba.prange(nz):
         for y in range(ny):
@@ -339,4 +340,69 @@ def voxel_flags(labels, out):
                       or (y > 0 and labels[x, y - 1, z] != 0) or (y < ny - 1 and labels[x, y + 1, z] != 0)
                       or (z > 0 and labels[x, y, z - 1] != 0) or (z < nz - 1 and labels[x, y, z + 1] != 0)):
                     flag |= 4
+                else:
+                    flag |= 8
                 out[x, y, z] = flag
+
+
+@njit(cache=True, nogil=True)
+def bone_cells(labels, size, n_bones):
+    """Which ``size``-cubes of ``labels`` ``[x, y, z]`` hold a voxel of each label: ``(starts (n_bones + 1,),
+    cells (N, 3) int32)``, label l's cubes (their lower corner / size) at ``cells[starts[l - 1]:starts[l]]``.
+    Two passes, a cube at a time: count, then fill."""
+    nx, ny, nz = labels.shape
+    cx, cy, cz = -(-nx // size), -(-ny // size), -(-nz // size)
+    seen = np.zeros(n_bones + 1, np.bool_)
+    found = np.empty(n_bones + 1, np.int64)
+    count = np.zeros(n_bones + 1, np.int64)
+    starts = np.zeros(n_bones + 1, np.int64)
+    cells = np.empty((0, 3), np.int32)
+    for fill in range(2):
+        if fill:
+            starts[1:] = np.cumsum(count[1:])
+            cells = np.empty((starts[-1], 3), np.int32)
+            count[1:] = starts[:-1]  # each label's next row
+        for kz in range(cz):
+            for ky in range(cy):
+                for kx in range(cx):
+                    nf = 0
+                    for z in range(kz * size, min(nz, kz * size + size)):
+                        for y in range(ky * size, min(ny, ky * size + size)):
+                            for x in range(kx * size, min(nx, kx * size + size)):
+                                v = labels[x, y, z]
+                                if v != 0 and v <= n_bones and not seen[v]:
+                                    seen[v] = True
+                                    found[nf] = v
+                                    nf += 1
+                    for i in range(nf):
+                        v = found[i]
+                        seen[v] = False
+                        if fill:
+                            cells[count[v], 0], cells[count[v], 1], cells[count[v], 2] = kx, ky, kz
+                        count[v] += 1
+    return starts, cells
+
+
+@njit(cache=True, nogil=True)
+def flagged_voxels(labels, flags, bit, n_bones):
+    """Each label's voxels whose ``flags`` have ``bit``: ``(starts (n_bones + 1,), voxels (N, 3) int32)``, label
+    l's at ``voxels[starts[l - 1]:starts[l]]``, in the labels' order."""
+    nx, ny, nz = labels.shape
+    count = np.zeros(n_bones + 1, np.int64)
+    starts = np.zeros(n_bones + 1, np.int64)
+    voxels = np.empty((0, 3), np.int32)
+    for fill in range(2):
+        if fill:
+            starts[1:] = np.cumsum(count[1:])
+            voxels = np.empty((starts[-1], 3), np.int32)
+            count[1:] = starts[:-1]
+        for z in range(nz):
+            for y in range(ny):
+                for x in range(nx):
+                    v = labels[x, y, z]
+                    if v == 0 or v > n_bones or not flags[x, y, z] & bit:
+                        continue
+                    if fill:
+                        voxels[count[v], 0], voxels[count[v], 1], voxels[count[v], 2] = x, y, z
+                    count[v] += 1
+    return starts, voxels

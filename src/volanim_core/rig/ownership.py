@@ -35,6 +35,8 @@ import numpy as np
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
+    bone_cells,
+    flagged_voxels,
     own_by_tubes,
     pool_labels,
     row_ends,
@@ -47,6 +49,8 @@ from volanim_core.rig.specks import join_specks
 from volanim_core.volume import tight_bounds
 
 SECTION_VOXELS = 64_000_000  # the lattice the cross-sections' moments are gathered on
+CELL = 2  # the cube a turned bone's reads are planned by (Ownership.cells): its cubes moved mark where it can land
+THIN = 2  # Ownership.flags' bit of a body voxel one voxel thick along some axis
 
 
 def label_dtype(n_bones: int):
@@ -77,6 +81,8 @@ class Ownership:
     _hulls: list | None = field(default=None, repr=False)
     _spans: np.ndarray | None = field(default=None, repr=False)
     _flags: np.ndarray | None = field(default=None, repr=False)
+    _cells: tuple | None = field(default=None, repr=False)
+    _thin: tuple | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.origin = tuple(int(v) for v in self.origin)
@@ -127,13 +133,29 @@ class Ownership:
         """``[x, y, z]`` uint8 beside :attr:`labels` (made once): bit 1 where a voxel and its 26 neighbours hold
         one label (a posed read there needs no interpolation), bit 2 on a body voxel one voxel thick along some
         axis (pushed forward too when its bone turns, so a thin limb stays whole), bit 4 on an outside voxel with
-        a face neighbour in the body (only near those can a read be more than half body): rig/_ownership_kernels."""
+        a face neighbour in the body (only near those can a read be more than half body), bit 8 on every other
+        outside voxel (a read nearest one is refused at once): rig/_ownership_kernels."""
         if self._flags is None:
             # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
             flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")
             voxel_flags(self.labels, flags)
             self._flags = flags
         return self._flags
+
+    def cells(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each bone's :data:`CELL`-cubes of :attr:`labels` (made once): ``(starts (B + 1,), cells (N, 3))``, bone b's
+        cubes (lower corner / CELL) at ``cells[starts[b]:starts[b + 1]]``. A turned bone's cubes, moved, say which
+        output cubes its reads can find it in (reconstruct/owned.py): a frog leg's row holds the other leg too."""
+        if self._cells is None:
+            self._cells = bone_cells(self.labels, CELL, len(self.bones))
+        return self._cells
+
+    def thin(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each bone's thin voxels (:meth:`flags` bit 2), made once: ``(starts (B + 1,), voxels (N, 3))`` as
+        :meth:`cells`. A turned bone pushes these forward too (reconstruct/_owned_kernels.splat_turned)."""
+        if self._thin is None:
+            self._thin = flagged_voxels(self.labels, self.flags(), THIN, len(self.bones))
+        return self._thin
 
     def counts(self) -> np.ndarray:
         """Each bone's owned voxels."""
