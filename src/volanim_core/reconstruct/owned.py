@@ -126,12 +126,12 @@ def reconstruct_owned(
     shifts = whole_voxel_shifts(matrices)
     # a bone whose posed box misses the grid adds nothing (a live update's box holds few): not splatted
     reaches = (boxes[:, 3:] >= lo).all(1) & (boxes[:, :3] <= np.asarray(grid.hi)).all(1)
-    turned, marks = _turned_marks(own, matrices, (shifts[:, 3] == 0) & reaches, lo, (nz, ny, nx))
     nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
     reads = 0
     try:
+        turned, marks = _turned_marks(own, matrices, (shifts[:, 3] == 0) & reaches, lo, (nz, ny, nx))
         total = 2 * nz if mode == "sampled" else nz
         report(0, total)
         # a first, small launch measures the pace; the next ones last about LAUNCH_SECONDS each (engine's rule)
