@@ -26,7 +26,7 @@ import numba
 import numpy as np
 from numba import njit
 
-ZB = 4  # output slices a thread reads row by row (warp_owners)
+ZB = 4  # output slices a thread takes at a time (warp_owners)
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -47,9 +47,10 @@ def warp_owners(labels, flags, spans, rest_lo, inv, shifts, turned, marks, cell,
     nb = inv.shape[0]
     nblocks = -(-nz // ZB)
     reads = np.zeros(threads, np.int64)
-    # blocks of ZB slices dealt round the threads (a thread's share spread over the launch: a limb fills few
-    # slices), each block row by row: a turn about y lays an output row across the rest slices, and the same
-    # row of the block's next slice reads the same cache lines of the labels, a voxel along
+    # blocks of ZB slices dealt round the threads: a thread's share is spread over the launch (a limb fills few
+    # slices: split in two halves, one thread had most of the work). Each block row by row, for the labels'
+    # cache lines a turn about y shares between the slices; measured, it changes little (the frog's frame on
+    # one thread, ZB 1 / 4 / 8: 1.11 / 1.07 / 1.08 times the sphere frame)
     for t in numba.prange(threads):
         n = 0
         for k in range(t, nblocks, threads):
