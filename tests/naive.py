@@ -284,3 +284,25 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
             if out[idx] == 0 and ((q - centre) ** 2).sum() < radius ** 2:
                 out[idx] = bone + 1
     return out
+
+
+def voxel_flags(labels):
+    """Ownership.flags() by its definition (rig/_ownership_kernels.voxel_flags), with whole-array shifts:
+    1 where the 3x3x3 around a voxel holds its label (outside the array: 0), 2 on a body voxel whose two face
+    neighbours along some axis are outside, 4 on an outside voxel with a face neighbour in the body, 8 on
+    every other outside voxel."""
+    nx, ny, nz = labels.shape
+    p = np.pad(labels, 1)
+    same = np.ones(labels.shape, bool)
+    for dx, dy, dz in np.ndindex(3, 3, 3):
+        same &= p[dx:dx + nx, dy:dy + ny, dz:dz + nz] == labels
+    inside = np.pad(labels != 0, 1)
+    body = labels != 0
+
+    def at(d):
+        return inside[1 + d[0]:1 + d[0] + nx, 1 + d[1]:1 + d[1] + ny, 1 + d[2]:1 + d[2] + nz]
+
+    axes = np.eye(3, dtype=int)
+    thin = body & np.any([~at(a) & ~at(-a) for a in axes], axis=0)
+    skin = ~body & np.any([at(a) | at(-a) for a in axes], axis=0)
+    return (same * 1 | thin * 2 | skin * 4 | (~body & ~skin) * 8).astype(np.uint8)

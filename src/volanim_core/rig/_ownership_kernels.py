@@ -308,6 +308,11 @@ def speck_rings(pieces, specks, boxes):
     return starts, ring[:n]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _at(labels, x, y, z, nx, ny, nz):
+    return labels[x, y, z] if 0 <= x < nx and 0 <= y < ny and 0 <= z < nz else 0
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def voxel_flags(labels, out):
     """``out[x, y, z]`` (uint8, zeroed) for each voxel of ``labels`` ``[x, y, z]`` (outside the array: 0):
@@ -315,54 +320,87 @@ def voxel_flags(labels, out):
     no interpolation; bit 2 (THIN) when it is a body voxel whose two face neighbours along some axis are both
     outside the body: a limb one voxel thick there; bit 4 (SKIN) when it is outside the body with a face
     neighbour in it: only there can a point whose nearest voxel is outside be more than half body; bit 8 (FAR) on
-    every other outside voxel."""
+    every other outside voxel.
+
+    The 3x3x3 test axis by axis (bits 16 and 32 hold the steps): the row's two neighbours alike (16), then the
+    3x3 of the slice (32: the rows above and below alike and 16), then the slices before and after: 13 reads a
+    voxel, not 27, read in order (the frog's box: 0.25 -> 0.07 s)."""
     nx, ny, nz = labels.shape
-    for z in numba.prange(nz):
+    for z in numba.prange(nz):  # the row: x - 1 and x + 1 hold its label
         for y in range(ny):
             for x in range(nx):
                 v = labels[x, y, z]
-                same = True
-                for dz in range(-1, 2):
-                    for dy in range(-1, 2):
-                        for dx in range(-1, 2):
-                            a, b, c = x + dx, y + dy, z + dz
-                            w = labels[a, b, c] if 0 <= a < nx and 0 <= b < ny and 0 <= c < nz else 0
-                            if w != v:
-                                same = False
+                if _at(labels, x - 1, y, z, nx, ny, nz) == v and _at(labels, x + 1, y, z, nx, ny, nz) == v:
+                    out[x, y, z] = 16
+    for z in numba.prange(nz):  # the slice's 3x3: the rows above and below alike, their neighbours too
+        for y in range(ny):
+            for x in range(nx):
+                v = labels[x, y, z]
+                same = out[x, y, z] & 16 != 0
+                for b in (y - 1, y + 1):
+                    if not same:
+                        break
+                    if 0 <= b < ny:
+                        same = labels[x, b, z] == v and out[x, b, z] & 16 != 0
+                    else:  # a row outside the array: all 0
+                        same = v == 0
+                if same:
+                    out[x, y, z] |= 32
+    for z in numba.prange(nz):  # the 3x3x3: the slices before and after alike; then the face bits
+        for y in range(ny):
+            for x in range(nx):
+                v = labels[x, y, z]
+                same = out[x, y, z] & 32 != 0
+                for c in (z - 1, z + 1):
+                    if not same:
+                        break
+                    if 0 <= c < nz:
+                        same = labels[x, y, c] == v and out[x, y, c] & 32 != 0
+                    else:
+                        same = v == 0
                 flag = 1 if same else 0
                 if v != 0:
-                    out_x = (x == 0 or labels[x - 1, y, z] == 0) and (x == nx - 1 or labels[x + 1, y, z] == 0)
-                    out_y = (y == 0 or labels[x, y - 1, z] == 0) and (y == ny - 1 or labels[x, y + 1, z] == 0)
-                    out_z = (z == 0 or labels[x, y, z - 1] == 0) and (z == nz - 1 or labels[x, y, z + 1] == 0)
+                    out_x = _at(labels, x - 1, y, z, nx, ny, nz) == 0 and _at(labels, x + 1, y, z, nx, ny, nz) == 0
+                    out_y = _at(labels, x, y - 1, z, nx, ny, nz) == 0 and _at(labels, x, y + 1, z, nx, ny, nz) == 0
+                    out_z = _at(labels, x, y, z - 1, nx, ny, nz) == 0 and _at(labels, x, y, z + 1, nx, ny, nz) == 0
                     if out_x or out_y or out_z:
                         flag |= 2
-                elif ((x > 0 and labels[x - 1, y, z] != 0) or (x < nx - 1 and labels[x + 1, y, z] != 0)
-                      or (y > 0 and labels[x, y - 1, z] != 0) or (y < ny - 1 and labels[x, y + 1, z] != 0)
-                      or (z > 0 and labels[x, y, z - 1] != 0) or (z < nz - 1 and labels[x, y, z + 1] != 0)):
+                elif (_at(labels, x - 1, y, z, nx, ny, nz) != 0 or _at(labels, x + 1, y, z, nx, ny, nz) != 0
+                      or _at(labels, x, y - 1, z, nx, ny, nz) != 0 or _at(labels, x, y + 1, z, nx, ny, nz) != 0
+                      or _at(labels, x, y, z - 1, nx, ny, nz) != 0 or _at(labels, x, y, z + 1, nx, ny, nz) != 0):
                     flag |= 4
                 else:
                     flag |= 8
-                out[x, y, z] = flag
+                out[x, y, z] = (out[x, y, z] & 48) | flag  # the steps stay till every slice has read them
+    for z in numba.prange(nz):
+        for y in range(ny):
+            for x in range(nx):
+                out[x, y, z] &= 15
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def bone_cells(labels, size, n_bones):
     """Which ``size``-cubes of ``labels`` ``[x, y, z]`` hold a voxel of each label: ``(starts (n_bones + 1,),
-    cells (N, 3) int32)``, label l's cubes (their lower corner / size) at ``cells[starts[l - 1]:starts[l]]``.
-    Two passes, a cube at a time: count, then fill."""
+    cells (N, 3) int32)``, label l's cubes (their lower corner / size) at ``cells[starts[l - 1]:starts[l]]``,
+    in z, y, x order. Two parallel passes over the layers of cubes: count, then fill."""
     nx, ny, nz = labels.shape
     cx, cy, cz = -(-nx // size), -(-ny // size), -(-nz // size)
-    seen = np.zeros(n_bones + 1, np.bool_)
-    found = np.empty(n_bones + 1, np.int64)
-    count = np.zeros(n_bones + 1, np.int64)
+    count = np.zeros((cz + 1, n_bones + 1), np.int64)  # count[kz + 1, l]: layer kz's cubes of label l
     starts = np.zeros(n_bones + 1, np.int64)
     cells = np.empty((0, 3), np.int32)
     for fill in range(2):
         if fill:
-            starts[1:] = np.cumsum(count[1:])
+            for v in range(1, n_bones + 1):  # label by label, layer by layer: each layer's first row
+                starts[v] = starts[v - 1] + count[:, v].sum()
+                at = starts[v - 1]
+                for kz in range(cz + 1):  # row kz: after every layer before kz (held in rows 1 .. kz)
+                    at += count[kz, v]
+                    count[kz, v] = at
             cells = np.empty((starts[-1], 3), np.int32)
-            count[1:] = starts[:-1]  # each label's next row
-        for kz in range(cz):
+        for kz in numba.prange(cz):
+            seen = np.zeros(n_bones + 1, np.bool_)
+            found = np.empty(n_bones + 1, np.int64)
+            mine = count[kz] if fill else count[kz + 1]
             for ky in range(cy):
                 for kx in range(cx):
                     nf = 0
@@ -378,8 +416,8 @@ def bone_cells(labels, size, n_bones):
                         v = found[i]
                         seen[v] = False
                         if fill:
-                            cells[count[v], 0], cells[count[v], 1], cells[count[v], 2] = kx, ky, kz
-                        count[v] += 1
+                            cells[mine[v], 0], cells[mine[v], 1], cells[mine[v], 2] = kx, ky, kz
+                        mine[v] += 1
     return starts, cells
 
 
