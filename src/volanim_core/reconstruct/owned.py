@@ -187,10 +187,15 @@ def _turned_marks(own: Ownership, matrices: np.ndarray, which: np.ndarray, lo: n
     rest_lo = np.asarray(own.origin, np.int64)
     for k, b in enumerate(which):
         turned[b] = k
-        stretch = float(np.linalg.norm(matrices[b, :3, :3], 2))
-        reach = stretch * (CELL - 1 + 2) * np.sqrt(3) / 2 + 1e-6  # half the cube's diagonal, and a voxel's diagonal
-        K.posed_cells(cells[starts[b]:starts[b + 1]], CELL, rest_lo, matrices[b], reach, lo, marks[k])
+        K.posed_cells(cells[starts[b]:starts[b + 1]], CELL, rest_lo, matrices[b], cube_reach(matrices[b]), lo, marks[k])
     return turned, marks
+
+
+def cube_reach(m: np.ndarray) -> float:
+    """How far from a rest cube's centre, moved by ``m``, a read can find one of the cube's voxels: half the
+    cube's diagonal (its farthest voxel) and a voxel's diagonal (the 8 voxels around a read's point), times
+    the matrix's largest stretch."""
+    return float(np.linalg.norm(np.asarray(m)[:3, :3], 2)) * (CELL - 1 + 2) * np.sqrt(3) / 2 + 1e-6
 
 
 def whole_voxel_shifts(matrices: np.ndarray) -> np.ndarray:

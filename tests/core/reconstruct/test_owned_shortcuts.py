@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from volanim_core import samples
 from volanim_core.reconstruct import _owned_kernels as K
-from volanim_core.reconstruct.owned import posed_boxes, reconstruct_owned
+from volanim_core.reconstruct.owned import cube_reach, posed_boxes, reconstruct_owned
 from volanim_core.rig.attach import connect
 from volanim_core.rig.ownership import CELL, ownership
 from volanim_core.rig.pose import pose_matrices
@@ -38,8 +38,8 @@ def test_a_bones_cubes_mark_every_output_voxel_within_a_diagonal_of_its_voxels()
         lo = boxes[b, :3] - 3
         shape = boxes[b, 3:] + 3 - lo + 1
         marks = np.zeros(tuple(-(-shape[::-1] // CELL)), np.uint8)
-        reach = (CELL + 1) * np.sqrt(3) / 2 + 1e-6
-        K.posed_cells(cells[starts[b]:starts[b + 1]], CELL, np.asarray(own.origin, np.int64), m, reach, lo, marks)
+        K.posed_cells(cells[starts[b]:starts[b + 1]], CELL, np.asarray(own.origin, np.int64), m, cube_reach(m), lo,
+                      marks)
         # every output voxel of the box whose rest point has the bone among its 8 voxels
         q = np.argwhere(np.ones(tuple(shape), bool)) + lo
         p = (np.column_stack([q, np.ones(len(q))]) @ np.linalg.inv(m))[:, :3] - own.origin
