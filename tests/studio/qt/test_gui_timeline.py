@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QObject, Qt, Slot
 
 from paths import ASSETS, FOX, WALK  # WALK: the real clip, bundled with its MIT licence
 from runnable import run_in_process
@@ -462,6 +462,28 @@ def _pool_workers():
 ENDS_WITHIN_MS = 60_000
 
 
+class _SignalAtProgress(QObject):
+    """Sends ``sig`` to every pool worker when the job first reports a value in ``[lo, hi)``. Connected
+    blocking, so the job's thread waits in its report until the signals are sent: the stage has at most the
+    tasks already in flight left to finish, never the whole run (a kill from a test that polled for the
+    workers came after the render had ended on a loaded CI machine, and the job rightly succeeded)."""
+
+    def __init__(self, sig, lo: int, hi: int):
+        super().__init__()
+        self.sig, self.lo, self.hi, self.sent = sig, lo, hi, []
+
+    @Slot(int, int)
+    def progressed(self, done: int, total: int) -> None:
+        if not self.sent and self.lo <= done < self.hi:
+            for p in _pool_workers():
+                p.send_signal(self.sig)
+                self.sent.append(p)
+
+    def watch(self, worker) -> None:
+        """Connected as the job starts: its first frame comes after two processes are spawned and warm."""
+        worker.progressed.connect(self.progressed, Qt.ConnectionType.BlockingQueuedConnection)
+
+
 @pytest.mark.parametrize("stage", ["sequence", "render"])
 def test_a_dead_movie_worker_fails_the_job_and_says_so(qtbot, rigged, tmp_path, stage):
     """#83 item 4: a worker process killed mid-movie. The job must end with a message that says a worker
@@ -472,17 +494,14 @@ def test_a_dead_movie_worker_fails_the_job_and_says_so(qtbot, rigged, tmp_path, 
     w = rigged
     assert load_walk(qtbot, w, lambda dialog: True)
     w.doc.settings.preview_mode = "binary"
+    n = len(range(0, 401, 10))  # progress: 1..41 the sequence's frames, 42..82 the pictures
+    kill = _SignalAtProgress(signal.SIGKILL, *((1, n - 8) if stage == "sequence" else (n + 1, 2 * n - 8)))
     worker = w.timeline.render_movie(tmp_path / "walk.gif", first=0, last=400, step=10, size=(160, 120), workers=2)
+    kill.watch(worker)
     failed = []
     worker.failed.connect(failed.append)
-    if stage == "render":  # the sequence is made; the pictures' workers are drawing
-        qtbot.waitUntil(lambda: (tmp_path / ".walk.gif.frames").exists() and len(_pool_workers()) >= 2,
-                        timeout=JOB_TIMEOUT_MS)
-    else:
-        qtbot.waitUntil(lambda: (tmp_path / ".walk.gif.zarr").exists() and len(_pool_workers()) >= 2,
-                        timeout=JOB_TIMEOUT_MS)
-    _pool_workers()[-1].send_signal(signal.SIGKILL)
-    qtbot.waitUntil(lambda: not w.busy, timeout=ENDS_WITHIN_MS)
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    assert len(kill.sent) == 2, kill.sent  # both of the stage's workers, while it had work left
     assert failed and "a worker process" in failed[0] and "died" in failed[0], failed
     assert "unexpected" not in failed[0] and "died" in (w.last_error or "")
     assert not (tmp_path / "walk.gif").exists()
@@ -499,12 +518,11 @@ def test_cancel_ends_a_movie_whose_worker_hangs(qtbot, rigged, tmp_path):
     w = rigged
     assert load_walk(qtbot, w, lambda dialog: True)
     w.doc.settings.preview_mode = "binary"
+    stop = _SignalAtProgress(signal.SIGSTOP, 1, 33)  # hung while the sequence still has frames to make
     worker = w.timeline.render_movie(tmp_path / "walk.gif", first=0, last=400, step=10, size=(160, 120), workers=2)
-    qtbot.waitUntil(lambda: (tmp_path / ".walk.gif.zarr").exists() and len(_pool_workers()) >= 2,
-                    timeout=JOB_TIMEOUT_MS)
-    stopped = _pool_workers()
-    for p in stopped:
-        p.send_signal(signal.SIGSTOP)
+    stop.watch(worker)
+    qtbot.waitUntil(lambda: len(stop.sent) == 2, timeout=JOB_TIMEOUT_MS)
+    stopped = stop.sent
     try:
         w.jobs.dialog.findChild(QPushButton).click()  # Cancel
         qtbot.waitUntil(lambda: not w.busy, timeout=ENDS_WITHIN_MS)
