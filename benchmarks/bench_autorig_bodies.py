@@ -72,6 +72,21 @@ def leaf_poses(skel, bones, angles, mask=None) -> dict:
     return out
 
 
+def out_of_reach(skel, bones, mask) -> str:
+    """The bones whose flesh touches the body only through another limb's (rig/reach.py): what `volanim
+    connect` warns about, for the leaves that tear."""
+    from volanim_core.rig.attach import connect
+    from volanim_core.rig.curve_skeleton import balls
+    from volanim_core.rig.ownership import ownership
+    from volanim_core.rig.reach import unreached
+
+    conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
+    own = ownership(mask if mask is not None else balls(skel), conn)
+    lost, counts = unreached(own), own.counts()
+    named = [f"{own.bones[k].label} {int(lost[k])}" for k in np.flatnonzero(lost > 0.01 * np.maximum(counts, 1))]
+    return ", ".join(named) or "none"
+
+
 def clip_of_its_kind(bones, folder: Path) -> str:
     """The rig's kind (by names, else by shape: motion/chains.py) and a clip of that kind retargeted onto it:
     the share of sampled frames its least-held check holds, or why none ran. The quadruped's and the insect's
@@ -109,8 +124,9 @@ def main(argv=None) -> int:
     angles = [int(a) for a in args.angles.split(",")]
     cols = [f"{j} {a}°" for j in JOINTS for a in angles]
     print("| body | bones (template) | mean joint error | " + " | ".join(cols)
-          + " | kind: a clip of its kind, frames plausible | autorig s | / skeletonize |")
-    print("|---|---|---|" + "---|" * len(cols) + "---|---|---|")
+          + " | flesh out of its chain's reach | kind: a clip of its kind, frames plausible | autorig s"
+          + " | / skeletonize |")
+    print("|---|---|---|" + "---|" * len(cols) + "---|---|---|---|")
     broken = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.bodies.split(","):
@@ -128,7 +144,8 @@ def main(argv=None) -> int:
             cells = [f"{ok}/{of}" for ok, of, _ in poses.values()]
             broken += [f"{name} {j} {a}°: {bad[0]}" for (j, a), (_, _, bad) in poses.items() if bad]
             print(f"| {name} | {len(bones.bones)} ({proposal.template}) | {error} | " + " | ".join(cells)
-                  + f" | {clip_of_its_kind(bones, Path(tmp))} | {t2 - t1:.2f} | {(t2 - t1) / (t1 - t0):.1f} |",
+                  + f" | {out_of_reach(skel, bones, mask)} | {clip_of_its_kind(bones, Path(tmp))} | {t2 - t1:.2f}"
+                  + f" | {(t2 - t1) / (t1 - t0):.1f} |",
                   flush=True)
     if broken:
         print("\nfirst broken pose per cell:")

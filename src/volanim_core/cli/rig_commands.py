@@ -4,6 +4,7 @@ sorttskel, mirror -- proposing bones, attaching points to them, and posing them 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 
 import numpy as np
@@ -92,6 +93,7 @@ def _write_ownership(args, skel, conn, mask) -> None:
     rest (the thesis's rest pose, which the identity frame then gives back unchanged)."""
     from volanim_core.io.ownership_files import ownership_path, write_ownership
     from volanim_core.rig.ownership import ownership
+    from volanim_core.rig.reach import reach_notes
 
     t0 = time.perf_counter()
     body = mask if mask is not None else _sphere_body(conn)
@@ -102,6 +104,8 @@ def _write_ownership(args, skel, conn, mask) -> None:
         own = _fixed(args, conn.with_ownership(own))
     write_ownership(path, own)
     print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
+    for line in reach_notes(own):  # flesh that would come off when its bone moves (rig/reach.py)
+        print(f"warning: {line}", file=sys.stderr)
 
 
 def _fixed(args, conn):

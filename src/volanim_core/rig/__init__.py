@@ -8,7 +8,8 @@
                       islands.py (each bone's flesh in one piece)
     ownership.py .... which bone owns each rest voxel (the rig's label volume): tubes fitted to each bone's
                       middle, each voxel to the tube that holds it deepest (_ownership_kernels.py);
-                      specks.py gives a speck of one bone inside another's flesh to the flesh around it
+                      specks.py gives a speck of one bone inside another's flesh to the flesh around it;
+                      reach.py names flesh that hangs from the body only through another limb's
     symmetry.py ..... one side's attachments mirrored to the other (L_/R_ names)
     autorig.py ...... propose bones from the skeleton: curve_skeleton.py (the tree), tree_walks.py (its
                       paths and bends), landmarks.py (shoulders and hips off the body), templates.py (names)
