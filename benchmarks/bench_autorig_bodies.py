@@ -45,22 +45,25 @@ def leaves(bones) -> list[str]:
     return [bones.bones[i].label for i in bones.leaves()]
 
 
-def leaf_poses(skel, bones, angles, mask=None) -> dict:
+def leaf_poses(skel, bones, angles, mask=None) -> tuple[dict, str]:
     """{(joints, angle): (healthy, of, first broken verdict)} with the pieces connect: owned (the default since
-    #84: the body's voxels moved by the bones that own them, ``mask`` the body), rigid and smooth spheres."""
+    #84: the body's voxels moved by the bones that own them, ``mask`` the body), rigid and smooth spheres; and
+    the bones whose flesh touches the body only through another limb's (rig/reach.py: what `volanim connect`
+    warns about), for the leaves that tear."""
     from volanim_core.reconstruct.checks import report
     from volanim_core.rig.attach import connect
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.curve_skeleton import balls
     from volanim_core.rig.ownership import ownership
     from volanim_core.rig.pose import bend_across, pose_matrices, root_bones
+    from volanim_core.rig.reach import out_of_reach
     from volanim_core.rig.skinning import Joints
 
     conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
+    own = ownership(mask if mask is not None else balls(skel), conn)
     out = {}
     for joints in JOINTS:
-        c = conn.with_ownership(ownership(mask if mask is not None else balls(skel), conn)) if joints == "owned" \
-            else conn.with_joints(Joints(joints))
+        c = conn.with_ownership(own) if joints == "owned" else conn.with_joints(Joints(joints))
         for angle in angles:
             bad = []
             for leaf in leaves(bones):
@@ -69,22 +72,8 @@ def leaf_poses(skel, bones, angles, mask=None) -> dict:
                 if not rep.healthy:
                     bad.append(f"{leaf}: {rep.verdict.splitlines()[0][:60]}")
             out[(joints, angle)] = (len(leaves(bones)) - len(bad), len(leaves(bones)), bad[:1])
-    return out
-
-
-def out_of_reach(skel, bones, mask) -> str:
-    """The bones whose flesh touches the body only through another limb's (rig/reach.py): what `volanim
-    connect` warns about, for the leaves that tear."""
-    from volanim_core.rig.attach import connect
-    from volanim_core.rig.curve_skeleton import balls
-    from volanim_core.rig.ownership import ownership
-    from volanim_core.rig.reach import unreached
-
-    conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
-    own = ownership(mask if mask is not None else balls(skel), conn)
-    lost, counts = unreached(own), own.counts()
-    named = [f"{own.bones[k].label} {int(lost[k])}" for k in np.flatnonzero(lost > 0.01 * np.maximum(counts, 1))]
-    return ", ".join(named) or "none"
+    named = ", ".join(f"{own.bones[k].label} {lost}" for k, lost in out_of_reach(own)) or "none"
+    return out, named
 
 
 def clip_of_its_kind(bones, folder: Path) -> str:
@@ -140,11 +129,11 @@ def main(argv=None) -> int:
             error = ""
             if truth is not None and proposal.template == "humanoid":
                 error = f"{np.mean([np.linalg.norm(bones.joints[k] - v) for k, v in truth.joints.items()]):.1f}"
-            poses = leaf_poses(skel, bones, angles, mask)
+            poses, unreached = leaf_poses(skel, bones, angles, mask)
             cells = [f"{ok}/{of}" for ok, of, _ in poses.values()]
             broken += [f"{name} {j} {a}°: {bad[0]}" for (j, a), (_, _, bad) in poses.items() if bad]
             print(f"| {name} | {len(bones.bones)} ({proposal.template}) | {error} | " + " | ".join(cells)
-                  + f" | {out_of_reach(skel, bones, mask)} | {clip_of_its_kind(bones, Path(tmp))} | {t2 - t1:.2f}"
+                  + f" | {unreached} | {clip_of_its_kind(bones, Path(tmp))} | {t2 - t1:.2f}"
                   + f" | {(t2 - t1) / (t1 - t0):.1f} |",
                   flush=True)
     if broken:

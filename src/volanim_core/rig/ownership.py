@@ -299,18 +299,25 @@ def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None
     return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes)
 
 
+def _meets(bones: list[BoneSegment]) -> np.ndarray:
+    """``(B, B)`` whether bone ``j``'s distal joint is bone ``k``'s proximal one, at ``[k, j]``."""
+    starts = np.array([b.proximal for b in bones], np.float64).reshape(-1, 3)
+    ends = np.array([b.distal for b in bones], np.float64).reshape(-1, 3)
+    return np.all(np.abs(starts[:, None, :] - ends[None, :, :]) < 1e-6, axis=2)
+
+
+def bone_parents(bones: list[BoneSegment]) -> list[int | None]:
+    """Each bone's parent: the first bone whose distal joint is its proximal one (None: it leaves a root joint)."""
+    return [int(np.argmax(row)) if row.any() else None for row in _meets(bones)]
+
+
 def _yields(bones: list[BoneSegment]) -> np.ndarray:
     """``(B, 2)`` whether each bone's round end behind its proximal joint and past its distal one yields to the
     other tubes (holds only what none holds): behind the proximal joint when a bone ends there (the thigh's end
     inside the pelvis is the pelvis's flesh), past the distal joint when exactly one bone goes on from it (a
     limb's next segment; a branching joint's end, the shoulders' above the spine, is body)."""
-    starts = np.array([b.proximal for b in bones], np.float64)
-    ends = np.array([b.distal for b in bones], np.float64)
-    out = np.zeros((len(bones), 2), np.bool_)
-    for k, b in enumerate(bones):
-        out[k, 0] = bool(np.all(np.abs(ends - b.proximal) < 1e-6, axis=1).any())
-        out[k, 1] = int(np.all(np.abs(starts - b.distal) < 1e-6, axis=1).sum()) == 1
-    return out
+    meets = _meets(bones)
+    return np.stack([meets.any(axis=1), meets.sum(axis=0) == 1], axis=1)
 
 
 def _z_reach(tubes: np.ndarray, z0: int) -> np.ndarray:

@@ -23,24 +23,14 @@ from __future__ import annotations
 import numpy as np
 
 from volanim_core.rig._ownership_kernels import piece_stats
-from volanim_core.rig.ownership import Ownership
-
-
-def parents(own: Ownership) -> list[int | None]:
-    """Each bone's parent: the bone whose distal joint is its proximal one (None: it leaves a root joint)."""
-    ends = np.array([b.distal for b in own.bones], np.float64).reshape(-1, 3)
-    out: list[int | None] = []
-    for b in own.bones:
-        at = np.flatnonzero(np.all(np.abs(ends - np.asarray(b.proximal, np.float64)) < 1e-6, axis=1))
-        out.append(int(at[0]) if len(at) else None)
-    return out
+from volanim_core.rig.ownership import Ownership, bone_parents
 
 
 def unreached(own: Ownership) -> np.ndarray:
     """``(B,)`` each bone's owned voxels its chain cannot reach (module docstring); 0 for the trunk's."""
     import cc3d
 
-    up = parents(own)
+    up = bone_parents(own.bones)
     trunk = {k for k, p in enumerate(up) if p is None}
     allowed = []  # each bone's ancestors and the trunk: the flesh it may hang from
     for k in range(len(up)):
@@ -111,11 +101,16 @@ def _spread(start: np.ndarray, near: list[list[int]], may) -> np.ndarray:
     return reached
 
 
-def reach_notes(own: Ownership, least: float = 0.01) -> list[str]:
-    """One line per bone with more than ``least`` of its flesh out of its chain's reach, for the user."""
+def out_of_reach(own: Ownership, least: float = 0.01) -> list[tuple[int, int]]:
+    """``[(bone, voxels)]``: the bones with more than ``least`` of their flesh out of their chain's reach (the
+    rest: specks a repaint is not worth), and how many voxels."""
     lost, counts = unreached(own), own.counts()
-    lines = []
-    for k in np.flatnonzero(lost > least * np.maximum(counts, 1)):
-        lines.append(f"{own.bones[k].label}: {int(lost[k])} of its {int(counts[k])} voxels touch the body only "
-                     "through another limb's flesh; posed, they come off: move the bone, or repaint them")
-    return lines
+    return [(int(k), int(lost[k])) for k in np.flatnonzero(lost > least * np.maximum(counts, 1))]
+
+
+def reach_notes(own: Ownership, least: float = 0.01) -> list[str]:
+    """One line per bone of :func:`out_of_reach`, for the user."""
+    counts = own.counts()
+    return [f"{own.bones[k].label}: {lost} of its {int(counts[k])} voxels touch the body only through another "
+            "limb's flesh; posed, they come off: move the bone, or repaint them"
+            for k, lost in out_of_reach(own, least)]
