@@ -343,11 +343,18 @@ class PreviewController(Controller):
         conn = self.doc.pose.tskel().connectivity
         doc, names = self.doc, tuple(b.label for b in self.doc.bones.bones)
 
-        def done(own) -> None:
+        def made(progress, cancel):
+            from volanim_core.rig.reach import out_of_reach
+
+            own = doc.ownership.of(conn)
+            return own, (out_of_reach(own) if own is not None else [])
+
+        def done(result) -> None:
             from volanim_core.render.slices import default_window, describe
 
             from .slice_window import SlicesSource, SliceWindow
 
+            own, torn = result
             if own is None:
                 self.show_error("Ownership", "nothing attached: connect points to bones first")
                 return
@@ -357,10 +364,15 @@ class PreviewController(Controller):
             window = SliceWindow(doc.volume_path or "body", source, self.window)
             self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
             window.show()
+            # flesh that touches the body only through another limb's comes off when its bone moves
+            # (rig/reach.py): said here, where the animator can see it and repaint, as volanim connect does
+            off = "; ".join(f"{names[k]} {lost:,}" for k, lost in torn)
             doc.message(f"Ownership of {int(own.mask.sum()):,} voxels by {len(names)} bones; the mouse says "
-                        "whose a voxel is. Repaint with the cube (Pose menu) or Fix a lump.")
+                        "whose a voxel is. Repaint with the cube (Pose menu) or Fix a lump."
+                        + (f" Flesh that touches the body only through another limb's, and comes off when its "
+                           f"bone moves: {off} voxels." if off else ""))
 
-        return self.jobs.run("Ownership", lambda progress, cancel: doc.ownership.of(conn), done)
+        return self.jobs.run("Ownership", made, done)
 
     def colour_hull_by_owners(self) -> Worker | None:
         """With *Colour by owning bone* on, the ownership of the rig as it is made in the background and handed to

@@ -689,6 +689,16 @@ def test_ownership_on_slices_shows_whose_each_voxel_is_and_follows_a_repaint(qtb
     box[box != 0] = arm + 1
     after = opened().canvas.picture.astype(int)
     assert np.abs(after - expected(painted)[0]).max() <= 1 and not np.array_equal(after, want)
+    assert "comes off" not in w.statusBar().currentMessage()
+    # flesh painted to the forearm inside the other leg's shin touches nothing of the arm's: said, by bone
+    shin = np.argwhere(own == doc.bones.index("R_SHIN") + 1)
+    at = shin[np.argmin(np.abs(shin - np.median(shin, axis=0)).sum(1))]
+    lo, hi = at - 2, at + 2
+    assert (own[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1, lo[2]:hi[2] + 1] == doc.bones.index("R_SHIN") + 1).all()
+    doc.ownership.paint_box(tuple(lo), tuple(hi), doc.bones.index("L_FOREARM"))
+    opened()
+    message = w.statusBar().currentMessage()
+    assert "comes off when its bone moves: L_FOREARM 125 voxels" in message, message
 
 
 def test_the_hull_coloured_by_owning_bone_follows_a_repaint(qtbot, posed_window):
