@@ -55,6 +55,8 @@ def _autorig(args):
         write_connect(args.connect, conn, thinness=args.thinness)
         counts = np.bincount(conn.bone, minlength=len(conn.bones))
         print(f"{report} ({args.method}); fewest points on one bone: {counts.min()} -> {args.connect}")
+        if args.ownership:  # as volanim connect: without it the frames re-grow the thesis's spheres
+            _write_ownership(args.connect, conn, mask if args.volume else None)
 
 
 def _mask(args, skel):
@@ -84,27 +86,35 @@ def _connect(args):
     counts = np.bincount(conn.bone, minlength=len(conn.bones))
     print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")
     if args.ownership:
-        _write_ownership(args, skel, conn, mask)
+        _write_ownership(args.output, conn, mask, (lambda own: _fixed(args, conn.with_ownership(own)))
+                         if args.fix_lumps else None)
 
 
-def _write_ownership(args, skel, conn, mask) -> None:
+def _write_ownership(connect_path, conn, mask, fix=None) -> None:
     """The rig's ownership beside the .connect (rig/ownership.py): of the scan's object with --volume (the
     rest pose is then the segmentation voxel for voxel), else of the body the skeleton's spheres re-grow at
-    rest (the thesis's rest pose, which the identity frame then gives back unchanged)."""
+    rest (the thesis's rest pose, which the identity frame then gives back unchanged); ``fix(own)``: the
+    ownership with the lumps of test poses fixed. Flesh its chain cannot reach is warned about."""
     from volanim_core.io.ownership_files import ownership_path, write_ownership
     from volanim_core.rig.ownership import ownership
-    from volanim_core.rig.reach import reach_notes
 
     t0 = time.perf_counter()
     body = mask if mask is not None else _sphere_body(conn)
     own = ownership(body, conn)
-    path = ownership_path(args.output)
+    path = ownership_path(connect_path)
     of = "the scan's object" if mask is not None else "the body its spheres re-grow (give --volume for the scan's own)"
-    if args.fix_lumps:
-        own = _fixed(args, conn.with_ownership(own))
+    if fix is not None:
+        own = fix(own)
     write_ownership(path, own)
     print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
-    for line in reach_notes(own):  # flesh that would come off when its bone moves (rig/reach.py)
+    _warn_out_of_reach(own)
+
+
+def _warn_out_of_reach(own) -> None:
+    """Flesh that would come off when its bone moves (rig/reach.py), by bone, on stderr."""
+    from volanim_core.rig.reach import reach_notes
+
+    for line in reach_notes(own):
         print(f"warning: {line}", file=sys.stderr)
 
 
@@ -230,6 +240,9 @@ def register(sub) -> None:
     add_dims(p)
     p.add_argument("--threshold", type=parse_range, metavar="LO[:HI]", help="segment the scan as skeletonize did")
     p.add_argument("--fill-cavities", action="store_true", help="fill enclosed background, as skeletonize did")
+    p.add_argument("--no-ownership", dest="ownership", action="store_false",
+                   help="with --connect: write no NAME.owners.nrrd beside it (frames then re-grow the thesis's "
+                        "spheres)")
 
     p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
                     ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",

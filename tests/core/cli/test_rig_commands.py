@@ -106,9 +106,16 @@ def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
     With smooth joints the abdomen's tip bent 90 degrees tore a one-voxel speck off the waist: it took the
     weights of a thorax sphere it lay deepest in by power distance but did not touch; now the sphere whose
     surface is nearest."""
+    assert main(["autorig", str(ant / "ant.mskel"), "-o", str(ant / "owned.bones"),
+                 "--connect", str(ant / "owned.connect")]) == 0
+    said, warned = capsys.readouterr()
+    # the ownership beside it, as volanim connect writes it (the owned default), and no flesh out of reach
+    assert (ant / "owned.owners.nrrd").exists() and "ownership of" in said and "warning" not in warned, warned
+    # the spheres' rigid and smooth joints are what this test judges: no ownership beside the .connect
     assert main(["autorig", str(ant / "ant.mskel"), "-o", str(ant / "auto.bones"),
-                 "--connect", str(ant / "auto.connect")]) == 0
+                 "--connect", str(ant / "auto.connect"), "--no-ownership"]) == 0
     said = capsys.readouterr().out
+    assert not (ant / "auto.owners.nrrd").exists() and "ownership of" not in said
     bones = io.read_bones(ant / "auto.bones")
     assert len(io.read_connect(ant / "auto.connect").points) == len(io.read_skeleton(ant / "ant.mskel").points)
     leaves = _leaves(bones)
@@ -125,3 +132,26 @@ def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
                     broken.append(f"{leaf} {angle} {joints}: {capsys.readouterr().out.splitlines()[0]}")
     assert broken == []
     assert "(pieces)" in said
+
+
+@pytest.mark.slow
+def test_autorig_connect_writes_the_ownership_and_names_the_frogs_leg_that_comes_off(tmp_path, capsys):
+    """#86: `volanim autorig --connect` gives the rig the ownership `volanim connect` gives it (without it
+    every frame re-grew the thesis's spheres, whatever the tutorial's table said), and warns by bone about
+    flesh that touches the body only through another limb's: on the frog, R_POST_3's 27,000 voxels, the leaf
+    that tears at 45 degrees (tests/core/rig/test_reach.py)."""
+    from volanim_core import samples
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.load("frog")
+    io.write_skeleton(tmp_path / "frog.mskel", skeletonize(s.mask))
+    io.write_volume(tmp_path / "frog.nrrd", s.mask.astype(np.uint8))
+    assert main(["autorig", str(tmp_path / "frog.mskel"), "-o", str(tmp_path / "frog.bones"), "--connect",
+                 str(tmp_path / "frog.connect"), "--volume", str(tmp_path / "frog.nrrd")]) == 0
+    said, warned = capsys.readouterr()
+    assert "ownership of" in said and "the scan's object" in said
+    conn = io.read_connect(tmp_path / "frog.connect")
+    assert conn.ownership is not None and int(conn.ownership.mask.sum()) == int(s.mask.sum())
+    lines = [line for line in warned.splitlines() if line.startswith("warning: ")]
+    assert [line.split(":")[1].strip() for line in lines] == ["R_POST_3"], warned
+
