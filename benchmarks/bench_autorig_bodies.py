@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 BODIES = ("mannequin", "mannequin-large", "frog", "ant", "rabbit", "spot", "bob")
-JOINTS = ("owned", "rigid", "smooth")
+JOINTS = ("owned", "hung on", "rigid", "smooth")
 
 
 def body_mask(name: str, folder: Path):
@@ -56,14 +56,16 @@ def leaf_poses(skel, bones, angles, mask=None) -> tuple[dict, str]:
     from volanim_core.rig.curve_skeleton import balls
     from volanim_core.rig.ownership import ownership
     from volanim_core.rig.pose import bend_across, pose_matrices, root_bones
-    from volanim_core.rig.reach import out_of_reach
+    from volanim_core.rig.reach import hang_on, out_of_reach
     from volanim_core.rig.skinning import Joints
 
     conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
     own = ownership(mask if mask is not None else balls(skel), conn)
+    hung = hang_on(own)[0]
     out = {}
     for joints in JOINTS:
-        c = conn.with_ownership(own) if joints == "owned" else conn.with_joints(Joints(joints))
+        c = conn.with_ownership(own) if joints == "owned" else conn.with_ownership(hung) if joints == "hung on" \
+            else conn.with_joints(Joints(joints))
         for angle in angles:
             bad = []
             for leaf in leaves(bones):

@@ -56,7 +56,7 @@ def _autorig(args):
         counts = np.bincount(conn.bone, minlength=len(conn.bones))
         print(f"{report} ({args.method}); fewest points on one bone: {counts.min()} -> {args.connect}")
         if args.ownership:  # as volanim connect: without it the frames re-grow the thesis's spheres
-            _write_ownership(args.connect, conn, mask if args.volume else None)
+            _write_ownership(args.connect, conn, mask if args.volume else None, hang=args.hang_on)
 
 
 def _mask(args, skel):
@@ -87,16 +87,18 @@ def _connect(args):
     print(f"{report} ({args.method}); {len(conn.bones)} bones, fewest points on one: {counts.min()} -> {args.output}")
     if args.ownership:
         _write_ownership(args.output, conn, mask, (lambda own: _fixed(args, conn.with_ownership(own)))
-                         if args.fix_lumps else None)
+                         if args.fix_lumps else None, hang=args.hang_on)
 
 
-def _write_ownership(connect_path, conn, mask, fix=None) -> None:
+def _write_ownership(connect_path, conn, mask, fix=None, hang=False) -> None:
     """The rig's ownership beside the .connect (rig/ownership.py): of the scan's object with --volume (the
     rest pose is then the segmentation voxel for voxel), else of the body the skeleton's spheres re-grow at
     rest (the thesis's rest pose, which the identity frame then gives back unchanged); ``fix(own)``: the
-    ownership with the lumps of test poses fixed. Flesh its chain cannot reach is warned about."""
+    ownership with the lumps of test poses fixed; ``hang``: flesh its chain cannot reach given to the flesh
+    it hangs from (rig/reach.hang_on), said by bone; else it is warned about."""
     from volanim_core.io.ownership_files import ownership_path, write_ownership
     from volanim_core.rig.ownership import ownership
+    from volanim_core.rig.reach import hang_on
 
     t0 = time.perf_counter()
     body = mask if mask is not None else _sphere_body(conn)
@@ -105,17 +107,30 @@ def _write_ownership(connect_path, conn, mask, fix=None) -> None:
     of = "the scan's object" if mask is not None else "the body its spheres re-grow (give --volume for the scan's own)"
     if fix is not None:
         own = fix(own)
+    moved = []
+    if hang:
+        own, moved = hang_on(own)
     write_ownership(path, own)
     print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
-    _warn_out_of_reach(own)
+    counts = own.counts()
+    for a, b, n in moved:
+        if n > 0.01 * (n + counts[a]):  # as the warning: specks a repaint is not worth go unsaid
+            print(f"  {own.bones[a].label}: {n:,} voxels that touched the body only through another limb's flesh "
+                  f"given to {own.bones[b].label}, the flesh they hang from ({int(counts[a]):,} left: move the "
+                  "bone onto its flesh, or repaint)")
+    _warn_out_of_reach(own, hint=not hang)
 
 
-def _warn_out_of_reach(own) -> None:
-    """Flesh that would come off when its bone moves (rig/reach.py), by bone, on stderr."""
+def _warn_out_of_reach(own, hint: bool) -> None:
+    """Flesh that would come off when its bone moves (rig/reach.py), by bone, on stderr; ``hint``: and that
+    --hang-on would give it to the flesh it hangs from."""
     from volanim_core.rig.reach import reach_notes
 
-    for line in reach_notes(own):
+    notes = reach_notes(own)
+    for line in notes:
         print(f"warning: {line}", file=sys.stderr)
+    if notes and hint:
+        print("warning: --hang-on gives such flesh to the limb it hangs from", file=sys.stderr)
 
 
 def _fixed(args, conn):
@@ -243,6 +258,10 @@ def register(sub) -> None:
     p.add_argument("--no-ownership", dest="ownership", action="store_false",
                    help="with --connect: write no NAME.owners.nrrd beside it (frames then re-grow the thesis's "
                         "spheres)")
+    p.add_argument("--hang-on", action=argparse.BooleanOptionalAction, default=True,
+                   help="with --connect: flesh of a proposed bone that touches the body only through another "
+                        "limb's, and would come off when the bone moves, goes to the flesh it hangs from "
+                        "(default; --no-hang-on keeps it, with a warning)")
 
     p = add_command(sub, "connect", "Attach every skeleton point to a bone -> .connect (the studio's auto-connect).",
                     ("volanim connect mannequin.mskel mannequin.bones --thinness 0.5 -o mannequin.0.50.connect",
@@ -269,6 +288,9 @@ def register(sub) -> None:
                         "in the ownership (the studio's Fix, headless)")
     p.add_argument("--no-ownership", dest="ownership", action="store_false",
                    help="write no NAME.owners.nrrd (frames then re-grow the thesis's spheres)")
+    p.add_argument("--hang-on", action="store_true",
+                   help="flesh of a bone that touches the body only through another limb's (warned about: it "
+                        "comes off when the bone moves) goes to the flesh it hangs from")
     p.add_argument("-o", "--output", required=True,
                    help="the .connect; NAME.owners.nrrd beside it holds which bone owns each rest voxel")
 

@@ -28,6 +28,50 @@ from volanim_core.rig.ownership import Ownership, bone_parents
 
 def unreached(own: Ownership) -> np.ndarray:
     """``(B,)`` each bone's owned voxels its chain cannot reach (module docstring); 0 for the trunk's."""
+    lost = np.zeros(len(own.bones), np.int64)
+    p = _pieces(own)
+    if p is not None:
+        np.add.at(lost, p.bone[p.gone], p.sizes[p.gone])
+    return lost
+
+
+def hang_on(own: Ownership, rounds: int = 8) -> tuple[Ownership, list[tuple[int, int, int]]]:
+    """The ownership with every piece of flesh its chain cannot reach given to the bone of the largest reached
+    piece it touches (the flesh it hangs from), in rounds until none is left; and ``[(from bone, to bone,
+    voxels)]``. What `volanim connect --hang-on` and the studio's *Hang on* do, when the animator would rather
+    keep the bone where it is: the frog's R_POST_3 then moves 118 voxels, and its leaves bend without tearing."""
+    labels = own.labels
+    moved: dict[tuple[int, int], int] = {}
+    for _ in range(rounds):
+        p = _pieces(own.with_labels(labels) if labels is not own.labels else own)
+        if p is None or not p.gone.any():
+            break
+        lut = np.zeros(len(p.bone), labels.dtype)
+        for piece in np.flatnonzero(p.gone):
+            held = [q for q in p.near[piece] if p.reached[q]]
+            if held:
+                q = max(held, key=lambda q: p.sizes[q])
+                lut[piece] = p.bone[q] + 1
+                key = (int(p.bone[piece]), int(p.bone[q]))
+                moved[key] = moved.get(key, 0) + int(p.sizes[piece])
+        if not lut.any():
+            break
+        new = lut[p.pieces]
+        labels = np.where(new > 0, new, labels)
+    out = own if labels is own.labels else own.with_labels(labels)
+    return out, [(a, b, n) for (a, b), n in sorted(moved.items())]
+
+
+class _Pieces:
+    """The flesh's pieces (26-connected, each of one bone) and what :func:`unreached` asks of them."""
+
+    def __init__(self, pieces, bone, sizes, near, reached, attached):
+        self.pieces, self.bone, self.sizes, self.near = pieces, bone, sizes, near
+        self.reached = reached
+        self.gone = attached & ~reached  # an island at rest is no limb's loss
+
+
+def _pieces(own: Ownership) -> _Pieces | None:
     import cc3d
 
     up = bone_parents(own.bones)
@@ -42,7 +86,7 @@ def unreached(own: Ownership) -> np.ndarray:
         allowed.append(chain)
     pieces, n = cc3d.connected_components(own.labels, connectivity=26, out_dtype=np.uint32, return_N=True)
     if n == 0:
-        return np.zeros(len(up), np.int64)
+        return None
     label, sizes = np.zeros(n + 1, np.int64), np.zeros(n + 1, np.int64)
     boxes = np.empty((n + 1, 6), np.int64)
     boxes[:, :3], boxes[:, 3:] = np.iinfo(np.int64).max, -1
@@ -57,11 +101,8 @@ def unreached(own: Ownership) -> np.ndarray:
     trunk_pieces[0] = False
     seeds = trunk_pieces | _at_own_joint(own, pieces, bone, boxes)
     reached = _spread(seeds, near, lambda piece, q: bone[q] in allowed[bone[piece]])
-    attached = _spread(trunk_pieces, near, lambda piece, q: True)  # an island at rest is no limb's loss
-    lost = np.zeros(len(up), np.int64)
-    gone = attached & ~reached
-    np.add.at(lost, bone[gone], sizes[gone])
-    return lost
+    attached = _spread(trunk_pieces, near, lambda piece, q: True)
+    return _Pieces(pieces, bone, sizes, near, reached, attached)
 
 
 def _at_own_joint(own: Ownership, pieces: np.ndarray, bone: np.ndarray, boxes: np.ndarray) -> np.ndarray:

@@ -170,6 +170,30 @@ class OwnershipState:
         if not self.available:
             raise ValueError("ownership needs the volume: open it (File → Open volume)")
 
+    def hang_on(self, own: Ownership) -> tuple[list, list]:
+        """What *Hang stray flesh on* paints (rig/reach.hang_on): ``([(bone, flat indices over the volume's grid)],
+        [(from bone, to bone, voxels)])``, flesh that touches the body only through another limb's given to the
+        flesh it hangs from. Pure: made in a worker, painted by :meth:`paint_many` (one undo step)."""
+        from volanim_core.rig.reach import hang_on
+
+        hung, moved = hang_on(own)
+        changed = hung.labels != own.labels
+        xyz = np.argwhere(changed) + np.asarray(own.origin)
+        bone = hung.labels[changed].astype(np.int64) - 1
+        flat = np.ravel_multi_index(tuple(xyz.T), self.doc.mask.shape, order="F")
+        return [(int(b), flat[bone == b]) for b in np.unique(bone)], moved
+
+    def paint_many(self, paints: list, label: str) -> None:
+        """Several bones' voxels (``[(bone, flat indices)]``) repainted as one undo step."""
+        from .undo import Command
+
+        for bone, _ in paints:
+            self._check(bone)
+        old = self.paints
+        new = (*old, *((bone, ("voxels", np.unique(np.asarray(idx, np.int64)))) for bone, idx in paints if len(idx)))
+        if len(new) > len(old):
+            self.doc.undo.push(Command(label, lambda: self._set(new), lambda: self._set(old)))
+
     def fix_lump(self, own: Ownership, matrices: np.ndarray, lump, to_bone: int) -> int:
         """Give the rest voxels a lump was made of to ``to_bone``: each voxel of another bone whose posed place
         lies in the lump's box (:meth:`Ownership.carried_into`). One undo step; returns the voxels."""

@@ -4,6 +4,7 @@ main_window.py ........ MainWindow: the view, the panels, menus; owns the contro
 controller.py ......... what the window hands each controller; one way to report a user's error
 files_controller.py ... open/save volumes, skeletons, bones, connectivity, projects
 preview_controller.py . live and full previews, compare, export, poses (.trans/.tskel)
+ownership_actions.py .. the Pose menu's ownership: the cube repaint, slices by owner, hang stray flesh on
 connect_controller.py . the Connect menu: auto-connect and mirror
 timeline_controller.py  load clips, play, step, key, scan for breakage, export frames
 export_controller.py .. File → Export animated glTF: the posed body for any glTF viewer, in the worker

@@ -20,7 +20,6 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import numpy as np
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QFileDialog
 
@@ -29,6 +28,7 @@ from volanim_core import io
 from ..model.live_resolution import LiveResolution
 from ..model.preview import LivePreviews, live_surface, make_preview, with_report
 from ..model.settings import Mode
+from . import ownership_actions
 from .controller import FAILED, Controller
 from .live_worker import LiveWorker
 from .worker import Worker
@@ -85,6 +85,7 @@ class PreviewController(Controller):
         action("Export reconstruction…", lambda: self.save_dialog("volume"), menu=menu)
         action("Give the cube's voxels to the working bone", lambda: self.own_cube(), menu=menu)
         action("Show ownership on slices", lambda: self.show_ownership(), menu=menu)
+        action("Hang stray flesh on the limb it rests on", lambda: self.hang_on(), menu=menu)
 
     def wire(self, pose_panel, reconstruct_panel) -> None:
         """Connect the Pose and Reconstruct tabs' buttons to this controller."""
@@ -323,56 +324,15 @@ class PreviewController(Controller):
 
     def own_cube(self) -> None:
         """Repaint ownership: the body's voxels inside the cube (Cube mode places it) go to the working bone."""
-        bone, centre = self.doc.working_bone, self.doc.cube_centre
-        if bone is None or centre is None:
-            self.show_error("Ownership", "place the cube (Cube mode) and choose the working bone first")
-            return
-        half = self.doc.settings.cube_size / 2
-        lo, hi = np.ceil(np.asarray(centre) - half), np.floor(np.asarray(centre) + half)
-        self.attempt("Ownership", lambda: self.doc.ownership.paint_box(lo, hi, bone),
-                     f"The body inside the cube now moves with {self.doc.bones.bones[bone].label} (Ctrl+Z undoes); "
-                     "preview again (F5).")
+        ownership_actions.own_cube(self)
 
     def show_ownership(self) -> Worker | None:
-        """The scan's slices, each voxel tinted by the bone that moves it (the ownership with the repaints), in a
-        window of its own (``viewers[-1]``); the mouse says whose each voxel is. Made in a worker: on the
-        Visible Human the ownership takes seconds the first time."""
-        if self.doc.settings.body != "owned" or not self.doc.ownership.available:
-            self.show_error("Ownership", "ownership is the body's: open a volume and choose Body: owned")
-            return None
-        conn = self.doc.pose.tskel().connectivity
-        doc, names = self.doc, tuple(b.label for b in self.doc.bones.bones)
+        """The scan's slices tinted by the bone that moves each voxel (:mod:`.ownership_actions`)."""
+        return ownership_actions.show_ownership(self)
 
-        def made(progress, cancel):
-            from volanim_core.rig.reach import out_of_reach
-
-            own = doc.ownership.of(conn)
-            return own, (out_of_reach(own) if own is not None else [])
-
-        def done(result) -> None:
-            from volanim_core.render.slices import default_window, describe
-
-            from .slice_window import SlicesSource, SliceWindow
-
-            own, torn = result
-            if own is None:
-                self.show_error("Ownership", "nothing attached: connect points to bones first")
-                return
-            grey = default_window(doc.volume) if doc.volume.ndim == 3 else None
-            source = SlicesSource(doc.volume, doc.spacing, grey, describe(doc.volume, grey),
-                                  own.volume(doc.mask.shape), names)
-            window = SliceWindow(doc.volume_path or "body", source, self.window)
-            self.viewers = [v for v in getattr(self, "viewers", []) if v.isVisible()] + [window]
-            window.show()
-            # flesh that touches the body only through another limb's comes off when its bone moves
-            # (rig/reach.py): said here, where the animator can see it and repaint, as volanim connect does
-            off = "; ".join(f"{names[k]} {lost:,}" for k, lost in torn)
-            doc.message(f"Ownership of {int(own.mask.sum()):,} voxels by {len(names)} bones; the mouse says "
-                        "whose a voxel is. Repaint with the cube (Pose menu) or Fix a lump."
-                        + (f" Flesh that touches the body only through another limb's, and comes off when its "
-                           f"bone moves: {off} voxels." if off else ""))
-
-        return self.jobs.run("Ownership", made, done)
+    def hang_on(self) -> Worker | None:
+        """Flesh that touches the body only through another limb's, to that limb (:mod:`.ownership_actions`)."""
+        return ownership_actions.hang_on(self)
 
     def colour_hull_by_owners(self) -> Worker | None:
         """With *Colour by owning bone* on, the ownership of the rig as it is made in the background and handed to

@@ -135,23 +135,36 @@ def test_every_leaf_bone_of_the_ant_poses_healthy(ant, capsys):
 
 
 @pytest.mark.slow
-def test_autorig_connect_writes_the_ownership_and_names_the_frogs_leg_that_comes_off(tmp_path, capsys):
+def test_autorig_connect_hangs_the_frogs_stray_flesh_on_and_its_leaf_bends_whole(tmp_path, capsys):
     """#86: `volanim autorig --connect` gives the rig the ownership `volanim connect` gives it (without it
-    every frame re-grew the thesis's spheres, whatever the tutorial's table said), and warns by bone about
-    flesh that touches the body only through another limb's: on the frog, R_POST_3's 27,000 voxels, the leaf
-    that tears at 45 degrees (tests/core/rig/test_reach.py)."""
+    every frame re-grew the thesis's spheres, whatever the tutorial's table said). The frog's proposed
+    R_POST_3 owns 27,000 voxels that touch the body only through another limb's flesh: bent 45 degrees they
+    tore off. By default they now go to the flesh they hang from, said by bone, and the bent leaf stays
+    whole; --no-hang-on keeps them, warns by bone (tests/core/rig/test_reach.py), and the leaf tears."""
     from volanim_core import samples
     from volanim_core.skeleton.skeletonize import skeletonize
 
     s = samples.load("frog")
     io.write_skeleton(tmp_path / "frog.mskel", skeletonize(s.mask))
     io.write_volume(tmp_path / "frog.nrrd", s.mask.astype(np.uint8))
-    assert main(["autorig", str(tmp_path / "frog.mskel"), "-o", str(tmp_path / "frog.bones"), "--connect",
-                 str(tmp_path / "frog.connect"), "--volume", str(tmp_path / "frog.nrrd")]) == 0
-    said, warned = capsys.readouterr()
-    assert "ownership of" in said and "the scan's object" in said
-    conn = io.read_connect(tmp_path / "frog.connect")
-    assert conn.ownership is not None and int(conn.ownership.mask.sum()) == int(s.mask.sum())
-    lines = [line for line in warned.splitlines() if line.startswith("warning: ")]
-    assert [line.split(":")[1].strip() for line in lines] == ["R_POST_3"], warned
+    verdicts = {}
+    for flag in ("--hang-on", "--no-hang-on"):
+        name = tmp_path / flag.strip("-")
+        assert main(["autorig", str(tmp_path / "frog.mskel"), "-o", f"{name}.bones", "--connect",
+                     f"{name}.connect", "--volume", str(tmp_path / "frog.nrrd"), flag]) == 0
+        said, warned = capsys.readouterr()
+        assert "ownership of" in said and "the scan's object" in said
+        conn = io.read_connect(f"{name}.connect")
+        assert conn.ownership is not None and int(conn.ownership.mask.sum()) == int(s.mask.sum())
+        lines = [line for line in warned.splitlines() if line.startswith("warning: ")]
+        hung = [line.split(":")[0].strip() for line in said.splitlines() if "the flesh they hang from" in line]
+        if flag == "--hang-on":
+            assert lines == [] and hung == ["R_POST_3"], (said, warned)
+        else:
+            assert [line.split(":")[1].strip() for line in lines[:-1]] == ["R_POST_3"], warned
+            assert "--hang-on" in lines[-1] and hung == []
+        assert main(["pose", f"{name}.bones", "--rotate", "R_POST_3=0,45,0", "-o", f"{name}.trans"]) == 0
+        verdicts[flag] = main(["report", f"{name}.connect", f"{name}.trans", "--bones", f"{name}.bones"])
+        capsys.readouterr()
+    assert verdicts == {"--hang-on": 0, "--no-hang-on": 1}
 

@@ -10,7 +10,7 @@ from volanim_core import samples
 from volanim_core.reconstruct.checks import report
 from volanim_core.rig.connectivity import BoneSegment, Trans
 from volanim_core.rig.ownership import Ownership, bone_parents
-from volanim_core.rig.reach import out_of_reach, reach_notes, unreached
+from volanim_core.rig.reach import hang_on, out_of_reach, reach_notes, unreached
 
 
 def _body():
@@ -47,6 +47,25 @@ def test_flesh_that_touches_its_chain_only_through_another_limb_is_named():
     at_joint[5:10, 17:22, :] = 3  # its nearest voxel 3 from the joint
     assert not unreached(Ownership(at_joint, (0, 0, 0), own.bones, np.array([0, 0, 3.0, 0]))).any()
     assert unreached(Ownership(at_joint, (0, 0, 0), own.bones, np.zeros(4))).tolist()[2] > 0  # 1.5: too small
+
+
+def test_hang_on_gives_the_stray_flesh_to_the_limb_it_rests_on_and_nothing_else():
+    """`--hang-on`: the forearm resting on the right arm, apart from its own, becomes the right arm's flesh;
+    every other voxel keeps its owner, the body is the same, and nothing is left out of reach. An island that
+    touches no flesh is no limb's to hang on: it stays."""
+    own, labels = _body()
+    island = labels.copy()
+    island[12:15, 23, 0:2] = 2  # a speck of the arm's, touching nothing
+    own = Ownership(island, (0, 0, 0), own.bones, np.zeros(4))
+    hung, moved = hang_on(own)
+    forearm = labels == 3
+    assert moved == [(2, 3, int(forearm.sum()))]
+    assert (hung.labels[forearm] == 4).all()
+    assert np.array_equal(hung.labels[~forearm], island[~forearm])
+    assert not unreached(hung).any() and reach_notes(hung) == []
+    # a rig with nothing out of reach is given back as it is
+    same, none = hang_on(hung)
+    assert none == [] and same is hung
 
 
 def test_an_island_at_rest_is_no_limbs_loss():

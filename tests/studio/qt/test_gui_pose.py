@@ -699,6 +699,18 @@ def test_ownership_on_slices_shows_whose_each_voxel_is_and_follows_a_repaint(qtb
     opened()
     message = w.statusBar().currentMessage()
     assert "comes off when its bone moves: L_FOREARM 125 voxels" in message, message
+    # Pose → Hang stray flesh on: those voxels go back to the shin they rest in, one undo step
+    conn = doc.pose.tskel().connectivity
+    w.previews.hang_on()
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+    message = w.statusBar().currentMessage()
+    assert "L_FOREARM 125 voxels to R_SHIN" in message, message
+    box = (slice(lo[0], hi[0] + 1), slice(lo[1], hi[1] + 1), slice(lo[2], hi[2] + 1))
+    assert (doc.ownership.of(conn).volume(doc.mask.shape)[box] == doc.bones.index("R_SHIN") + 1).all()
+    opened()
+    assert "comes off" not in w.statusBar().currentMessage()
+    doc.undo.undo()
+    assert (doc.ownership.of(conn).volume(doc.mask.shape)[box] == doc.bones.index("L_FOREARM") + 1).all()
 
 
 def test_the_hull_coloured_by_owning_bone_follows_a_repaint(qtbot, posed_window):
