@@ -229,16 +229,22 @@ def _claims(labels, p, bone1):
     return all(w < share[bone1] or (w == share[bone1] and v > bone1) for v, w in share.items() if v != bone1)
 
 
+def _label_at(labels, j):
+    """The label at voxel ``j``; 0 outside the array."""
+    return labels[tuple(j)] if all(0 <= j[a] < labels.shape[a] for a in range(3)) else 0
+
+
 def _thin(labels, k):
-    """A body voxel whose two face neighbours along some axis are both outside the body (or the array)."""
-    def body(j):
-        return all(0 <= j[a] < labels.shape[a] for a in range(3)) and labels[tuple(j)] != 0
+    """A body voxel whose two face neighbours along some axis are both not of its label (outside the body, another
+    bone's, or outside the array)."""
+    def mine(j):
+        return all(0 <= j[a] < labels.shape[a] for a in range(3)) and labels[tuple(j)] == labels[tuple(k)]
 
     for a in range(3):
         lo, hi = list(k), list(k)
         lo[a] -= 1
         hi[a] += 1
-        if not body(lo) and not body(hi):
+        if not mine(lo) and not mine(hi):
             return True
     return False
 
@@ -247,8 +253,9 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     """The ownership warp (reconstruct/owned.py) voxel by voxel: each output voxel q of ``bounds`` is bone b's
     (first in order) when b claims the rest point ``[q 1] @ inv(M_b)`` (:func:`_claims`: the body's trilinear
     share there more than half, and p b's); a bone moved by whole voxels only reads its own voxel there.
-    Then each thin rest voxel (one voxel thick along an axis) of a turned bone is written where it lands,
-    rounded, if that is empty; then each empty voxel strictly inside a ball ``(centre, radius, bone)`` (in
+    Then each thin rest voxel (its bone's flesh one voxel thick along an axis) of a turned bone is written where
+    it lands, rounded, if that is empty, and so is the midpoint to each of its edge and corner neighbours of the
+    same bone; then each empty voxel strictly inside a ball ``(centre, radius, bone)`` (in
     order) is that ball's bone. Returns 1 + bone per voxel ``[x, y, z]``."""
     import math
 
@@ -273,11 +280,14 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
         for k in np.argwhere(labels == b + 1):
             if not _thin(labels, k):
                 continue
-            p = k + rest_lo
-            v = [p[0] * m[0, i] + p[1] * m[1, i] + p[2] * m[2, i] + m[3, i] for i in range(3)]  # the kernel's sums
-            q = np.array([int(math.floor(x + 0.5)) for x in v]) - lo
-            if (q >= 0).all() and (q < out.shape).all() and out[tuple(q)] == 0:
-                out[tuple(q)] = b + 1
+            at = k + rest_lo
+            points = [at] + [at + (np.array(d) - 1) / 2 for d in np.ndindex(3, 3, 3)
+                             if np.abs(np.array(d) - 1).sum() >= 2 and _label_at(labels, k + np.array(d) - 1) == b + 1]
+            for p in points:
+                v = [p[0] * m[0, i] + p[1] * m[1, i] + p[2] * m[2, i] + m[3, i] for i in range(3)]  # kernel's sums
+                q = np.array([int(math.floor(x + 0.5)) for x in v]) - lo
+                if (q >= 0).all() and (q < out.shape).all() and out[tuple(q)] == 0:
+                    out[tuple(q)] = b + 1
     for centre, radius, bone in balls:
         for idx in np.ndindex(*out.shape):
             q = np.asarray(idx) + lo
@@ -289,8 +299,8 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
 def voxel_flags(labels):
     """Ownership.flags() by its definition (rig/_ownership_kernels.voxel_flags), with whole-array shifts:
     1 where the 3x3x3 around a voxel holds its label (outside the array: 0), 2 on a body voxel whose two face
-    neighbours along some axis are outside, 4 on an outside voxel with a face neighbour in the body, 8 on
-    every other outside voxel."""
+    neighbours along some axis are not of its label, 4 on an outside voxel with a face neighbour in the body, 8
+    on every other outside voxel."""
     nx, ny, nz = labels.shape
     p = np.pad(labels, 1)
     same = np.ones(labels.shape, bool)
@@ -302,7 +312,10 @@ def voxel_flags(labels):
     def at(d):
         return inside[1 + d[0]:1 + d[0] + nx, 1 + d[1]:1 + d[1] + ny, 1 + d[2]:1 + d[2] + nz]
 
+    def label_at(d):
+        return p[1 + d[0]:1 + d[0] + nx, 1 + d[1]:1 + d[1] + ny, 1 + d[2]:1 + d[2] + nz]
+
     axes = np.eye(3, dtype=int)
-    thin = body & np.any([~at(a) & ~at(-a) for a in axes], axis=0)
+    thin = body & np.any([(label_at(a) != labels) & (label_at(-a) != labels) for a in axes], axis=0)
     skin = ~body & np.any([at(a) | at(-a) for a in axes], axis=0)
     return (same * 1 | thin * 2 | skin * 4 | (~body & ~skin) * 8).astype(np.uint8)

@@ -147,8 +147,8 @@ def reconstruct_owned(
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
         starts, thin = own.thin()
         for b in np.flatnonzero((shifts[:, 3] == 0) & reaches):
-            K.splat_turned(thin[starts[b]:starts[b + 1]], rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi,
-                           claims, count)
+            K.splat_turned(thin[starts[b]:starts[b + 1]], own.labels, K.DIAGONALS, rest_lo, matrices[b], int(b), lo,
+                           owner, row_lo, row_hi, claims, count)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
         volume = _by_mode(owner, claims, mode, n_bones, value)

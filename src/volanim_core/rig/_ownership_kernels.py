@@ -318,9 +318,9 @@ def voxel_flags(labels, out):
     """``out[x, y, z]`` (uint8, zeroed) for each voxel of ``labels`` ``[x, y, z]`` (outside the array: 0):
     bit 1 (UNIFORM) when it and its 26 neighbours hold one label (0 or a bone): a sub-voxel read near it needs
     no interpolation; bit 2 (THIN) when it is a body voxel whose two face neighbours along some axis are both
-    outside the body: a limb one voxel thick there; bit 4 (SKIN) when it is outside the body with a face
-    neighbour in it: only there can a point whose nearest voxel is outside be more than half body; bit 8 (FAR) on
-    every other outside voxel.
+    outside its bone's flesh (outside the body, or another bone's): its bone's flesh one voxel thick there;
+    bit 4 (SKIN) when it is outside the body with a face neighbour in it: only there can a point whose nearest
+    voxel is outside be more than half body; bit 8 (FAR) on every other outside voxel.
 
     The 3x3x3 test axis by axis (bits 16 and 32 hold the steps): the row's two neighbours alike (16), then the
     3x3 of the slice (32: the rows above and below alike and 16), then the slices before and after: 13 reads a
@@ -359,10 +359,10 @@ def voxel_flags(labels, out):
                     else:
                         same = v == 0
                 flag = 1 if same else 0
-                if v != 0:
-                    out_x = _at(labels, x - 1, y, z, nx, ny, nz) == 0 and _at(labels, x + 1, y, z, nx, ny, nz) == 0
-                    out_y = _at(labels, x, y - 1, z, nx, ny, nz) == 0 and _at(labels, x, y + 1, z, nx, ny, nz) == 0
-                    out_z = _at(labels, x, y, z - 1, nx, ny, nz) == 0 and _at(labels, x, y, z + 1, nx, ny, nz) == 0
+                if v != 0:  # thin in its own bone's flesh: another bone's behind it does not move with it
+                    out_x = _at(labels, x - 1, y, z, nx, ny, nz) != v and _at(labels, x + 1, y, z, nx, ny, nz) != v
+                    out_y = _at(labels, x, y - 1, z, nx, ny, nz) != v and _at(labels, x, y + 1, z, nx, ny, nz) != v
+                    out_z = _at(labels, x, y, z - 1, nx, ny, nz) != v and _at(labels, x, y, z + 1, nx, ny, nz) != v
                     if out_x or out_y or out_z:
                         flag |= 2
                 elif (_at(labels, x - 1, y, z, nx, ny, nz) != 0 or _at(labels, x + 1, y, z, nx, ny, nz) != 0

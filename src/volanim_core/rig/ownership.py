@@ -50,7 +50,7 @@ from volanim_core.volume import tight_bounds
 
 SECTION_VOXELS = 64_000_000  # the lattice the cross-sections' moments are gathered on
 CELL = 2  # the cube a turned bone's reads are planned by (Ownership.cells): its cubes moved mark where it can land
-THIN = 2  # Ownership.flags' bit of a body voxel one voxel thick along some axis
+THIN = 2  # Ownership.flags' bit of a body voxel its bone's flesh holds one voxel thick along some axis
 
 
 def label_dtype(n_bones: int):
