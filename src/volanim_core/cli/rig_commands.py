@@ -98,7 +98,7 @@ def _write_ownership(connect_path, conn, mask, fix=None, hang=False) -> None:
     it hangs from (rig/reach.hang_on), said by bone; else it is warned about."""
     from volanim_core.io.ownership_files import ownership_path, write_ownership
     from volanim_core.rig.ownership import ownership
-    from volanim_core.rig.reach import hang_on
+    from volanim_core.rig.reach import LEAST, hang_on
 
     t0 = time.perf_counter()
     body = mask if mask is not None else _sphere_body(conn)
@@ -114,7 +114,7 @@ def _write_ownership(connect_path, conn, mask, fix=None, hang=False) -> None:
     print(f"ownership of {int(own.mask.sum())} voxels ({of}) in {time.perf_counter() - t0:.1f} s -> {path}")
     counts = own.counts()
     for a, b, n in moved:
-        if n > 0.01 * (n + counts[a]):  # as the warning: specks a repaint is not worth go unsaid
+        if n > LEAST * (n + counts[a]):  # as the warning: specks a repaint is not worth go unsaid
             print(f"  {own.bones[a].label}: {n:,} voxels that touched the body only through another limb's flesh "
                   f"given to {own.bones[b].label}, the flesh they hang from ({int(counts[a]):,} left: move the "
                   "bone onto its flesh, or repaint)")

@@ -142,14 +142,17 @@ def _spread(start: np.ndarray, near: list[list[int]], may) -> np.ndarray:
     return reached
 
 
-def out_of_reach(own: Ownership, least: float = 0.01) -> list[tuple[int, int]]:
+LEAST = 0.01  # of a bone's flesh: out of reach below this is a speck a repaint is not worth, and goes unsaid
+
+
+def out_of_reach(own: Ownership, least: float = LEAST) -> list[tuple[int, int]]:
     """``[(bone, voxels)]``: the bones with more than ``least`` of their flesh out of their chain's reach (the
     rest: specks a repaint is not worth), and how many voxels."""
     lost, counts = unreached(own), own.counts()
     return [(int(k), int(lost[k])) for k in np.flatnonzero(lost > least * np.maximum(counts, 1))]
 
 
-def reach_notes(own: Ownership, least: float = 0.01) -> list[str]:
+def reach_notes(own: Ownership, least: float = LEAST) -> list[str]:
     """One line per bone of :func:`out_of_reach`, for the user."""
     counts = own.counts()
     return [f"{own.bones[k].label}: {lost} of its {int(counts[k])} voxels touch the body only through another "

@@ -124,10 +124,11 @@ class OwnershipState:
         self.version += 1
         self.doc.events.ownership.emit()
 
-    def _push(self, label: str, paint) -> None:
+    def _push(self, label: str, *paints) -> None:
+        """Repaints as one undo step."""
         from .undo import Command
 
-        old, new = self.paints, (*self.paints, paint)
+        old, new = self.paints, (*self.paints, *paints)
         self.doc.undo.push(Command(label, lambda: self._set(new), lambda: self._set(old)))
 
     def paint_box(self, lo, hi, bone: int) -> None:
@@ -185,14 +186,11 @@ class OwnershipState:
 
     def paint_many(self, paints: list, label: str) -> None:
         """Several bones' voxels (``[(bone, flat indices)]``) repainted as one undo step."""
-        from .undo import Command
-
         for bone, _ in paints:
             self._check(bone)
-        old = self.paints
-        new = (*old, *((bone, ("voxels", np.unique(np.asarray(idx, np.int64)))) for bone, idx in paints if len(idx)))
-        if len(new) > len(old):
-            self.doc.undo.push(Command(label, lambda: self._set(new), lambda: self._set(old)))
+        kept = [(bone, ("voxels", np.unique(np.asarray(idx, np.int64)))) for bone, idx in paints if len(idx)]
+        if kept:
+            self._push(label, *kept)
 
     def fix_lump(self, own: Ownership, matrices: np.ndarray, lump, to_bone: int) -> int:
         """Give the rest voxels a lump was made of to ``to_bone``: each voxel of another bone whose posed place
