@@ -234,6 +234,20 @@ def _label_at(labels, j):
     return labels[tuple(j)] if all(0 <= j[a] < labels.shape[a] for a in range(3)) else 0
 
 
+def _unjoined(labels, k, step):
+    """Whether voxel ``k``'s edge or corner neighbour ``k + step`` is of its bone and (an edge) no thin voxel of its
+    bone lies a face step from both."""
+    mine = labels[tuple(k)]
+    if _label_at(labels, k + step) != mine:
+        return False
+    if np.abs(step).sum() == 2:
+        for a in np.flatnonzero(step):
+            face = k + np.where(np.arange(3) == a, step, 0)
+            if _label_at(labels, face) == mine and _thin(labels, face):
+                return False
+    return True
+
+
 def _thin(labels, k):
     """A body voxel whose two face neighbours along some axis are both not of its label (outside the body, another
     bone's, or outside the array)."""
@@ -255,8 +269,9 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     share there more than half, and p b's); a bone moved by whole voxels only reads its own voxel there.
     Then each thin rest voxel (its bone's flesh one voxel thick along an axis) of a turned bone is written where
     it lands, rounded, if that is empty, and so is the midpoint to each of its edge and corner neighbours of the
-    same bone; then each empty voxel strictly inside a ball ``(centre, radius, bone)`` (in
-    order) is that ball's bone. Returns 1 + bone per voxel ``[x, y, z]``."""
+    same bone (an edge's: unless a thin voxel of the bone lies between them, a face step from each); then each
+    empty voxel strictly inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. Returns 1 + bone
+    per voxel ``[x, y, z]``."""
     import math
 
     lo, hi = np.asarray(bounds[0]), np.asarray(bounds[1])
@@ -282,7 +297,7 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
                 continue
             at = k + rest_lo
             points = [at] + [at + (np.array(d) - 1) / 2 for d in np.ndindex(3, 3, 3)
-                             if np.abs(np.array(d) - 1).sum() >= 2 and _label_at(labels, k + np.array(d) - 1) == b + 1]
+                             if np.abs(np.array(d) - 1).sum() >= 2 and _unjoined(labels, k, np.array(d) - 1)]
             for p in points:
                 v = [p[0] * m[0, i] + p[1] * m[1, i] + p[2] * m[2, i] + m[3, i] for i in range(3)]  # kernel's sums
                 q = np.array([int(math.floor(x + 0.5)) for x in v]) - lo

@@ -249,25 +249,17 @@ def posed_cells(cells, size, rest_lo, m, reach, out_lo, marks):
                     marks[z, y, x] = 1
 
 
-#: the 20 edge and corner neighbours of a voxel: two such voxels of one bone, each pushed to where it lands and
-#: rounded, can land two voxels apart on an axis (their centres up to sqrt(3) apart); their midpoint, pushed too,
-#: lands at most one voxel from each (half of sqrt(3) < 1 on every axis), so the pair stays 26-connected
-DIAGONALS = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)
-                      if abs(dx) + abs(dy) + abs(dz) >= 2], np.int64)
-
-
 @njit(cache=True, nogil=True)
-def splat_turned(voxels, labels, diagonals, rest_lo, m, bone, out_lo, out, row_lo, row_hi, claims, count):
+def splat_turned(voxels, bits, diagonals, rest_lo, m, bone, out_lo, out, row_lo, row_hi, claims, count):
     """Each thin rest voxel of a turned bone (``voxels``: Ownership.thin(), its bone's flesh one voxel thick along
     some axis) written at its posed place rounded, where no bone wrote yet; and the midpoint to each of its edge
-    and corner neighbours of the same bone (``labels``, ``diagonals``: :data:`DIAGONALS`). The inverse read alone
-    can step over a limb one voxel thin that a turn lays across the grid (the ant's legs came apart in single
+    and corner neighbours ``diagonals[d]`` whose bit ``d`` of ``bits`` is set (Ownership.diagonals). The inverse
+    read alone can step over a limb one voxel thin that a turn lays across the grid (the ant's legs came apart in single
     voxels); every such voxel pushed to where it lands keeps the limb in one piece: two face neighbours land at
     most one voxel apart on each axis, two diagonal ones with their midpoint between (the ant's leg tip, held on
     by a corner, came off at 90 degrees without it). Thick flesh is left to the read: pushed too, its surface
     came back in stairs (the walk's Dice 0.9762 -> 0.9738). Returns the voxels written."""
     nz, ny, nx = out.shape
-    lx, ly, lz = labels.shape
     n = 0
     for i in range(len(voxels)):
         ax, ay, az = voxels[i, 0], voxels[i, 1], voxels[i, 2]
@@ -275,8 +267,7 @@ def splat_turned(voxels, labels, diagonals, rest_lo, m, bone, out_lo, out, row_l
             if d < 0:  # the voxel itself
                 px, py, pz = float(ax), float(ay), float(az)
             else:
-                bx, by, bz = ax + diagonals[d, 0], ay + diagonals[d, 1], az + diagonals[d, 2]
-                if bx < 0 or by < 0 or bz < 0 or bx >= lx or by >= ly or bz >= lz or labels[bx, by, bz] != bone + 1:
+                if not (bits[i] >> d) & 1:
                     continue
                 px, py, pz = ax + 0.5 * diagonals[d, 0], ay + 0.5 * diagonals[d, 1], az + 0.5 * diagonals[d, 2]
             # rounded on the rest grid first, then made an index: the same voxel whatever the output's box

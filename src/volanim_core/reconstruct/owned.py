@@ -44,7 +44,7 @@ from volanim_core.reconstruct._owned_kernels import ZB
 from volanim_core.reconstruct.plan import LAUNCH_SECONDS, MODES, mottled_values, output_dtype
 from volanim_core.reconstruct.result import Reconstruction
 from volanim_core.reconstruct.sampling import grid_to_source, sample_source
-from volanim_core.rig.ownership import CELL, Ownership
+from volanim_core.rig.ownership import CELL, DIAGONALS, Ownership
 from volanim_core.volume import Bounds
 
 
@@ -146,9 +146,10 @@ def reconstruct_owned(
             report(z1, total)
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
         starts, thin = own.thin()
+        bits = own.diagonals()
         for b in np.flatnonzero((shifts[:, 3] == 0) & reaches):
-            K.splat_turned(thin[starts[b]:starts[b + 1]], own.labels, K.DIAGONALS, rest_lo, matrices[b], int(b), lo,
-                           owner, row_lo, row_hi, claims, count)
+            K.splat_turned(thin[starts[b]:starts[b + 1]], bits[starts[b]:starts[b + 1]], DIAGONALS, rest_lo,
+                           matrices[b], int(b), lo, owner, row_lo, row_hi, claims, count)
         K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         filled = int(np.count_nonzero(owner))
         volume = _by_mode(owner, claims, mode, n_bones, value)

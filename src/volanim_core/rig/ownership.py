@@ -50,6 +50,11 @@ from volanim_core.volume import tight_bounds
 
 SECTION_VOXELS = 64_000_000  # the lattice the cross-sections' moments are gathered on
 CELL = 2  # the cube a turned bone's reads are planned by (Ownership.cells): its cubes moved mark where it can land
+#: a voxel's 20 edge and corner neighbours: two such voxels of one bone, each pushed forward and rounded, can land
+#: two voxels apart on an axis (centres up to sqrt(3) apart); their midpoint pushed too lands at most one voxel from
+#: each (half of sqrt(3) < 1 on every axis), so the pair stays 26-connected (Ownership.diagonals)
+DIAGONALS = np.array([(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)
+                      if abs(dx) + abs(dy) + abs(dz) >= 2], np.int64)
 THIN = 2  # Ownership.flags' bit of a body voxel its bone's flesh holds one voxel thick along some axis
 
 
@@ -83,6 +88,7 @@ class Ownership:
     _flags: np.ndarray | None = field(default=None, repr=False)
     _cells: tuple | None = field(default=None, repr=False)
     _thin: tuple | None = field(default=None, repr=False)
+    _diagonals: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.origin = tuple(int(v) for v in self.origin)
@@ -156,6 +162,35 @@ class Ownership:
         if self._thin is None:
             self._thin = flagged_voxels(self.labels, self.flags(), THIN, len(self.bones))
         return self._thin
+
+    def diagonals(self) -> np.ndarray:
+        """``(N,)`` uint32 beside :meth:`thin`'s voxels, made once: bit ``d`` where the voxel's edge or corner neighbour
+        :data:`DIAGONALS` ``[d]`` is its bone's, and (for an edge) neither face neighbour between them is a thin voxel
+        of its bone: pushed forward, such a pair can land two voxels apart, and the splat pushes their midpoint too
+        (reconstruct/_owned_kernels.splat_turned); a thin face neighbour between them, pushed, joins them anyway."""
+        if self._diagonals is None:
+            voxels = self.thin()[1]
+            thin = (self.flags() & THIN) != 0
+
+            def mine(step, only_thin=False):
+                at = voxels + step
+                ok = np.all((at >= 0) & (at < self.labels.shape), axis=1)
+                out = np.zeros(len(voxels), bool)
+                where = tuple(at[ok].T)
+                out[ok] = self.labels[where] == self.labels[tuple(voxels[ok].T)]
+                if only_thin:
+                    out[ok] &= thin[where]
+                return out
+
+            bits = np.zeros(len(voxels), np.uint32)
+            for d, step in enumerate(DIAGONALS):
+                keep = mine(step)
+                if np.abs(step).sum() == 2:  # an edge: the two face steps it is made of
+                    faces = [np.where(np.arange(3) == a, step, 0) for a in np.flatnonzero(step)]
+                    keep &= ~(mine(faces[0], True) | mine(faces[1], True))
+                bits[keep] |= np.uint32(1 << d)
+            self._diagonals = bits
+        return self._diagonals
 
     def counts(self) -> np.ndarray:
         """Each bone's owned voxels."""
