@@ -2,7 +2,7 @@
 and the ownership (once per rig) against the skeletonize it follows, same run, as ratios.
 
     body (frog, mannequin, mannequin-large) --skeletonize (timed)--> skeleton --connect (nearest)--> connectivity
-        --ownership and the tables every frame reads (flags, cells, thin, spans, hulls), timed--> labels
+        --ownership and the tables every frame reads (flags, cells, thin, diagonals, spans, hulls), timed--> labels
     one pose, frames alternated: reconstruct(method='spheres') vs reconstruct(method='owned'), bone mode
     goals: frame owned / spheres <= 1.0; ownership / skeletonize <= 1.0
 
@@ -40,11 +40,12 @@ def main() -> None:
         t_skel = time.perf_counter() - t0
         conn = connect(skel, s.bones)[0]
         warm = ownership(s.mask, conn)  # compiled
-        for table in (warm.flags, warm.cells, warm.thin, warm.spans, warm.hulls):
+        for table in (warm.flags, warm.cells, warm.thin, warm.diagonals, warm.spans, warm.hulls):
             table()
         t0 = time.perf_counter()
         own = ownership(s.mask, conn)
-        for table in (own.flags, own.cells, own.thin, own.spans, own.hulls):  # made once per rig, at the first frame
+        # the tables are made once per rig, at the first frame
+        for table in (own.flags, own.cells, own.thin, own.diagonals, own.spans, own.hulls):
             table()
         t_own = time.perf_counter() - t0
         frame = conn.with_ownership(own).posed(pose_matrices(s.bones, POSES[name]))

@@ -235,16 +235,15 @@ def _label_at(labels, j):
 
 
 def _unjoined(labels, k, step):
-    """Whether voxel ``k``'s edge or corner neighbour ``k + step`` is of its bone and (an edge) no thin voxel of its
-    bone lies a face step from both."""
+    """Whether voxel ``k``'s edge or corner neighbour ``k + step`` is of its bone and no thin voxel of its bone
+    lies a face step from ``k`` along one of ``step``'s axes."""
     mine = labels[tuple(k)]
     if _label_at(labels, k + step) != mine:
         return False
-    if np.abs(step).sum() == 2:
-        for a in np.flatnonzero(step):
-            face = k + np.where(np.arange(3) == a, step, 0)
-            if _label_at(labels, face) == mine and _thin(labels, face):
-                return False
+    for a in np.flatnonzero(step):
+        face = k + np.where(np.arange(3) == a, step, 0)
+        if _label_at(labels, face) == mine and _thin(labels, face):
+            return False
     return True
 
 
@@ -269,7 +268,7 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     share there more than half, and p b's); a bone moved by whole voxels only reads its own voxel there.
     Then each thin rest voxel (its bone's flesh one voxel thick along an axis) of a turned bone is written where
     it lands, rounded, if that is empty, and so is the midpoint to each of its edge and corner neighbours of the
-    same bone (an edge's: unless a thin voxel of the bone lies between them, a face step from each); then each
+    same bone (unless a thin voxel of the bone lies a face step from it on the way); then each
     empty voxel strictly inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. Returns 1 + bone
     per voxel ``[x, y, z]``."""
     import math

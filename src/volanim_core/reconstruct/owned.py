@@ -129,7 +129,7 @@ def reconstruct_owned(
     nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
-    reads = 0
+    reads = filled = 0
     try:
         turned, marks = _turned_marks(own, matrices, (shifts[:, 3] == 0) & reaches, lo, (nz, ny, nx))
         total = 2 * nz if mode == "sampled" else nz
@@ -140,18 +140,18 @@ def reconstruct_owned(
             slab = local.copy()
             slab[:, 2] = np.maximum(slab[:, 2] - z0, 0)
             slab[:, 5] = np.minimum(slab[:, 5] - z0, z1 - z0 - 1)
-            reads += K.warp_owners(own.labels, flags, own.spans(), rest_lo, inv, shifts, turned, marks, CELL, z0, slab,
-                                   lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
-                                   claims[z0:z1] if count else claims, count, nthreads)
+            visits, wrote = K.warp_owners(own.labels, flags, own.spans(), rest_lo, inv, shifts, turned, marks, CELL, z0,
+                                          slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
+                                          claims[z0:z1] if count else claims, count, nthreads)
+            reads, filled = reads + visits, filled + wrote
             report(z1, total)
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
         starts, thin = own.thin()
         bits = own.diagonals()
         for b in np.flatnonzero((shifts[:, 3] == 0) & reaches):
-            K.splat_turned(thin[starts[b]:starts[b + 1]], bits[starts[b]:starts[b + 1]], DIAGONALS, rest_lo,
-                           matrices[b], int(b), lo, owner, row_lo, row_hi, claims, count)
-        K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
-        filled = int(np.count_nonzero(owner))
+            filled += K.splat_turned(thin[starts[b]:starts[b + 1]], bits[starts[b]:starts[b + 1]], DIAGONALS,
+                                     rest_lo, matrices[b], int(b), lo, owner, row_lo, row_hi, claims, count)
+        filled += K.close_joints(owner, lo, centres, r2s, ball_bones, row_lo, row_hi, claims, count)
         volume = _by_mode(owner, claims, mode, n_bones, value)
         if mode == "sampled":
             # a coarse ownership's voxel c is the source's voxel factor c (Ownership.coarse)

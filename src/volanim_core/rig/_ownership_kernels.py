@@ -152,40 +152,44 @@ def section_moments(mask, lo, tubes, z_reach, step, sums):
         sums += per[k]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _side(ys, xs, n, sign, out_y, out_x):
+    """The convex chain of ``n`` points ``(y, x)`` (y rising) seen from the side ``sign`` (-1: least x, 1: most x)
+    into ``out_*``: Andrew's monotone chain, points on a straight stretch dropped. Returns its length."""
+    k = 0
+    for i in range(n):
+        while k >= 2 and sign * ((out_y[k - 1] - out_y[k - 2]) * (xs[i] - out_x[k - 2])
+                                 - (out_x[k - 1] - out_x[k - 2]) * (ys[i] - out_y[k - 2])) >= 0:
+            k -= 1
+        out_y[k], out_x[k] = ys[i], xs[i]
+        k += 1
+    return k
+
+
 @njit(cache=True, nogil=True)
-def row_ends(labels, n_bones):
-    """Each label's first and last voxel on every row ``(y, z)`` of ``labels`` ``[x, y, z]``: ``(points (N, 3),
-    label (N,))``, every vertex of each label's convex hull among them."""
-    nx, ny, nz = labels.shape
-    first = np.full(n_bones + 1, -1, np.int64)
-    last = np.full(n_bones + 1, -1, np.int64)
-    cap = 2 * ny * nz * 4
-    pts = np.empty((cap, 3), np.int64)
-    lab = np.empty(cap, np.int64)
+def hull_ends(spans):
+    """From :func:`row_spans`' ``spans (B, Y, Z, 2)``: each bone's row ends that are corners of its slice's convex
+    outline, ``(points (N, 3) x y z, bone (N,))``. Every vertex of a bone's convex hull is a corner of its
+    slice's outline, so these hold all of them: a slice's chain, not its every row, goes to qhull."""
+    nb, ny, nz = spans.shape[0], spans.shape[1], spans.shape[2]
+    pts = np.empty((2 * ny * nz, 3), np.int64)
+    lab = np.empty(2 * ny * nz, np.int64)
+    ys, xs, cy, cx = np.empty(ny, np.int64), np.empty(ny, np.int64), np.empty(ny, np.int64), np.empty(ny, np.int64)
     n = 0
-    for z in range(nz):
-        for y in range(ny):
-            first[:] = -1
-            for x in range(nx):
-                v = labels[x, y, z]
-                if v == 0 or v > n_bones:
-                    continue
-                if first[v] < 0:
-                    first[v] = x
-                last[v] = x
-            for v in range(1, n_bones + 1):
-                if first[v] < 0:
-                    continue
-                for x in (first[v], last[v]):
-                    if n == cap:  # grow: more labels on a row than four
-                        cap *= 2
-                        p2 = np.empty((cap, 3), np.int64)
-                        p2[:n] = pts[:n]
-                        l2 = np.empty(cap, np.int64)
-                        l2[:n] = lab[:n]
-                        pts, lab = p2, l2
-                    pts[n, 0], pts[n, 1], pts[n, 2] = x, y, z
-                    lab[n] = v - 1
+    for b in range(nb):
+        if n + 2 * ny * nz > len(lab):  # room for one more bone's worst case
+            pts = np.concatenate((pts[:n], np.empty((2 * ny * nz, 3), np.int64)))
+            lab = np.concatenate((lab[:n], np.empty(2 * ny * nz, np.int64)))
+        for z in range(nz):
+            for end in range(2):
+                m = 0
+                for y in range(ny):
+                    if spans[b, y, z, 0] <= spans[b, y, z, 1]:
+                        ys[m], xs[m] = y, spans[b, y, z, end]
+                        m += 1
+                for i in range(_side(ys, xs, m, 2 * end - 1, cy, cx)):
+                    pts[n, 0], pts[n, 1], pts[n, 2] = cx[i], cy[i], z
+                    lab[n] = b
                     n += 1
     return pts[:n], lab[:n]
 
@@ -419,28 +423,3 @@ def bone_cells(labels, size, n_bones):
                             cells[mine[v], 0], cells[mine[v], 1], cells[mine[v], 2] = kx, ky, kz
                         mine[v] += 1
     return starts, cells
-
-
-@njit(cache=True, nogil=True)
-def flagged_voxels(labels, flags, bit, n_bones):
-    """Each label's voxels whose ``flags`` have ``bit``: ``(starts (n_bones + 1,), voxels (N, 3) int32)``, label
-    l's at ``voxels[starts[l - 1]:starts[l]]``, in the labels' order."""
-    nx, ny, nz = labels.shape
-    count = np.zeros(n_bones + 1, np.int64)
-    starts = np.zeros(n_bones + 1, np.int64)
-    voxels = np.empty((0, 3), np.int32)
-    for fill in range(2):
-        if fill:
-            starts[1:] = np.cumsum(count[1:])
-            voxels = np.empty((starts[-1], 3), np.int32)
-            count[1:] = starts[:-1]
-        for z in range(nz):
-            for y in range(ny):
-                for x in range(nx):
-                    v = labels[x, y, z]
-                    if v == 0 or v > n_bones or not flags[x, y, z] & bit:
-                        continue
-                    if fill:
-                        voxels[count[v], 0], voxels[count[v], 1], voxels[count[v], 2] = x, y, z
-                    count[v] += 1
-    return starts, voxels

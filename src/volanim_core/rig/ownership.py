@@ -36,14 +36,14 @@ from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
     bone_cells,
-    flagged_voxels,
+    hull_ends,
     own_by_tubes,
     pool_labels,
-    row_ends,
     row_spans,
     section_moments,
     voxel_flags,
 )
+from volanim_core.rig._thin_kernels import diagonal_bits, flagged_voxels
 from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.rig.specks import join_specks
 from volanim_core.volume import tight_bounds
@@ -111,7 +111,7 @@ class Ownership:
         if self._hulls is None:
             from scipy.spatial import ConvexHull, QhullError
 
-            pts, lab = row_ends(self.labels, len(self.bones))
+            pts, lab = hull_ends(self.spans())
             pts = pts + np.asarray(self.origin)
             order = np.argsort(lab, kind="stable")
             starts = np.searchsorted(lab[order], np.arange(len(self.bones) + 1))
@@ -165,31 +165,15 @@ class Ownership:
 
     def diagonals(self) -> np.ndarray:
         """``(N,)`` uint32 beside :meth:`thin`'s voxels, made once: bit ``d`` where the voxel's edge or corner neighbour
-        :data:`DIAGONALS` ``[d]`` is its bone's, and (for an edge) neither face neighbour between them is a thin voxel
-        of its bone: pushed forward, such a pair can land two voxels apart, and the splat pushes their midpoint too
-        (reconstruct/_owned_kernels.splat_turned); a thin face neighbour between them, pushed, joins them anyway."""
+        :data:`DIAGONALS` ``[d]`` is its bone's and no face neighbour on the way (one step along one of ``d``'s
+        axes) is a thin voxel of its bone. Pushed forward, such a pair can land two voxels apart, and the splat
+        pushes their midpoint too (reconstruct/_owned_kernels.splat_turned). A thin face neighbour F on the way,
+        pushed too, joins them anyway: it lands a voxel from the first at most, and F's own bits join F to the
+        other (a face or an edge step). The frog's: 292,000 midpoints -> 231,000 (corners 131,000 -> 70,000)."""
         if self._diagonals is None:
             voxels = self.thin()[1]
-            thin = (self.flags() & THIN) != 0
-
-            def mine(step, only_thin=False):
-                at = voxels + step
-                ok = np.all((at >= 0) & (at < self.labels.shape), axis=1)
-                out = np.zeros(len(voxels), bool)
-                where = tuple(at[ok].T)
-                out[ok] = self.labels[where] == self.labels[tuple(voxels[ok].T)]
-                if only_thin:
-                    out[ok] &= thin[where]
-                return out
-
-            bits = np.zeros(len(voxels), np.uint32)
-            for d, step in enumerate(DIAGONALS):
-                keep = mine(step)
-                if np.abs(step).sum() == 2:  # an edge: the two face steps it is made of
-                    faces = [np.where(np.arange(3) == a, step, 0) for a in np.flatnonzero(step)]
-                    keep &= ~(mine(faces[0], True) | mine(faces[1], True))
-                bits[keep] |= np.uint32(1 << d)
-            self._diagonals = bits
+            self._diagonals = np.zeros(len(voxels), np.uint32)
+            diagonal_bits(self.labels, self.flags(), THIN, voxels, DIAGONALS, self._diagonals)
         return self._diagonals
 
     def counts(self) -> np.ndarray:

@@ -65,6 +65,21 @@ def test_kernel_matches_the_voxel_by_voxel_oracle_with_balls():
 
 
 @pytest.mark.parametrize("mode", MODES)
+def test_filled_is_the_posed_voxels_counted(mannequin_rig, mode):
+    """The kernels count what they write (the read, the thin flesh pushed, the balls); the count is the output's,
+    every mode, with an elbow bent so all three write."""
+    s, conn = mannequin_rig
+    m, _, grid = _posed(s, "L_FOREARM", (-150, 0, 0))
+    r = reconstruct(conn.posed(m), mode=mode, source=s.volume, bounds=grid)
+    # sampled: a posed voxel can read a source value of 0; its body is the bone mode's
+    bone = r if mode == "bone" else reconstruct(conn.posed(m), mode="bone", bounds=grid)
+    body = r.volume.any(axis=-1) if r.volume.ndim == 4 else r.volume > 0
+    assert r.stats["balls"] > 0 and r.stats["filled"] == int((bone.volume > 0).sum())
+    if mode != "sampled":
+        assert np.array_equal(body, bone.volume > 0)
+
+
+@pytest.mark.parametrize("mode", MODES)
 def test_the_identity_pose_gives_back_the_segmentation_voxel_for_voxel(mannequin_rig, mode):
     s, conn = mannequin_rig
     whole = Bounds((0, 0, 0), tuple(n - 1 for n in s.volume.shape))

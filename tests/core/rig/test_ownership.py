@@ -78,3 +78,22 @@ def test_the_ant_rigged_from_slicer_markups_keeps_no_speck_and_steps_whole(tmp_p
     capsys.readouterr()
     assert main(["report", f"{a}/nearest.connect", f"{a}/walk/ant.0012.trans", "--bones", f"{a}/ant.bones"]) == 0, \
         capsys.readouterr().out
+
+
+def test_each_bone_s_hull_is_scipy_s_hull_of_all_its_voxels():
+    """Ownership.hulls reads only the corners of each slice's outline (hull_ends); qhull over every voxel of the
+    bone finds the same vertices."""
+    from scipy.spatial import ConvexHull
+
+    from volanim_core.rig.attach import connect
+    from volanim_core.rig.ownership import ownership
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.mannequin()
+    own = ownership(s.mask, connect(skeletonize(s.mask, min_thinness=0.5), s.bones)[0])
+    hulls = own.hulls()
+    assert len(hulls) == len(own.bones)
+    for b, hull in enumerate(hulls):
+        voxels = np.argwhere(own.labels == b + 1) + np.asarray(own.origin)
+        want = voxels[ConvexHull(voxels).vertices]
+        assert {tuple(p) for p in hull.astype(np.int64)} == {tuple(p) for p in want}, own.bones[b]
