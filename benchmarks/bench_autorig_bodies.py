@@ -46,10 +46,10 @@ def leaves(bones) -> list[str]:
 
 
 def leaf_poses(skel, bones, angles, mask=None) -> tuple[dict, str]:
-    """{(joints, angle): (healthy, of, first broken verdict)} with the pieces connect: owned (the default since
-    #84: the body's voxels moved by the bones that own them, ``mask`` the body), rigid and smooth spheres; and
-    the bones whose flesh touches the body only through another limb's (rig/reach.py: what `volanim connect`
-    warns about), for the leaves that tear."""
+    """{(joints, angle): (healthy, of, first broken verdict, poses with a lump)} with the pieces connect: owned
+    (the default since #84: the body's voxels moved by the bones that own them, ``mask`` the body), rigid and
+    smooth spheres; and the bones whose flesh touches the body only through another limb's (rig/reach.py: what
+    `volanim connect` warns about), for the leaves that tear."""
     from volanim_core.reconstruct.checks import report
     from volanim_core.rig.attach import connect
     from volanim_core.rig.connectivity import Trans
@@ -67,13 +67,14 @@ def leaf_poses(skel, bones, angles, mask=None) -> tuple[dict, str]:
         c = conn.with_ownership(own) if joints == "owned" else conn.with_ownership(hung) if joints == "hung on" \
             else conn.with_joints(Joints(joints))
         for angle in angles:
-            bad = []
+            bad, lumps = [], 0
             for leaf in leaves(bones):
                 m = pose_matrices(bones, {leaf: bend_across(bones, leaf, angle)})
                 rep = report(c, Trans(root_bones(bones), m), bones=bones)
                 if not rep.healthy:
                     bad.append(f"{leaf}: {rep.verdict.splitlines()[0][:60]}")
-            out[(joints, angle)] = (len(leaves(bones)) - len(bad), len(leaves(bones)), bad[:1])
+                lumps += bool(rep.lumps)  # named by the report; not yet in its verdict (#84 item 4)
+            out[(joints, angle)] = (len(leaves(bones)) - len(bad), len(leaves(bones)), bad[:1], lumps)
     named = ", ".join(f"{own.bones[k].label} {lost}" for k, lost in out_of_reach(own)) or "none"
     return out, named
 
@@ -132,8 +133,8 @@ def main(argv=None) -> int:
             if truth is not None and proposal.template == "humanoid":
                 error = f"{np.mean([np.linalg.norm(bones.joints[k] - v) for k, v in truth.joints.items()]):.1f}"
             poses, unreached = leaf_poses(skel, bones, angles, mask)
-            cells = [f"{ok}/{of}" for ok, of, _ in poses.values()]
-            broken += [f"{name} {j} {a}°: {bad[0]}" for (j, a), (_, _, bad) in poses.items() if bad]
+            cells = [f"{ok}/{of}" + (f" ({lumps} lump)" if lumps else "") for ok, of, _, lumps in poses.values()]
+            broken += [f"{name} {j} {a}°: {bad[0]}" for (j, a), (_, _, bad, _) in poses.items() if bad]
             print(f"| {name} | {len(bones.bones)} ({proposal.template}) | {error} | " + " | ".join(cells)
                   + f" | {unreached} | {clip_of_its_kind(bones, Path(tmp))} | {t2 - t1:.2f}"
                   + f" | {(t2 - t1) / (t1 - t0):.1f} |",

@@ -7,8 +7,8 @@
                                  verdict `volanim report` gives that pose
 
 Every body goes the README's way: voxelized at 160 voxels along its longest side (the frog: its own
-scan), skeletonized, `autorig`, connected by pieces (autorig --connect's default). Same renderer and
-camera for both panels of a row.
+scan), skeletonized, `autorig`, connected by pieces with the ownership and stray flesh hung on (autorig
+--connect's default), posed from ownership (the default). Same renderer and camera for both panels of a row.
 
 Run: make screenshots   (or .venv/bin/python docs/make_autorig_pictures.py)
 """
@@ -52,7 +52,9 @@ def row(name: str, view: str) -> np.ndarray:
     from volanim_core.rig.autorig import autorig
     from volanim_core.rig.connectivity import Trans
     from volanim_core.rig.curve_skeleton import balls
+    from volanim_core.rig.ownership import ownership
     from volanim_core.rig.pose import pose_matrices, root_bones
+    from volanim_core.rig.reach import hang_on
     from volanim_core.skeleton.skeletonize import skeletonize
 
     with tempfile.TemporaryDirectory() as tmp:
@@ -60,6 +62,8 @@ def row(name: str, view: str) -> np.ndarray:
     skel = skeletonize(mask)
     bones = autorig(skel).bones
     conn, _ = connect(skel, bones, method="pieces", mask=balls(skel))
+    # as autorig --connect writes it: the ownership of the body the spheres re-grow, stray flesh hung on
+    conn = conn.with_ownership(hang_on(ownership(balls(skel), conn))[0])
     leaves = [bones.bones[i].label for i in bones.leaves()]
     rest = pose_matrices(bones, {})
     lo0 = np.asarray(skel.points.min(axis=0), float) - skel.dt.max()
