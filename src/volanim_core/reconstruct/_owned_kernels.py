@@ -5,8 +5,13 @@
         p = [q 1] @ inv[b]: q is b's (the first such bone keeps it) when the body fills more than half of p
         (trilinear over the 8 voxels around p) and p is b's (its nearest voxel's bone; outside the body, the
         largest share: :func:`claims_point`); a bone moved by whole voxels reads its own voxel, exactly
+    posed_cells(cells, size, rest_lo, m, reach, out_lo, marks)
+        the output cubes a turned bone's reads can find it in (warp_owners reads only there)
+    splat_turned(voxels, bits, diagonals, rest_lo, m, bone, out_lo, out, row_lo, row_hi, claims, count)
+        a turned bone's thin rest voxels (and midpoints to its diagonal neighbours) pushed to where they land
     close_joints(out, out_lo, centres, r2s, bones, row_lo, row_hi, claims)
         every empty voxel strictly inside a joint's ball goes to that ball's bone
+    Each returns what it wrote (warp_owners: and its reads), summed into the frame's "filled".
 
 Why an inverse warp: a forward one (each owned voxel pushed to its posed place) leaves holes wherever a
 rotation spreads voxels apart; reading each output voxel from the rest voxel its bone brings it from writes
