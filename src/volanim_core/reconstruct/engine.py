@@ -106,7 +106,8 @@ def reconstruct(
     value : int
         Binary mode's value.
     threads : int, optional
-        numba threads (default: all cores). The result does not depend on it.
+        numba threads (default: the calling thread's numba setting, all cores unless it was set: the studio's
+        live thread keeps a core for the window). The result does not depend on it.
     neighbours : (N, k) int ndarray, optional
         ``sphere_neighbours`` of this connectivity (made once per connectivity and remembered when not
         given); lets each sphere skip voxels a larger neighbour provably wins.
@@ -152,7 +153,7 @@ def reconstruct(
     plan = plan_frame(tskel, mode, source=source, kernel=kernel, value=value, bounds=bounds, padding=padding,
                       neighbours=neighbours, speedups=speedups)
     nz, ny, nx = plan.shape
-    nthreads = int(threads or numba.config.NUMBA_NUM_THREADS)
+    nthreads = int(threads or numba.get_num_threads())
     nthreads = max(1, min(nthreads, numba.config.NUMBA_NUM_THREADS))
     out = _output_array(out, (nz, ny, nx), plan.out_dtype, plan.final_dtype)
     # one slice of stencil per thread: a slice is filled by one thread, start to end

@@ -56,7 +56,7 @@ class LiveFrame:
                  threads: int | None = None, clock: Clock = time.perf_counter):
         self.bounds, self.mode, self.source, self.kernel, self.value = bounds, mode, source, kernel, value
         self.source_geometry, self.clock = source_geometry, clock
-        self.threads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
+        self.threads = max(1, min(int(threads or numba.get_num_threads()), numba.config.NUMBA_NUM_THREADS))
         self._last = None  # (connectivity arrays, centres, r2s) of the frame the arrays hold
         self.redone = 0  # slices the last update filled: what it cost (all of them on a first frame)
 

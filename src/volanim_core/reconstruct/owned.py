@@ -126,7 +126,7 @@ def reconstruct_owned(
     shifts = whole_voxel_shifts(matrices)
     # a bone whose posed box misses the grid adds nothing (a live update's box holds few): not splatted
     reaches = (boxes[:, 3:] >= lo).all(1) & (boxes[:, :3] <= np.asarray(grid.hi)).all(1)
-    nthreads = max(1, min(int(threads or numba.config.NUMBA_NUM_THREADS), numba.config.NUMBA_NUM_THREADS))
+    nthreads = max(1, min(int(threads or numba.get_num_threads()), numba.config.NUMBA_NUM_THREADS))
     previous = numba.get_num_threads()
     numba.set_num_threads(nthreads)
     reads = filled = 0

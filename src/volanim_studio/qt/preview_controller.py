@@ -33,6 +33,8 @@ from .controller import FAILED, Controller
 from .live_worker import LiveWorker
 from .worker import Worker
 
+DRAW_WAIT_MS = 300  # a live picture not drawn by then lets the next be made all the same
+
 
 class PreviewController(Controller):
     def __init__(self, window):
@@ -212,16 +214,22 @@ class PreviewController(Controller):
 
     def _live_made(self, result) -> None:
         """A live picture made: drawn, unless a full preview was asked for since (it would hide it)."""
-        if isinstance(result, ValueError):
+        if isinstance(result, Exception):
+            self.live_worker.drawn()  # nothing to draw: the next may be made now
+            if not isinstance(result, ValueError):
+                raise result  # a bug: seen, as on the GUI thread
             self.doc.message(str(result))
             return
-        if isinstance(result, Exception):
-            raise result  # a bug: seen, as on the GUI thread
         p, full, t0 = result
         asked = self.clock() - t0  # asked -> made (drawn at the next render): a drag's pace, waits included
         self.live_timings.append(asked)
         if full != self._full_asked or self.doc.settings.mode != Mode.POSE:
+            self.live_worker.drawn()  # dropped: the next may be made now
             return
+        # the next picture is made once this one is drawn (live_worker's docstring); a picture never drawn (the
+        # window hidden, the rest pose shown) lets it go after DRAW_WAIT_MS all the same
+        self.scene.after_next_draw(self.live_worker.drawn)
+        QTimer.singleShot(DRAW_WAIT_MS, self.window, self.live_worker.drawn)
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
         # its cost picks the next one's resolution: its stages (the scene adds the last draw), or the wait from
         # asking, when longer (the frog's half-size pictures: 59 ms of stages, one drawn every 140 ms)

@@ -83,6 +83,7 @@ class PoseLayer:
         view.doc.events.selection.connect(lambda **_: self.draw_axes() if view.posing else None)
         # stopped: the bones follow the pose again (drawn now, not at the next pose change)
         view.doc.settings.events.playing.connect(lambda value: None if value else self.on_pose_changed())
+        view.doc.settings.events.dragging.connect(lambda value: None if value else self.on_pose_changed())
         for event in (view.doc.events.stale, view.doc.events.preview, view.doc.settings.events.dragging,
                       view.doc.settings.events.playing, view.doc.settings.events.mode):
             event.connect(lambda **_: self.draw_stale_note())
@@ -115,10 +116,20 @@ class PoseLayer:
             self._marks(name, [], "", 0)
         if not view.posing:
             return
-        p = view.doc.preview
-        if view.doc.settings.playing and p is not None and p.joints is not None:
-            return  # playing: the bones wait for the body of their frame (draw() puts them with it)
+        if self._bones_wait():
+            return  # the bones wait for the body of their pose (draw() puts them with it)
         self.draw_bones(view.doc.pose.posed_joints())
+
+    def _bones_wait(self) -> bool:
+        """Playing, or dragging with live pictures coming: the bones are drawn with the body of their pose, not
+        on each pose change. One render per picture, not two: a render holds Python's lock (VTK's wheels never
+        release it), and the frog's 60 ms software-GL draws of bones alone kept the live thread from making the
+        next picture (#85: 16 renders for 10 pictures in a drag)."""
+        view = self.view
+        st, p = view.doc.settings, view.doc.preview
+        if p is None or p.joints is None:
+            return False
+        return st.playing or (st.dragging and st.live_preview and p.live)
 
     def draw_bones(self, pj: dict) -> None:
         """The posed bones through the joints ``pj`` (name -> rest-grid voxels), and the working bone's axes.
@@ -181,8 +192,8 @@ class PoseLayer:
             except ValueError as exc:
                 doc.message(str(exc))
                 return
-        if p is not None and doc.settings.playing and p.joints is not None and self.view.posing:
-            self.draw_bones(p.joints)  # the body's own frame: bones and body never show two frames
+        if self._bones_wait() and self.view.posing:
+            self.draw_bones(doc.preview.joints)  # the body's own pose: bones and body never show two poses
         if p is None:
             self.clear()
         elif p.live and p.mode in ("bone", "binary"):  # a live preview: a surface draws fastest

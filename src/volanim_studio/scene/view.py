@@ -72,6 +72,9 @@ class SceneView:
         window = plotter.render_window
         window.AddObserver("StartEvent", lambda *_: setattr(self, "_draw_began", self.clock()))
         window.AddObserver("EndEvent", lambda *_: setattr(self, "draw_seconds", self.clock() - self._draw_began))
+        self._after_draw: list = []  # called once the next frame is on screen (after_next_draw)
+        if hasattr(plotter, "frameSwapped"):  # Qt's widget: on screen once composed (software GL: read back)
+            plotter.frameSwapped.connect(self._frame_shown)
         plotter.set_background("#1e1f24")
         self._fix_pixel_ratio()
         self._quiet_keys()
@@ -422,6 +425,16 @@ class SceneView:
                 actors[name].SetVisibility(self.posing)
         self.xray.show(self.posing)
         self.names.show(not self.posing)
+
+    def after_next_draw(self, call) -> None:
+        """``call()`` once the next frame is on screen: drawn, and composed into the window (software GL finishes
+        the drawing there). The live thread's next picture waits for it. Off screen (no Qt widget): never."""
+        self._after_draw.append(call)
+
+    def _frame_shown(self) -> None:
+        calls, self._after_draw = self._after_draw, []
+        for call in calls:
+            call()
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once (software GL takes

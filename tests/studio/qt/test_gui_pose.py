@@ -82,6 +82,35 @@ def test_pose_arm_45_preview_bone_mode_and_report(qtbot, posed_window):
     assert w.mode == Mode.VIEW
 
 
+def test_a_drag_draws_the_bones_with_the_body_of_their_pose_never_ahead_of_it(qtbot, posed_window):
+    """#85: while a bone was dragged the bones moved at each pose change and the body a picture later: two
+    renders a picture (each held the live thread back: a render holds Python's lock), and bones that were not
+    the body's. Now they wait for the body of their pose, as playing does; the release draws them at the pose."""
+    w = posed_window
+    w.bone_panel.tree.topLevelItem(w.doc.bones.index("L_UPPERARM")).setSelected(True)
+    layer, worker, bones = w.scene.pose_layer, w.previews.live_worker, w.doc.bones.bones
+
+    def drawn_at(joints) -> bool:
+        want = w.scene.world(np.array([[joints[b.proximal], joints[b.distal]] for b in bones])).reshape(-1, 3)
+        return np.allclose(np.asarray(layer._bone_lines.points), want, atol=1e-3)
+
+    seen = []  # each live picture drawn: (its bones drawn, the pose then not its own)
+    w.doc.events.preview.connect(lambda **_: seen.append(
+        (drawn_at(w.doc.preview.joints), not drawn_at(w.doc.pose.posed_joints()))) if w.doc.preview.live else None)
+    slider = w.pose_panel.sliders[1]
+    slider.setSliderDown(True)
+    slider.setValue(-30)
+    begun = worker.begun
+    qtbot.waitUntil(lambda: worker.begun > begun, timeout=JOB_TIMEOUT_MS)  # the -30 picture is being made
+    slider.setValue(-60)  # before it is drawn: the bones stay with the body shown
+    qtbot.waitUntil(lambda: len(seen) >= 2 and worker.idle, timeout=JOB_TIMEOUT_MS)
+    assert all(own for own, _ in seen) and seen[0][1]  # the -30 body with its own bones, not -60's
+    slider.setSliderDown(False)
+    qtbot.waitUntil(lambda: not w.busy and w.doc.preview is not None and not w.doc.preview.live,
+                    timeout=JOB_TIMEOUT_MS)
+    assert drawn_at(w.doc.pose.posed_joints())
+
+
 def test_a_drag_shows_the_owned_body_the_release_shows_and_says_what_each_picture_costs(qtbot, posed_window):
     """#85: while a bone was dragged the live pictures were the thesis's spheres, the armpit lump and all, and the
     release swapped in the owned body. Now every live picture is the owned body (the last one, of the release's
