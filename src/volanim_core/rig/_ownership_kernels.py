@@ -63,30 +63,49 @@ def tube_depth(tube, px, py, pz, yields):
     return (d - 1.0) * (tube[7] + t * tube[8]) / math.sqrt(n1 * n2)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _near(reach, z, y, near, m, row):
+    """Of the ``m`` bones ``near[:m]`` (whose reach holds slice z), those whose reach holds row y too, into
+    ``row``; returns how many."""
+    k = 0
+    for i in range(m):
+        b = near[i]
+        if reach[b, 2] <= y <= reach[b, 3]:
+            row[k] = b
+            k += 1
+    return k
+
+
 @njit(cache=True, nogil=True, parallel=True)
-def own_by_tubes(mask, lo, tubes, yields, z_reach, out):
+def own_by_tubes(mask, lo, tubes, yields, reach, out):
     """``out[x, y, z]`` = 1 + the bone whose tube holds mask voxel ``(x, y, z) + lo`` deepest, in voxels (the
-    least :func:`tube_depth`); 0 outside the mask. ``z_reach[b]``: the slices (of ``mask``) bone b's tube can
-    hold a voxel in; a voxel no tube holds is measured against every bone."""
+    least :func:`tube_depth`); 0 outside the mask. ``reach[b]``: ``x0 x1 y0 y1 z0 z1``, the box (of ``mask``'s
+    indices) bone b's tube can hold a voxel in: a bone is measured only where it can hold the voxel, and a
+    voxel no tube holds is measured against every bone (the same owners as measuring every bone everywhere)."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
     for z in numba.prange(nz):
         near = np.empty(nb, np.int64)
+        row = np.empty(nb, np.int64)
         m = 0
         for b in range(nb):
-            if z_reach[b, 0] <= z <= z_reach[b, 1]:
+            if reach[b, 4] <= z <= reach[b, 5]:
                 near[m] = b
                 m += 1
         for y in range(ny):
+            k = _near(reach, z, y, near, m, row)
             for x in range(nx):
                 if not mask[x, y, z]:
                     continue
                 px, py, pz = x + lo[0], y + lo[1], z + lo[2]
                 best, who = np.inf, 0
-                for i in range(m):
-                    d = tube_depth(tubes[near[i]], px, py, pz, yields[near[i]])
+                for i in range(k):
+                    b = row[i]
+                    if x < reach[b, 0] or x > reach[b, 1]:
+                        continue
+                    d = tube_depth(tubes[b], px, py, pz, yields[b])
                     if d < best:
-                        best, who = d, near[i] + 1
+                        best, who = d, b + 1
                 if best >= 0.0:  # held by no tube near (or only by a round end that yields): the nearest of all
                     for b in range(nb):
                         d = tube_depth(tubes[b], px, py, pz, yields[b])
@@ -96,11 +115,11 @@ def own_by_tubes(mask, lo, tubes, yields, z_reach, out):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def section_moments(mask, lo, tubes, z_reach, step, sums):
+def section_moments(mask, lo, tubes, reach, step, sums):
     """For the mask voxels on a lattice of ``step`` voxels: the bone whose tube holds each deepest relative to
     its size (the least :func:`tube_distance`) and, where it lies in the middle of that bone (0.3 < t < 0.7),
     its offset v from the bone's segment into ``sums[b]``: count, the sums of v (3) and of v v^T (xx xy xz yy
-    yz zz). ``z_reach`` as :func:`own_by_tubes`'s. Slices in parallel, each into its own row, summed in order
+    yz zz). ``reach`` as :func:`own_by_tubes`'s. Slices in parallel, each into its own row, summed in order
     after: the same sums whatever the threads."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
@@ -109,21 +128,26 @@ def section_moments(mask, lo, tubes, z_reach, step, sums):
     for k in numba.prange(len(zs)):
         z = zs[k]
         near = np.empty(nb, np.int64)
+        row = np.empty(nb, np.int64)
         m = 0
         for b in range(nb):
-            if z_reach[b, 0] <= z <= z_reach[b, 1]:
+            if reach[b, 4] <= z <= reach[b, 5]:
                 near[m] = b
                 m += 1
         for y in range(0, ny, step):
+            n = _near(reach, z, y, near, m, row)
             for x in range(0, nx, step):
                 if not mask[x, y, z]:
                     continue
                 px, py, pz = x + lo[0], y + lo[1], z + lo[2]
                 best, who = np.inf, -1
-                for i in range(m):
-                    d = tube_distance(tubes[near[i]], px, py, pz)
+                for i in range(n):
+                    b = row[i]
+                    if x < reach[b, 0] or x > reach[b, 1]:
+                        continue
+                    d = tube_distance(tubes[b], px, py, pz)
                     if d < best:
-                        best, who = d, near[i]
+                        best, who = d, b
                 if best >= 1.0:  # held by no tube near: the relatively nearest of all
                     for b in range(nb):
                         d = tube_distance(tubes[b], px, py, pz)
@@ -194,13 +218,13 @@ def hull_ends(spans):
     return pts[:n], lab[:n]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def row_spans(labels, spans):
     """``spans[l - 1, y, z]`` = the first and last x of label l on row ``(y, z)`` of ``labels`` ``[x, y, z]``
-    (``spans`` filled with ``(1, 0)`` beforehand: none)."""
+    (``spans`` filled with ``(1, 0)`` beforehand: none). Slices in parallel: each writes its own."""
     nx, ny, nz = labels.shape
     nb = spans.shape[0]
-    for z in range(nz):
+    for z in numba.prange(nz):
         for y in range(ny):
             for x in range(nx):
                 v = labels[x, y, z]

@@ -97,3 +97,34 @@ def test_each_bone_s_hull_is_scipy_s_hull_of_all_its_voxels():
         voxels = np.argwhere(own.labels == b + 1) + np.asarray(own.origin)
         want = voxels[ConvexHull(voxels).vertices]
         assert {tuple(p) for p in hull.astype(np.int64)} == {tuple(p) for p in want}, own.bones[b]
+
+
+def test_a_bone_measured_only_in_its_tube_s_box_gives_the_owners_measuring_every_bone_everywhere_gives():
+    """tube_boxes: each kernel measures a bone only in the box its tube can hold a voxel in (mannequin-large: 1.7
+    bones a voxel, not 3.7). A tube holds nothing outside its box, so the owners and the cross-sections' moments
+    are those of measuring every bone at every voxel, exactly."""
+    from volanim_core.rig._ownership_kernels import own_by_tubes, section_moments
+    from volanim_core.rig.attach import connect
+    from volanim_core.rig.ownership import _yields, ownership, tube_boxes, tube_radii, tube_rows
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.mannequin()
+    conn = connect(skeletonize(s.mask, min_thinness=0.5), s.bones)[0]
+    own = ownership(s.mask, conn)
+    lo = np.asarray(own.origin)
+    box = np.asfortranarray(s.mask[tuple(slice(a, a + n) for a, n in zip(lo, own.labels.shape))] != 0)
+    a = np.array([b.proximal for b in conn.bones], np.float64)
+    ab = np.array([b.distal - b.proximal for b in conn.bones], np.float64)
+    round_tubes = tube_rows(a, ab, tube_radii(conn, box, lo), [None] * len(a))
+    everywhere = np.tile(np.array([-1, 10**6] * 3, np.int64), (len(a), 1))
+    for tubes in (round_tubes, own.tubes):
+        boxes = tube_boxes(tubes, lo)
+        assert (boxes[:, 1::2] - boxes[:, ::2] < np.array(box.shape)).any()  # the boxes do leave voxels out
+        moments = [np.zeros((len(a), 10)) for _ in range(2)]
+        for reach, sums in zip((boxes, everywhere), moments):
+            section_moments(box, lo.astype(np.float64), tubes, reach, 1, sums)
+        assert np.array_equal(*moments)
+    labels = [np.zeros(box.shape, np.uint8, order="F") for _ in range(2)]
+    for reach, out in zip((tube_boxes(own.tubes, lo), everywhere), labels):
+        own_by_tubes(box, lo.astype(np.float64), own.tubes, _yields(conn.bones), reach, out)
+    assert np.array_equal(*labels) and (labels[0] > 0).sum() == box.sum()
