@@ -126,6 +126,7 @@ docs: install-test system-deps
 
 screenshots: install-test system-deps
 	xvfb-run -a -s "-screen 0 1600x1000x24" $(PY) docs/make_screenshots.py
+	xvfb-run -a $(PY) docs/make_drag_strip.py
 	$(PY) docs/make_colour_renders.py
 	$(PY) docs/make_shape_pictures.py
 	$(PY) docs/make_autorig_pictures.py
