@@ -62,21 +62,20 @@ def main() -> None:
             app.processEvents()
         if len(frames) < len(ANGLES) and a <= ANGLES[len(frames)]:
             settle()  # the picture of this pose drawn: kept as the window shows it
-            p = w.doc.preview
             caption = f"{abs(a):.0f} deg: {w.pose_panel.verdict.plain.split(' (release')[0]}"
-            frames.append((np.ascontiguousarray(w.plotter.screenshot(return_img=True)[:, :, :3]), caption, p))
+            frames.append((np.ascontiguousarray(w.plotter.screenshot(return_img=True)[:, :, :3]), caption))
     w.doc.settings.dragging = False
     settle()
     w.close()
     # one crop for every frame: the box of what differs from the background in any of them, squared
-    body = np.any([np.abs(img.astype(int) - img[0, 0]).sum(2) > 30 for img, _, _ in frames], axis=0)
+    body = np.any([np.abs(img.astype(int) - img[0, 0]).sum(2) > 30 for img, _ in frames], axis=0)
     body[-150:, :150] = False  # the orientation axes' corner
     ys, xs = np.nonzero(body)
     side = max(ys.max() - ys.min(), xs.max() - xs.min()) + 40
     cy, cx = (ys.max() + ys.min()) // 2, (xs.max() + xs.min()) // 2
     box = (cx - side // 2, cy - side // 2, cx + side // 2, cy + side // 2)
     tiles = []
-    for img, caption, _ in frames:
+    for img, caption in frames:
         tile = Image.fromarray(img).crop(box).resize((400, 400))
         canvas = Image.new("RGB", (400, 440), (30, 31, 36))
         canvas.paste(tile, (0, 0))
@@ -89,7 +88,7 @@ def main() -> None:
     path = HERE / "studio-drag-large.png"
     strip.save(path)
     print(f"wrote {path}: {len(shown)} live pictures drawn in the drag")
-    for _, caption, p in frames:
+    for _, caption in frames:
         print(" ", caption)
 
 
