@@ -10,31 +10,40 @@ read by reconstruct/_owned_kernels.splat_turned).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def flagged_voxels(labels, flags, bit, n_bones):
     """Each label's voxels whose ``flags`` have ``bit``: ``(starts (n_bones + 1,), voxels (N, 3) int32)``, label
-    l's at ``voxels[starts[l - 1]:starts[l]]``, in the labels' order."""
+    l's at ``voxels[starts[l - 1]:starts[l]]``, in the labels' order. Slices in parallel, twice: each slice's
+    count of each label, then each slice writes its voxels after the slices before it (the same order as one
+    pass: mannequin-large's 31 -> 13 ms, the frog's 48 -> 20)."""
     nx, ny, nz = labels.shape
-    count = np.zeros(n_bones + 1, np.int64)
+    count = np.zeros((nz, n_bones + 1), np.int64)  # count[z, l]: slice z's voxels of label l
+    for z in prange(nz):
+        for y in range(ny):
+            for x in range(nx):
+                v = labels[x, y, z]
+                if v != 0 and v <= n_bones and flags[x, y, z] & bit:
+                    count[z, v] += 1
     starts = np.zeros(n_bones + 1, np.int64)
-    voxels = np.empty((0, 3), np.int32)
-    for fill in range(2):
-        if fill:
-            starts[1:] = np.cumsum(count[1:])
-            voxels = np.empty((starts[-1], 3), np.int32)
-            count[1:] = starts[:-1]
+    first = np.zeros((nz, n_bones + 1), np.int64)  # first[z, l]: where slice z's voxels of label l begin
+    for v in range(1, n_bones + 1):  # label by label, slice by slice
+        at = starts[v - 1]
         for z in range(nz):
-            for y in range(ny):
-                for x in range(nx):
-                    v = labels[x, y, z]
-                    if v == 0 or v > n_bones or not flags[x, y, z] & bit:
-                        continue
-                    if fill:
-                        voxels[count[v], 0], voxels[count[v], 1], voxels[count[v], 2] = x, y, z
-                    count[v] += 1
+            first[z, v] = at
+            at += count[z, v]
+        starts[v] = at
+    voxels = np.empty((starts[-1], 3), np.int32)
+    for z in prange(nz):
+        at = first[z].copy()
+        for y in range(ny):
+            for x in range(nx):
+                v = labels[x, y, z]
+                if v != 0 and v <= n_bones and flags[x, y, z] & bit:
+                    voxels[at[v], 0], voxels[at[v], 1], voxels[at[v], 2] = x, y, z
+                    at[v] += 1
     return starts, voxels
 
 

@@ -128,3 +128,22 @@ def test_a_bone_measured_only_in_its_tube_s_box_gives_the_owners_measuring_every
     for reach, out in zip((tube_boxes(own.tubes, lo), everywhere), labels):
         own_by_tubes(box, lo.astype(np.float64), own.tubes, _yields(conn.bones), reach, out)
     assert np.array_equal(*labels) and (labels[0] > 0).sum() == box.sum()
+
+
+@pytest.mark.parametrize("name", ["mannequin", "frog"])
+def test_each_bone_s_thin_voxels_are_numpy_s_in_the_labels_order(name):
+    """Ownership.thin (flagged_voxels, slices in parallel): bone by bone, every voxel of the bone whose flags have
+    THIN, in z, y, x order, as numpy finds them."""
+    from volanim_core.rig.attach import connect
+    from volanim_core.rig.ownership import THIN, ownership
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.load(name)
+    own = ownership(s.mask, connect(skeletonize(s.mask, **({} if name == "frog" else {"min_thinness": 0.5})),
+                                    s.bones)[0])
+    starts, voxels = own.thin()
+    thin = (own.flags() & THIN) != 0
+    assert starts[0] == 0 and starts[-1] == thin.sum() > 0
+    for b in range(len(own.bones)):
+        want = np.argwhere(((own.labels == b + 1) & thin).T)[:, ::-1]  # [z, y, x] order, as (x, y, z)
+        assert np.array_equal(voxels[starts[b]:starts[b + 1]], want), own.bones[b].label
