@@ -228,7 +228,7 @@ class PreviewController(Controller):
             return
         # the next picture is made once this one is drawn (live_worker's docstring); a picture never drawn (the
         # window hidden, the rest pose shown) lets it go after DRAW_WAIT_MS all the same
-        self.scene.after_next_draw(self.live_worker.drawn)
+        self.scene.frames.after_next(self.live_worker.drawn)
         QTimer.singleShot(DRAW_WAIT_MS, self.window, self.live_worker.drawn)
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
         # its cost picks the next one's resolution: its stages (the scene adds the last draw), or the wait from

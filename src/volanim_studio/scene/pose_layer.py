@@ -364,7 +364,7 @@ class PoseLayer:
         view.apply_stage()
         view.render()
         if p.stages is not None:  # the draw the last live picture took (this one's is known once drawn)
-            p.stages["last draw"] = view.draw_seconds
+            p.stages["last draw"] = view.frames.seconds
 
     def clear(self, render: bool = True) -> None:
         self.view.plotter.remove_actor("preview", render=False)

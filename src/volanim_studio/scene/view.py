@@ -11,7 +11,6 @@ intercept a click and HiDPI scaling cannot offset it.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
 import numpy as np
@@ -24,6 +23,7 @@ from ..model.document import Document
 from ..model.interaction import PickEvent
 from . import camera_moves
 from .bones_layer import BonesLayer
+from .frame_watch import FrameWatch
 from .hull_layer import HullLayer
 from .names_layer import ACTORS as NAME_ACTORS
 from .names_layer import NamesLayer
@@ -66,15 +66,7 @@ class SceneView:
         self._after_drag: tuple[bool, bool] | None = None  # the renderer's FXAA and OIT, put back on release
         self._render_pending = False
         self._drawn_once = False
-        self.draw_seconds = 0.0  # how long the last frame took to draw (software GL: most of a live update's)
-        self._draw_began = 0.0
-        self.clock = time.perf_counter  # times the draws (a test's own: the live resolution they pick)
-        window = plotter.render_window
-        window.AddObserver("StartEvent", lambda *_: setattr(self, "_draw_began", self.clock()))
-        window.AddObserver("EndEvent", lambda *_: setattr(self, "draw_seconds", self.clock() - self._draw_began))
-        self._after_draw: list = []  # called once the next frame is on screen (after_next_draw)
-        if hasattr(plotter, "frameSwapped"):  # Qt's widget: on screen once composed (software GL: read back)
-            plotter.frameSwapped.connect(self._frame_shown)
+        self.frames = FrameWatch(plotter)  # each draw's time; what waits for the next frame on screen
         plotter.set_background("#1e1f24")
         self._fix_pixel_ratio()
         self._quiet_keys()
@@ -425,16 +417,6 @@ class SceneView:
                 actors[name].SetVisibility(self.posing)
         self.xray.show(self.posing)
         self.names.show(not self.posing)
-
-    def after_next_draw(self, call) -> None:
-        """``call()`` once the next frame is on screen: drawn, and composed into the window (software GL finishes
-        the drawing there). The live thread's next picture waits for it. Off screen (no Qt widget): never."""
-        self._after_draw.append(call)
-
-    def _frame_shown(self) -> None:
-        calls, self._after_draw = self._after_draw, []
-        for call in calls:
-            call()
 
     def render(self) -> None:
         """Request a frame; many model changes in one event-loop pass draw once (software GL takes

@@ -43,7 +43,7 @@ def test_slow_live_pictures_go_to_half_size_say_so_and_fast_ones_come_back(qtbot
 
     # the live thread's clock alone: each of a picture's three stages costs one step; the draws cost nothing
     # (a draw is painted when the event loop gets to it, before or after the next step is set)
-    w.scene.clock = lambda: 0.0
+    w.scene.frames.clock = lambda: 0.0
     w.previews.clock = ticking(0.05)  # 150 ms a picture: under 10 a second
     slider.setSliderDown(True)
     assert pictures([-5, -10, -15, -20]) == [1, 1, 1, 2]
