@@ -50,6 +50,7 @@ def main() -> None:
     bone = w.doc.bones.index("L_UPPERARM")
     w.doc.select_bones([bone])
     w.scene.front_view()
+    w.plotter.camera.zoom(0.8)  # room above the head for the hand raised to 120 degrees
     settle()
     frames, shown = [], []
     w.doc.events.preview.connect(lambda **_: shown.append(w.doc.preview) if w.doc.preview.live else None)
@@ -73,7 +74,10 @@ def main() -> None:
     ys, xs = np.nonzero(body)
     side = max(ys.max() - ys.min(), xs.max() - xs.min()) + 40
     cy, cx = (ys.max() + ys.min()) // 2, (xs.max() + xs.min()) // 2
-    box = (cx - side // 2, cy - side // 2, cx + side // 2, cy + side // 2)
+    h, w_ = body.shape
+    side = min(side, h, w_)  # within the picture: a crop past its edge came out as a black band
+    x0, y0 = min(max(0, cx - side // 2), w_ - side), min(max(0, cy - side // 2), h - side)
+    box = (x0, y0, x0 + side, y0 + side)
     tiles = []
     for img, caption in frames:
         tile = Image.fromarray(img).crop(box).resize((400, 400))

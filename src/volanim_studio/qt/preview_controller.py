@@ -50,6 +50,12 @@ class PreviewController(Controller):
         self._live_timer.setSingleShot(True)
         self._live_timer.setInterval(0)
         self._live_timer.timeout.connect(self.live_preview)
+        # a live picture never drawn (the window hidden, the rest pose shown) lets the next be made all the same;
+        # one timer, restarted per picture: an earlier picture's never lets a later one's go early
+        self._draw_wait = QTimer(window)
+        self._draw_wait.setSingleShot(True)
+        self._draw_wait.setInterval(DRAW_WAIT_MS)
+        self._draw_wait.timeout.connect(self.live_worker.drawn)
         ev, st = self.doc.events, self.doc.settings.events
         ev.pose.connect(self._on_pose_changed)
         ev.pose_settled.connect(lambda **_: self._settled())
@@ -226,10 +232,8 @@ class PreviewController(Controller):
         if full != self._full_asked or self.doc.settings.mode != Mode.POSE:
             self.live_worker.drawn()  # dropped: the next may be made now
             return
-        # the next picture is made once this one is drawn (live_worker's docstring); a picture never drawn (the
-        # window hidden, the rest pose shown) lets it go after DRAW_WAIT_MS all the same
-        self.scene.frames.after_next(self.live_worker.drawn)
-        QTimer.singleShot(DRAW_WAIT_MS, self.window, self.live_worker.drawn)
+        self.scene.frames.after_next(self.live_worker.drawn)  # the next is made once this one is drawn
+        self._draw_wait.start()
         self.doc.set_preview(p)  # drawn by the scene's coalesced render: one frame per pose change
         # its cost picks the next one's resolution: its stages (the scene adds the last draw), or the wait from
         # asking, when longer (the frog's half-size pictures: 59 ms of stages, one drawn every 140 ms)

@@ -23,8 +23,10 @@ class FrameWatch:
 
     def after_next(self, call) -> None:
         """``call()`` once the next frame is on screen: drawn, and composed into the window (software GL finishes
-        the drawing there). Off screen (no Qt widget): never."""
-        self._after.append(call)
+        the drawing there). Off screen (no Qt widget): never. A call already waiting is not added again (a hidden
+        window's frames never come: its waiting calls would pile up)."""
+        if call not in self._after:
+            self._after.append(call)
 
     def _shown(self) -> None:
         calls, self._after = self._after, []
