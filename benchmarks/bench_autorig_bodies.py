@@ -11,7 +11,7 @@ side, as the README's ant): trimesh's rabbit, and Keenan Crane's Spot (a cow) an
 from geometry-central's test assets in potpourri3d's source distribution on PyPI (``volanim samples``
 copies all three). Seconds are autorig's, with its ratio to skeletonize measured beside it.
 
-Run: .venv/bin/python benchmarks/bench_autorig_bodies.py [--bodies a,b,...] [--angles 45,90]
+Run: .venv/bin/python benchmarks/bench_autorig_bodies.py [--bodies a,b,...] [--angles 45,90] [--size 320]
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ BODIES = ("mannequin", "mannequin-large", "frog", "ant", "rabbit", "spot", "bob"
 JOINTS = ("owned", "hung on", "rigid", "smooth")
 
 
-def body_mask(name: str, folder: Path):
-    """(mask, hand-made bones or None) for one body."""
+def body_mask(name: str, folder: Path, size: int = 160):
+    """(mask, hand-made bones or None) for one body; a mesh voxelized at ``size`` voxels along its longest side."""
     from volanim_core import samples
     from volanim_core.io.mesh_files import read_mesh, voxelize
 
@@ -37,7 +37,7 @@ def body_mask(name: str, folder: Path):
         s = samples.load(name)
         return s.mask, (s.bones if name != "frog" else None)
     samples.write_sample(name, folder)
-    vol, _ = voxelize(read_mesh(folder / f"{name}.ply"), size=160)
+    vol, _ = voxelize(read_mesh(folder / f"{name}.ply"), size=size)
     return vol > 0, None
 
 
@@ -112,6 +112,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--bodies", default=",".join(BODIES))
     p.add_argument("--angles", default="45,90")
+    p.add_argument("--size", type=int, default=160, help="voxels along a mesh's longest side (#86: 160 and 320)")
     args = p.parse_args(argv)
     angles = [int(a) for a in args.angles.split(",")]
     cols = [f"{j} {a}°" for j in JOINTS for a in angles]
@@ -122,7 +123,7 @@ def main(argv=None) -> int:
     broken = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.bodies.split(","):
-            mask, truth = body_mask(name, Path(tmp))
+            mask, truth = body_mask(name, Path(tmp), args.size)
             t0 = time.perf_counter()
             skel = skeletonize(mask)
             t1 = time.perf_counter()

@@ -8,7 +8,8 @@
                       islands.py (each bone's flesh in one piece)
     ownership.py .... which bone owns each rest voxel (the rig's label volume): tubes fitted to each bone's
                       middle, each voxel to the tube that holds it deepest (_ownership_kernels.py); the
-                      thin flesh a turned bone pushes forward (_thin_kernels.py);
+                      thin flesh a turned bone pushes forward (_thin_kernels.py); each bone's hull
+                      from its slices' outlines (_hull_kernels.py);
                       specks.py gives a speck of one bone inside another's flesh to the flesh around it;
                       reach.py names flesh that hangs from the body only through another limb's
     symmetry.py ..... one side's attachments mirrored to the other (L_/R_ names)

@@ -10,7 +10,10 @@ from numba import njit
 
 #: a tube's row: a(3) ab(3) 1/|ab|^2 s0 ds w1(3) w2(3) u(3) cap0 cap1
 TUBE_COLUMNS = 20
-YIELDED = 1e6  # tube_depth of a voxel in a round end that yields: after every voxel a tube really holds
+#: tube_depth's tiers past a tube's surface, least first: a tube near (held by none, within FAR of its size),
+#: a round end that yields and holds the voxel, a tube far, a round end that yields and does not hold it
+YIELDED, BEYOND, PAST = 1e6, 2e6, 3e6
+FAR = 30.0  # tube_distance beyond which a tube is no nearer than a round end that holds the voxel
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -47,20 +50,26 @@ def tube_depth(tube, px, py, pz, yields):
     one, times the tube's size there (its taper times the geometric mean of its cross-section's semi-axes),
     inf for a tube that holds nothing. Why voxels and not the relative distance: the mannequin's true body
     parts are "the capsule a voxel lies deepest in" (mannequin_body.py), and a relative measure gave the thin
-    thigh a third of the pelvis it overlaps (the walk clip carried 2,200 voxels of it as a lump at every step)."""
+    thigh a third of the pelvis it overlaps (the walk clip carried 2,200 voxels of it as a lump at every step).
+
+    Past the surface the tiers of :data:`YIELDED` order what no tube holds. A round end that yields
+    (ownership._yields) and holds the voxel comes after every tube within :data:`FAR` of its size and before
+    the ones beyond: the frog's snout-tip leaf, a tube one voxel wide, took the lower jaw 47 voxels away (48 of
+    its sizes) that its parent's round end held, and its 90-degree turn tore the head (#86)."""
     d = tube_distance(tube, px, py, pz)
     if d == np.inf:
         return np.inf
     dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
     raw = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
     if (raw < 0.0 and yields[0]) or (raw > 1.0 and yields[1]):  # a round end that yields (ownership._yields)
-        return YIELDED + d
+        return (YIELDED if d < 1.0 else PAST) + d
     t = min(1.0, max(0.0, raw))
     n1 = math.sqrt(tube[9] * tube[9] + tube[10] * tube[10] + tube[11] * tube[11])
     n2 = math.sqrt(tube[12] * tube[12] + tube[13] * tube[13] + tube[14] * tube[14])
     if n1 <= 0.0 or n2 <= 0.0:
         return np.inf
-    return (d - 1.0) * (tube[7] + t * tube[8]) / math.sqrt(n1 * n2)
+    depth = (d - 1.0) * (tube[7] + t * tube[8]) / math.sqrt(n1 * n2)
+    return BEYOND + depth if d >= FAR else depth
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -174,48 +183,6 @@ def section_moments(mask, lo, tubes, reach, step, sums):
                 s[9] += vz * vz
     for k in range(len(zs)):
         sums += per[k]
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _side(ys, xs, n, sign, out_y, out_x):
-    """The convex chain of ``n`` points ``(y, x)`` (y rising) seen from the side ``sign`` (-1: least x, 1: most x)
-    into ``out_*``: Andrew's monotone chain, points on a straight stretch dropped. Returns its length."""
-    k = 0
-    for i in range(n):
-        while k >= 2 and sign * ((out_y[k - 1] - out_y[k - 2]) * (xs[i] - out_x[k - 2])
-                                 - (out_x[k - 1] - out_x[k - 2]) * (ys[i] - out_y[k - 2])) >= 0:
-            k -= 1
-        out_y[k], out_x[k] = ys[i], xs[i]
-        k += 1
-    return k
-
-
-@njit(cache=True, nogil=True)
-def hull_ends(spans):
-    """From :func:`row_spans`' ``spans (B, Y, Z, 2)``: each bone's row ends that are corners of its slice's convex
-    outline, ``(points (N, 3) x y z, bone (N,))``. Every vertex of a bone's convex hull is a corner of its
-    slice's outline, so these hold all of them: a slice's chain, not its every row, goes to qhull."""
-    nb, ny, nz = spans.shape[0], spans.shape[1], spans.shape[2]
-    pts = np.empty((2 * ny * nz, 3), np.int64)
-    lab = np.empty(2 * ny * nz, np.int64)
-    ys, xs, cy, cx = np.empty(ny, np.int64), np.empty(ny, np.int64), np.empty(ny, np.int64), np.empty(ny, np.int64)
-    n = 0
-    for b in range(nb):
-        if n + 2 * ny * nz > len(lab):  # room for one more bone's worst case
-            pts = np.concatenate((pts[:n], np.empty((2 * ny * nz, 3), np.int64)))
-            lab = np.concatenate((lab[:n], np.empty(2 * ny * nz, np.int64)))
-        for z in range(nz):
-            for end in range(2):
-                m = 0
-                for y in range(ny):
-                    if spans[b, y, z, 0] <= spans[b, y, z, 1]:
-                        ys[m], xs[m] = y, spans[b, y, z, end]
-                        m += 1
-                for i in range(_side(ys, xs, m, 2 * end - 1, cy, cx)):
-                    pts[n, 0], pts[n, 1], pts[n, 2] = cx[i], cy[i], z
-                    lab[n] = b
-                    n += 1
-    return pts[:n], lab[:n]
 
 
 @njit(cache=True, nogil=True, parallel=True)

@@ -19,7 +19,10 @@ the frog's leaf poses 3/6 and 3/6 healthy where they were 2/6 and 1/6). A tube's
 yields (holds only what no other tube holds) where the body there is another bone's: behind a bone's
 proximal joint when a bone ends there, past its distal joint when one bone goes on (_yields). Without it the
 thick parent's round end took the base of a thin leaf (the rabbit's and Spot's leaf bent 90 degrees tore
-off). The ball at the joint keeps the torso whole where a limb leaves it.
+off). What no tube holds goes to the nearest tube's surface, but a round end that yields keeps what it holds
+from a tube more than FAR (30) of its sizes away: the frog's snout-tip leaf, one voxel wide, took the lower jaw
+47 voxels off that its parent's end held, and tore the head at 90 degrees (#86). The ball at the joint keeps
+the torso whole where a limb leaves it.
 
 Every voxel of the mask gets an owner, so at the identity pose the posed body is the mask voxel for
 voxel. The animator repaints ownership where the rule is wrong (the studio, ``volanim connect
@@ -33,10 +36,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from volanim_core.geometry import IDENTITY, Geometry
+from volanim_core.rig._hull_kernels import hull_ends
 from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
     bone_cells,
-    hull_ends,
     own_by_tubes,
     pool_labels,
     row_spans,

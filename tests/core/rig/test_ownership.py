@@ -147,3 +147,33 @@ def test_each_bone_s_thin_voxels_are_numpy_s_in_the_labels_order(name):
     for b in range(len(own.bones)):
         want = np.argwhere(((own.labels == b + 1) & thin).T)[:, ::-1]  # [z, y, x] order, as (x, y, z)
         assert np.array_equal(voxels[starts[b]:starts[b + 1]], want), own.bones[b].label
+
+
+def test_flesh_a_round_end_that_yields_holds_stays_with_it_not_with_a_thin_tube_far_away():
+    """#86: the frog's snout-tip leaf (a tube one voxel wide) took the lower jaw, 47 voxels from it, because the
+    jaw lay only in its parent's round end past the joint, which yields: no tube held it, and the nearest
+    surface won. Its 90-degree turn tore the head. A yielding end that holds a voxel now comes before any tube
+    FAR (30) of its sizes away, and after the ones nearer."""
+    from volanim_core.rig._ownership_kernels import FAR, own_by_tubes, tube_distance
+    from volanim_core.rig.connectivity import BoneSegment
+    from volanim_core.rig.ownership import _yields, tube_boxes, tube_rows
+
+    # a head along x (radius 10) whose end yields to the snout going on up from it (radius 0.5), then its tip
+    bones = [BoneSegment(np.array([0.0, 0, 0]), np.array([40.0, 0, 0]), "HEAD"),
+             BoneSegment(np.array([40.0, 0, 0]), np.array([40.0, 10, 0]), "SNOUT"),
+             BoneSegment(np.array([40.0, 10, 0]), np.array([44.0, 10, 0]), "TIP")]
+    assert _yields(bones).tolist() == [[False, True], [True, True], [True, False]]
+    a = np.array([b.proximal for b in bones])
+    tubes = tube_rows(a, np.array([b.distal for b in bones]) - a, np.array([[10.0, 10], [0.5, 0.5], [0.5, 0.5]]),
+                      [None] * 3)
+    lo = np.array([-12.0, -12, -2])
+    jaw, by_tip = np.array([45.0, -6, 0]), np.array([46.0, 10, 0])
+    assert tube_distance(tubes[0], *jaw) < 1 and tube_distance(tubes[2], *jaw) > FAR  # only the head's end holds it
+    assert tube_distance(tubes[0], *by_tip) > 1 and 1 < tube_distance(tubes[2], *by_tip) < FAR  # none holds it
+    mask = np.zeros((70, 30, 5), bool, order="F")
+    for p in (jaw, by_tip):
+        mask[tuple((p - lo).astype(int))] = True
+    out = np.zeros(mask.shape, np.uint8, order="F")
+    own_by_tubes(mask, lo, tubes, _yields(bones), tube_boxes(tubes, lo), out)
+    assert out[tuple((jaw - lo).astype(int))] == 1  # the head's yielding end, not the tip 32 of its sizes away
+    assert out[tuple((by_tip - lo).astype(int))] == 3  # held by none: the nearest surface, the tip's
