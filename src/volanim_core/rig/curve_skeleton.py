@@ -42,7 +42,8 @@ BRIDGE = 0.08  # a bridge may cross background this fraction of the body's lengt
 GAP = 3.0  # balls this many voxels apart still link (a coarse voxel's slack)
 SPREAD = 4  # a coarse voxel may be this many times the thickest ball's radius, no more
 COARSE_VOXELS = 8_000_000  # the solid body is remade on a grid of at most this many voxels
-CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues)
+CLOSE = 4.0  # gaps narrower than this many voxels are closed (unlabelled seams between tissues) ...
+CLOSE_SHARE = 0.12  # ... or than this x the thickest ball's radius: a mesh voxelized finer has wider gaps in voxels
 POROUS = 0.05  # a body that closing grows by more than this fraction is porous (a dissected frog's tissues) ...
 PORE = 1.2  # ... and its gaps narrower than this x its thickest ball's radius are closed too
 
@@ -256,7 +257,8 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
     """The medial points ``(points, radii)`` of the body the skeleton's balls make, remade solid.
 
     The balls are painted on a grid coarse enough to hold at most ``COARSE_VOXELS`` voxels, gaps
-    narrower than ``close`` voxels are closed, cavities filled, and the solid is thinned to a curve
+    narrower than ``close`` voxels (or ``CLOSE_SHARE`` of the thickest ball's radius) are closed, cavities
+    filled, and the solid is thinned to a curve
     (scikit-image's ``skeletonize``, Lee's 3-D thinning) with its distance transform as radius: a
     porous segmentation (the frog's tissues, unlabelled seams between muscles) becomes one body
     whose thickness means something, and a flat part (a torso) a curve rather than a sheet.
@@ -275,6 +277,10 @@ def solid(skeleton: Skeleton, *, close: float = CLOSE, step=None) -> tuple[np.nd
                           f"thickest ball's radius is {skeleton.dt.max():.3g} voxels: on a grid coarse enough to hold "
                           f"that span its body would vanish; parts this far apart are not one body (crop the "
                           "scan to the creature)")
+    # the gap between a rabbit's tail and its body is a voxel or two at 160 voxels along the rabbit, twice that at
+    # 320, where a closing of CLOSE voxels left it open: no chain reached the tail or a hind foot (#86). Every
+    # body at 160 voxels and the scans (the thickest radius 13-33 voxels) close CLOSE voxels, as before
+    close = max(close, CLOSE_SHARE * float(skeleton.dt.max())) if close else 0.0
     steps = max(1, int(round(close / 2 / h)))  # a closing by k steps bridges gaps of about 2 k
     pad = steps + 1
     shape = tuple(int(v) for v in np.ceil((hi - lo) / h) + 1 + 2 * pad)

@@ -267,3 +267,24 @@ def test_stubby_limbs_are_limbs():
         trans = Trans(root_bones(bones), matrices(bones, {bone.label: (0.0, 45.0, 0.0)}))
         rep = report(conn, trans, bones=bones)
         assert rep.healthy, (bone.label, rep.verdict)
+
+
+def test_the_rabbit_voxelized_twice_as_fine_keeps_a_chain_in_its_tail_and_each_foot(tmp_path):
+    """#86: the voxel size must not change what is rigged. At 320 voxels along trimesh's rabbit its tail and
+    a hind foot joined the body across a gap twice as wide in voxels as at 160, which a closing of CLOSE
+    voxels left open: no chain reached them (20 bones, 7 leaves; 25 and 8 at 160). The closing now grows
+    with the thickest ball's radius (CLOSE_SHARE), so every leaf of the rig at 160 has one at 320 near it."""
+    from volanim_core.io.mesh_files import read_mesh, voxelize
+
+    samples.write_sample("rabbit", tmp_path)
+    mesh = read_mesh(tmp_path / "rabbit.ply")
+    tips = {}
+    for size in (160, 320):
+        vol, _ = voxelize(mesh, size=size)
+        bones = autorig(skeletonize(vol > 0)).bones
+        tips[size] = np.array([bones.joints[bones.bones[i].distal] for i in bones.leaves()]) * 160 / size
+    assert len(tips[160]) == 8
+    apart = np.linalg.norm(tips[160][:, None] - tips[320][None], axis=2).min(axis=1)
+    # five of the eight come within 8 voxels, the rest within 25 (a long ear's chain is drawn out to the surface
+    # along its last bend, which moves with the bends found); at a closing of CLOSE voxels one was 40 off
+    assert apart.max() < 25, apart.round(1)
