@@ -14,6 +14,13 @@ def leaf_bends(skel, bones, angles=(45, 90), joints: str = "rigid") -> list[str]
     """Each leaf bone bent by each of ``angles`` degrees (:func:`bend_across`), the skeleton connected by
     pieces as `autorig --connect` does: ``"LABEL ANGLE: verdict"`` of every pose not healthy."""
     conn = connect(skel, bones, method="pieces", mask=balls(skel))[0].with_joints(Joints(joints))
+    return broken_bends(conn, bones, angles)
+
+
+def broken_bends(conn, bones, angles=(45, 90)) -> list[str]:
+    """Each leaf bone of ``bones`` bent by each of ``angles`` degrees (:func:`bend_across`) on ``conn`` as it
+    is (its ownership, its joints): ``"LABEL ANGLE: verdict"`` of every pose `volanim report` calls not
+    healthy."""
     broken = []
     for k in bones.leaves():
         label = bones.bones[k].label

@@ -288,3 +288,24 @@ def test_the_rabbit_voxelized_twice_as_fine_keeps_a_chain_in_its_tail_and_each_f
     # five of the eight come within 8 voxels, the rest within 25 (a long ear's chain is drawn out to the surface
     # along its last bend, which moves with the bends found); at a closing of CLOSE voxels one was 40 off
     assert apart.max() < 25, apart.round(1)
+
+
+@pytest.mark.slow
+def test_bob_voxelized_twice_as_fine_is_cut_where_its_ring_meets_and_each_leaf_bends_whole(tmp_path):
+    """#86: Bob is a ring; the curve tree cuts it where two of its ends meet. At 320 voxels each of those ends
+    was drawn out to the surface along its branch, which ran on along the ring 73 voxels into the other
+    chain's flesh: the two last bones crossed, and one turned 45 degrees tore the ring (2 of 3 leaves healthy).
+    An end whose ball overlaps another end's is no tip now, and every leaf bends whole."""
+    from leaf_bends import broken_bends
+    from volanim_core.io.mesh_files import read_mesh, voxelize
+    from volanim_core.rig.ownership import ownership
+    from volanim_core.rig.reach import hang_on
+
+    samples.write_sample("bob", tmp_path)
+    vol, _ = voxelize(read_mesh(tmp_path / "bob.ply"), size=320)
+    mask = vol > 0
+    skel = skeletonize(mask)
+    bones = autorig(skel).bones
+    conn = connect(skel, bones, method="pieces", mask=balls(skel))[0]
+    conn = conn.with_ownership(hang_on(ownership(mask, conn))[0])  # as autorig --connect --volume makes it
+    assert len(bones.leaves()) == 3 and broken_bends(conn, bones) == []
