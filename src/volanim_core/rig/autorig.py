@@ -115,7 +115,7 @@ def chains(tree: Tree, geometry, *, bones: int | None = None) -> BoneSkeleton:
         prev = start
         for n, node in enumerate(stops, 1):
             name = f"{label}_{n}"
-            is_end = node == path[-1] and tree.degree(node) == 1 and not _meets_an_end(tree, node)
+            is_end = node == path[-1] and tree.degree(node) == 1
             joints[name] = tree.tip(node) if is_end else tree.p[node]
             if node == path[-1]:
                 name_of[node] = name
@@ -125,15 +125,6 @@ def chains(tree: Tree, geometry, *, bones: int | None = None) -> BoneSkeleton:
         raise NotRiggable("the skeleton has no branches longer than it is thick: nothing to bend (a ball, a box "
                           "or a flat sheet?); autorig needs a body with limbs; draw the bones in the studio instead")
     return BoneSkeleton(joints, out)
-
-
-def _meets_an_end(tree: Tree, end: int) -> bool:
-    """Whether another end's ball overlaps this end's: the body goes on there (a ring cut where the tree's two
-    ends meet), so the end is no tip to draw out to the surface. Bob voxelized at 320 voxels: each end's ray ran
-    on along the ring, 73 voxels into the other chain's flesh, the two last bones crossed, and one, turned 45
-    degrees, tore the ring."""
-    ends = [i for i in range(len(tree.p)) if i != end and tree.degree(i) == 1]
-    return any(np.linalg.norm(tree.p[i] - tree.p[end]) < tree.r[i] + tree.r[end] for i in ends)
 
 
 def _with_exit(tree: Tree, path: list[int], cuts: list[int]) -> list[int]:
