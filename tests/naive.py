@@ -333,3 +333,13 @@ def voxel_flags(labels):
     thin = body & np.any([(label_at(a) != labels) & (label_at(-a) != labels) for a in axes], axis=0)
     skin = ~body & np.any([at(a) | at(-a) for a in axes], axis=0)
     return (same * 1 | thin * 2 | skin * 4 | (~body & ~skin) * 8).astype(np.uint8)
+
+
+def paint_runs(shape, first, x0, x1, piece) -> np.ndarray:
+    """The label grid the runs describe (plain loop): volanim_core/_run_kernels' rows ``z * ny + y``."""
+    out = np.zeros(shape, np.int64)
+    for row in range(len(first) - 1):
+        z, y = divmod(row, shape[1])
+        for r in range(first[row], first[row + 1]):
+            out[z, y, x0[r]:x1[r] + 1] = piece[r]
+    return out

@@ -17,6 +17,8 @@ cli/. The modules beside them:
     isosurface.py ........ an isosurface as plain arrays (VTK's flying edges) for code below render/
     voxel_faces.py ....... the faces between filled and empty voxels as plain arrays: the live preview's
                            surface (numba kernels in _face_kernels.py)
+    _run_kernels.py ...... a grid's rows as runs and their 26-connected pieces: the breakage report's and
+                           ownership's specks' labelling
     memo.py .............. a few recent results kept by a hash of their inputs
     parallel.py .......... where many tasks run: this process, a spawn pool, or a Dask cluster
     cluster_config.py .... a Dask cluster started from a file (dask-ctl's spec): --cluster-config

@@ -96,9 +96,12 @@ def compile_kernels(progress=None) -> float:
     balls(skel)  # a proposed rig's body of balls (auto-rig)
     # the ownership default (#84): the rig's ownership, then a frame in every mode from it, uint8 labels
     from volanim_core.rig.ownership import ownership
+    from volanim_core.rig.reach import out_of_reach
     from volanim_core.rig.specks import join_specks
 
-    owned = conn.with_ownership(ownership(mask, conn)).posed(matrices)
+    own = ownership(mask, conn)
+    out_of_reach(own)  # flesh that hangs on only through another limb (volanim connect warns of it)
+    owned = conn.with_ownership(own).posed(matrices)
     specks = np.ones((6, 4, 4), np.uint8, order="F")
     specks[5], specks[2, 1, 1] = 2, 2  # bone 2's flesh at one end, a speck of it in bone 1's
     join_specks(specks, 2)  # a speck of one bone inside another's flesh

@@ -185,24 +185,6 @@ def section_moments(mask, lo, tubes, reach, step, sums):
         sums += per[k]
 
 
-@njit(cache=True, nogil=True, parallel=True)
-def row_spans(labels, spans):
-    """``spans[l - 1, y, z]`` = the first and last x of label l on row ``(y, z)`` of ``labels`` ``[x, y, z]``
-    (``spans`` filled with ``(1, 0)`` beforehand: none). Slices in parallel: each writes its own."""
-    nx, ny, nz = labels.shape
-    nb = spans.shape[0]
-    for z in numba.prange(nz):
-        for y in range(ny):
-            for x in range(nx):
-                v = labels[x, y, z]
-                if v == 0 or v > nb:
-                    continue
-                s = spans[v - 1, y, z]
-                if s[1] < s[0]:
-                    s[0] = x
-                s[1] = x
-
-
 @njit(cache=True, nogil=True)
 def piece_stats(pieces, labels, label, count, box):
     """Each piece ``p`` of a label volume (``pieces``, ``labels``: ``[x, y, z]``): ``label[p]`` its label (a piece
@@ -270,46 +252,13 @@ def pool_labels(labels, offset, f, out):
                     out[i, j, k] = seen[best]
 
 
-@njit(cache=True, nogil=True)
-def speck_rings(pieces, specks, boxes):
-    """Each speck's ring: the piece (0: outside the body) of every voxel 26-next to speck ``specks[k]`` and not in
-    it, once each. ``boxes[k]``: the speck's box ``x0 y0 z0 x1 y1 z1`` (stops excluded). Returns ``starts``
-    (``K + 1``) and the rings' pieces, speck k's at ``ring[starts[k]:starts[k + 1]]``."""
-    nx, ny, nz = pieces.shape
-    room = 0
-    for k in range(len(specks)):
-        room += (boxes[k, 3] - boxes[k, 0] + 2) * (boxes[k, 4] - boxes[k, 1] + 2) * (boxes[k, 5] - boxes[k, 2] + 2)
-    ring = np.empty(room, np.int64)
-    starts = np.zeros(len(specks) + 1, np.int64)
-    n = 0
-    for k in range(len(specks)):
-        p = specks[k]
-        x0, y0, z0 = max(0, boxes[k, 0] - 1), max(0, boxes[k, 1] - 1), max(0, boxes[k, 2] - 1)
-        x1, y1, z1 = min(nx, boxes[k, 3] + 1), min(ny, boxes[k, 4] + 1), min(nz, boxes[k, 5] + 1)
-        seen = np.zeros((x1 - x0, y1 - y0, z1 - z0), np.bool_)
-        for z in range(boxes[k, 2], boxes[k, 5]):
-            for y in range(boxes[k, 1], boxes[k, 4]):
-                for x in range(boxes[k, 0], boxes[k, 3]):
-                    if pieces[x, y, z] != p:
-                        continue
-                    for c in range(max(z0, z - 1), min(z1, z + 2)):
-                        for b in range(max(y0, y - 1), min(y1, y + 2)):
-                            for a in range(max(x0, x - 1), min(x1, x + 2)):
-                                if pieces[a, b, c] != p and not seen[a - x0, b - y0, c - z0]:
-                                    seen[a - x0, b - y0, c - z0] = True
-                                    ring[n] = pieces[a, b, c]
-                                    n += 1
-        starts[k + 1] = n
-    return starts, ring[:n]
-
-
 @njit(cache=True, nogil=True, inline="always")
 def _at(labels, x, y, z, nx, ny, nz):
     return labels[x, y, z] if 0 <= x < nx and 0 <= y < ny and 0 <= z < nz else 0
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def voxel_flags(labels, out):
+def voxel_flags(labels, busy, out):
     """``out[x, y, z]`` (uint8, zeroed) for each voxel of ``labels`` ``[x, y, z]`` (outside the array: 0):
     bit 1 (UNIFORM) when it and its 26 neighbours hold one label (0 or a bone): a sub-voxel read near it needs
     no interpolation; bit 2 (THIN) when it is a body voxel whose two face neighbours along some axis are both
@@ -319,16 +268,25 @@ def voxel_flags(labels, out):
 
     The 3x3x3 test axis by axis (bits 16 and 32 hold the steps): the row's two neighbours alike (16), then the
     3x3 of the slice (32: the rows above and below alike and 16), then the slices before and after: 13 reads a
-    voxel, not 27, read in order (the frog's box: 0.25 -> 0.07 s)."""
+    voxel, not 27, read in order (the frog's box: 0.25 -> 0.07 s). ``busy[z, y]``: row (y, z) or one of its 8
+    neighbour rows holds body (rig/_table_kernels.busy_rows); the others are outside, as are all their
+    neighbours, so all their bits are known: UNIFORM and FAR, and both steps (the frog's box is 96 % empty:
+    38 -> 1x ms)."""
     nx, ny, nz = labels.shape
     for z in numba.prange(nz):  # the row: x - 1 and x + 1 hold its label
         for y in range(ny):
+            if not busy[z, y]:
+                for x in range(nx):
+                    out[x, y, z] = 16 | 32 | 1 | 8
+                continue
             for x in range(nx):
                 v = labels[x, y, z]
                 if _at(labels, x - 1, y, z, nx, ny, nz) == v and _at(labels, x + 1, y, z, nx, ny, nz) == v:
                     out[x, y, z] = 16
     for z in numba.prange(nz):  # the slice's 3x3: the rows above and below alike, their neighbours too
         for y in range(ny):
+            if not busy[z, y]:
+                continue
             for x in range(nx):
                 v = labels[x, y, z]
                 same = out[x, y, z] & 16 != 0
@@ -343,6 +301,8 @@ def voxel_flags(labels, out):
                     out[x, y, z] |= 32
     for z in numba.prange(nz):  # the 3x3x3: the slices before and after alike; then the face bits
         for y in range(ny):
+            if not busy[z, y]:
+                continue
             for x in range(nx):
                 v = labels[x, y, z]
                 same = out[x, y, z] & 32 != 0
@@ -371,46 +331,3 @@ def voxel_flags(labels, out):
         for y in range(ny):
             for x in range(nx):
                 out[x, y, z] &= 15
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def bone_cells(labels, size, n_bones):
-    """Which ``size``-cubes of ``labels`` ``[x, y, z]`` hold a voxel of each label: ``(starts (n_bones + 1,),
-    cells (N, 3) int32)``, label l's cubes (their lower corner / size) at ``cells[starts[l - 1]:starts[l]]``,
-    in z, y, x order. Two parallel passes over the layers of cubes: count, then fill."""
-    nx, ny, nz = labels.shape
-    cx, cy, cz = -(-nx // size), -(-ny // size), -(-nz // size)
-    count = np.zeros((cz + 1, n_bones + 1), np.int64)  # count[kz + 1, l]: layer kz's cubes of label l
-    starts = np.zeros(n_bones + 1, np.int64)
-    cells = np.empty((0, 3), np.int32)
-    for fill in range(2):
-        if fill:
-            for v in range(1, n_bones + 1):  # label by label, layer by layer: each layer's first row
-                starts[v] = starts[v - 1] + count[:, v].sum()
-                at = starts[v - 1]
-                for kz in range(cz + 1):  # row kz: after every layer before kz (held in rows 1 .. kz)
-                    at += count[kz, v]
-                    count[kz, v] = at
-            cells = np.empty((starts[-1], 3), np.int32)
-        for kz in numba.prange(cz):
-            seen = np.zeros(n_bones + 1, np.bool_)
-            found = np.empty(n_bones + 1, np.int64)
-            mine = count[kz] if fill else count[kz + 1]
-            for ky in range(cy):
-                for kx in range(cx):
-                    nf = 0
-                    for z in range(kz * size, min(nz, kz * size + size)):
-                        for y in range(ky * size, min(ny, ky * size + size)):
-                            for x in range(kx * size, min(nx, kx * size + size)):
-                                v = labels[x, y, z]
-                                if v != 0 and v <= n_bones and not seen[v]:
-                                    seen[v] = True
-                                    found[nf] = v
-                                    nf += 1
-                    for i in range(nf):
-                        v = found[i]
-                        seen[v] = False
-                        if fill:
-                            cells[mine[v], 0], cells[mine[v], 1], cells[mine[v], 2] = kx, ky, kz
-                        mine[v] += 1
-    return starts, cells

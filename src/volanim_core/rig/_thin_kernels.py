@@ -1,50 +1,14 @@
 """Numba kernels of the thin flesh a turned bone pushes forward (rig/ownership.py's thin() and diagonals(),
 read by reconstruct/_owned_kernels.splat_turned).
 
-    flagged_voxels(labels, flags, bit, n_bones)
-        each bone's voxels whose flags have a bit (THIN): (starts, voxels), bone by bone
+    (each bone's thin voxels: rig/_table_kernels.flagged_voxels, on the labels' runs)
     diagonal_bits(labels, flags, thin, voxels, diagonals, out)
         per such voxel, the edge and corner neighbours whose midpoint the splat pushes too
 """
 
 from __future__ import annotations
 
-import numpy as np
-from numba import njit, prange
-
-
-@njit(cache=True, nogil=True, parallel=True)
-def flagged_voxels(labels, flags, bit, n_bones):
-    """Each label's voxels whose ``flags`` have ``bit``: ``(starts (n_bones + 1,), voxels (N, 3) int32)``, label
-    l's at ``voxels[starts[l - 1]:starts[l]]``, in the labels' order. Slices in parallel, twice: each slice's
-    count of each label, then each slice writes its voxels after the slices before it (the same order as one
-    pass: mannequin-large's 31 -> 13 ms, the frog's 48 -> 20)."""
-    nx, ny, nz = labels.shape
-    count = np.zeros((nz, n_bones + 1), np.int64)  # count[z, l]: slice z's voxels of label l
-    for z in prange(nz):
-        for y in range(ny):
-            for x in range(nx):
-                v = labels[x, y, z]
-                if v != 0 and v <= n_bones and flags[x, y, z] & bit:
-                    count[z, v] += 1
-    starts = np.zeros(n_bones + 1, np.int64)
-    first = np.zeros((nz, n_bones + 1), np.int64)  # first[z, l]: where slice z's voxels of label l begin
-    for v in range(1, n_bones + 1):  # label by label, slice by slice
-        at = starts[v - 1]
-        for z in range(nz):
-            first[z, v] = at
-            at += count[z, v]
-        starts[v] = at
-    voxels = np.empty((starts[-1], 3), np.int32)
-    for z in prange(nz):
-        at = first[z].copy()
-        for y in range(ny):
-            for x in range(nx):
-                v = labels[x, y, z]
-                if v != 0 and v <= n_bones and flags[x, y, z] & bit:
-                    voxels[at[v], 0], voxels[at[v], 1], voxels[at[v], 2] = x, y, z
-                    at[v] += 1
-    return starts, voxels
+from numba import njit
 
 
 @njit(cache=True, nogil=True)

@@ -35,20 +35,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from volanim_core._run_kernels import run_values, runs
 from volanim_core.geometry import IDENTITY, Geometry
 from volanim_core.rig._hull_kernels import hull_ends
 from volanim_core.rig._ownership_kernels import (
     TUBE_COLUMNS,
-    bone_cells,
     own_by_tubes,
     pool_labels,
-    row_spans,
     section_moments,
     voxel_flags,
 )
-from volanim_core.rig._thin_kernels import diagonal_bits, flagged_voxels
+from volanim_core.rig._table_kernels import bone_cells, busy_rows, flagged_voxels, row_spans
+from volanim_core.rig._thin_kernels import diagonal_bits
 from volanim_core.rig.connectivity import BoneSegment, Connectivity
-from volanim_core.rig.specks import join_specks
+from volanim_core.rig.specks import speck_runs
 from volanim_core.volume import tight_bounds
 
 SECTION_VOXELS = 64_000_000  # the lattice the cross-sections' moments are gathered on
@@ -92,6 +92,7 @@ class Ownership:
     _cells: tuple | None = field(default=None, repr=False)
     _thin: tuple | None = field(default=None, repr=False)
     _diagonals: np.ndarray | None = field(default=None, repr=False)
+    _runs: tuple | None = field(default=None, repr=False)
 
     def __post_init__(self):
         self.origin = tuple(int(v) for v in self.origin)
@@ -128,13 +129,24 @@ class Ownership:
             self._hulls = hulls
         return self._hulls
 
+    def runs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(first, x0, x1, value)``: the runs of one label each along x of every row of :attr:`labels` (row
+        ``z * Y + y``; volanim_core/_run_kernels.runs), made once (ownership() keeps the ones its specks read).
+        The tables :meth:`spans` and :meth:`cells` are made from them, not from every voxel of the box."""
+        if self._runs is None:
+            zyx = np.ascontiguousarray(self.labels.T)
+            first, x0, x1 = runs(zyx, True)
+            self._runs = (first, x0, x1, run_values(zyx, first, x0))
+        return self._runs
+
     def spans(self) -> np.ndarray:
         """``(B, Y, Z, 2)`` int32: each bone's first and last x on each row of :attr:`labels` (x1 < x0: none),
         so a bone moved by whole voxels reads only its own stretch of each row."""
         if self._spans is None:
             spans = np.empty((len(self.bones), *self.labels.shape[1:], 2), np.int32)
             spans[..., 0], spans[..., 1] = 1, 0
-            row_spans(self.labels, spans)
+            first, x0, x1, value = self.runs()
+            row_spans(first, x0, x1, value, self.labels.shape[1], spans)
             self._spans = spans
         return self._spans
 
@@ -147,7 +159,7 @@ class Ownership:
         if self._flags is None:
             # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
             flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")
-            voxel_flags(self.labels, flags)
+            voxel_flags(self.labels, busy_rows(self.runs()[0], *self.labels.shape[1:]), flags)
             self._flags = flags
         return self._flags
 
@@ -156,14 +168,14 @@ class Ownership:
         cubes (lower corner / CELL) at ``cells[starts[b]:starts[b + 1]]``. A turned bone's cubes, moved, say which
         output cubes its reads can find it in (reconstruct/owned.py): a frog leg's row holds the other leg too."""
         if self._cells is None:
-            self._cells = bone_cells(self.labels, CELL, len(self.bones))
+            self._cells = bone_cells(*self.runs(), np.array(self.labels.shape, np.int64), CELL, len(self.bones))
         return self._cells
 
     def thin(self) -> tuple[np.ndarray, np.ndarray]:
         """Each bone's thin voxels (:meth:`flags` bit 2), made once: ``(starts (B + 1,), voxels (N, 3))`` as
         :meth:`cells`. A turned bone pushes these forward too (reconstruct/_owned_kernels.splat_turned)."""
         if self._thin is None:
-            self._thin = flagged_voxels(self.labels, self.flags(), THIN, len(self.bones))
+            self._thin = flagged_voxels(*self.runs(), self.flags(), THIN, len(self.bones), self.labels.shape[1])
         return self._thin
 
     def diagonals(self) -> np.ndarray:
@@ -316,9 +328,10 @@ def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None
     labels = np.zeros(box.shape, label_dtype(len(conn.bones)), order="F")
     tubes = tube_rows(a, ab, radii, cross_sections(box, lo, tube_rows(a, ab, radii, [None] * len(a))))
     own_by_tubes(box, lo.astype(np.float64), tubes, _yields(conn.bones), tube_boxes(tubes, lo), labels)
-    join_specks(labels, len(a))
+    runs_after = speck_runs(labels, len(a))[1]
     balls = np.array([_ball_inside(box, s.proximal - lo) for s in conn.bones])
-    return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes)
+    return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes,
+                     _runs=runs_after)
 
 
 def _meets(bones: list[BoneSegment]) -> np.ndarray:

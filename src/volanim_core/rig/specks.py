@@ -1,24 +1,28 @@
 """Specks of a bone's flesh cut off inside another's, given to the flesh around them: ownership's last step.
 
     labels [x, y, z] (1 + bone, 0 outside)
-        --cc3d (26-connected pieces of each label, once)--> pieces
-        --_ownership_kernels.piece_stats (one pass: each piece's label, size, box)--> each bone's largest piece
-          its main one, the others specks
-        --_ownership_kernels.speck_rings (each speck's ring: the pieces of the voxels around it, counted)-->
+        --_run_kernels.label_runs (the rows' runs of one label, 26-connected pieces of each label, once)-->
+        --_speck_kernels.piece_boxes (each piece's label, size, box)--> each bone's largest piece its main
+          one, the others specks
+        --_speck_kernels.speck_rings (each speck's ring on its box painted from the runs: the pieces of the
+          voxels around it, counted)-->
         --rounds on the pieces' graph (union-find: a speck that joins a bone merges with the pieces of
           that bone it touches)--> each speck's new bone
-        --> labels, each speck relabelled in its box
+        --_speck_kernels.relabel_runs--> labels, each speck's runs relabelled
 
 Why a graph and not rounds on the volume: a speck that touches only other specks can only join once they
 have; labelling the whole volume's pieces again for each such round cost the frog 0.7 s (three passes of
-cc3d over 27 M voxels) where a skeletonize takes 0.4. The pieces' graph is a few hundred nodes.
+cc3d over 27 M voxels) where a skeletonize takes 0.4. The pieces' graph is a few hundred nodes. Why runs and
+not cc3d's grid of pieces: the frog's box is 96 % empty; labelling every voxel into a 108 MB grid and reading it
+again cost 0.10-0.24 s of its ownership, the runs 0.0x s (rig/_speck_kernels.py).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from volanim_core.rig._ownership_kernels import piece_stats, speck_rings
+from volanim_core._run_kernels import label_runs, run_values
+from volanim_core.rig._speck_kernels import paint_box, piece_boxes, relabel_runs, speck_rings
 
 
 def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
@@ -33,32 +37,40 @@ def join_specks(labels: np.ndarray, n_bones: int, rounds: int = 8) -> int:
     have joined; when no speck can join a main piece, each speck none of whose neighbours changed this round
     takes the bone most of its other-bone neighbours have.
     """
-    import cc3d
+    return speck_runs(labels, n_bones, rounds)[0]
 
-    # one piece dtype whatever the volume's size: the kernels compile once (the warm-up's)
-    pieces, n = cc3d.connected_components(labels, connectivity=26, out_dtype=np.uint32, return_N=True)
-    bone, sizes = np.zeros(n + 1, np.int64), np.zeros(n + 1, np.int64)
-    boxes_all = np.empty((n + 1, 6), np.int64)
-    boxes_all[:, :3], boxes_all[:, 3:] = np.iinfo(np.int64).max, -1
-    piece_stats(pieces, labels, bone, sizes, boxes_all)
+
+def speck_runs(labels: np.ndarray, n_bones: int, rounds: int = 8) -> tuple[int, tuple]:
+    """:func:`join_specks`, and the labels' runs it read, as they are after: ``(moved, (first, x0, x1, value))``
+    (volanim_core/_run_kernels.runs ``by_value`` over ``labels.T``; a run's value is its label). The tables
+    every posed frame reads are made from them (rig/_table_kernels.py)."""
+    zyx = labels.T  # rows along x: labels [x, y, z] are laid out x fastest (Fortran), so this view is C-ordered
+    first, x0, x1, pieces, n = label_runs(zyx, True)
+    ny = zyx.shape[1]
+    value = run_values(zyx, first, x0)
+    bone, sizes, boxes_all = piece_boxes(first, x0, x1, pieces, value, n, ny)
     main, has = np.zeros(len(sizes), bool), np.zeros(n_bones + 1, bool)
     for piece in np.argsort(sizes, kind="stable")[::-1]:  # each bone's first piece seen is its largest
         if piece and bone[piece] and not has[bone[piece]]:
             main[piece] = has[bone[piece]] = True
     specks = np.flatnonzero((bone > 0) & ~main)
     if not len(specks):
-        return 0
-    boxes = np.ascontiguousarray(boxes_all[specks])
-    starts, ring = speck_rings(pieces, specks.astype(np.int64), boxes)
-    near = [np.unique(ring[starts[k]:starts[k + 1]], return_counts=True) for k in range(len(specks))]
+        return 0, (first, x0, x1, value)
+    near = [_ring(first, x0, x1, pieces, ny, labels.shape, piece, boxes_all[piece]) for piece in specks]
     new = _rounds(specks, near, bone.copy(), main, rounds)
-    moved = 0
-    for k, piece in enumerate(specks):
-        if new[piece] != bone[piece]:
-            box = tuple(slice(int(a), int(b)) for a, b in zip(boxes[k, :3], boxes[k, 3:]))
-            labels[box][pieces[box] == piece] = new[piece]
-            moved += int(sizes[piece])
-    return moved
+    changed = np.where(new != bone, new, 0)
+    changed[0] = 0
+    return int(relabel_runs(zyx, first, x0, x1, pieces, changed, value)), (first, x0, x1, value)
+
+
+def _ring(first, x0, x1, pieces, ny, shape, piece: int, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Speck ``piece``'s ring (the pieces of the voxels 26-next to it, and how many of each), read on its box and
+    a voxel around it (within the grid), painted from the runs."""
+    lo = np.maximum(box[:3] - 1, 0)
+    hi = np.minimum(box[3:] + 1, shape)
+    grid = paint_box(first, x0, x1, pieces, ny, lo, hi)
+    starts, ring = speck_rings(grid, np.array([piece], np.int64), (box - np.tile(lo, 2)).reshape(1, 6))
+    return np.unique(ring, return_counts=True)
 
 
 def _rounds(specks: np.ndarray, near: list, bone: np.ndarray, main: np.ndarray, rounds: int) -> np.ndarray:

@@ -5,22 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy import ndimage
+from tests import naive
 
 from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct import breakage
 from volanim_core.reconstruct.shape import piece_count
 
 SHAPES = [(1, 1, 1), (1, 1, 6), (3, 1, 7), (1, 9, 1), (5, 6, 7), (20, 20, 20), (7, 30, 2), (33, 17, 29)]
-
-
-def paint(shape, first, x0, x1, piece) -> np.ndarray:
-    """The label grid the runs describe (the tests' own, plain loop)."""
-    out = np.zeros(shape, np.int64)
-    for row in range(len(first) - 1):
-        z, y = divmod(row, shape[1])
-        for r in range(first[row], first[row + 1]):
-            out[z, y, x0[r]:x1[r] + 1] = piece[r]
-    return out
 
 
 def noise(shape, density, seed):
@@ -35,7 +26,7 @@ def test_pieces_are_scipys_26_connected_labels_in_the_same_order(shape, density)
     first, x0, x1, piece, n = L.label_runs(zyx)
     want, m = ndimage.label(zyx, structure=np.ones((3, 3, 3), bool))
     assert n == m
-    assert np.array_equal(paint(shape, first, x0, x1, piece), want)
+    assert np.array_equal(naive.paint_runs(shape, first, x0, x1, piece), want)
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -59,7 +50,7 @@ def test_runs_that_touch_only_by_a_corner_or_an_edge_join():
     zyx[0, 3, 4] = 1  # a corner of (1, 2, 5), in a row scanned before it: joins the second
     first, x0, x1, piece, n = L.label_runs(zyx)
     want, m = ndimage.label(zyx, structure=np.ones((3, 3, 3), bool))
-    assert n == m == 2 and np.array_equal(paint(zyx.shape, first, x0, x1, piece), want)
+    assert n == m == 2 and np.array_equal(naive.paint_runs(zyx.shape, first, x0, x1, piece), want)
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -71,7 +62,7 @@ def test_runs_by_value_are_the_longest_runs_of_one_label(shape, density):
     zyx //= 50  # few labels, so neighbours often share one
     first, x0, x1 = L.runs(zyx, True)
     value = L.run_values(zyx, first, x0)
-    assert np.array_equal(paint(shape, first, x0, x1, value), zyx)
+    assert np.array_equal(naive.paint_runs(shape, first, x0, x1, value), zyx)
     for row in range(len(first) - 1):
         z, y = divmod(row, shape[1])
         for r in range(first[row], first[row + 1]):
@@ -79,14 +70,15 @@ def test_runs_by_value_are_the_longest_runs_of_one_label(shape, density):
             if r + 1 < first[row + 1]:
                 assert x0[r + 1] > x1[r] + 1 or value[r + 1] != value[r]
     plain = L.runs(zyx)  # without by_value: runs of non-zero voxels, whatever their values
-    assert np.array_equal(paint(shape, *plain, np.ones(len(plain[1]), np.int64)), (zyx != 0).astype(np.int64))
+    ones = np.ones(len(plain[1]), np.int64)
+    assert np.array_equal(naive.paint_runs(shape, *plain, ones), (zyx != 0).astype(np.int64))
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_counts_centroid_sums_voxels_and_boundary_of_every_piece(seed):
     zyx = noise((14, 16, 18), 0.3, seed)
     first, x0, x1, piece, n = L.label_runs(zyx)
-    labels = paint(zyx.shape, first, x0, x1, piece)
+    labels = naive.paint_runs(zyx.shape, first, x0, x1, piece)
     counts, sums = L.piece_stats(first, x0, x1, piece, n, zyx.shape[1])
     assert counts.tolist() == [0, *np.bincount(labels.ravel(), minlength=n + 1)[1:].tolist()]
     for k in range(1, n + 1):
