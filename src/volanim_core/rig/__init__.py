@@ -9,8 +9,10 @@
     ownership.py .... which bone owns each rest voxel (the rig's label volume): tubes fitted to each bone's
                       middle, each voxel to the tube that holds it deepest (_ownership_kernels.py); the
                       thin flesh a turned bone pushes forward (_thin_kernels.py); each bone's hull
-                      from its slices' outlines (_hull_kernels.py);
-                      specks.py gives a speck of one bone inside another's flesh to the flesh around it;
+                      from its slices' outlines (_hull_kernels.py); the tables a posed frame reads, made
+                      from the labels' runs (_table_kernels.py);
+                      specks.py gives a speck of one bone inside another's flesh to the flesh around it
+                      (_speck_kernels.py);
                       reach.py names flesh that hangs from the body only through another limb's
     symmetry.py ..... one side's attachments mirrored to the other (L_/R_ names)
     autorig.py ...... propose bones from the skeleton: curve_skeleton.py (the tree), tree_walks.py (its

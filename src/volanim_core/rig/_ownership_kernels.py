@@ -271,7 +271,7 @@ def voxel_flags(labels, busy, out):
     voxel, not 27, read in order (the frog's box: 0.25 -> 0.07 s). ``busy[z, y]``: row (y, z) or one of its 8
     neighbour rows holds body (rig/_table_kernels.busy_rows); the others are outside, as are all their
     neighbours, so all their bits are known: UNIFORM and FAR, and both steps (the frog's box is 96 % empty:
-    38 -> 1x ms)."""
+    38 -> 25 ms)."""
     nx, ny, nz = labels.shape
     for z in numba.prange(nz):  # the row: x - 1 and x + 1 hold its label
         for y in range(ny):

@@ -14,7 +14,7 @@ Why a graph and not rounds on the volume: a speck that touches only other specks
 have; labelling the whole volume's pieces again for each such round cost the frog 0.7 s (three passes of
 cc3d over 27 M voxels) where a skeletonize takes 0.4. The pieces' graph is a few hundred nodes. Why runs and
 not cc3d's grid of pieces: the frog's box is 96 % empty; labelling every voxel into a 108 MB grid and reading it
-again cost 0.10-0.24 s of its ownership, the runs 0.0x s (rig/_speck_kernels.py).
+again cost 0.10-0.24 s of its ownership, the runs 0.04 s (rig/_speck_kernels.py).
 """
 
 from __future__ import annotations
