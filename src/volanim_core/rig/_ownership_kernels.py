@@ -73,6 +73,17 @@ def tube_depth(tube, px, py, pz, yields):
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _in_slice(reach, z, near):
+    """The bones whose reach holds slice z, into ``near``; returns how many."""
+    m = 0
+    for b in range(reach.shape[0]):
+        if reach[b, 4] <= z <= reach[b, 5]:
+            near[m] = b
+            m += 1
+    return m
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _near(reach, z, y, near, m, row):
     """Of the ``m`` bones ``near[:m]`` (whose reach holds slice z), those whose reach holds row y too, into
     ``row``; returns how many."""
@@ -86,45 +97,43 @@ def _near(reach, z, y, near, m, row):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def own_by_tubes(mask, lo, tubes, yields, reach, out):
+def own_by_tubes(mask, lo, tubes, yields, reach, out, threads):
     """``out[x, y, z]`` = 1 + the bone whose tube holds mask voxel ``(x, y, z) + lo`` deepest, in voxels (the
     least :func:`tube_depth`); 0 outside the mask. ``reach[b]``: ``x0 x1 y0 y1 z0 z1``, the box (of ``mask``'s
     indices) bone b's tube can hold a voxel in: a bone is measured only where it can hold the voxel, and a
-    voxel no tube holds is measured against every bone (the same owners as measuring every bone everywhere)."""
+    voxel no tube holds is measured against every bone (the same owners as measuring every bone everywhere).
+    ``threads``: numba's (the slices dealt round them)."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
-    for z in numba.prange(nz):
-        near = np.empty(nb, np.int64)
-        row = np.empty(nb, np.int64)
-        m = 0
-        for b in range(nb):
-            if reach[b, 4] <= z <= reach[b, 5]:
-                near[m] = b
-                m += 1
-        for y in range(ny):
-            k = _near(reach, z, y, near, m, row)
-            for x in range(nx):
-                if not mask[x, y, z]:
-                    continue
-                px, py, pz = x + lo[0], y + lo[1], z + lo[2]
-                best, who = np.inf, 0
-                for i in range(k):
-                    b = row[i]
-                    if x < reach[b, 0] or x > reach[b, 1]:
+    # slices dealt round the threads: a body's halves differ (mannequin-large standing: its legs below)
+    for t in numba.prange(threads):
+        for z in range(t, nz, threads):
+            near, row = np.empty(nb, np.int64), np.empty(nb, np.int64)
+            m = _in_slice(reach, z, near)
+            for y in range(ny):
+                k = _near(reach, z, y, near, m, row)
+                for x in range(nx):
+                    if not mask[x, y, z]:
                         continue
-                    d = tube_depth(tubes[b], px, py, pz, yields[b])
-                    if d < best:
-                        best, who = d, b + 1
-                if best >= 0.0:  # held by no tube near (or only by a round end that yields): the nearest of all
-                    for b in range(nb):
+                    px, py, pz = x + lo[0], y + lo[1], z + lo[2]
+                    best, who = np.inf, 0
+                    for i in range(k):
+                        b = row[i]
+                        if x < reach[b, 0] or x > reach[b, 1]:
+                            continue
                         d = tube_depth(tubes[b], px, py, pz, yields[b])
                         if d < best:
                             best, who = d, b + 1
-                out[x, y, z] = who
+                    if best >= 0.0:  # held by no tube near (or only by a round end that yields): the nearest of all
+                        for b in range(nb):
+                            d = tube_depth(tubes[b], px, py, pz, yields[b])
+                            if d < best:
+                                best, who = d, b + 1
+                    out[x, y, z] = who
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def section_moments(mask, lo, tubes, reach, step, sums):
+def section_moments(mask, lo, tubes, reach, step, sums, threads):
     """For the mask voxels on a lattice of ``step`` voxels: the bone whose tube holds each deepest relative to
     its size (the least :func:`tube_distance`) and, where it lies in the middle of that bone (0.3 < t < 0.7),
     its offset v from the bone's segment into ``sums[b]``: count, the sums of v (3) and of v v^T (xx xy xz yy
@@ -134,53 +143,49 @@ def section_moments(mask, lo, tubes, reach, step, sums):
     nb = tubes.shape[0]
     zs = np.arange(0, nz, step)
     per = np.zeros((len(zs), nb, 10))
-    for k in numba.prange(len(zs)):
-        z = zs[k]
-        near = np.empty(nb, np.int64)
-        row = np.empty(nb, np.int64)
-        m = 0
-        for b in range(nb):
-            if reach[b, 4] <= z <= reach[b, 5]:
-                near[m] = b
-                m += 1
-        for y in range(0, ny, step):
-            n = _near(reach, z, y, near, m, row)
-            for x in range(0, nx, step):
-                if not mask[x, y, z]:
-                    continue
-                px, py, pz = x + lo[0], y + lo[1], z + lo[2]
-                best, who = np.inf, -1
-                for i in range(n):
-                    b = row[i]
-                    if x < reach[b, 0] or x > reach[b, 1]:
+    for t in numba.prange(threads):  # slices dealt round the threads, as own_by_tubes'
+        for k in range(t, len(zs), threads):
+            z = zs[k]
+            near, row = np.empty(nb, np.int64), np.empty(nb, np.int64)
+            m = _in_slice(reach, z, near)
+            for y in range(0, ny, step):
+                n = _near(reach, z, y, near, m, row)
+                for x in range(0, nx, step):
+                    if not mask[x, y, z]:
                         continue
-                    d = tube_distance(tubes[b], px, py, pz)
-                    if d < best:
-                        best, who = d, b
-                if best >= 1.0:  # held by no tube near: the relatively nearest of all
-                    for b in range(nb):
+                    px, py, pz = x + lo[0], y + lo[1], z + lo[2]
+                    best, who = np.inf, -1
+                    for i in range(n):
+                        b = row[i]
+                        if x < reach[b, 0] or x > reach[b, 1]:
+                            continue
                         d = tube_distance(tubes[b], px, py, pz)
                         if d < best:
                             best, who = d, b
-                if who < 0:
-                    continue
-                tube = tubes[who]
-                dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
-                t = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
-                if t <= 0.3 or t >= 0.7:
-                    continue
-                vx, vy, vz = dx - t * tube[3], dy - t * tube[4], dz - t * tube[5]
-                s = per[k, who]
-                s[0] += 1.0
-                s[1] += vx
-                s[2] += vy
-                s[3] += vz
-                s[4] += vx * vx
-                s[5] += vx * vy
-                s[6] += vx * vz
-                s[7] += vy * vy
-                s[8] += vy * vz
-                s[9] += vz * vz
+                    if best >= 1.0:  # held by no tube near: the relatively nearest of all
+                        for b in range(nb):
+                            d = tube_distance(tubes[b], px, py, pz)
+                            if d < best:
+                                best, who = d, b
+                    if who < 0:
+                        continue
+                    tube = tubes[who]
+                    dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
+                    t = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
+                    if t <= 0.3 or t >= 0.7:
+                        continue
+                    vx, vy, vz = dx - t * tube[3], dy - t * tube[4], dz - t * tube[5]
+                    s = per[k, who]
+                    s[0] += 1.0
+                    s[1] += vx
+                    s[2] += vy
+                    s[3] += vz
+                    s[4] += vx * vx
+                    s[5] += vx * vy
+                    s[6] += vx * vz
+                    s[7] += vy * vy
+                    s[8] += vy * vz
+                    s[9] += vz * vz
     for k in range(len(zs)):
         sums += per[k]
 
@@ -331,3 +336,17 @@ def voxel_flags(labels, busy, out):
         for y in range(ny):
             for x in range(nx):
                 out[x, y, z] &= 15
+
+
+@njit(cache=True, nogil=True)
+def nearest_outside(box, px, py, pz, r):
+    """The least squared distance from voxel ``p`` to a voxel of ``box`` (``[x, y, z]`` bool) that is not set,
+    within ``r`` of it on every axis (inside the array); inf where there is none."""
+    nx, ny, nz = box.shape
+    best = np.inf
+    for z in range(max(0, pz - r), min(nz, pz + r + 1)):
+        for y in range(max(0, py - r), min(ny, py + r + 1)):
+            for x in range(max(0, px - r), min(nx, px + r + 1)):
+                if not box[x, y, z]:
+                    best = min(best, float((x - px) ** 2 + (y - py) ** 2 + (z - pz) ** 2))
+    return best

@@ -121,12 +121,12 @@ def test_a_bone_measured_only_in_its_tube_s_box_gives_the_owners_measuring_every
         boxes = tube_boxes(tubes, lo)
         assert (boxes[:, 1::2] - boxes[:, ::2] < np.array(box.shape)).any()  # the boxes do leave voxels out
         moments = [np.zeros((len(a), 10)) for _ in range(2)]
-        for reach, sums in zip((boxes, everywhere), moments):
-            section_moments(box, lo.astype(np.float64), tubes, reach, 1, sums)
+        for reach, sums, threads in zip((boxes, everywhere), moments, (2, 1)):  # nor do the threads matter
+            section_moments(box, lo.astype(np.float64), tubes, reach, 1, sums, threads)
         assert np.array_equal(*moments)
     labels = [np.zeros(box.shape, np.uint8, order="F") for _ in range(2)]
-    for reach, out in zip((tube_boxes(own.tubes, lo), everywhere), labels):
-        own_by_tubes(box, lo.astype(np.float64), own.tubes, _yields(conn.bones), reach, out)
+    for reach, out, threads in zip((tube_boxes(own.tubes, lo), everywhere), labels, (2, 1)):
+        own_by_tubes(box, lo.astype(np.float64), own.tubes, _yields(conn.bones), reach, out, threads)
     assert np.array_equal(*labels) and (labels[0] > 0).sum() == box.sum()
 
 
@@ -174,6 +174,6 @@ def test_flesh_a_round_end_that_yields_holds_stays_with_it_not_with_a_thin_tube_
     for p in (jaw, by_tip):
         mask[tuple((p - lo).astype(int))] = True
     out = np.zeros(mask.shape, np.uint8, order="F")
-    own_by_tubes(mask, lo, tubes, _yields(bones), tube_boxes(tubes, lo), out)
+    own_by_tubes(mask, lo, tubes, _yields(bones), tube_boxes(tubes, lo), out, 1)
     assert out[tuple((jaw - lo).astype(int))] == 1  # the head's yielding end, not the tip 32 of its sizes away
     assert out[tuple((by_tip - lo).astype(int))] == 3  # held by none: the nearest surface, the tip's
