@@ -114,6 +114,15 @@ def warp_owners(labels, flags, spans, rest_lo, inv, shifts, turned, marks, cell,
     return reads.sum(), wrote.sum()
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def zeroed(out):
+    """``out`` (``[z, y, x]``, fresh from np.empty) set to 0, slices in parallel: its pages are first touched here,
+    by both threads, not one by one inside the warp."""
+    for z in numba.prange(out.shape[0]):
+        out[z] = 0
+    return out
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _take(out, claims, z, y, x, bone1, count):
     """Output voxel ``(z, y, x)`` to label ``bone1`` where no bone has it; in hotspot mode (``count``) one claim

@@ -112,7 +112,7 @@ def reconstruct_owned(
     lo = np.asarray(grid.lo, np.int64)
     nx, ny, nz = grid.shape
     n_bones = len(own.bones)
-    owner = np.zeros((nz, ny, nx), own.labels.dtype)
+    owner = K.zeroed(np.empty((nz, ny, nx), own.labels.dtype))
     count = mode == "hotspot"
     claims = np.zeros((nz, ny, nx) if count else (1, 1, 1), np.uint16)
     row_lo = np.full((nz, ny), nx, np.int32)
