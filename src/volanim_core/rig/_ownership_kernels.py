@@ -84,24 +84,69 @@ def _in_slice(reach, z, near):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _near(reach, z, y, near, m, row):
-    """Of the ``m`` bones ``near[:m]`` (whose reach holds slice z), those whose reach holds row y too, into
-    ``row``; returns how many."""
+def _row_stretch(tube, r, py, pz, lox):
+    """The x stretch ``(x0, x1)`` (indices of a grid whose voxel 0 lies at x = ``lox``; x0 > x1: none) of the
+    row ``(py, pz)`` that lies within ``r`` of the tube's segment (the capsule its reach bounds), a voxel wider
+    each way: the distance to a segment is convex along a line, so it is one stretch, the hull of the row's
+    stretches in the balls at both ends and in the cylinder between them. ``r`` inf: the whole row."""
+    lo, hi = np.inf, -np.inf
+    for end in range(2):  # the balls at both ends
+        ex, ey, ez = tube[0] + end * tube[3], tube[1] + end * tube[4], tube[2] + end * tube[5]
+        h = r * r - (py - ey) ** 2 - (pz - ez) ** 2
+        if h >= 0.0:
+            lo, hi = min(lo, ex - math.sqrt(h)), max(hi, ex + math.sqrt(h))
+    length2 = tube[3] * tube[3] + tube[4] * tube[4] + tube[5] * tube[5]
+    if length2 > 0.0:  # the cylinder: x' = x - a_x with 0 <= (p - a).u <= |ab| and the rest of p - a within r
+        length = math.sqrt(length2)
+        ux, uy, uz = tube[3] / length, tube[4] / length, tube[5] / length
+        dy, dz = py - tube[1], pz - tube[2]
+        cu = dy * uy + dz * uz
+        t0, t1 = -np.inf, np.inf  # the slab between the joints
+        if abs(ux) > 1e-12:
+            t0, t1 = min(-cu / ux, (length - cu) / ux), max(-cu / ux, (length - cu) / ux)
+        elif cu < 0.0 or cu > length:
+            t0, t1 = np.inf, -np.inf
+        a2, bq, cc = 1.0 - ux * ux, -ux * cu, dy * dy + dz * dz - cu * cu - r * r  # a2 x'^2 + 2 bq x' + cc <= 0
+        if a2 > 1e-12:
+            disc = bq * bq - a2 * cc
+            if disc >= 0.0:
+                t0, t1 = max(t0, (-bq - math.sqrt(disc)) / a2), min(t1, (-bq + math.sqrt(disc)) / a2)
+            else:
+                t0, t1 = np.inf, -np.inf
+        elif cc > 0.0:  # along x: the row is the axis's parallel, farther than r
+            t0, t1 = np.inf, -np.inf
+        if t0 <= t1:
+            lo, hi = min(lo, tube[0] + t0), max(hi, tube[0] + t1)
+    if lo > hi:
+        return 1, 0
+    return int(math.floor(max(lo - lox, -2.0))) - 1, int(math.ceil(min(hi - lox, 1e15))) + 1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _near(reach, radius, tubes, lo, z, y, near, m, row, x0, x1):
+    """Of the ``m`` bones ``near[:m]`` (whose reach holds slice z), those whose reach holds some voxel of row
+    ``y``, into ``row``, with the stretch of the row each can hold a voxel in (``x0``, ``x1``: its box's and
+    :func:`_row_stretch`'s, ``radius`` its reach); returns how many. mannequin-large's voxels: 1.73 tubes
+    measured each by their boxes, 1.14 of them holding the voxel."""
     k = 0
     for i in range(m):
         b = near[i]
         if reach[b, 2] <= y <= reach[b, 3]:
-            row[k] = b
-            k += 1
+            s0, s1 = _row_stretch(tubes[b], radius[b], y + lo[1], z + lo[2], lo[0])
+            s0, s1 = max(s0, reach[b, 0]), min(s1, reach[b, 1])
+            if s0 <= s1:
+                row[k], x0[k], x1[k] = b, s0, s1
+                k += 1
     return k
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def own_by_tubes(mask, lo, tubes, yields, reach, out, threads):
+def own_by_tubes(mask, lo, tubes, yields, reach, radius, out, threads):
     """``out[x, y, z]`` = 1 + the bone whose tube holds mask voxel ``(x, y, z) + lo`` deepest, in voxels (the
     least :func:`tube_depth`); 0 outside the mask. ``reach[b]``: ``x0 x1 y0 y1 z0 z1``, the box (of ``mask``'s
-    indices) bone b's tube can hold a voxel in: a bone is measured only where it can hold the voxel, and a
-    voxel no tube holds is measured against every bone (the same owners as measuring every bone everywhere).
+    indices) bone b's tube can hold a voxel in, and ``radius[b]`` how far from its segment (ownership.tube_reach;
+    inf: anywhere in its box): a bone is measured only where it can hold the voxel (:func:`_near`), and a voxel
+    no tube holds is measured against every bone (the same owners as measuring every bone everywhere).
     ``threads``: numba's (the slices dealt round them)."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
@@ -109,9 +154,10 @@ def own_by_tubes(mask, lo, tubes, yields, reach, out, threads):
     for t in numba.prange(threads):
         for z in range(t, nz, threads):
             near, row = np.empty(nb, np.int64), np.empty(nb, np.int64)
+            x0, x1 = np.empty(nb, np.int64), np.empty(nb, np.int64)
             m = _in_slice(reach, z, near)
             for y in range(ny):
-                k = _near(reach, z, y, near, m, row)
+                k = _near(reach, radius, tubes, lo, z, y, near, m, row, x0, x1)
                 for x in range(nx):
                     if not mask[x, y, z]:
                         continue
@@ -119,7 +165,7 @@ def own_by_tubes(mask, lo, tubes, yields, reach, out, threads):
                     best, who = np.inf, 0
                     for i in range(k):
                         b = row[i]
-                        if x < reach[b, 0] or x > reach[b, 1]:
+                        if x < x0[i] or x > x1[i]:
                             continue
                         d = tube_depth(tubes[b], px, py, pz, yields[b])
                         if d < best:
@@ -133,12 +179,12 @@ def own_by_tubes(mask, lo, tubes, yields, reach, out, threads):
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def section_moments(mask, lo, tubes, reach, step, sums, threads):
+def section_moments(mask, lo, tubes, reach, radius, step, sums, threads):
     """For the mask voxels on a lattice of ``step`` voxels: the bone whose tube holds each deepest relative to
     its size (the least :func:`tube_distance`) and, where it lies in the middle of that bone (0.3 < t < 0.7),
     its offset v from the bone's segment into ``sums[b]``: count, the sums of v (3) and of v v^T (xx xy xz yy
-    yz zz). ``reach`` as :func:`own_by_tubes`'s. Slices in parallel, each into its own row, summed in order
-    after: the same sums whatever the threads."""
+    yz zz). ``reach``, ``radius`` as :func:`own_by_tubes`'s. Slices in parallel, each into its own row, summed in
+    order after: the same sums whatever the threads."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
     zs = np.arange(0, nz, step)
@@ -147,9 +193,10 @@ def section_moments(mask, lo, tubes, reach, step, sums, threads):
         for k in range(t, len(zs), threads):
             z = zs[k]
             near, row = np.empty(nb, np.int64), np.empty(nb, np.int64)
+            x0, x1 = np.empty(nb, np.int64), np.empty(nb, np.int64)
             m = _in_slice(reach, z, near)
             for y in range(0, ny, step):
-                n = _near(reach, z, y, near, m, row)
+                n = _near(reach, radius, tubes, lo, z, y, near, m, row, x0, x1)
                 for x in range(0, nx, step):
                     if not mask[x, y, z]:
                         continue
@@ -157,7 +204,7 @@ def section_moments(mask, lo, tubes, reach, step, sums, threads):
                     best, who = np.inf, -1
                     for i in range(n):
                         b = row[i]
-                        if x < reach[b, 0] or x > reach[b, 1]:
+                        if x < x0[i] or x > x1[i]:
                             continue
                         d = tube_distance(tubes[b], px, py, pz)
                         if d < best:
@@ -273,26 +320,24 @@ def voxel_flags(labels, busy, out):
 
     The 3x3x3 test axis by axis (bits 16 and 32 hold the steps): the row's two neighbours alike (16), then the
     3x3 of the slice (32: the rows above and below alike and 16), then the slices before and after: 13 reads a
-    voxel, not 27, read in order (the frog's box: 0.25 -> 0.07 s). ``busy[z, y]``: row (y, z) or one of its 8
-    neighbour rows holds body (rig/_table_kernels.busy_rows); the others are outside, as are all their
-    neighbours, so all their bits are known: UNIFORM and FAR, and both steps (the frog's box is 96 % empty:
-    38 -> 25 ms)."""
+    voxel, not 27, read in order (the frog's box: 0.25 -> 0.07 s). ``busy[z, y]``: the stretch ``lo..hi`` of row
+    (y, z) whose voxels are body or touch it (rig/_table_kernels.busy_extents); the rest of the row is outside, as
+    are all its neighbours, so all its bits are known: UNIFORM and FAR, and both steps (the frog's box is 96 %
+    empty: 38 -> 25 ms by whole rows; mannequin-large's rows are a third body, and its arms and legs apart)."""
     nx, ny, nz = labels.shape
     for z in numba.prange(nz):  # the row: x - 1 and x + 1 hold its label
         for y in range(ny):
-            if not busy[z, y]:
-                for x in range(nx):
-                    out[x, y, z] = 16 | 32 | 1 | 8
-                continue
+            lo, hi = busy[z, y, 0], busy[z, y, 1]
             for x in range(nx):
+                if x < lo or x > hi:
+                    out[x, y, z] = 16 | 32 | 1 | 8
+            for x in range(lo, hi + 1):
                 v = labels[x, y, z]
                 if _at(labels, x - 1, y, z, nx, ny, nz) == v and _at(labels, x + 1, y, z, nx, ny, nz) == v:
                     out[x, y, z] = 16
     for z in numba.prange(nz):  # the slice's 3x3: the rows above and below alike, their neighbours too
         for y in range(ny):
-            if not busy[z, y]:
-                continue
-            for x in range(nx):
+            for x in range(busy[z, y, 0], busy[z, y, 1] + 1):
                 v = labels[x, y, z]
                 same = out[x, y, z] & 16 != 0
                 for b in (y - 1, y + 1):
@@ -306,9 +351,7 @@ def voxel_flags(labels, busy, out):
                     out[x, y, z] |= 32
     for z in numba.prange(nz):  # the 3x3x3: the slices before and after alike; then the face bits
         for y in range(ny):
-            if not busy[z, y]:
-                continue
-            for x in range(nx):
+            for x in range(busy[z, y, 0], busy[z, y, 1] + 1):
                 v = labels[x, y, z]
                 same = out[x, y, z] & 32 != 0
                 for c in (z - 1, z + 1):

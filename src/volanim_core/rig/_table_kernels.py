@@ -2,7 +2,7 @@
 
     row_spans(first, x0, x1, value, ny, spans)    -> each bone's first and last x on each row
     bone_cells(first, x0, x1, value, shape, size, n_bones) -> each bone's cubes of ``size`` voxels a side
-    busy_rows(first, ny, nz)                      -> the rows that hold body or touch a row that does
+    busy_extents(first, x0, x1, ny, nz, nx)       -> the stretch of each row that holds body or touches it
     flagged_voxels(first, x0, x1, value, flags, bit, n_bones, ny) -> each bone's voxels whose flags have a bit
 
 The runs (volanim_core/_run_kernels.runs ``by_value``, over the ``[z, y, x]`` view of the labels ``[x, y, z]``:
@@ -89,16 +89,25 @@ def bone_cells(first, x0, x1, value, shape, size, n_bones):
 
 
 @njit(cache=True, nogil=True)
-def busy_rows(first, ny, nz):
-    """``(nz, ny)`` bool: row ``(y, z)`` or one of its 8 neighbour rows (y and z each one apart) holds a run."""
-    out = np.zeros((nz, ny), np.bool_)
+def busy_extents(first, x0, x1, ny, nz, nx):
+    """``(nz, ny, 2)`` int64: the x range ``lo..hi`` (inclusive; lo > hi: none) of row ``(y, z)`` whose voxels have
+    body among their 26 neighbours or are body: the runs of the row and its 8 neighbour rows (y and z each one
+    apart), widened by one, inside ``0..nx - 1``. Beyond it a voxel and all its neighbours are outside."""
+    ends = np.empty((nz, ny, 2), np.int64)  # each row's own runs' first and last x
+    ends[..., 0], ends[..., 1] = nx, -1
     for z in range(nz):
         for y in range(ny):
             row = z * ny + y
             if first[row + 1] > first[row]:
-                for c in range(max(0, z - 1), min(nz, z + 2)):
-                    for b in range(max(0, y - 1), min(ny, y + 2)):
-                        out[c, b] = True
+                ends[z, y, 0], ends[z, y, 1] = x0[first[row]], x1[first[row + 1] - 1]
+    out = np.empty((nz, ny, 2), np.int64)
+    for z in range(nz):
+        for y in range(ny):
+            lo, hi = nx, -1
+            for c in range(max(0, z - 1), min(nz, z + 2)):
+                for b in range(max(0, y - 1), min(ny, y + 2)):
+                    lo, hi = min(lo, ends[c, b, 0]), max(hi, ends[c, b, 1])
+            out[z, y, 0], out[z, y, 1] = max(0, lo - 1), min(nx - 1, hi + 1)
     return out
 
 

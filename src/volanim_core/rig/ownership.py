@@ -47,7 +47,7 @@ from volanim_core.rig._ownership_kernels import (
     section_moments,
     voxel_flags,
 )
-from volanim_core.rig._table_kernels import bone_cells, busy_rows, flagged_voxels, row_spans
+from volanim_core.rig._table_kernels import bone_cells, busy_extents, flagged_voxels, row_spans
 from volanim_core.rig._thin_kernels import diagonal_bits
 from volanim_core.rig.connectivity import BoneSegment, Connectivity
 from volanim_core.rig.specks import speck_runs
@@ -161,7 +161,8 @@ class Ownership:
         if self._flags is None:
             # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
             flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")
-            voxel_flags(self.labels, busy_rows(self.runs()[0], *self.labels.shape[1:]), flags)
+            first, x0, x1 = self.runs()[:3]
+            voxel_flags(self.labels, busy_extents(first, x0, x1, *self.labels.shape[1:], self.labels.shape[0]), flags)
             self._flags = flags
         return self._flags
 
@@ -274,6 +275,11 @@ def tube_reach(tube: np.ndarray) -> float:
     return float(max(scale / min(norms), tube[18], tube[19]))
 
 
+def tube_reaches(tubes: np.ndarray) -> np.ndarray:
+    """``(B,)``: each tube's :func:`tube_reach`."""
+    return np.array([tube_reach(t) for t in tubes], np.float64).reshape(len(tubes))
+
+
 def tube_radii(conn: Connectivity, box: np.ndarray, lo: np.ndarray) -> np.ndarray:
     """``(B, 2)``: each bone's tube radius at its proximal and distal joint, from its own points' fit
     (:func:`~volanim_core.rig.limb_tubes.tube_profiles`); a bone too short or too bare for a fit takes the
@@ -330,8 +336,8 @@ def ownership(mask: np.ndarray, conn: Connectivity, *, geometry: Geometry | None
     ab = np.array([s.distal - s.proximal for s in conn.bones], np.float64)
     labels = np.zeros(box.shape, label_dtype(len(conn.bones)), order="F")
     tubes = tube_rows(a, ab, radii, cross_sections(box, lo, tube_rows(a, ab, radii, [None] * len(a))))
-    own_by_tubes(box, lo.astype(np.float64), tubes, _yields(conn.bones), tube_boxes(tubes, lo), labels,
-                 numba.get_num_threads())
+    own_by_tubes(box, lo.astype(np.float64), tubes, _yields(conn.bones), tube_boxes(tubes, lo), tube_reaches(tubes),
+                 labels, numba.get_num_threads())
     runs_after = speck_runs(labels, len(a))[1]
     balls = np.array([_ball_inside(box, s.proximal - lo) for s in conn.bones])
     return Ownership(labels, tuple(lo), list(conn.bones), balls, geometry or conn.geometry, tubes,
@@ -366,8 +372,7 @@ def tube_boxes(tubes: np.ndarray, lo) -> np.ndarray:
     the same owners: mannequin-large's voxels were measured against 3.7 bones each (those reaching the slice),
     now 1.7 (its ownership 0.35 -> 0.25 s)."""
     out = np.zeros((len(tubes), 6), np.int64)
-    for b, tube in enumerate(tubes):
-        r = tube_reach(tube)
+    for b, (tube, r) in enumerate(zip(tubes, tube_reaches(tubes))):
         for axis in range(3):
             ends = (tube[axis], tube[axis] + tube[3 + axis])
             out[b, 2 * axis:2 * axis + 2] = (np.floor(min(ends) - r) - lo[axis] - 1,
@@ -408,8 +413,8 @@ def cross_sections(box: np.ndarray, lo: np.ndarray, round_tubes: np.ndarray) -> 
     hip's gap on the mannequin from 4.6 % to 11 % of the leg, so the fit is sensitive to it."""
     step = max(1, int(np.ceil((box.size / SECTION_VOXELS) ** (1 / 3))))
     sums = np.zeros((len(round_tubes), 10))
-    section_moments(box, lo.astype(np.float64), round_tubes, tube_boxes(round_tubes, lo), step, sums,
-                    numba.get_num_threads())
+    section_moments(box, lo.astype(np.float64), round_tubes, tube_boxes(round_tubes, lo), tube_reaches(round_tubes),
+                    step, sums, numba.get_num_threads())
     out = []
     for s in sums:
         if s[0] < 30:

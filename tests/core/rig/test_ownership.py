@@ -105,7 +105,7 @@ def test_a_bone_measured_only_in_its_tube_s_box_gives_the_owners_measuring_every
     are those of measuring every bone at every voxel, exactly."""
     from volanim_core.rig._ownership_kernels import own_by_tubes, section_moments
     from volanim_core.rig.attach import connect
-    from volanim_core.rig.ownership import _yields, ownership, tube_boxes, tube_radii, tube_rows
+    from volanim_core.rig.ownership import _yields, ownership, tube_boxes, tube_radii, tube_reaches, tube_rows
     from volanim_core.skeleton.skeletonize import skeletonize
 
     s = samples.mannequin()
@@ -122,11 +122,13 @@ def test_a_bone_measured_only_in_its_tube_s_box_gives_the_owners_measuring_every
         assert (boxes[:, 1::2] - boxes[:, ::2] < np.array(box.shape)).any()  # the boxes do leave voxels out
         moments = [np.zeros((len(a), 10)) for _ in range(2)]
         for reach, sums, threads in zip((boxes, everywhere), moments, (2, 1)):  # nor do the threads matter
-            section_moments(box, lo.astype(np.float64), tubes, reach, 1, sums, threads)
+            radius = tube_reaches(tubes) if reach is boxes else np.full(len(a), np.inf)
+            section_moments(box, lo.astype(np.float64), tubes, reach, radius, 1, sums, threads)
         assert np.array_equal(*moments)
     labels = [np.zeros(box.shape, np.uint8, order="F") for _ in range(2)]
-    for reach, out, threads in zip((tube_boxes(own.tubes, lo), everywhere), labels, (2, 1)):
-        own_by_tubes(box, lo.astype(np.float64), own.tubes, _yields(conn.bones), reach, out, threads)
+    for reach, radius, out, threads in zip((tube_boxes(own.tubes, lo), everywhere),
+                                           (tube_reaches(own.tubes), np.full(len(a), np.inf)), labels, (2, 1)):
+        own_by_tubes(box, lo.astype(np.float64), own.tubes, _yields(conn.bones), reach, radius, out, threads)
     assert np.array_equal(*labels) and (labels[0] > 0).sum() == box.sum()
 
 
@@ -156,7 +158,7 @@ def test_flesh_a_round_end_that_yields_holds_stays_with_it_not_with_a_thin_tube_
     FAR (30) of its sizes away, and after the ones nearer."""
     from volanim_core.rig._ownership_kernels import FAR, own_by_tubes, tube_distance
     from volanim_core.rig.connectivity import BoneSegment
-    from volanim_core.rig.ownership import _yields, tube_boxes, tube_rows
+    from volanim_core.rig.ownership import _yields, tube_boxes, tube_reaches, tube_rows
 
     # a head along x (radius 10) whose end yields to the snout going on up from it (radius 0.5), then its tip
     bones = [BoneSegment(np.array([0.0, 0, 0]), np.array([40.0, 0, 0]), "HEAD"),
@@ -174,6 +176,34 @@ def test_flesh_a_round_end_that_yields_holds_stays_with_it_not_with_a_thin_tube_
     for p in (jaw, by_tip):
         mask[tuple((p - lo).astype(int))] = True
     out = np.zeros(mask.shape, np.uint8, order="F")
-    own_by_tubes(mask, lo, tubes, _yields(bones), tube_boxes(tubes, lo), out, 1)
+    own_by_tubes(mask, lo, tubes, _yields(bones), tube_boxes(tubes, lo), tube_reaches(tubes), out, 1)
     assert out[tuple((jaw - lo).astype(int))] == 1  # the head's yielding end, not the tip 32 of its sizes away
     assert out[tuple((by_tip - lo).astype(int))] == 3  # held by none: the nearest surface, the tip's
+
+
+@pytest.mark.parametrize("ab", [(9.0, 4.0, -3.0), (12.0, 0.0, 0.0), (0.0, 0.0, 7.0), (0.0, 5.0, 5.0), (0.0, 0.0, 0.0)])
+def test_a_rows_stretch_holds_every_voxel_within_a_tubes_reach_of_its_segment_and_a_voxel_more_at_most(ab):
+    """_row_stretch (own_by_tubes and section_moments measure a tube only there): every voxel of the row within
+    the reach of the segment (numpy's distance to it) lies in the stretch, which is at most one voxel wider each
+    way; the segment along a row (ab along x), across it, and a point (no length)."""
+    from volanim_core.rig._ownership_kernels import TUBE_COLUMNS, _row_stretch
+
+    tube = np.zeros(TUBE_COLUMNS)
+    tube[:3], tube[3:6] = (20.3, 18.7, 21.1), ab
+    a, ab, r, lox = tube[:3], np.asarray(ab), 6.5, -3.0
+    x = np.arange(60) + lox
+    rows = 0
+    for py in np.arange(5.0, 35.0):
+        for pz in np.arange(5.0, 35.0):
+            p = np.stack([x, np.full_like(x, py), np.full_like(x, pz)], axis=1)
+            t = np.clip((p - a) @ ab / (ab @ ab), 0, 1) if ab @ ab > 0 else np.zeros(len(x))
+            inside = np.flatnonzero(np.linalg.norm(p - a - t[:, None] * ab, axis=1) <= r)
+            x0, x1 = _row_stretch(tube, r, py, pz, lox)
+            if len(inside):
+                rows += 1
+                assert x0 <= inside[0] and inside[-1] <= x1, (py, pz)
+                assert inside[0] - x0 <= 2 and x1 - inside[-1] <= 2, (py, pz)  # a voxel, and the rounding
+            else:  # no whole voxel within: a stretch under one voxel long, a voxel more each way, at most
+                assert x1 - x0 <= 3, (py, pz)
+    assert rows > 50
+
