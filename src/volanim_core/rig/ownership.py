@@ -7,26 +7,24 @@
         --DT of the mask at each bone's proximal joint--> ball radii (the body's depth at the joint)
         --> Ownership (labels cropped to the body, its origin, the bones, the balls)
 
-Why tubes and not the points' attachments: the nearest-bone attachment gives the armpit to the arm
-(its skeleton points lie a few voxels from the arm's segment and twenty from the spine's), and any rule
-built on points inherits that. A voxel in the armpit lies outside the arm's own round tube and well
-inside the torso's, so the torso holds it deeper; the tube's radius is measured from the limb's own middle
-(limb_tubes.tube_profiles), where no other limb touches it. Where two tubes overlap (a limb's end inside
-the torso) the voxel goes to the one whose surface is farther, as the mannequin's true parts are made: a
-rule relative to each tube's size gave the thin thigh a third of the pelvis it overlaps, which it then
-carried off at every step of the walk clip as a lump of 2,200 voxels (#84; the absolute rule: none, and
-the frog's leaf poses 3/6 and 3/6 healthy where they were 2/6 and 1/6). A tube's round end past a joint
-yields (holds only what no other tube holds) where the body there is another bone's: behind a bone's
-proximal joint when a bone ends there, past its distal joint when one bone goes on (_yields). Without it the
-thick parent's round end took the base of a thin leaf (the rabbit's and Spot's leaf bent 90 degrees tore
-off). What no tube holds goes to the nearest tube's surface, but a round end that yields keeps what it holds
-from a tube more than FAR (30) of its sizes away: the frog's snout-tip leaf, one voxel wide, took the lower jaw
-47 voxels off that its parent's end held, and tore the head at 90 degrees (#86). The ball at the joint keeps
-the torso whole where a limb leaves it.
+Why tubes and not the points' attachments: the nearest-bone attachment gives the armpit to the arm (its skeleton
+points lie a few voxels from the arm's segment and twenty from the spine's), and any rule built on points inherits
+that. A voxel in the armpit lies outside the arm's own round tube and well inside the torso's, so the torso holds it
+deeper; the tube's radius is measured from the limb's own middle (limb_tubes.tube_profiles), where no other limb
+touches it. Where two tubes overlap (a limb's end inside the torso) the voxel goes to the one whose surface is
+farther, as the mannequin's true parts are made: a rule relative to each tube's size gave the thin thigh a third of
+the pelvis it overlaps, which it then carried off at every step of the walk clip as a lump of 2,200 voxels (#84; the
+absolute rule: none, and the frog's leaf poses 3/6 and 3/6 healthy where they were 2/6 and 1/6). A tube's round end
+past a joint yields (holds only what no other tube holds) where the body there is another bone's: behind a bone's
+proximal joint when a bone ends there, past its distal joint when one bone goes on (_yields). Without it the thick
+parent's round end took the base of a thin leaf (the rabbit's and Spot's leaf bent 90 degrees tore off). What no tube
+holds goes to the nearest tube's surface, but a round end that yields keeps what it holds from a tube more than FAR
+(30) of its sizes away: the frog's snout-tip leaf, one voxel wide, took the lower jaw 47 voxels off that its parent's
+end held, and tore the head at 90 degrees (#86). The ball at the joint keeps the torso whole where a limb leaves it.
 
-Every voxel of the mask gets an owner, so at the identity pose the posed body is the mask voxel for
-voxel. The animator repaints ownership where the rule is wrong (the studio, ``volanim connect
---fix-lumps``): :meth:`Ownership.with_labels`.
+Every voxel of the mask gets an owner, so at the identity pose the posed body is the mask voxel for voxel. The
+animator repaints ownership where the rule is wrong (the studio, ``volanim connect --fix-lumps``):
+:meth:`Ownership.with_labels`.
 """
 
 from __future__ import annotations
@@ -161,8 +159,7 @@ class Ownership:
         if self._flags is None:
             # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
             flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")
-            first, x0, x1 = self.runs()[:3]
-            voxel_flags(self.labels, busy_extents(first, x0, x1, *self.labels.shape[1:], self.labels.shape[0]), flags)
+            voxel_flags(self.labels, busy_extents(*self.runs()[:3], *self.labels.shape[1:], len(self.labels)), flags)
             self._flags = flags
         return self._flags
 
@@ -275,8 +272,7 @@ def tube_reach(tube: np.ndarray) -> float:
     return float(max(scale / min(norms), tube[18], tube[19]))
 
 
-def tube_reaches(tubes: np.ndarray) -> np.ndarray:
-    """``(B,)``: each tube's :func:`tube_reach`."""
+def tube_reaches(tubes: np.ndarray) -> np.ndarray:  # (B,): each tube's tube_reach
     return np.array([tube_reach(t) for t in tubes], np.float64).reshape(len(tubes))
 
 
