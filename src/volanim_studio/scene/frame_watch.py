@@ -1,5 +1,14 @@
-"""When the view's frames are drawn and on screen: what the last draw took, and calls made once the next frame
-is shown (the live thread begins its next picture then, #85)."""
+"""When the view's frames are drawn: what the last draw took, and calls made once the next frame is drawn (the live
+thread begins its next picture then, #85).
+
+    after_next(call) --> waiting --StartEvent (a draw begins: it draws what the model holds now)--> in this draw
+                                 --EndEvent (that draw is done)--> call()
+
+A call waits for a draw that *begins* after it was given: a draw already under way may not hold what the
+caller just put in the scene. It is made when that draw ends, not when Qt has composed the window: composing
+(software GL: the picture read back, 15-20 ms on the frog) neither holds Python's lock nor draws, so the live
+thread makes its next picture meanwhile (#85: the frog's quarter-size drag 10.7 -> 15.1 pictures a second).
+"""
 
 from __future__ import annotations
 
@@ -8,27 +17,33 @@ import time
 
 class FrameWatch:
     """Times each frame the plotter's render window draws (``seconds``: the last one; software GL makes it most
-    of a live update's) and calls what :meth:`after_next` was given once the next frame is on screen."""
+    of a live update's) and calls what :meth:`after_next` was given once the next frame is drawn; ``before()`` as
+    each draw begins."""
 
-    def __init__(self, plotter):
+    def __init__(self, plotter, before=lambda: None):
         self.seconds = 0.0
         self.clock = time.perf_counter  # times the draws (a test's own: the live resolution they pick)
         self._began = 0.0
-        self._after: list = []
+        self._waiting: list = []  # given since the last draw began
+        self._drawing: list = []  # given before the draw under way began: called when it ends
+        self._before = before
         window = plotter.render_window
-        window.AddObserver("StartEvent", lambda *_: setattr(self, "_began", self.clock()))
-        window.AddObserver("EndEvent", lambda *_: setattr(self, "seconds", self.clock() - self._began))
-        if hasattr(plotter, "frameSwapped"):  # Qt's widget: on screen once composed (software GL: read back)
-            plotter.frameSwapped.connect(self._shown)
+        window.AddObserver("StartEvent", lambda *_: self._began_draw())
+        window.AddObserver("EndEvent", lambda *_: self._ended_draw())
 
     def after_next(self, call) -> None:
-        """``call()`` once the next frame is on screen: drawn, and composed into the window (software GL finishes
-        the drawing there). Off screen (no Qt widget): never. A call already waiting is not added again (a hidden
-        window's frames never come: its waiting calls would pile up)."""
-        if call not in self._after:
-            self._after.append(call)
+        """``call()`` once the next draw that begins from now has ended. A call already waiting is not added again
+        (a hidden window draws nothing: its waiting calls would pile up)."""
+        if call not in self._waiting:
+            self._waiting.append(call)
 
-    def _shown(self) -> None:
-        calls, self._after = self._after, []
+    def _began_draw(self) -> None:
+        self._before()
+        self._began = self.clock()
+        self._drawing, self._waiting = self._drawing + self._waiting, []
+
+    def _ended_draw(self) -> None:
+        self.seconds = self.clock() - self._began
+        calls, self._drawing = self._drawing, []
         for call in calls:
             call()
