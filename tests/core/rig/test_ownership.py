@@ -80,9 +80,9 @@ def test_the_ant_rigged_from_slicer_markups_keeps_no_speck_and_steps_whole(tmp_p
         capsys.readouterr().out
 
 
-def test_each_bone_s_hull_is_scipy_s_hull_of_all_its_voxels():
-    """Ownership.hulls reads only the corners of each slice's outline (hull_ends); qhull over every voxel of the
-    bone finds the same vertices."""
+def test_each_bone_s_hull_points_are_its_voxels_and_hold_every_vertex_of_scipy_s_hull_of_all_of_them():
+    """Ownership.hulls keeps only the corners of each z slice's and y plane's outline (rig/_hull_kernels): owned
+    voxels, among them every vertex qhull finds over every voxel of the bone, so the hull is the same."""
     from scipy.spatial import ConvexHull
 
     from volanim_core.rig.attach import connect
@@ -93,10 +93,35 @@ def test_each_bone_s_hull_is_scipy_s_hull_of_all_its_voxels():
     own = ownership(s.mask, connect(skeletonize(s.mask, min_thinness=0.5), s.bones)[0])
     hulls = own.hulls()
     assert len(hulls) == len(own.bones)
+    assert sum(map(len, hulls)) < own.counts().sum() / 50  # a few of them: what every posed box is read from
     for b, hull in enumerate(hulls):
         voxels = np.argwhere(own.labels == b + 1) + np.asarray(own.origin)
-        want = voxels[ConvexHull(voxels).vertices]
-        assert {tuple(p) for p in hull.astype(np.int64)} == {tuple(p) for p in want}, own.bones[b]
+        got = {tuple(p) for p in hull.astype(np.int64)}
+        assert {tuple(p) for p in voxels[ConvexHull(voxels).vertices]} <= got, own.bones[b]
+        assert got <= {tuple(p) for p in voxels}, own.bones[b]
+
+
+def test_a_posed_bone_s_box_is_the_box_of_all_its_voxels_moved():
+    """posed_boxes reads only the hull points: the box of every owned voxel moved, two voxels wider, exactly."""
+    from scipy.spatial.transform import Rotation
+
+    from volanim_core.reconstruct.owned import posed_boxes
+    from volanim_core.rig.attach import connect
+    from volanim_core.rig.ownership import ownership
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    s = samples.mannequin()
+    own = ownership(s.mask, connect(skeletonize(s.mask, min_thinness=0.5), s.bones)[0])
+    rng = np.random.default_rng(84)
+    matrices = np.zeros((len(own.bones), 4, 4))
+    matrices[:, :3, :3] = Rotation.random(len(own.bones), random_state=rng).as_matrix()
+    matrices[:, 3, :3] = rng.uniform(-20, 20, (len(own.bones), 3))
+    matrices[:, 3, 3] = 1
+    boxes = posed_boxes(own, matrices)
+    for b in range(len(own.bones)):
+        moved = (np.argwhere(own.labels == b + 1) + np.asarray(own.origin)) @ matrices[b, :3, :3] + matrices[b, 3, :3]
+        want = np.concatenate([np.floor(moved.min(0)) - 2, np.ceil(moved.max(0)) + 2])
+        assert (boxes[b] == want).all(), (own.bones[b], boxes[b], want)
 
 
 def test_a_bone_measured_only_in_its_tube_s_box_gives_the_owners_measuring_every_bone_everywhere_gives():
