@@ -22,6 +22,7 @@ INLINED = {
     "volanim_core.rig._ownership_kernels._near",
     "volanim_core.rig._ownership_kernels._in_slice",
     "volanim_core.rig._ownership_kernels._row_stretch",
+    "volanim_core.rig._ownership_kernels._middles",
     "volanim_core.rig._hull_kernels._side",
     "volanim_core.rig._table_kernels._counted_to_starts",
     "volanim_core.reconstruct._owned_kernels._take",

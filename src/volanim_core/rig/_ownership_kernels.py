@@ -178,13 +178,52 @@ def own_by_tubes(mask, lo, tubes, yields, reach, radius, out, threads):
                     out[x, y, z] = who
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _middles(tubes, lo, py, pz, nx, ia, ib):
+    """The stretches of row (py, pz) (x from 0 to nx - 1) where some tube is in its middle (0.3 < t < 0.7), merged
+    and in order into ``ia``/``ib`` (inclusive), a voxel wider each way than the planes bounding the middle cut
+    the row (rounding never drops one). Returns how many. t is linear along a row, so each tube's is one stretch;
+    a tube across the row holds the whole row in its middle or none of it."""
+    k = 0
+    for b in range(tubes.shape[0]):
+        tube = tubes[b]
+        s = tube[3] * tube[6]  # t's step per x
+        t0 = ((lo[0] - tube[0]) * tube[3] + (py - tube[1]) * tube[4] + (pz - tube[2]) * tube[5]) * tube[6]
+        if abs(s) * nx < 1e-9:  # across the row (to rounding): all of it or none, a margin wider
+            if not (0.3 - 1e-9 < t0 < 0.7 + 1e-9):
+                continue
+            xa, xb = 0, nx - 1
+        else:
+            ea, eb = (0.3 - t0) / s, (0.7 - t0) / s
+            xa = int(math.floor(max(-2.0, min(ea, eb)))) - 1
+            xb = int(math.ceil(min(nx + 1.0, max(ea, eb)))) + 1
+            xa, xb = max(0, xa), min(nx - 1, xb)
+            if xa > xb:
+                continue
+        i = k  # kept in order of their starts (a row meets few)
+        while i > 0 and ia[i - 1] > xa:
+            ia[i], ib[i] = ia[i - 1], ib[i - 1]
+            i -= 1
+        ia[i], ib[i] = xa, xb
+        k += 1
+    n = 0
+    for i in range(k):  # merged: a voxel in two tubes' middles is read once
+        if n > 0 and ia[i] <= ib[n - 1] + 1:
+            ib[n - 1] = max(ib[n - 1], ib[i])
+        else:
+            ia[n], ib[n] = ia[i], ib[i]
+            n += 1
+    return n
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def section_moments(mask, lo, tubes, reach, radius, step, sums, threads):
     """For the mask voxels on a lattice of ``step`` voxels: the bone whose tube holds each deepest relative to
     its size (the least :func:`tube_distance`) and, where it lies in the middle of that bone (0.3 < t < 0.7),
     its offset v from the bone's segment into ``sums[b]``: count, the sums of v (3) and of v v^T (xx xy xz yy
     yz zz). ``reach``, ``radius`` as :func:`own_by_tubes`'s. Slices in parallel, each into its own row, summed in
-    order after: the same sums whatever the threads."""
+    order after: the same sums whatever the threads. Only the stretches of a row where some tube is in its middle
+    are read (:func:`_middles`): a voxel elsewhere adds to no bone's sums, whichever bone holds it."""
     nx, ny, nz = mask.shape
     nb = tubes.shape[0]
     zs = np.arange(0, nz, step)
@@ -194,45 +233,47 @@ def section_moments(mask, lo, tubes, reach, radius, step, sums, threads):
             z = zs[k]
             near, row = np.empty(nb, np.int64), np.empty(nb, np.int64)
             x0, x1 = np.empty(nb, np.int64), np.empty(nb, np.int64)
+            ia, ib = np.empty(nb, np.int64), np.empty(nb, np.int64)
             m = _in_slice(reach, z, near)
             for y in range(0, ny, step):
                 n = _near(reach, radius, tubes, lo, z, y, near, m, row, x0, x1)
-                for x in range(0, nx, step):
-                    if not mask[x, y, z]:
-                        continue
-                    px, py, pz = x + lo[0], y + lo[1], z + lo[2]
-                    best, who = np.inf, -1
-                    for i in range(n):
-                        b = row[i]
-                        if x < x0[i] or x > x1[i]:
+                for j in range(_middles(tubes, lo, y + lo[1], z + lo[2], nx, ia, ib)):
+                    for x in range(-(-ia[j] // step) * step, ib[j] + 1, step):
+                        if not mask[x, y, z]:
                             continue
-                        d = tube_distance(tubes[b], px, py, pz)
-                        if d < best:
-                            best, who = d, b
-                    if best >= 1.0:  # held by no tube near: the relatively nearest of all
-                        for b in range(nb):
+                        px, py, pz = x + lo[0], y + lo[1], z + lo[2]
+                        best, who = np.inf, -1
+                        for i in range(n):
+                            b = row[i]
+                            if x < x0[i] or x > x1[i]:
+                                continue
                             d = tube_distance(tubes[b], px, py, pz)
                             if d < best:
                                 best, who = d, b
-                    if who < 0:
-                        continue
-                    tube = tubes[who]
-                    dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
-                    t = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
-                    if t <= 0.3 or t >= 0.7:
-                        continue
-                    vx, vy, vz = dx - t * tube[3], dy - t * tube[4], dz - t * tube[5]
-                    s = per[k, who]
-                    s[0] += 1.0
-                    s[1] += vx
-                    s[2] += vy
-                    s[3] += vz
-                    s[4] += vx * vx
-                    s[5] += vx * vy
-                    s[6] += vx * vz
-                    s[7] += vy * vy
-                    s[8] += vy * vz
-                    s[9] += vz * vz
+                        if best >= 1.0:  # held by no tube near: the relatively nearest of all
+                            for b in range(nb):
+                                d = tube_distance(tubes[b], px, py, pz)
+                                if d < best:
+                                    best, who = d, b
+                        if who < 0:
+                            continue
+                        tube = tubes[who]
+                        dx, dy, dz = px - tube[0], py - tube[1], pz - tube[2]
+                        t = (dx * tube[3] + dy * tube[4] + dz * tube[5]) * tube[6]
+                        if t <= 0.3 or t >= 0.7:
+                            continue
+                        vx, vy, vz = dx - t * tube[3], dy - t * tube[4], dz - t * tube[5]
+                        s = per[k, who]
+                        s[0] += 1.0
+                        s[1] += vx
+                        s[2] += vy
+                        s[3] += vz
+                        s[4] += vx * vx
+                        s[5] += vx * vy
+                        s[6] += vx * vz
+                        s[7] += vy * vy
+                        s[8] += vy * vz
+                        s[9] += vz * vz
     for k in range(len(zs)):
         sums += per[k]
 

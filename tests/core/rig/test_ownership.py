@@ -232,3 +232,35 @@ def test_a_rows_stretch_holds_every_voxel_within_a_tubes_reach_of_its_segment_an
                 assert x1 - x0 <= 3, (py, pz)
     assert rows > 50
 
+
+
+@pytest.mark.parametrize("ab", [(9.0, 4.0, -3.0), (12.0, 0, 0), (0, 0, 7.0), (1e-14, 5.0, 5.0), (-4.0, 2.0, 0)])
+def test_a_rows_middles_hold_every_voxel_in_some_tube_s_middle_merged_in_order(ab):
+    """_middles (section_moments reads only there): every voxel of the row at which some tube's t -- as the kernel
+    computes it -- lies in 0.3..0.7 is in one of the stretches; they are in order, apart, on the row, and at most
+    a voxel and the rounding wider than the voxels they hold; a tube along the row, across it, and all but across."""
+    from volanim_core.rig._ownership_kernels import TUBE_COLUMNS, _middles
+
+    tubes = np.zeros((3, TUBE_COLUMNS))
+    tubes[:, :3] = (20.3, 18.7, 21.1), (30.0, 25.0, 10.0), (12.0, 9.5, 30.0)
+    tubes[:, 3:6] = ab, (3.0, -2.0, 8.0), (0.0, 6.0, 0.0)
+    tubes[:, 6] = 1 / (tubes[:, 3:6] ** 2).sum(1)
+    lo, nx = np.array([-3.0, 0.0, 0.0]), 60
+    ia, ib = np.empty(3, np.int64), np.empty(3, np.int64)
+    x = np.arange(nx) + lo[0]
+    rows = 0
+    for py in np.arange(0.0, 40.0):
+        for pz in np.arange(0.0, 40.0):
+            t = (((x[:, None] - tubes[:, 0]) * tubes[:, 3] + (py - tubes[:, 1]) * tubes[:, 4]
+                  + (pz - tubes[:, 2]) * tubes[:, 5]) * tubes[:, 6])
+            want = np.flatnonzero(((t > 0.3) & (t < 0.7)).any(1))
+            n = _middles(tubes, lo, py, pz, nx, ia, ib)
+            got = np.zeros(nx, bool)
+            for j in range(n):
+                assert 0 <= ia[j] <= ib[j] < nx and (j == 0 or ia[j] > ib[j - 1] + 1), (py, pz, ia[:n], ib[:n])
+                got[ia[j]:ib[j] + 1] = True
+                held = want[(want >= ia[j]) & (want <= ib[j])]
+                assert not len(held) or (held[0] - ia[j] <= 3 and ib[j] - held[-1] <= 3), (py, pz)
+            assert got[want].all(), (py, pz)
+            rows += len(want) > 0
+    assert rows > 100
