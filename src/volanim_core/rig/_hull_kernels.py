@@ -5,8 +5,9 @@ slice's outline, read from row_spans' spans, then those of them that are corners
     plane_corners(pts, lab, ny, nz)        of those, the ones that are corners of their y plane's outline as well
 
 A vertex of a convex hull is a corner of the outline of the hull's points in any plane through it: were it
-between two of them, it would be between two points of the hull. So each filter keeps every vertex, and qhull
-reads fewer points (mannequin-large: 47,000 -> see ownership.hulls).
+between two of them, it would be between two points of the hull. So each filter keeps every vertex, and the points
+kept bound a posed bone's box as its hull's vertices would, with no qhull (mannequin-large: 47,000 row ends ->
+7,600 points).
 """
 
 from __future__ import annotations

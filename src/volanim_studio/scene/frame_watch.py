@@ -7,7 +7,7 @@ thread begins its next picture then, #85).
 A call waits for a draw that *begins* after it was given: a draw already under way may not hold what the
 caller just put in the scene. It is made when that draw ends, not when Qt has composed the window: composing
 (software GL: the picture read back, 15-20 ms on the frog) neither holds Python's lock nor draws, so the live
-thread makes its next picture meanwhile (#85: the frog's quarter-size drag 10.7 -> 15.1 pictures a second).
+thread makes its next picture meanwhile (#85: the frog's drag 10.7 -> 15.1 pictures a second in one run).
 """
 
 from __future__ import annotations
