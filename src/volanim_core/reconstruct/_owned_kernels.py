@@ -252,20 +252,21 @@ def _moved(m, px, py, pz):
 @njit(cache=True, nogil=True, parallel=True)
 def posed_cells(cells, size, rest_lo, m, reach, out_lo, marks):
     """Where one turned bone can be read: ``marks[kz, ky, kx]`` (uint8, an output cube of ``size`` voxels a side,
-    its first voxel ``size * (kx, ky, kz)`` of the output) set to 1 for every output cube within ``reach`` of a
-    rest cube of the bone (``cells``: lower corners / size, on the labels' grid, voxel ``[0, 0, 0]`` at
-    ``rest_lo``) moved by ``m`` (``[p 1] @ m``), its centre's reach taken. A read finds the bone only among the
-    8 voxels around its point, each within a voxel's diagonal of it; a voxel lies within half a cube's
-    diagonal of its cube's centre: ``reach`` is the sum, times the matrix's largest stretch."""
+    its first voxel ``size * (kx, ky, kz)`` of the output) set to 1 for every output cube that holds a voxel within
+    ``reach (3,)`` along each axis of a rest cube of the bone (``cells``: lower corners / size, on the labels' grid,
+    voxel ``[0, 0, 0]`` at ``rest_lo``) moved by ``m`` (``[p 1] @ m``), its centre. A read finds the bone only
+    among the 8 voxels around its point, each within a voxel of it along each axis, and a voxel lies within
+    half a cube of its cube's centre: ``reach`` is that box moved (reconstruct/owned.cube_reach)."""
     nz, ny, nx = marks.shape
     h = (size - 1) / 2.0
     for i in numba.prange(len(cells)):  # threads may set one mark at once: each writes the same 1
         qx, qy, qz = _moved(m, cells[i, 0] * size + h + rest_lo[0], cells[i, 1] * size + h + rest_lo[1],
                             cells[i, 2] * size + h + rest_lo[2])
         qx, qy, qz = qx - out_lo[0], qy - out_lo[1], qz - out_lo[2]
-        x0, x1 = max(0, int(math.floor((qx - reach) / size))), min(nx - 1, int(math.floor((qx + reach) / size)))
-        y0, y1 = max(0, int(math.floor((qy - reach) / size))), min(ny - 1, int(math.floor((qy + reach) / size)))
-        z0, z1 = max(0, int(math.floor((qz - reach) / size))), min(nz - 1, int(math.floor((qz + reach) / size)))
+        rx, ry, rz = reach[0], reach[1], reach[2]
+        x0, x1 = max(0, int(math.floor((qx - rx) / size))), min(nx - 1, int(math.floor((qx + rx) / size)))
+        y0, y1 = max(0, int(math.floor((qy - ry) / size))), min(ny - 1, int(math.floor((qy + ry) / size)))
+        z0, z1 = max(0, int(math.floor((qz - rz) / size))), min(nz - 1, int(math.floor((qz + rz) / size)))
         for z in range(z0, z1 + 1):
             for y in range(y0, y1 + 1):
                 for x in range(x0, x1 + 1):

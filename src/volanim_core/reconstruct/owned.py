@@ -192,11 +192,12 @@ def _turned_marks(own: Ownership, matrices: np.ndarray, which: np.ndarray, lo: n
     return turned, marks
 
 
-def cube_reach(m: np.ndarray) -> float:
-    """How far from a rest cube's centre, moved by ``m``, a read can find one of the cube's voxels: half the
-    cube's diagonal (its farthest voxel) and a voxel's diagonal (the 8 voxels around a read's point), times
-    the matrix's largest stretch."""
-    return float(np.linalg.norm(np.asarray(m)[:3, :3], 2)) * (CELL - 1 + 2) * np.sqrt(3) / 2 + 1e-6
+def cube_reach(m: np.ndarray) -> np.ndarray:
+    """How far from a rest cube's centre, moved by ``m``, along each output axis, a read can find one of the cube's
+    voxels: a read's point is within a voxel of the voxel it finds (one of the 8 around it) and that voxel within
+    half a cube of its centre, along each rest axis; moved, output axis k spans that much times ``sum_j |m[j, k]|``.
+    The box this bounds, not a ball round the largest stretch: a turn of 45 degrees marks half the cubes."""
+    return ((CELL - 1) / 2 + 1) * np.abs(np.asarray(m, np.float64)[:3, :3]).sum(0) + 1e-6
 
 
 def whole_voxel_shifts(matrices: np.ndarray) -> np.ndarray:
