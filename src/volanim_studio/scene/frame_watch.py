@@ -18,7 +18,7 @@ import time
 class FrameWatch:
     """Times each frame the plotter's render window draws (``seconds``: the last one; software GL makes it most
     of a live update's) and calls what :meth:`after_next` was given once the next frame is drawn; ``before()`` as
-    each draw begins."""
+    a draw begins after :meth:`changed` (the view fits its clipping planes there, wherever the draw comes from)."""
 
     def __init__(self, plotter, before=lambda: None):
         self.seconds = 0.0
@@ -27,6 +27,7 @@ class FrameWatch:
         self._waiting: list = []  # given since the last draw began
         self._drawing: list = []  # given before the draw under way began: called when it ends
         self._before = before
+        self._changed = False
         window = plotter.render_window
         window.AddObserver("StartEvent", lambda *_: self._began_draw())
         window.AddObserver("EndEvent", lambda *_: self._ended_draw())
@@ -37,8 +38,19 @@ class FrameWatch:
         if call not in self._waiting:
             self._waiting.append(call)
 
+    def changed(self) -> None:
+        """The scene changed: the next draw to begin calls ``before()`` first (once for many changes)."""
+        self._changed = True
+
+    def prepare(self) -> None:
+        """``before()`` now if the scene changed since it was last called (at a draw's start, or for a draw
+        pyvista skips: a window not yet shown)."""
+        if self._changed:
+            self._changed = False
+            self._before()
+
     def _began_draw(self) -> None:
-        self._before()
+        self.prepare()
         self._began = self.clock()
         self._drawing, self._waiting = self._drawing + self._waiting, []
 

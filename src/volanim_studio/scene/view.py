@@ -65,8 +65,8 @@ class SceneView:
         self._after_drag: tuple[bool, bool] | None = None  # the renderer's FXAA and OIT, put back on release
         self._render_pending = False
         self._drawn_once = False
-        self._clip_pending = False  # model changes since the last draw: its start fits the clipping planes
-        self.frames = FrameWatch(plotter, before=self._fit_clipping)  # draws' times; what waits for the next
+        # draws' times; what waits for the next; after model changes a draw's start fits the clipping planes
+        self.frames = FrameWatch(plotter, before=lambda: reset_clipping(plotter.renderer))
         plotter.set_background("#1e1f24")
         self._fix_pixel_ratio()
         self._quiet_keys()
@@ -422,7 +422,7 @@ class SceneView:
         """Request a frame; many model changes in one event-loop pass draw once (software GL takes 100-500 ms for a
         large cloud). On screen, the widget's update() at once: Qt composes it with the labels changed beside it.
         A zero timer composed a live picture's status line first, then the picture: 15-20 ms more a picture (#85)."""
-        self._clip_pending = True
+        self.frames.changed()
         if not self.in_qt:  # an off-screen Plotter: no event loop to gather renders in, so now
             self._render_now()
         elif self._drawn_once and self.plotter.isVisible():
@@ -438,13 +438,8 @@ class SceneView:
         if getattr(self.plotter, "_closed", False):
             return
         if self._drawn_once and self.in_qt and self.plotter.isVisible():
-            return self.plotter.update()
-        self._fit_clipping()  # pyvista skips a window's render before it is shown: fitted here all the same
+            self.plotter.update()
+            return
+        self.frames.prepare()  # pyvista skips a window's render before it is shown: fitted here all the same
         self.plotter.render()  # also tells pyvista the window has rendered (screenshots need it)
         self._drawn_once = True
-
-    def _fit_clipping(self) -> None:
-        """At a draw's start after model changes: the clipping planes fit what is shown (a walked body uncut)."""
-        if self._clip_pending:
-            self._clip_pending = False
-            reset_clipping(self.plotter.renderer)

@@ -235,6 +235,7 @@ def test_a_speck_at_the_surface_moves_with_the_flesh_it_lies_on(angle):
     np.testing.assert_allclose(skin.weight[at[len(conn) - 1]], skin.weight[at[host]])
 
 
+@pytest.mark.slow  # Visible-Human scale (the full tier): 6-11 s each
 def test_mannequin_large_raises_its_arm_with_nothing_torn_off_and_no_stump():
     """The largest sample, arm raised 90 degrees with smooth joints: its one-voxel surface specks (two
     stay apart at rest already) moved rigidly while the flesh they lie on blended, and tore off two pieces
@@ -341,6 +342,7 @@ def test_thinned_radii_follow_the_points_in_any_order():
     assert r.shape == (len(half),) and (r >= 0.75 * 3.0).all()
 
 
+@pytest.mark.slow  # Visible-Human scale (the full tier): 6-11 s each
 def test_mannequin_large_bends_its_hip_120_degrees_within_3_percent_of_its_volume():
     """Hip flexion 120 degrees with smooth joints: the crotch's medial sheet, blended between torso and
     thigh, fanned out with its radii kept and the body grew 4.6 % (target: within 3 %). Its spheres now

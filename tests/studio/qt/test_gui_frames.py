@@ -44,7 +44,9 @@ def test_a_status_line_composed_is_not_the_picture_drawn(qtbot):
     assert "draw" not in seen and calls == [], "a composition without a draw let the next picture begin"
     w.scene.render()
     qtbot.waitUntil(lambda: bool(calls), timeout=10_000)
-    assert calls[0] == ["shown", "draw"]  # called in the draw asked after it was given, before it was composed
+    # called as the draw asked after it was given ends, before that draw is composed (the label's setText may
+    # compose the window more than once before: how often is Qt's, not ours)
+    assert calls[0].count("draw") == 1 and calls[0][-1] == "draw", calls
     w.scene.render()
     qtbot.waitUntil(lambda: seen.count("draw") >= 2, timeout=10_000)
     assert len(calls) == 1  # given once, called once
