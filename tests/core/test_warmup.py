@@ -90,3 +90,35 @@ def test_numba_runs_on_a_thread_safe_layer():
 
     assert total(np.ones(64)) == 64.0  # a parallel kernel has run: numba has chosen its layer
     assert numba.threading_layer() in ("omp", "tbb")
+
+
+LAYOUTS = r"""
+import numpy as np
+from numba.core.registry import CPUDispatcher
+from volanim_core.cli import main
+from volanim_core.reconstruct import _owned_kernels
+from volanim_core.reconstruct.owned import reconstruct_owned
+from volanim_core.rig import _ownership_kernels, _table_kernels
+from volanim_core.rig.connectivity import BoneSegment
+from volanim_core.rig.ownership import Ownership
+assert main(["warmup"]) == 0
+kernels = [v for mod in (_owned_kernels, _ownership_kernels, _table_kernels) for v in vars(mod).values()
+           if isinstance(v, CPUDispatcher)]
+before = {k: len(k.signatures) for k in kernels}
+labels = np.zeros((9, 8, 10), np.uint8)  # C order, as np.zeros makes it: a user's own labels
+labels[1:8, 1:7, 1:5], labels[2:7, 2:6, 5:10] = 1, 2
+own = Ownership(labels, (0, 0, 0), [BoneSegment((4, 4, 1), (4, 4, 5)), BoneSegment((4, 4, 5), (4, 4, 11))], [0, 2])
+turn = np.eye(4)
+turn[:2, :2] = [[0.6, 0.8], [-0.8, 0.6]]
+reconstruct_owned(own, np.stack([np.eye(4), turn]), mode="bone")
+print("compiled again:", sorted(f"{k.py_func.__module__}.{k.__name__}" for k in kernels
+                                if len(k.signatures) > before[k]))
+"""
+
+
+@pytest.mark.long("a process of its own: only there does a dispatcher's compiled state come from the warm-up alone")
+def test_an_ownership_of_labels_in_c_order_uses_the_kernels_the_warm_up_compiled():
+    """Labels given in C order (np.zeros's) were used as given, and the warp's kernels compiled again for that
+    layout on first use: 20 s after the warm-up (the owned oracle test, in a clean clone)."""
+    out = subprocess.run([sys.executable, "-c", LAYOUTS], capture_output=True, text=True, check=True).stdout
+    assert "compiled again: []" in out, out

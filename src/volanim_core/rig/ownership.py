@@ -101,6 +101,9 @@ class Ownership:
             raise ValueError(f"ownership labels must be a 3-D volume [x, y, z], got shape {self.labels.shape}")
         if self.labels.dtype.kind != "u":
             raise ValueError(f"ownership labels must be unsigned integers, got {self.labels.dtype}")
+        # one layout, x fastest, as ownership() makes them and the warm-up compiles for: labels given in C order
+        # made every kernel compile again on first use (20 s after `volanim_core warmup`)
+        self.labels = np.asfortranarray(self.labels)
         if self.tubes is None:  # no tubes (all zero: a tube that holds nothing): a bone carries what it owns
             self.tubes = np.zeros((len(self.bones), TUBE_COLUMNS))
         self.tubes = np.ascontiguousarray(self.tubes, np.float64).reshape(len(self.bones), TUBE_COLUMNS)
