@@ -41,6 +41,7 @@ def compile_kernels(progress=None) -> float:
 
     ``progress(done, total)`` is called after each step (for a message or a bar).
     """
+    from volanim_core._run_kernels import run_values, runs
     from volanim_core.colour.sort import sort_palette
     from volanim_core.reconstruct._whole_kernels import touches_any
     from volanim_core.reconstruct.breakage import breakage_report, components
@@ -89,6 +90,10 @@ def compile_kernels(progress=None) -> float:
     two = np.zeros((6, 6, 6), np.uint8)
     two[1, 1, 1] = two[4, 4, 4] = 1
     components(two)  # a report's detached pieces: where each is nearest the main body
+    two16 = np.ascontiguousarray(two.astype(np.uint16))  # a smooth frame's report: its pieces and rest owners
+    components(two16)
+    first, x0, _ = runs(two16, True)
+    run_values(two16, first, x0)
     # a clip scan's proof of one piece: its small spheres' voxel test, with a scan's own dtypes
     touches_any(np.zeros((2, 3)), np.array([4.0, 1.0]), np.array([1]), np.array([[0]]), np.array([True, False]),
                 np.zeros(1, np.int8))
