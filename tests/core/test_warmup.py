@@ -92,27 +92,36 @@ def test_numba_runs_on_a_thread_safe_layer():
     assert numba.threading_layer() in ("omp", "tbb")
 
 
-LAYOUTS = r"""
-import numpy as np
+
+def compiled_again(modules: list[str], body: str) -> str:
+    """What ``body`` (Python, run in a process of its own after the warm-up) made numba compile or load anew: the
+    kernels of ``modules`` that gained a signature, as the child prints them."""
+    script = f"""
+import importlib
 from numba.core.registry import CPUDispatcher
 from volanim_core.cli import main
-from volanim_core.reconstruct import _owned_kernels
+assert main(["warmup"]) == 0
+kernels = list({{id(v): v for name in {modules!r} for v in vars(importlib.import_module(name)).values()
+                if isinstance(v, CPUDispatcher)}}.values())  # one entry each: a module may import another's
+before = {{k: len(k.signatures) for k in kernels}}
+{body}
+print("compiled again:", sorted(f"{{k.py_func.__module__}}.{{k.__name__}}" for k in kernels
+                                if len(k.signatures) > before[k]))
+"""
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
+
+
+C_ORDER_POSE = """
+import numpy as np
 from volanim_core.reconstruct.owned import reconstruct_owned
-from volanim_core.rig import _ownership_kernels, _table_kernels
 from volanim_core.rig.connectivity import BoneSegment
 from volanim_core.rig.ownership import Ownership
-assert main(["warmup"]) == 0
-kernels = [v for mod in (_owned_kernels, _ownership_kernels, _table_kernels) for v in vars(mod).values()
-           if isinstance(v, CPUDispatcher)]
-before = {k: len(k.signatures) for k in kernels}
 labels = np.zeros((9, 8, 10), np.uint8)  # C order, as np.zeros makes it: a user's own labels
 labels[1:8, 1:7, 1:5], labels[2:7, 2:6, 5:10] = 1, 2
 own = Ownership(labels, (0, 0, 0), [BoneSegment((4, 4, 1), (4, 4, 5)), BoneSegment((4, 4, 5), (4, 4, 11))], [0, 2])
 turn = np.eye(4)
 turn[:2, :2] = [[0.6, 0.8], [-0.8, 0.6]]
 reconstruct_owned(own, np.stack([np.eye(4), turn]), mode="bone")
-print("compiled again:", sorted(f"{k.py_func.__module__}.{k.__name__}" for k in kernels
-                                if len(k.signatures) > before[k]))
 """
 
 
@@ -120,28 +129,20 @@ print("compiled again:", sorted(f"{k.py_func.__module__}.{k.__name__}" for k in 
 def test_an_ownership_of_labels_in_c_order_uses_the_kernels_the_warm_up_compiled():
     """Labels given in C order (np.zeros's) were used as given, and the warp's kernels compiled again for that
     layout on first use: 20 s after the warm-up (the owned oracle test, in a clean clone)."""
-    out = subprocess.run([sys.executable, "-c", LAYOUTS], capture_output=True, text=True, check=True).stdout
+    out = compiled_again(["volanim_core.reconstruct._owned_kernels", "volanim_core.rig._ownership_kernels",
+                          "volanim_core.rig._table_kernels"], C_ORDER_POSE)
     assert "compiled again: []" in out, out
 
 
-SMOOTH_REPORT = r"""
-from numba.core.registry import CPUDispatcher
-from volanim_core import _run_kernels, samples
-from volanim_core.cli import main
-from volanim_core.reconstruct import _label_kernels
+SMOOTH_REPORT = """
+from volanim_core import samples
 from volanim_core.reconstruct.breakage import breakage_report
 from volanim_core.rig.pose import pose_matrices, posed_joints
 from volanim_core.rig.skinning import Joints
-assert main(["warmup"]) == 0
-kernels = list({id(v): v for mod in (_run_kernels, _label_kernels) for v in vars(mod).values()
-                if isinstance(v, CPUDispatcher)}.values())  # one entry each: a module may import another's
-before = {k: len(k.signatures) for k in kernels}
 s = samples.load("mannequin")
 m = pose_matrices(s.bones, {"L_FOREARM": (0, 0, 60)})
 breakage_report(samples.part_connectivity(s).with_joints(Joints("smooth")).posed(m), s.bones.joints,
                 posed_joints(s.bones, m))
-print("compiled again:", sorted(f"{k.py_func.__module__}.{k.__name__}" for k in kernels
-                                if len(k.signatures) > before[k]))
 """
 
 
@@ -149,5 +150,5 @@ print("compiled again:", sorted(f"{k.py_func.__module__}.{k.__name__}" for k in 
 def test_a_smooth_frames_report_uses_the_kernels_the_warm_up_compiled():
     """A smooth frame's report reads uint16 labels (its claims), which the warm-up never gave the run and piece
     kernels: every user's first smooth report compiled four of them (2.5 s of the rabbit's leaf test)."""
-    out = subprocess.run([sys.executable, "-c", SMOOTH_REPORT], capture_output=True, text=True, check=True).stdout
+    out = compiled_again(["volanim_core._run_kernels", "volanim_core.reconstruct._label_kernels"], SMOOTH_REPORT)
     assert "compiled again: []" in out, out

@@ -155,7 +155,7 @@ class Ownership:
         outside voxel (a read nearest one is refused at once): rig/_ownership_kernels."""
         if self._flags is None:
             # laid out as the labels are (Fortran: x runs fastest), so a read of both touches the same lines
-            flags = np.zeros(self.labels.shape, np.uint8, order="F" if self.labels.flags.f_contiguous else "C")
+            flags = np.zeros(self.labels.shape, np.uint8, order="F")
             voxel_flags(self.labels, busy_extents(*self.runs()[:3], *self.labels.shape[1:], len(self.labels)), flags)
             self._flags = flags
         return self._flags
