@@ -79,21 +79,70 @@ def main() -> None:
 
 def stages_alone(w, makers, factor: int) -> float:
     """Median seconds of a live picture's stages (pose, body, surface) over the drag's frames ``makers``, remade
-    one after another at ``factor`` on this thread with the window idle: what the live thread's work costs
-    without the draw beside it."""
-    from volanim_studio.model.preview import LivePreviews, live_surface
+    one after another at ``factor`` on this thread with the window idle, on the live thread's kernel threads
+    (:func:`live_threads`): what the live thread's work costs without the draw beside it."""
+    import numba
+
+    from volanim_studio.model.preview import LivePreviews
+    from volanim_studio.qt.live_worker import live_threads
 
     live, costs = LivePreviews(), []
-    for make in makers:
-        t0 = time.perf_counter()
-        p = live.make(w.doc.ownership.attach(make()), mode="bone", factor=factor, padding=2)
-        live_surface(p, w.doc.transfer.function, len(w.doc.bones), tuple(w.scene.spacing))
-        costs.append(time.perf_counter() - t0)
+    threads = numba.get_num_threads()
+    numba.set_num_threads(live_threads())  # the live thread's (one here): on all cores they were not what it costs
+    try:
+        for make in makers:
+            t0 = time.perf_counter()
+            p = live.make(w.doc.ownership.attach(make()), mode="bone", factor=factor, padding=2)
+            live.surface(p, w.doc.transfer.function, len(w.doc.bones), tuple(w.scene.spacing))
+            costs.append(time.perf_counter() - t0)
+    finally:
+        numba.set_num_threads(threads)
     return statistics.median(costs[1:])  # the first: a whole new grid
+
+
+def drag(w, app, bone) -> tuple[list, list, float]:
+    """A drag of ``bone`` as a mouse makes it: a step every 1/60 s (the events a held slider sends), 2 degrees a
+    step for 1.5 s; in between, the window handles what comes (pictures made, drawn). Not as fast as the loop can
+    go: a loop that never idles holds Python's lock and starves the live thread as no user does.
+    Returns the live pictures put on screen, every 6th step's frame maker (:func:`stages_alone`) and the seconds."""
+    w.doc.settings.dragging = True  # what pressing a pose slider does
+    w.previews.live_timings.clear()
+    pictures, makers = [], []
+
+    def shown(**_):
+        if w.doc.preview is not None and w.doc.preview.live and w.doc.preview.stages:
+            pictures.append(w.doc.preview)
+    w.doc.events.preview.connect(shown)
+    t0 = time.perf_counter()
+    for k, a in enumerate(np.linspace(0, -180, 91)):
+        w.doc.pose.set_angles(bone, (0, float(a), 0))  # -> live preview (coalesced) -> drawn
+        if k % 6 == 0:
+            makers.append(w.doc.pose.frame_maker())
+        app.processEvents()
+        while time.perf_counter() < t0 + (k + 1) / MOUSE_HZ:
+            time.sleep(0.001)
+            app.processEvents()
+    w.doc.events.preview.disconnect(shown)
+    return pictures, makers, time.perf_counter() - t0
+
+
+def stage_row(w, name: str, label: str, pictures: list, makers: list) -> list[str]:
+    """A row of the stage table: the live pictures' stages in the studio (the first, of a whole new grid, left out)
+    beside the same drag's frames remade alone at their factor."""
+    stages = [p.stages for p in pictures[1:]]
+    if not stages:
+        return [name, label, "0"] + ["-"] * (len(STAGES) + 3)
+    draws = [st["last draw"] for st in stages if "last draw" in st]
+    alone = stages_alone(w, makers, pictures[-1].factor)
+    return ([name, label, str(len(stages)), f"{1000 * alone:.0f}"]
+            + [f"{1000 * statistics.median(st[k] for st in stages):.0f}" for k in STAGES]
+            + [f"{1000 * statistics.median(draws):.0f}" if draws else "-",
+               f"{1000 * statistics.median(sum(st[k] for k in STAGES) for st in stages):.0f}"])
 
 
 STAGES = ("pose", "body", "surface")  # the live thread's: what this machine's goal counts (not the draw)
 MOUSE_HZ = 60  # pose changes a second in a drag (a mouse's move events, as a held slider passes them on)
+GOAL_RESOLUTION = {"mannequin": "full"}  # #85's stage goals: the mannequin at full resolution, the others at half
 
 
 def bench_preview(app) -> None:
@@ -108,7 +157,7 @@ def bench_preview(app) -> None:
 
     root = Path(__file__).resolve().parents[1]
     names = [a for a in sys.argv[1:] if not a.startswith("-")] or ["mannequin", "frog", "mannequin-large"]
-    rows, stage_rows = [], []
+    rows, stage_rows, held_rows = [], [], []
     for name in names:
         w = MainWindow()
         w.resize(1200, 800)
@@ -145,49 +194,18 @@ def bench_preview(app) -> None:
             app.processEvents()
             time.sleep(0.005)
         w.doc.select_bones([bone])
-        w.doc.settings.dragging = True  # what pressing a pose slider does
-        w.previews.live_timings.clear()
-        pictures = []
-        w.doc.events.preview.connect(lambda w=w, pictures=pictures, **_: pictures.append(w.doc.preview))
-        # a drag as a mouse makes it: a step every 1/60 s (the events a held slider sends), 2 degrees a step for
-        # 1.5 s; in between, the window handles what comes (pictures made, drawn). Not as fast as the loop can
-        # go: a loop that never idles holds Python's lock and starves the live thread as no user does.
-        makers = []  # every 6th step's frame, remade alone after the drag (stage_alone)
-        t0 = time.perf_counter()
-        for k, a in enumerate(np.linspace(0, -180, 91)):
-            w.doc.pose.set_angles(bone, (0, float(a), 0))  # -> live preview (coalesced) -> drawn
-            if k % 6 == 0:
-                makers.append(w.doc.pose.frame_maker())
-            app.processEvents()
-            while time.perf_counter() < t0 + (k + 1) / MOUSE_HZ:
-                time.sleep(0.001)
-                app.processEvents()
-        elapsed = time.perf_counter() - t0
+        pictures, makers, elapsed = drag(w, app, bone)
         # by resolution: the live resolution adapts (a drag starts at the size rule's and moves), and each
         # factor's first picture is of a whole new grid, left out as the drag's first is
-        by_factor: dict = {}
-        for p in pictures:
-            if p is not None and p.live and p.stages:
-                by_factor.setdefault(p.factor, []).append(p.stages)
-        for f, stages in sorted(by_factor.items()):
-            stages = stages[1:]
-            if not stages:
-                continue
-            draws = [st["last draw"] for st in stages if "last draw" in st]
-            alone = stages_alone(w, makers, f)
-            stage_rows.append([name, f"1/{f}", str(len(stages)), f"{1000 * alone:.0f}"]
-                              + [f"{1000 * statistics.median(st[k] for st in stages):.0f}"
-                                 for k in STAGES]
-                              + [f"{1000 * statistics.median(draws):.0f}" if draws else "-",
-                                 f"{1000 * statistics.median(sum(st[k] for k in STAGES) for st in stages):.0f}"])
+        for f in sorted({p.factor for p in pictures}):
+            stage_rows.append(stage_row(w, name, f"1/{f}", [p for p in pictures if p.factor == f], makers))
         live = statistics.median(w.previews.live_timings[1:]) if len(w.previews.live_timings) > 1 else float("nan")
-        rate = sum(1 for p in pictures if p is not None and p.live) / elapsed  # live pictures put on screen
-        used = [p.factor for p in pictures if p is not None and p.live]  # the live resolution's (auto: adapts)
+        rate = len(pictures) / elapsed  # live pictures put on screen
+        used = [p.factor for p in pictures]  # the live resolution's (auto: adapts)
         factor = "/".join(f"1/{f}" for f in dict.fromkeys(used)) or f"1/{live_factor(w.doc.pose.tskel())}"
         if "--verbose" in sys.argv:
             for p in pictures:
-                if p is not None and p.live:
-                    print(name, f"1/{p.factor}", {k: round(1000 * v) for k, v in p.stages.items()})
+                print(name, f"1/{p.factor}", {k: round(1000 * v) for k, v in p.stages.items()})
         t0 = time.perf_counter()
         w.doc.settings.dragging = False  # the release: the full preview, drawn, then its report
         picture = None
@@ -200,6 +218,15 @@ def bench_preview(app) -> None:
         full = time.perf_counter() - t0
         rows.append([name, f"{opened:.1f}", f"{1000 * statistics.median(slider):.0f}",
                      f"{1000 * live:.0f} ({factor})", f"{rate:.1f}", f"{picture:.2f}", f"{full:.2f}"])
+        # the same drag again with the live resolution held at the goal's (the drag above settles on a coarser one
+        # on software GL and keeps the goal's for its first two pictures only): the stages at that resolution
+        w.doc.settings.live_resolution = GOAL_RESOLUTION.get(name, "half")
+        held, makers, _ = drag(w, app, bone)
+        held_rows.append(stage_row(w, name, f"1/{held[-1].factor} held", held, makers))
+        w.doc.settings.dragging = False
+        while w.busy:
+            app.processEvents()
+            time.sleep(0.002)
         w.close()
     print("\nthe three bodies in the studio (bone mode; 1200x800 window, software GL)")
     print(table(rows, ["body", "open s (segment, skeletonize, hull)", "thinness step ms (median, held)",
@@ -211,7 +238,7 @@ def bench_preview(app) -> None:
           "stages alone: the same drag's frames remade with the window idle (pose, body, surface), median: what\n"
           "they cost; the columns after it: in the studio while it draws, composes and handles the drag on the\n"
           "same 2 cores")
-    print(table(stage_rows, ["body", "resolution", "pictures",
+    print(table(stage_rows + held_rows, ["body", "resolution", "pictures",
                              "stages alone (goal: mannequin <= 20 at 1/1, frog <= 40, large <= 60 at 1/2)",
                              "pose (frame + ownership)", "body (kernel: what moved)", "surface", "draw",
                              "stages in the studio"]))

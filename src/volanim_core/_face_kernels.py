@@ -1,7 +1,8 @@
 """numba kernels of :mod:`volanim_core.voxel_faces` (tested against a NumPy count in tests/core/render).
 
-    faces_per_slice   for each z slice (threads take slices): its filled voxels' faces towards empty ones
-                      (or the grid's edge), counted
+    row_extents       for each row: its first filled voxel and one past its last (the kernels below read inside)
+    faces_per_slice   for each z slice of a range (threads take slices): its filled voxels' faces towards empty
+                      ones (or the grid's edge), counted
     fill_faces        again, each face written at its slice's offset: 4 corners, the colour of its voxel
 
 The volume is read as its C-ordered ``[z, y, x]`` array (the studio's pictures are the transposes of their
@@ -26,52 +27,95 @@ CORNERS = 0.5 * np.array([
 
 
 @njit(cache=True, inline="always")
-def _empty(vol, z, y, x):
+def _empty_beside(vol, lo, hi, z, y, x):
+    """Whether voxel (z, y, x) is empty or past the grid, reading it only inside its row's filled extent."""
     nz, ny, nx = vol.shape
-    return z < 0 or z >= nz or y < 0 or y >= ny or x < 0 or x >= nx or vol[z, y, x] == 0
+    if z < 0 or z >= nz or y < 0 or y >= ny or x < lo[z, y] or x >= hi[z, y]:
+        return True
+    return vol[z, y, x] == 0
 
 
 @njit(cache=True, parallel=True, nogil=True)
-def faces_per_slice(vol, counts):
-    """``counts[z]``: the faces of slice z's filled voxels of ``vol [z, y, x]`` that meet an empty voxel."""
+def row_extents(vol, lo, hi):
+    """``lo[z, y]``, ``hi[z, y]``: the first filled voxel of row (z, y) of ``vol [z, y, x]`` and one past its last
+    (0, 0 for an empty row). The face kernels read only inside them: a body fills a few percent of its box, and
+    a tight scan for the first and the last filled voxel is what reading the rest costs (#85: the mannequin's
+    full-size faces, 19 ms on one thread, mostly spent on empty voxels' neighbour tests)."""
     nz, ny, nx = vol.shape
     for z in prange(nz):
+        for y in range(ny):
+            a = 0
+            while a < nx and vol[z, y, a] == 0:
+                a += 1
+            b = nx
+            while b > a and vol[z, y, b - 1] == 0:
+                b -= 1
+            lo[z, y] = a if a < nx else 0
+            hi[z, y] = b if a < nx else 0
+
+
+@njit(cache=True, parallel=True, nogil=True)
+def faces_per_slice(vol, lo, hi, z0, z1, counts):
+    """``counts[z - z0]`` for the slices ``z0 <= z < z1``: the faces of slice z's filled voxels of ``vol [z, y, x]``
+    that meet an empty voxel (``lo``, ``hi``: :func:`row_extents`). The slices around them are read as
+    neighbours: a slab's faces with the slices beside it as they are."""
+    nz, ny, nx = vol.shape
+    for z in prange(z0, z1):
         n = 0
         for y in range(ny):
-            for x in range(nx):
+            for x in range(lo[z, y], hi[z, y]):
                 if vol[z, y, x] != 0:
-                    n += (_empty(vol, z, y, x - 1) + _empty(vol, z, y, x + 1) + _empty(vol, z, y - 1, x)
-                          + _empty(vol, z, y + 1, x) + _empty(vol, z - 1, y, x) + _empty(vol, z + 1, y, x))
-        counts[z] = n
+                    n += (_empty_beside(vol, lo, hi, z, y, x - 1) + _empty_beside(vol, lo, hi, z, y, x + 1)
+                          + _empty_beside(vol, lo, hi, z, y - 1, x) + _empty_beside(vol, lo, hi, z, y + 1, x)
+                          + _empty_beside(vol, lo, hi, z - 1, y, x) + _empty_beside(vol, lo, hi, z + 1, y, x))
+        counts[z - z0] = n
 
 
 @njit(cache=True, parallel=True, nogil=True)
-def fill_faces(vol, starts, corners, origin, spacing, table, points, faces, rgb):
-    """Each face of slice z written from ``starts[z]``: ``points[4f:4f+4]`` its corners in world units
-    (``origin + spacing * (voxel + corner)``, (x, y, z)), ``faces[f]`` their indices, ``rgb[4f:4f+4]`` the
-    colour ``table[value]`` of its filled voxel (RGB or RGBA, as the table's rows; past the table: its last row)."""
+def fill_faces(vol, lo, hi, z0, z1, z_at, starts, corners, origin, spacing, table, points, faces, rgb):
+    """Each face of slice z (``z0 <= z < z1``, as :func:`faces_per_slice` counted them) written from
+    ``starts[z - z0]``: ``points[4f:4f+4]`` its corners in world units (``origin + spacing * (voxel + corner)``,
+    (x, y, z), where ``vol``'s slice z is the grid's slice ``z + z_at``), ``faces[f]`` their indices,
+    ``rgb[4f:4f+4]`` the colour ``table[value]`` of its filled voxel (RGB or RGBA, as the table's rows; past the
+    table: its last row). ``lo``, ``hi``: :func:`row_extents`."""
     nz, ny, nx = vol.shape
     top = table.shape[0] - 1
-    for z in prange(nz):
-        f = starts[z]
+    nch = rgb.shape[1]  # RGB, or RGBA (a transfer function's opacity)
+    at = np.empty((6, 4, 3), np.float64)  # each corner's offset in world units, and the steps a voxel
+    for d in range(6):
+        for k in range(4):
+            for a in range(3):
+                at[d, k, a] = origin[a] + spacing[a] * corners[d, k, a]
+    for z in prange(z0, z1):
+        f = starts[z - z0]
         for y in range(ny):
-            for x in range(nx):
+            for x in range(lo[z, y], hi[z, y]):
                 v = vol[z, y, x]
                 if v == 0:
                     continue
-                c = table[min(np.int64(v), top)]
+                row = min(np.int64(v), top)  # an index, not a view of the table: no reference counts a voxel
+                wx, wy, wz = spacing[0] * x, spacing[1] * y, spacing[2] * (z + z_at)
                 for d in range(6):
-                    dx = -1 if d == 0 else (1 if d == 1 else 0)
-                    dy = -1 if d == 2 else (1 if d == 3 else 0)
-                    dz = -1 if d == 4 else (1 if d == 5 else 0)
-                    if not _empty(vol, z + dz, y + dy, x + dx):
+                    if d == 0:
+                        open_ = _empty_beside(vol, lo, hi, z, y, x - 1)
+                    elif d == 1:
+                        open_ = _empty_beside(vol, lo, hi, z, y, x + 1)
+                    elif d == 2:
+                        open_ = _empty_beside(vol, lo, hi, z, y - 1, x)
+                    elif d == 3:
+                        open_ = _empty_beside(vol, lo, hi, z, y + 1, x)
+                    elif d == 4:
+                        open_ = _empty_beside(vol, lo, hi, z - 1, y, x)
+                    else:
+                        open_ = _empty_beside(vol, lo, hi, z + 1, y, x)
+                    if not open_:
                         continue
+                    p = 4 * f
                     for k in range(4):
-                        p = 4 * f + k
-                        points[p, 0] = origin[0] + spacing[0] * (x + corners[d, k, 0])
-                        points[p, 1] = origin[1] + spacing[1] * (y + corners[d, k, 1])
-                        points[p, 2] = origin[2] + spacing[2] * (z + corners[d, k, 2])
-                        faces[f, k] = p
-                        for ch in range(rgb.shape[1]):  # RGB, or RGBA (a transfer function's opacity)
-                            rgb[p, ch] = c[ch]
+                        points[p + k, 0] = at[d, k, 0] + wx
+                        points[p + k, 1] = at[d, k, 1] + wy
+                        points[p + k, 2] = at[d, k, 2] + wz
+                        faces[f, k] = p + k
+                        for ch in range(nch):
+                            rgb[p + k, ch] = table[row, ch]
                     f += 1

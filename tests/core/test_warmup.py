@@ -10,7 +10,7 @@ import pytest
 
 # numba functions only ever called from inside other kernels: compiled into their callers, never on their own
 INLINED = {
-    "volanim_core._face_kernels._empty",
+    "volanim_core._face_kernels._empty_beside",
     "volanim_core.colour._tour_kernels.two_opt",
     "volanim_core.reconstruct._clip_kernels._last_inside",
     "volanim_core.reconstruct._clip_kernels._row_run",

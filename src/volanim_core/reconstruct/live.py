@@ -59,6 +59,8 @@ class LiveFrame:
         self.threads = max(1, min(int(threads or numba.get_num_threads()), numba.config.NUMBA_NUM_THREADS))
         self._last = None  # (connectivity arrays, centres, r2s) of the frame the arrays hold
         self.redone = 0  # slices the last update filled: what it cost (all of them on a first frame)
+        # the grid's z-slices the last update may have changed: (first, last), None (none) or "all" (a first frame)
+        self.changed: tuple[int, int] | None | str = "all"
 
     def update(self, tskel: Tskel, *, progress=None, cancel=None, copy: bool = True) -> Reconstruction:
         """The frame ``tskel`` reconstructed on the fixed grid. ``copy=False`` returns a view of the live
@@ -78,6 +80,7 @@ class LiveFrame:
             redo = _moved_slices(self._last[1], self._last[2], plan, nz)
         spans = _runs(redo)
         self.redone = int(redo.sum())
+        self.changed = "all" if not same else ((int(spans[0][0]), int(spans[-1][1]) - 1) if spans else None)
         previous = numba.get_num_threads()
         numba.set_num_threads(self.threads)
         try:

@@ -47,6 +47,8 @@ class LiveOwned:
         self._frame: Reconstruction | None = None
         self._matrices: np.ndarray | None = None
         self.redone = 0  # voxels the last update decided again (the whole grid's on a first frame)
+        # the grid's z-slices the last update may have changed: (first, last), None (none) or "all" (a first frame)
+        self.changed: tuple[int, int] | None | str = "all"
 
     def update(self, matrices: np.ndarray, *, copy: bool = True) -> Reconstruction:
         """The frame posed by ``matrices`` on the fixed grid. ``copy=False`` returns the kept frame itself:
@@ -55,12 +57,15 @@ class LiveOwned:
         m = np.ascontiguousarray(matrices, np.float64)
         if self._frame is None:
             self._frame = self._made(m, self.bounds)
-            self.redone = int(np.prod(self.bounds.shape))
+            self.redone, self.changed = int(np.prod(self.bounds.shape)), "all"
         else:
             box = self._moved_box(self._matrices, m)
             self.redone = 0 if box is None else int(np.prod(box.shape))
+            self.changed = None
             if box is not None:
                 self._paste(self._made(m, box), box)
+                z = self._frame.origin[2]
+                self.changed = (box.lo[2] - z, box.hi[2] - z)
         self._matrices = m
         f = self._frame
         stats = {**f.stats, "seconds": self.clock() - t0, "redone": self.redone,

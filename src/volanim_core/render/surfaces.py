@@ -71,13 +71,17 @@ def voxel_faces(volume: np.ndarray, origin, spacing, table: np.ndarray | None = 
     A closed surface of the filled voxels, as :func:`label_surface`'s at iso 0.5 is, but with the voxels'
     corners rather than cut ones: it is what the voxels are, and it is made in one pass (threads over slices).
     """
-    import pyvista as pv
-
     from volanim_core.voxel_faces import face_arrays
 
     points, faces, rgb = face_arrays(volume, origin, spacing, table)
-    n = len(faces)
-    mesh = pv.PolyData.from_regular_faces(points, faces) if n else pv.PolyData()
-    if n and table is not None:
+    return faces_mesh(points, faces, None if table is None else rgb)
+
+
+def faces_mesh(points: np.ndarray, faces: np.ndarray, rgb: np.ndarray | None = None):
+    """The pyvista mesh of :func:`~volanim_core.voxel_faces.face_arrays`'s arrays (``rgb`` None: no colours)."""
+    import pyvista as pv
+
+    mesh = pv.PolyData.from_regular_faces(points, faces) if len(faces) else pv.PolyData()
+    if len(faces) and rgb is not None:
         mesh.point_data["rgb"] = rgb
     return mesh

@@ -75,23 +75,33 @@ def live_surface(preview: Preview, function=None, n_bones: int = 0, spacing=(1.0
     software GL draws a surface far faster than it ray-casts a volume. With the user's transfer ``function``,
     its colours and opacities by label (a label it makes clear is not drawn, #83); else the bone colours
     (``n_bones``) in bone mode, none in binary.
-    Pure arrays and VTK: made in the live worker, so the GUI thread only hands it to the view."""
-    from volanim_core.render.bone_colours import label_table
+    Pure arrays and VTK: made in the live worker, so the GUI thread only hands it to the view.
+    :meth:`LivePreviews.surface` makes the same, keeping the faces of what a drag did not change."""
     from volanim_core.render.surfaces import label_surface, voxel_faces
 
     volume = preview.reconstruction.volume
-    if function is not None and volume.ndim == 3:
-        rgba = function(np.arange(int(volume.max()) + 1, dtype=np.float64))
-        clear = rgba[:, 3] <= 0
-        if clear[1:].any():
-            volume = np.where(clear[volume], 0, volume)
-        table = np.round(np.clip(rgba, 0, 1) * 255).astype(np.uint8)  # RGBA: translucent where it says
-    else:
-        table = label_table(n_bones) if preview.mode == "bone" else None
+    table, clear = _surface_colours(preview.mode, volume, function, n_bones)
+    if clear is not None:
+        volume = np.where(clear[volume], 0, volume)
     world = np.asarray(spacing, np.float64)
     # the voxels' own faces: a quarter of flying edges' time on a live picture (colour volumes: flying edges)
     surface = voxel_faces if volume.ndim == 3 else label_surface
     return surface(volume, preview.origin_voxels * world, np.asarray(preview.spacing) * world, table)
+
+
+def _surface_colours(mode: str, volume: np.ndarray, function, n_bones: int):
+    """``(table, clear)``: a live surface's colour a label (the transfer ``function``'s RGBA, or the bone colours
+    in bone mode, or None) and the labels it makes clear (None: none), for the labels ``volume`` can hold."""
+    from volanim_core.render.bone_colours import label_table
+
+    if function is None or volume.ndim != 3:
+        return (label_table(n_bones) if mode == "bone" else None), None
+    # every label a byte can hold (no pass over the volume for its largest), or up to the largest of wider ones
+    labels = 256 if volume.dtype.itemsize == 1 else int(volume.max()) + 1
+    rgba = function(np.arange(labels, dtype=np.float64))
+    clear = rgba[:, 3] <= 0
+    table = np.round(np.clip(rgba, 0, 1) * 255).astype(np.uint8)  # RGBA: translucent where it says
+    return table, (clear if clear[1:].any() else None)
 
 
 def make_preview(tskel: Tskel, *, mode: str = "bone", kernel: int = 1, padding: int = 2, source=None,
@@ -154,6 +164,9 @@ class LivePreviews:
         # one live grid per factor of this mode: a factor left and taken again redoes only what moved since its last
         # picture, not its whole grid (the frog's half-size grid: 3.9 M voxels, 100 ms)
         self._kept: dict = {}
+        self._faces: dict = {}  # key -> the faces kept of its grid's last surface (surface())
+        self._made = None  # (the faces kept of its grid, the grid's volume, its origin, factor) of the last picture
+        self.faces_redone = 0  # z-slices of its grid whose faces the last surface made again
 
     def make(self, tskel: Tskel, *, mode: str = "bone", factor: int | None = None, padding: int = 2) -> Preview:
         """The preview :func:`make_preview` makes of ``tskel`` (same voxels, same grid), redoing only what moved.
@@ -186,12 +199,41 @@ class LivePreviews:
         self._kept = {k: v for k, v in self._kept.items() if k[0] == mode and k[1] != factor}  # another rig's: gone
         self._kept[key] = self._live = live
         self._key = key
+        faces = self._faces.get(key)
+        if faces is None or faces.live is not live:
+            faces = _GridFaces(live)
+        else:  # the slices changed since its last surface: this picture's, and any a picture made without one did
+            faces.pending = _either(faces.pending, live.changed)
+        self._faces = {k: v for k, v in self._faces.items() if k in self._kept}
+        self._faces[key] = faces
+        self._made = (faces, r.volume, r.origin, factor)
         lo = np.subtract(own.lo, r.origin)
         box = tuple(slice(a, a + n) for a, n in zip(lo, own.shape))
         # copied in its memory's order (the [x, y, z] view of [z, y, x] arrays, as reconstruct returns them):
         # a C-order copy of the frog's half-size grid took 18 ms, and the surface then copied it again
         cropped = Reconstruction(r.volume[box].copy(order="K"), own.lo, r.stats, r.geometry.shifted(lo))
         return Preview(cropped, factor, mode, live=True)
+
+    def surface(self, preview: Preview, function=None, n_bones: int = 0, spacing=(1.0, 1.0, 1.0)):
+        """:func:`live_surface` of the picture :meth:`make` made last (``preview``), from the faces of its grid kept
+        since that grid's last surface: only the slices the bones moved since then are made again (the mannequin's
+        full-size faces were more than half a live picture's stages). The same faces, in the same order."""
+        faces, volume, origin, factor = self._made
+        if volume.ndim != 3:  # colour: flying edges, made whole
+            return live_surface(preview, function, n_bones, spacing)
+        from volanim_core.render.surfaces import faces_mesh
+        from volanim_core.voxel_faces import KeptFaces
+
+        table, clear = _surface_colours(preview.mode, volume, function, n_bones)
+        world = np.asarray(spacing, np.float64) * factor
+        style = (None if table is None else table.tobytes(), None if clear is None else clear.tobytes(),
+                 tuple(world))
+        if faces.kept is None or faces.style != style:  # another colour table or spacing: made afresh
+            faces.kept = KeptFaces(np.asarray(origin) * world, world, table, clear)
+            faces.style, faces.pending = style, "all"
+        points, cells, rgb = faces.kept.update(volume, faces.pending)
+        faces.pending, self.faces_redone = None, faces.kept.redone
+        return faces_mesh(points, cells, None if table is None else rgb)
 
     @property
     def bounds(self) -> Bounds | None:
@@ -212,3 +254,20 @@ def _inside(inner: Bounds, outer: Bounds) -> bool:
 def _grown(b: Bounds, margin: float) -> Bounds:
     room = [max(4, int(np.ceil(margin * n))) for n in b.shape]
     return Bounds(tuple(v - r for v, r in zip(b.lo, room)), tuple(v + r for v, r in zip(b.hi, room)))
+
+
+class _GridFaces:
+    """The faces kept of one live grid (``live``, a LiveOwned or LiveFrame) and the slices changed since."""
+
+    def __init__(self, live):
+        self.live, self.kept, self.style = live, None, None
+        self.pending: tuple[int, int] | None | str = "all"
+
+
+def _either(a, b):
+    """The z-slices of two changes together: ``(first, last)``, None (no change) or "all"."""
+    if a is None or b is None:
+        return b if a is None else a
+    if isinstance(a, str) or isinstance(b, str):
+        return "all"
+    return (min(a[0], b[0]), max(a[1], b[1]))

@@ -26,7 +26,7 @@ from PySide6.QtWidgets import QFileDialog
 from volanim_core import io
 
 from ..model.live_resolution import LiveResolution
-from ..model.preview import LivePreviews, live_surface, make_preview, with_report
+from ..model.preview import LivePreviews, make_preview, with_report
 from ..model.settings import Mode
 from . import ownership_actions
 from .controller import FAILED, Controller
@@ -212,7 +212,7 @@ class PreviewController(Controller):
             p = live.make(attached, mode=mode, padding=2)  # only what moved, at the resolution keeping the rate
             t3 = clock()
             p.basis, p.joints, p.frame = basis, joints, frame
-            p.surface = live_surface(p, function, n_bones, spacing)
+            p.surface = live.surface(p, function, n_bones, spacing)  # only the slices that changed made again
             p.stages = {"pose": t2 - t1, "body": t3 - t2, "surface": clock() - t3}
             return p, full, t0
 

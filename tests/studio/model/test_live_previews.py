@@ -105,3 +105,46 @@ def test_a_factor_taken_again_redoes_what_moved_since_its_last_picture_not_its_w
             assert 0 < live.redone < whole // 2
     live.make(conn.posed(pose_matrices(s.bones, DRAG[1])), mode="binary", factor=2, padding=2)
     assert live.redone == (int(np.prod(live.bounds.shape)) if owned else live.bounds.shape[2])  # another mode: anew
+
+
+def clear_label_two(values: np.ndarray) -> np.ndarray:
+    """A transfer function (RGBA a label) that makes label 2 clear and the others a colour of their own."""
+    rgba = np.stack([values / 40.0 % 1, 0.5 + 0 * values, 1 - values / 40.0 % 1, 1 + 0 * values], axis=1)
+    rgba[values == 2, 3] = 0
+    return np.clip(rgba, 0, 1)
+
+
+@pytest.mark.parametrize("owned", [True, False])
+def test_a_drags_surfaces_are_the_pictures_surfaces_made_whole_with_only_the_changed_slices_made_again(owned):
+    """#85: a live picture's surface was made from the whole body each time (the mannequin's full-size faces: more
+    than half the live stages). Its faces are now kept from the last picture of the same grid and only the slices
+    the moved bones reach are made again: every surface of a drag is the one made whole from the picture, face
+    for face, across factors taken again, a picture made without its surface, and a transfer function changed."""
+    from volanim_core.rig.ownership import ownership
+    from volanim_studio.model.preview import live_surface
+
+    s = samples.mannequin()
+    conn = io.read_connect(ASSETS / "mannequin.0.50.connect")
+    if owned:
+        conn = conn.with_ownership(ownership(s.mask, conn))
+    live = LivePreviews()
+    n_bones, spacing = len(s.bones), (1.5, 1.5, 2.0)
+    arm = [{"L_FOREARM": (0, 0, a)} for a in range(0, 80, 10)]
+    # (factor, transfer function, surface made, pose): the undrawn picture also turns the head, which the
+    # next one keeps: only the kept slices' record of that picture's changes tells the next surface about it
+    steps = [(2, None, True, arm[0]), (2, None, True, arm[1]), (4, None, True, arm[2]),
+             (2, None, False, {**arm[2], "HEAD": (0, 0, 20)}), (2, None, True, {**arm[3], "HEAD": (0, 0, 20)}),
+             (2, clear_label_two, True, arm[4]), (2, clear_label_two, True, arm[5]), (1, None, True, arm[6]),
+             (1, None, True, arm[7])]
+    redone = []
+    for factor, function, drawn, pose in steps:
+        p = live.make(conn.posed(pose_matrices(s.bones, pose)), mode="bone", factor=factor, padding=2)
+        if not drawn:
+            continue  # its surface never made: the next one's redoes its slices as well
+        got, want = live.surface(p, function, n_bones, spacing), live_surface(p, function, n_bones, spacing)
+        assert got.n_cells == want.n_cells > 1000
+        assert np.array_equal(np.asarray(got.point_data["rgb"]), np.asarray(want.point_data["rgb"]))
+        assert np.allclose(np.asarray(got.points), np.asarray(want.points), atol=1e-4)
+        redone.append(live.faces_redone)
+    grid = live.bounds.shape[2]
+    assert redone[-1] < grid // 2 and redone[1] < redone[0]  # a step of the forearm: its own slices, not the grid's
