@@ -8,8 +8,10 @@ Then the three bodies (#65: mannequin, frog, mannequin-large) as a user meets th
 slider steps, a pose drag's live previews and the full preview after the release. The drag is paced as a
 mouse paces it (a pose change every 1/60 s for 1.5 s); its rate is the live pictures put on screen a second.
 Each live picture's stages (pose, body, surface) are given as measured in the studio, beside the same drag's
-frames remade with the window idle ("alone"): on 2 cores the window's draw and its handling of the drag
-share the cores and Python's lock with the live thread.
+frames remade with the window idle on the live thread's kernel threads ("alone"): on 2 cores the window's
+draw, its composition and its handling of the drag share the cores and Python's lock with the live thread.
+A second drag holds the live resolution at #85's goal's (the mannequin full, the others half): the auto
+drag settles coarser on software GL, so its goal-resolution row has two pictures only.
 Needs a display: ``xvfb-run -a .venv/bin/python benchmarks/bench_studio.py [--bodies [NAME ...]]``
 (``make bench`` does this).
 """
@@ -235,9 +237,10 @@ def bench_preview(app) -> None:
     print("targets (#65): mannequin-large live >= 10/s, full <= 0.5 s, slider <= 50 ms; frog live >= 15/s, "
           "full <= 0.3 s; mannequin live at full resolution >= 30/s")
     print("\na live update by stage (median ms over the drag; draw: software GL, what a GPU desktop makes cheap).\n"
-          "stages alone: the same drag's frames remade with the window idle (pose, body, surface), median: what\n"
-          "they cost; the columns after it: in the studio while it draws, composes and handles the drag on the\n"
-          "same 2 cores")
+          "stages alone: the same drag's frames remade with the window idle (pose, body, surface) on the live\n"
+          "thread's kernel threads, median: what they cost; the columns after it: in the studio while it draws,\n"
+          "composes and handles the drag on the same 2 cores. held: the drag again at the goal's resolution (the\n"
+          "studio's own choice settles coarser on software GL after a drag's first pictures)")
     print(table(stage_rows + held_rows, ["body", "resolution", "pictures",
                              "stages alone (goal: mannequin <= 20 at 1/1, frog <= 40, large <= 60 at 1/2)",
                              "pose (frame + ownership)", "body (kernel: what moved)", "surface", "draw",
