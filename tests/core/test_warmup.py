@@ -152,3 +152,33 @@ def test_a_smooth_frames_report_uses_the_kernels_the_warm_up_compiled():
     kernels: every user's first smooth report compiled four of them (2.5 s of the rabbit's leaf test)."""
     out = compiled_again(["volanim_core._run_kernels", "volanim_core.reconstruct._label_kernels"], SMOOTH_REPORT)
     assert "compiled again: []" in out, out
+
+
+LIVE_SPHERES_AND_OWN_REST = """
+import numpy as np
+from volanim_core import samples
+from volanim_core.reconstruct.breakage import rest_voxels
+from volanim_core.reconstruct.engine import Reconstruction, grid_bounds
+from volanim_core.reconstruct.live import LiveFrame
+from volanim_core.rig.pose import pose_matrices
+s = samples.load("mannequin")
+conn = samples.part_connectivity(s)
+frames = [conn.posed(pose_matrices(s.bones, {"L_FOREARM": (0, 0, a)})) for a in (0, 30)]
+live = LiveFrame(grid_bounds(frames[0], 8))
+for t in frames:
+    live.update(t)  # the studio's live spheres: their neighbour lists are the LiveFrame's own
+rest = np.zeros((12, 10, 8), np.uint8)  # a caller's own volume, in C order
+rest[2:9, 2:8, 1:4], rest[3:8, 3:7, 4:7] = 1, 2
+rest_voxels(Reconstruction(rest, (0, 0, 0)))
+"""
+
+
+@pytest.mark.long("a process of its own: only there does a dispatcher's compiled state come from the warm-up alone")
+def test_live_spheres_and_a_callers_rest_volume_use_the_kernels_the_warm_up_compiled():
+    """The sweep of the default tier (each test file in a process of its own after the warm-up, the dispatchers'
+    signatures before and after) found two product paths compiling on first use: the studio's live spheres gave
+    the overdraw cut their own, writeable neighbour lists (the warm-up's come read-only from the cache), and a
+    report's rest voxels of a C-ordered volume ran the run kernels on its Fortran-ordered transpose."""
+    out = compiled_again(["volanim_core.reconstruct._plan_kernels", "volanim_core._run_kernels"],
+                         LIVE_SPHERES_AND_OWN_REST)
+    assert "compiled again: []" in out, out

@@ -114,6 +114,10 @@ def plan_frame(tskel: Tskel, mode: str, *, source=None, kernel: int = 1, value: 
         # are tried; made once per connectivity, not per frame
         nbrs = cached_neighbours(rest, min_radius=CUT_MIN_RADIUS, r2=r2s if rest is tskel else None) \
             if neighbours is None else reorder_neighbours(neighbours, order)
+        # read-only as the cache keeps them, whoever made them: numba types a read-only array apart, and the
+        # studio's live spheres (their own lists) compiled the kernel again on first use after the warm-up
+        nbrs = nbrs.view()
+        nbrs.flags.writeable = False
         plane_start, planes = P.build_halfspaces(centres, r2s, nbrs, CUT_MIN_RADIUS**2)
     else:
         plane_start, planes = np.zeros(len(tskel) + 1, np.int64), np.zeros((0, 5))
