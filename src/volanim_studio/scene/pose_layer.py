@@ -71,6 +71,7 @@ class PoseLayer:
         self.view = view
         self.preview_actor = None
         self.preview_key = None  # (mode, shape, origin, spacing, bones, max): same key -> swap data only
+        self._surface = (None, None)  # a live picture's actor and its colouring: the next one swaps its faces in
         self._mapper = None  # the volume mapper for full previews, chosen once the GL context exists
         self._bone_lines = None  # the posed bones' lines as drawn: a drag's step moves their points
         self._note = None  # the "Old picture" text actor, once made
@@ -356,11 +357,23 @@ class PoseLayer:
         # own, and each redraw of a body with 1.5 mm voxels grew it 1.5 times)
         if surf is None:
             surf = live_surface(p, view.doc.transfer.function, len(view.doc.bones), view.spacing)
-        self.clear(render=False)
-        if surf.n_points and "rgb" in surf.point_data:
-            plotter.add_mesh(surf, scalars="rgb", rgb=True, name="preview", render=False, reset_camera=False)
-        elif surf.n_points:
-            plotter.add_mesh(surf, color=SKIN, name="preview", render=False, reset_camera=False)
+        # its colouring: RGB, RGBA (a transfer function's opacities: add_mesh sets the actor up for them) or none
+        kind = np.asarray(surf.point_data["rgb"]).shape[1] if "rgb" in surf.point_data else "skin"
+        actor = plotter.actors.get("preview")
+        if surf.n_points and actor is not None and actor is self._surface[0] and kind == self._surface[1]:
+            # the last picture's actor, given this one's faces: pyvista's add_mesh made a mapper and an actor anew
+            # each picture, 8 ms of the GUI thread's a live picture on the mannequin (#85)
+            if kind != "skin":
+                surf.point_data.active_scalars_name = "rgb"
+            actor.mapper.SetInputData(surf)
+        else:
+            self.clear(render=False)
+            if surf.n_points and kind != "skin":
+                actor = plotter.add_mesh(surf, scalars="rgb", rgb=True, name="preview", render=False,
+                                         reset_camera=False)
+            elif surf.n_points:
+                actor = plotter.add_mesh(surf, color=SKIN, name="preview", render=False, reset_camera=False)
+            self._surface = (actor, kind) if surf.n_points else (None, None)
         view.apply_stage()
         view.render()
         if p.stages is not None:  # the draw the last live picture took (this one's is known once drawn)
@@ -370,5 +383,6 @@ class PoseLayer:
         self.view.plotter.remove_actor("preview", render=False)
         self.view.plotter.remove_actor("slices", render=False)
         self.preview_actor = self.preview_key = None
+        self._surface = (None, None)
         if render:
             self.view.render()

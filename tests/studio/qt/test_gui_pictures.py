@@ -142,3 +142,30 @@ def test_a_live_picture_shows_the_voxels_it_made_from_every_side(qtbot, colour_w
         assert outside == 0.0 and got["stray"] < 0.01 and got["iou_rim"] >= 0.9, (resolution, view, got)
     doc.settings.dragging = False
     qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
+
+
+def test_a_drags_pictures_swap_their_faces_into_one_actor_and_show_what_a_new_one_would(qtbot, colour_window):
+    """#85: each live picture made a mapper and an actor anew (pyvista's add_mesh: 8 ms of the GUI thread a picture
+    on the mannequin). The drag's pictures after the first swap their faces into the first one's actor; what is
+    drawn is what a fresh actor draws, pixel for pixel, and the voxels the picture holds (the oracle)."""
+    w = colour_window
+    doc = w.doc
+    doc.settings.live_resolution = "full"
+    doc.settings.dragging = True
+    actors = []
+    for angle in (-20, -40, -60):
+        doc.pose.set_angles(doc.bones.index("L_UPPERARM"), (0, angle, 0))
+        qtbot.waitUntil(lambda: doc.preview is not None and doc.preview.live and doc.preview_is_current
+                        and w.previews.live_worker.idle and not w.busy, timeout=JOB_TIMEOUT_MS)
+        actors.append(w.plotter.actors["preview"])
+    assert actors[1] is actors[0] and actors[2] is actors[0]  # one actor, its faces swapped
+    got, outside = studio_picture(w)
+    assert outside == 0.0 and got["stray"] < 0.01 and got["iou_rim"] >= 0.9, got
+    swapped = np.asarray(w.plotter.screenshot(return_img=True))
+    layer = w.scene.pose_layer
+    layer.clear(render=False)
+    layer.show_surface(doc.preview)  # the same picture in an actor made afresh
+    assert w.plotter.actors["preview"] is not actors[0]
+    assert np.array_equal(np.asarray(w.plotter.screenshot(return_img=True)), swapped)
+    doc.settings.dragging = False
+    qtbot.waitUntil(lambda: not w.busy, timeout=JOB_TIMEOUT_MS)
