@@ -12,7 +12,7 @@ preview's surface (``render/surfaces.voxel_faces`` makes it a pyvista mesh). Bel
 Why a drag keeps faces: a live picture redoes the box of the bones that moved (#85), and the surface of the
 whole body was made again around it -- the mannequin's full-size faces were more than half of a live
 picture's stages. A slice's faces depend on that slice and the two beside it, so the slices a frame left
-alone keep theirs, voxel for voxel (the tests compare every update with ``face_arrays`` of the whole).
+alone keep theirs, face for face (the tests compare every update with ``face_arrays`` of the whole).
 """
 
 from __future__ import annotations
