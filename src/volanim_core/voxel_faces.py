@@ -34,10 +34,15 @@ def _rows(table: np.ndarray | None) -> np.ndarray:
     return np.zeros((1, 3), np.uint8) if table is None else np.ascontiguousarray(table, np.uint8)
 
 
+def _quads(n: int) -> np.ndarray:
+    """``(n, 4)``: face f's corners are points 4f..4f+3, as the kernel writes them."""
+    return np.arange(4 * n, dtype=np.int64).reshape(n, 4)
+
+
 def _slab_faces(vol: np.ndarray, z0: int, z1: int, origin, spacing, rows: np.ndarray, clear=None
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The faces of slices ``z0 <= z < z1`` of ``vol [z, y, x]`` (the slices beside them read as neighbours):
-    ``(points, faces, rgb, counts a slice)``, faces numbered from 0. ``clear[label]``: labels drawn as empty."""
+    ``(points, rgb, counts a slice)``. ``clear[label]``: labels drawn as empty."""
     h0, h1 = max(z0 - 1, 0), min(z1 + 1, vol.shape[0])  # the slab and the slice each side it meets
     slab = vol[h0:h1] if clear is None else np.where(clear[vol[h0:h1]], 0, vol[h0:h1]).astype(vol.dtype)
     lo, hi = np.empty(slab.shape[:2], np.int32), np.empty(slab.shape[:2], np.int32)
@@ -47,11 +52,10 @@ def _slab_faces(vol: np.ndarray, z0: int, z1: int, origin, spacing, rows: np.nda
     starts = np.concatenate([[0], np.cumsum(counts)])
     n = int(starts[-1])
     points = np.empty((4 * n, 3), np.float32)
-    faces = np.empty((n, 4), np.int64)
     rgb = np.empty((4 * n, rows.shape[1]), np.uint8)
     fill_faces(slab, lo, hi, z0 - h0, z1 - h0, h0, starts, CORNERS, np.asarray(origin, np.float64),
-               np.asarray(spacing, np.float64), rows, points, faces, rgb)
-    return points, faces, rgb, counts
+               np.asarray(spacing, np.float64), rows, points, rgb)
+    return points, rgb, counts
 
 
 def face_arrays(volume: np.ndarray, origin, spacing, table: np.ndarray | None = None
@@ -61,8 +65,8 @@ def face_arrays(volume: np.ndarray, origin, spacing, table: np.ndarray | None = 
     (``origin + spacing * voxel``) and their colour ``table[label]`` (the table's last row past its end; zeros
     without a table)."""
     vol = _labels(volume)
-    points, faces, rgb, _ = _slab_faces(vol, 0, vol.shape[0], origin, spacing, _rows(table))
-    return points, faces, rgb
+    points, rgb, _ = _slab_faces(vol, 0, vol.shape[0], origin, spacing, _rows(table))
+    return points, _quads(len(points) // 4), rgb
 
 
 class KeptFaces:
@@ -99,12 +103,12 @@ class KeptFaces:
         if b <= a:
             self.redone = 0
         elif a == 0 and b == nz:
-            self._points, _, self._rgb, counts = _slab_faces(vol, 0, nz, self.origin, self.spacing, self.rows,
+            self._points, self._rgb, counts = _slab_faces(vol, 0, nz, self.origin, self.spacing, self.rows,
                                                                 self.clear)
             self._starts = np.concatenate([[0], np.cumsum(counts)])
             self._shape, self.redone = vol.shape, nz
         else:
-            points, _, rgb, counts = _slab_faces(vol, a, b, self.origin, self.spacing, self.rows, self.clear)
+            points, rgb, counts = _slab_faces(vol, a, b, self.origin, self.spacing, self.rows, self.clear)
             s = self._starts
             cut = (4 * s[a], 4 * s[b])
             self._points = np.concatenate([self._points[:cut[0]], points, self._points[cut[1]:]])
@@ -112,5 +116,4 @@ class KeptFaces:
             self._starts = np.concatenate([s[:a + 1], s[a] + np.cumsum(counts), s[b + 1:] + (len(points) // 4
                                                                                           - (s[b] - s[a]))])
             self.redone = b - a
-        n = len(self._points) // 4
-        return self._points, np.arange(4 * n, dtype=np.int64).reshape(n, 4), self._rgb
+        return self._points, _quads(len(self._points) // 4), self._rgb

@@ -11,6 +11,7 @@ import pytest
 # numba functions only ever called from inside other kernels: compiled into their callers, never on their own
 INLINED = {
     "volanim_core._face_kernels._empty_beside",
+    "volanim_core._face_kernels._open_sides",
     "volanim_core.colour._tour_kernels.two_opt",
     "volanim_core.reconstruct._clip_kernels._last_inside",
     "volanim_core.reconstruct._clip_kernels._row_run",
