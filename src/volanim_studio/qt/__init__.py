@@ -22,5 +22,5 @@ status_line.py ........ the status bar; verdict_label.py the last preview's verd
 fine_slider.py ........ FineSlider: the pose sliders, a degree per 5 pixels with Shift held
 mode_keys.py .......... the mode letters work wherever the focus is
 interactor.py ......... a pyvistaqt interactor closed without a stale wrapper; gui_gc.py: garbage
-                        collected on the GUI thread only
+                        collected on the GUI thread only, never fully in a drag or a play
 """

@@ -35,7 +35,7 @@ from .connect_panel import ConnectPanel
 from .display_panel import DisplayPanel
 from .export_controller import ExportController
 from .files_controller import FilesController
-from .gui_gc import collect_on_gui_thread
+from .gui_gc import collect_on_gui_thread, freeze_start_up
 from .interactor import close_interactor
 from .mode_keys import LettersPastNumberFields
 from .naming_controller import NamingController
@@ -54,7 +54,8 @@ from .worker import JobRunner
 class MainWindow(QMainWindow):
     def __init__(self, doc: Document | None = None):
         super().__init__()
-        collect_on_gui_thread()  # before any worker thread runs: garbage holding Qt/VTK objects dies here
+        # before any worker thread runs: garbage holding Qt/VTK objects dies here; never a full collection in a drag
+        collect_on_gui_thread().hold_full_while(self)
         self.doc = doc or Document()
         self.setWindowTitle("volanim studio")
         self.resize(1400, 900)
@@ -367,6 +368,11 @@ class MainWindow(QMainWindow):
         return (self.jobs.running or self.readers.busy or self.savers.busy
                 or not self.previews.live_worker.idle)
 
+    def interacting(self) -> bool:
+        """A bone is dragged or the timeline plays: frames the user follows (a full collection waits, gui_gc)."""
+        settings = self.doc.settings
+        return bool(settings.dragging or settings.playing)
+
     def screenshot(self, path) -> None:
         self.plotter.screenshot(str(path))
 
@@ -387,6 +393,7 @@ class MainWindow(QMainWindow):
 def main_window_for(args) -> MainWindow:
     """A window loaded as the command line asks (see ``app.main``)."""
     w = MainWindow()
+    freeze_start_up()  # the program and its window, before any file is read: out of every later collection
 
     def then(_=None):  # files that build on the loaded skeleton, after any background load
         if args.mskel:

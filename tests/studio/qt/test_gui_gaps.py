@@ -8,7 +8,9 @@ decides. The wall gaps are printed beside it (``VOLANIM_GAP_TABLE=file`` writes 
 
 from __future__ import annotations
 
+import gc
 import os
+import threading
 import time
 
 import numpy as np
@@ -41,6 +43,19 @@ class Ticks:
 
         self.drawing = 0.0  # the GUI thread's CPU time in VTK's draws (paintGL), so far
         self.draws: list[float] = []  # each draw's, this phase
+        self.collections: list[float] = []  # each garbage collection's on the GUI thread, this phase (printed)
+        self._collecting = 0.0
+        gc.callbacks.append(self._collection)
+
+    def _collection(self, phase, info):
+        if threading.current_thread() is threading.main_thread():
+            if phase == "start":
+                self._collecting = time.thread_time()
+            else:
+                self.collections.append(time.thread_time() - self._collecting)
+
+    def close(self):
+        gc.callbacks.remove(self._collection)
 
     def _tick(self):
         self.wall.append(time.perf_counter())
@@ -81,10 +96,12 @@ class Ticks:
 
     def measure(self, qtbot, action, until) -> tuple[float, float]:
         """``action()``, then the loop runs until ``until()``: (longest GUI-thread work between two ticks
-        but VTK's draws, longest draw, longest wall gap between two ticks), the action's own call included."""
+        but VTK's draws, longest draw, longest wall gap between two ticks, longest garbage collection on the GUI
+        thread), the action's own call included."""
         self.wall.clear()
         self.cpu.clear()
         self.draws.clear()
+        self.collections.clear()
         self.timer.start(20)
         if os.environ.get("VOLANIM_GAP_STACKS"):
             self.watch()
@@ -98,7 +115,7 @@ class Ticks:
             for st, n in self.stacks.most_common(6):
                 print(f"   {n * 5:5d} ms  {st}")
         return (float(np.diff(self.cpu).max()), float(max(self.draws, default=0.0)),
-                float(np.diff(self.wall).max()))
+                float(np.diff(self.wall).max()), float(max(self.collections, default=0.0)))
 
 
 def _gl_widget_class(window):
@@ -122,8 +139,30 @@ def large_volume(tmp_path_factory):
     return folder
 
 
+@pytest.fixture
+def ticks(qtbot):
+    ticks = Ticks()
+    yield ticks
+    ticks.timer.stop()
+    ticks.close()
+
+
+@pytest.fixture
+def started_like_the_studio():
+    """This process's objects so far out of the collections, as ``volanim-studio`` does with its start-up
+    (``main_window_for``, gui_gc): a pytest worker late in a run holds ~400 k objects of earlier tests, and a
+    full collection of them took 410 ms of the GUI thread in the play phase under load (a CI failure) --
+    work a studio process does not have."""
+    from volanim_studio.qt.gui_gc import freeze_start_up
+
+    freeze_start_up()
+    yield
+    gc.unfreeze()
+
+
 @pytest.mark.long("mannequin-large opened, played, posed, auto-connected and rendered with a 20 ms timer ticking")
-def test_the_gui_thread_never_works_over_100_ms_at_a_time(qtbot, tmp_path, large_volume, monkeypatch):
+def test_the_gui_thread_never_works_over_100_ms_at_a_time(qtbot, tmp_path, large_volume, monkeypatch,
+                                                           started_like_the_studio, ticks):
     """#83 item 13: a 46 M-voxel body's live frame (0.6 s), its full picture's copy for VTK (0.17 s) and
     first pass (0.4 s), its project's clip and files, all ran on the GUI thread. Each phase of a session is
     measured by the GUI thread's own work between two ticks; VTK's draws are counted apart (software GL: a GPU
@@ -133,7 +172,6 @@ def test_the_gui_thread_never_works_over_100_ms_at_a_time(qtbot, tmp_path, large
 
     folder = large_volume
     w = new_window(qtbot)
-    ticks = Ticks()
     ticks.time_draws(monkeypatch, _gl_widget_class(w))
     rows = []
 
@@ -184,11 +222,12 @@ def test_the_gui_thread_never_works_over_100_ms_at_a_time(qtbot, tmp_path, large
     again.doc.undo.mark_clean()
     again.close()
 
-    table = "\n".join([f"{'phase':<24} {'GUI work':>9} {'VTK draw':>9} {'wall gap':>9}"] +
-                      [f"{n:<24} {c * 1000:7.0f}ms {d * 1000:7.0f}ms {g * 1000:7.0f}ms" for n, c, d, g in rows])
+    table = "\n".join([f"{'phase':<24} {'GUI work':>9} {'VTK draw':>9} {'wall gap':>9} {'GC':>7}"] +
+                      [f"{n:<24} {c * 1000:7.0f}ms {d * 1000:7.0f}ms {g * 1000:7.0f}ms {k * 1000:5.0f}ms"
+                       for n, c, d, g, k in rows])
     print(table)
     if os.environ.get("VOLANIM_GAP_TABLE"):
         with open(os.environ["VOLANIM_GAP_TABLE"], "a") as f:
             f.write(table + "\n")
-    slow = [(n, round(c, 3)) for n, c, _, _ in rows if c > BUDGET_S]
+    slow = [(n, round(c, 3)) for n, c, *_ in rows if c > BUDGET_S]
     assert not slow, f"the GUI thread worked over {BUDGET_S * 1000:.0f} ms at a time: {slow}\n{table}"
