@@ -12,12 +12,12 @@ collects with the same generation thresholds Python would use. This is the
 approach of pyqtgraph's ``GarbageCollector``.
 
 A full collection (generation 2) walks every tracked object of the process: the studio's ~380 k after opening
-mannequin-large took 100-160 ms of the GUI thread on this machine, a visible stop in a drag or a play (one every
-~50 s of activity). Two things keep it out of the user's way:
+mannequin-large took 140-290 ms of the GUI thread on this machine (which drifts 2x), a visible stop in a drag or a
+play (one every ~50 s of activity). Two things keep it out of the user's way:
 
 - :func:`freeze_start_up`: what the program built before any file was read (its modules, classes, the window:
   ~320 k objects) is moved out of every later collection with ``gc.freeze`` -- it lives until the program
-  quits, and a full collection then walks ~100 k objects (25 ms).
+  quits, and a full collection then walks ~100 k objects (20-30 ms).
 - while a window says it is :meth:`interacting <GuiThreadCollector.hold_full_while>` (a drag, a play), a full
   collection that falls due waits (the young generations, cheap, are still collected), at most
   ``HOLD_MAX_TICKS`` ticks, so a minute-long play cannot grow memory without end.
