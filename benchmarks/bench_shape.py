@@ -14,6 +14,9 @@
 Run: .venv/bin/python benchmarks/bench_shape.py [--large] [--step 15] [--joints "shoulder abduction,hip flexion"]
      .venv/bin/python benchmarks/bench_shape.py --walk 10     (the real walk clip, every 10th frame)
      .venv/bin/python benchmarks/bench_shape.py --cost 7      (fitted's cost against nearest, frog and mannequin)
+     .venv/bin/python benchmarks/bench_shape.py --floor [--joints ...] [--walk 1050]
+                                      (what a read of the rest segmentation can reach: perfect owners and overlaps)
+     .venv/bin/python benchmarks/bench_shape.py --true-owners [--joints ...]   (the truth's parts as owners)
 """
 
 from __future__ import annotations
@@ -269,6 +272,121 @@ def cost(rounds: int) -> None:
           f"{rounds * 4 / (time.perf_counter() - t0):.1f} updates/s (goal >= 10)")
 
 
+def rest_capsules() -> dict[int, np.ndarray]:
+    """bone index -> its capsules at rest on the mannequin's grid (bool, ``[x, y, z]``), painted by the truth's own
+    painter with every other bone moved off the grid: overlapping each other as the truth's capsules do."""
+    from volanim_core.mannequin_body import MANNEQUIN_SHAPE, mannequin_bones, paint_mannequin
+
+    bones = mannequin_bones()
+    out = {}
+    for b in range(len(bones.bones)):
+        m = np.tile(np.eye(4), (len(bones.bones), 1, 1))
+        m[np.arange(len(m)) != b, 3, 0] = 10.0 * max(MANNEQUIN_SHAPE)  # every other capsule misses the grid
+        out[b] = paint_mannequin(bones, np.ones(3), MANNEQUIN_SHAPE, matrices=m)[0] > 0
+    return out
+
+
+def read_floor(capsules: dict, matrices: np.ndarray, fields: dict) -> dict:
+    """Dice against ``posed_sample`` of each rest field in ``fields`` (name -> bone -> float32 occupancy) read
+    trilinearly at the rest point each bone's inverse brings every posed voxel to, a voxel in where any bone's
+    read is >= 1/2: the owners and the overlaps perfect, so only the read is measured."""
+    from scipy.ndimage import map_coordinates
+
+    from volanim_core.posed_truth import posed_sample
+
+    truth = posed_sample("mannequin", matrices)
+    want = truth.volume > 0
+    q = np.indices(want.shape, np.float64).reshape(3, -1).T + np.asarray(truth.origin)
+    out = {}
+    for name, field in fields.items():
+        got = np.zeros(len(q), bool)
+        for b in capsules:
+            inv = np.linalg.inv(matrices[b])
+            rest = q @ inv[:3, :3] + inv[3, :3]
+            got |= map_coordinates(field[b], rest.T, order=1, cval=0.0) >= 0.5
+        got = got.reshape(want.shape)
+        out[name] = 2.0 * (got & want).sum() / (got.sum() + want.sum())
+    return out
+
+
+def floor_rows(step: int, joints: list[str], walk_every: int | None) -> None:
+    """#84: the Dice any owner rule reaches with a trilinear read of the rest segmentation (the mannequin), and
+    with a smoother one: a Gaussian of one voxel clamped to the segmentation at voxel centres (>= 1/2 inside,
+    < 1/2 outside), so the rest pose stays voxel for voxel. A row's goal above its floor is out of the read's reach."""
+    from scipy.ndimage import gaussian_filter
+
+    from volanim_core import samples
+    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.motion.retarget import Retarget
+    from volanim_core.rig.pose import pose_matrices
+
+    capsules = rest_capsules()
+    smooth = {}
+    for b, mask in capsules.items():
+        g = gaussian_filter(mask.astype(np.float32), 1.0)
+        smooth[b] = np.where(mask, np.maximum(g, 0.5), np.minimum(g, np.float32(0.4999))).astype(np.float32)
+    fields = {"trilinear": {b: m.astype(np.float32) for b, m in capsules.items()}, "smoothed": smooth}
+    sample = samples.mannequin()
+    bones = sample.bones
+    poses = []
+    for label in joints:
+        bone, top, rotation = JOINTS[label]
+        b = bones.bones[bones.index(bone)]
+        axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
+        poses += [(f"{label} {a}", pose_matrices(bones, {bone: rotation(a, axis / np.linalg.norm(axis))}))
+                  for a in range(step, top + 1, step)]
+    if walk_every:
+        mats = Retarget.build(bones, read_bvh(samples.walk_clip())).matrices()
+        poses += [(f"walk frame {i}", mats[i]) for i in range(0, len(mats), walk_every)]
+    print("the floor of a read of the rest segmentation (the mannequin; true owners, overlapping capsules)")
+    print("| row | trilinear | smoothed (Gaussian 1 voxel, clamped) |")
+    print("|---|---|---|")
+    for name, m in poses:
+        d = read_floor(capsules, m, fields)
+        print(f"| {name} | {d['trilinear']:.4f} | {d['smoothed']:.4f} |", flush=True)
+
+
+def true_owner_rows(step: int, joints: list[str]) -> None:
+    """#84: the owned default over its own owners (nearest) and over the truth's parts as owners (the mannequin's
+    capsule each rest voxel lies deepest in; same balls): Dice / largest blob % of the moved limb. What perfect
+    single owners would give, so what is left is the capsules' overlap."""
+    from volanim_core import samples
+    from volanim_core.posed_truth import posed_sample
+    from volanim_core.reconstruct.engine import reconstruct
+    from volanim_core.reconstruct.shape import compare_shapes
+    from volanim_core.rig.ownership import ownership
+    from volanim_core.rig.pose import pose_matrices, posed_joints
+
+    s = samples.mannequin()
+    conn = default_connectivity(s)
+    own = ownership(s.mask, conn)
+    o, shape = np.asarray(own.origin), own.labels.shape
+    parts = s.part[o[0]:o[0] + shape[0], o[1]:o[1] + shape[1], o[2]:o[2] + shape[2]].astype(own.labels.dtype)
+    owners = {"nearest": own, "true parts": own.with_labels(np.where(own.labels > 0,
+                                                                     np.where(parts > 0, parts, own.labels), 0))}
+    bones = s.bones
+    print("| row | " + " | ".join(f"{k}: Dice / blob % limb" for k in owners) + " |")
+    print("|---|" + "---|" * len(owners))
+    for label in joints:
+        bone, top, rotation = JOINTS[label]
+        b = bones.bones[bones.index(bone)]
+        axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
+        limb = moved_limb_voxels(s, bone)
+        for angle in range(step, top + 1, step):
+            m = pose_matrices(bones, {bone: rotation(angle, axis / np.linalg.norm(axis))})
+            truth = posed_sample("mannequin", m)
+            at = posed_joints(bones, m)
+            segments = {q.label: (at[q.proximal], at[q.distal]) for q in bones.bones}
+            cells = []
+            for ov in owners.values():
+                r = reconstruct(conn.with_ownership(ov).posed(m), mode="bone")
+                rep = compare_shapes(r.volume, truth.volume, ours_origin=r.origin, truth_origin=truth.origin,
+                                     joints=at, segments=segments)
+                blob = max((x.voxels for x in (rep.largest_extra, rep.largest_missing) if x is not None), default=0)
+                cells.append(f"{rep.dice:.4f} / {100 * blob / limb:.2f}")
+            print(f"| {label} {angle} | " + " | ".join(cells) + " |", flush=True)
+
+
 def main() -> None:
     from volanim_core import samples
 
@@ -278,7 +396,17 @@ def main() -> None:
     parser.add_argument("--joints", default=",".join(JOINTS), help="comma-separated joints (default: all)")
     parser.add_argument("--walk", type=int, metavar="EVERY", help="only the walk clip, every EVERY-th frame")
     parser.add_argument("--cost", type=int, metavar="ROUNDS", help="only what fitted costs against nearest")
+    parser.add_argument("--floor", action="store_true",
+                        help="only the floor of a read of the rest segmentation per row (and walk frames with --walk)")
+    parser.add_argument("--true-owners", action="store_true",
+                        help="only the owned default over its owners and over the truth's parts as owners")
     args = parser.parse_args()
+    if args.true_owners:
+        true_owner_rows(args.step, [j.strip() for j in args.joints.split(",") if j.strip()])
+        return
+    if args.floor:
+        floor_rows(args.step, [j.strip() for j in args.joints.split(",") if j.strip()], args.walk)
+        return
     if args.cost:
         cost(args.cost)
         return
