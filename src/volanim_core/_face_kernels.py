@@ -46,20 +46,41 @@ def _open_sides(vol, lo, hi, z, y, x):
             | np.int64(e(vol, lo, hi, z - 1, y, x)) << 4 | np.int64(e(vol, lo, hi, z + 1, y, x)) << 5)
 
 
+STRIDE = 16  # voxels row_extents tests at once: one OR of a vector's lanes, not a branch per voxel
+
+
 @njit(cache=True, parallel=True, nogil=True)
 def row_extents(vol, lo, hi):
     """``lo[z, y]``, ``hi[z, y]``: the first filled voxel of row (z, y) of ``vol [z, y, x]`` and one past its last
     (0, 0 for an empty row). The face kernels read only inside them: a body fills a few percent of its box, and
     a tight scan for the first and the last filled voxel is what reading the rest costs (#85: the mannequin's
-    full-size faces, 19 ms on one thread, mostly spent on empty voxels' neighbour tests)."""
+    full-size faces, 19 ms on one thread, mostly spent on empty voxels' neighbour tests).
+    The empty run is skipped :data:`STRIDE` voxels a step (an OR over them, which LLVM makes one vector test),
+    then voxel by voxel: a live grid's rows are mostly empty, and a branch per voxel took 3-4 ms of the frog's
+    and the mannequin's live pictures, a third of their faces."""
     nz, ny, nx = vol.shape
     for z in prange(nz):
         for y in range(ny):
+            row = vol[z, y]
             a = 0
-            while a < nx and vol[z, y, a] == 0:
+            while a + STRIDE <= nx:
+                seen = 0
+                for k in range(STRIDE):
+                    seen |= row[a + k]
+                if seen != 0:
+                    break
+                a += STRIDE
+            while a < nx and row[a] == 0:
                 a += 1
             b = nx
-            while b > a and vol[z, y, b - 1] == 0:
+            while b - STRIDE >= a:
+                seen = 0
+                for k in range(STRIDE):
+                    seen |= row[b - STRIDE + k]
+                if seen != 0:
+                    break
+                b -= STRIDE
+            while b > a and row[b - 1] == 0:
                 b -= 1
             lo[z, y] = a if a < nx else 0
             hi[z, y] = b if a < nx else 0

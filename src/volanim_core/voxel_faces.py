@@ -43,19 +43,32 @@ def _slab_faces(vol: np.ndarray, z0: int, z1: int, origin, spacing, rows: np.nda
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The faces of slices ``z0 <= z < z1`` of ``vol [z, y, x]`` (the slices beside them read as neighbours):
     ``(points, rgb, counts a slice)``. ``clear[label]``: labels drawn as empty."""
-    h0, h1 = max(z0 - 1, 0), min(z1 + 1, vol.shape[0])  # the slab and the slice each side it meets
-    slab = vol[h0:h1] if clear is None else np.where(clear[vol[h0:h1]], 0, vol[h0:h1]).astype(vol.dtype)
-    lo, hi = np.empty(slab.shape[:2], np.int32), np.empty(slab.shape[:2], np.int32)
-    row_extents(slab, lo, hi)
-    counts = np.empty(z1 - z0, np.int64)
-    faces_per_slice(slab, lo, hi, z0 - h0, z1 - h0, counts)
-    starts = np.concatenate([[0], np.cumsum(counts)])
-    n = int(starts[-1])
+    slab = _Slab(vol, z0, z1, clear)
+    n = int(slab.counts.sum())
     points = np.empty((4 * n, 3), np.float32)
     rgb = np.empty((4 * n, rows.shape[1]), np.uint8)
-    fill_faces(slab, lo, hi, z0 - h0, z1 - h0, h0, starts, CORNERS, np.asarray(origin, np.float64),
-               np.asarray(spacing, np.float64), rows, points, rgb)
-    return points, rgb, counts
+    slab.fill(0, origin, spacing, rows, points, rgb)
+    return points, rgb, slab.counts
+
+
+class _Slab:
+    """Slices ``z0 <= z < z1`` of ``vol [z, y, x]`` with the slice each side they meet, their rows' filled extents
+    and each slice's face count: :meth:`fill` writes their faces into arrays a caller made for them."""
+
+    def __init__(self, vol: np.ndarray, z0: int, z1: int, clear=None):
+        h0, h1 = max(z0 - 1, 0), min(z1 + 1, vol.shape[0])  # the slab and the slice each side it meets
+        self.slab = vol[h0:h1] if clear is None else np.where(clear[vol[h0:h1]], 0, vol[h0:h1]).astype(vol.dtype)
+        self.lo, self.hi = np.empty(self.slab.shape[:2], np.int32), np.empty(self.slab.shape[:2], np.int32)
+        row_extents(self.slab, self.lo, self.hi)
+        self.z0, self.z1, self.h0 = z0, z1, h0
+        self.counts = np.empty(z1 - z0, np.int64)
+        faces_per_slice(self.slab, self.lo, self.hi, z0 - h0, z1 - h0, self.counts)
+
+    def fill(self, first: int, origin, spacing, rows: np.ndarray, points: np.ndarray, rgb: np.ndarray) -> None:
+        """The slab's faces written as faces ``first, first + 1, ...`` of ``points`` and ``rgb``."""
+        starts = first + np.concatenate([[0], np.cumsum(self.counts)])
+        fill_faces(self.slab, self.lo, self.hi, self.z0 - self.h0, self.z1 - self.h0, self.h0, starts, CORNERS,
+                   np.asarray(origin, np.float64), np.asarray(spacing, np.float64), rows, points, rgb)
 
 
 def face_arrays(volume: np.ndarray, origin, spacing, table: np.ndarray | None = None
@@ -107,13 +120,16 @@ class KeptFaces:
                                                                 self.clear)
             self._starts = np.concatenate([[0], np.cumsum(counts)])
             self._shape, self.redone = vol.shape, nz
-        else:
-            points, rgb, counts = _slab_faces(vol, a, b, self.origin, self.spacing, self.rows, self.clear)
-            s = self._starts
-            cut = (4 * s[a], 4 * s[b])
-            self._points = np.concatenate([self._points[:cut[0]], points, self._points[cut[1]:]])
-            self._rgb = np.concatenate([self._rgb[:cut[0]], rgb, self._rgb[cut[1]:]])
-            self._starts = np.concatenate([s[:a + 1], s[a] + np.cumsum(counts), s[b + 1:] + (len(points) // 4
-                                                                                          - (s[b] - s[a]))])
+        else:  # the slab's faces written in place between the kept ones, in new arrays (the last are drawn)
+            slab, s = _Slab(vol, a, b, self.clear), self._starts
+            grew = int(slab.counts.sum()) - int(s[b] - s[a])
+            points = np.empty((len(self._points) + 4 * grew, 3), np.float32)
+            rgb = np.empty((len(self._rgb) + 4 * grew, self._rgb.shape[1]), np.uint8)
+            for new, old in ((points, self._points), (rgb, self._rgb)):
+                new[:4 * s[a]] = old[:4 * s[a]]
+                new[4 * (s[b] + grew):] = old[4 * s[b]:]
+            slab.fill(int(s[a]), self.origin, self.spacing, self.rows, points, rgb)
+            self._points, self._rgb = points, rgb
+            self._starts = np.concatenate([s[:a + 1], s[a] + np.cumsum(slab.counts), s[b + 1:] + grew])
             self.redone = b - a
         return self._points, _quads(len(self._points) // 4), self._rgb

@@ -55,3 +55,29 @@ def test_kept_faces_redo_nothing_when_nothing_changed_and_everything_for_another
     empty = np.zeros((3, 4, 5), np.uint8)
     points, faces, rgb = kept.update(empty, (0, 1))
     assert len(points) == len(faces) == len(rgb) == 0
+
+
+def test_row_extents_are_numpys_first_and_last_filled_voxel_at_every_width_and_place():
+    """row_extents skips empty runs STRIDE voxels a step: rows narrower than it, as wide, and wider, each voxel filled
+    alone, and pairs either side of a stride's edge, in bytes and in 16-bit labels, against NumPy."""
+    from volanim_core._face_kernels import STRIDE, row_extents
+
+    for nx in (1, STRIDE - 1, STRIDE, STRIDE + 1, 2 * STRIDE, 3 * STRIDE + 5):
+        rows = [np.zeros(nx, np.uint16)]
+        for a in range(nx):
+            row = np.zeros(nx, np.uint16)
+            row[a] = 300
+            rows.append(row)
+            for b in (a + 1, a + STRIDE - 1, a + STRIDE, nx - 1):
+                if a < b < nx:
+                    row = np.zeros(nx, np.uint16)
+                    row[[a, b]] = 1
+                    rows.append(row)
+        for dtype in (np.uint8, np.uint16):
+            vol = np.stack(rows).astype(dtype)[None]  # [z, y, x]: one slice of these rows
+            lo, hi = np.empty(vol.shape[:2], np.int32), np.empty(vol.shape[:2], np.int32)
+            row_extents(vol, lo, hi)
+            for y, row in enumerate(vol[0]):
+                filled = np.flatnonzero(row)
+                want = (filled[0], filled[-1] + 1) if len(filled) else (0, 0)
+                assert (lo[0, y], hi[0, y]) == want, (nx, dtype, row.nonzero())

@@ -46,6 +46,7 @@ class LiveOwned:
         self.threads, self.clock = threads, clock
         self._frame: Reconstruction | None = None
         self._matrices: np.ndarray | None = None
+        self._owners = np.empty(0, own.labels.dtype)  # a moved box's owners, grown to the largest box so far
         self.redone = 0  # voxels the last update decided again (the whole grid's on a first frame)
         # the grid's z-slices the last update may have changed: (first, last), None (none) or "all" (a first frame)
         self.changed: tuple[int, int] | None | str = "all"
@@ -63,7 +64,7 @@ class LiveOwned:
             self.redone = 0 if box is None else int(np.prod(box.shape))
             self.changed = None
             if box is not None:
-                self._paste(self._made(m, box), box)
+                self._paste(self._made(m, box, kept=True), box)
                 z = self._frame.origin[2]
                 self.changed = (box.lo[2] - z, box.hi[2] - z)
         self._matrices = m
@@ -73,12 +74,19 @@ class LiveOwned:
         volume = f.volume.copy(order="K") if copy else f.volume
         return Reconstruction(volume, f.origin, stats, f.geometry)
 
-    def _made(self, matrices: np.ndarray, bounds: Bounds) -> Reconstruction:
+    def _made(self, matrices: np.ndarray, bounds: Bounds, kept: bool = False) -> Reconstruction:
+        """The frame within ``bounds``; ``kept``: its owners in this object's own array, which the next call
+        overwrites (a moved box, pasted at once: a fresh array a picture cost page faults on every voxel)."""
         # a small box on one thread: the kernels' thread barriers cost more than its voxels (a forearm's box
         # on the mannequin: 9 ms on one thread, 21 ms on two, with the machine busy)
-        small = np.prod(bounds.shape, dtype=np.int64) < ONE_THREAD_VOXELS
+        n = int(np.prod(bounds.shape, dtype=np.int64))
+        owners = None
+        if kept:
+            if self._owners.size < n:
+                self._owners = np.empty(n, self.own.labels.dtype)
+            owners = self._owners[:n].reshape(bounds.shape[::-1])
         return reconstruct_owned(self.own, matrices, mode=self.mode, bounds=bounds, value=self.value,
-                                 threads=1 if small else self.threads, clock=self.clock)
+                                 threads=1 if n < ONE_THREAD_VOXELS else self.threads, clock=self.clock, owners=owners)
 
     def _moved_box(self, old: np.ndarray, new: np.ndarray) -> Bounds | None:
         """The box of every voxel the bones whose matrix changed can decide, in either pose; None: none moved."""

@@ -214,3 +214,32 @@ def test_connect_fix_lumps_over_test_poses_says_what_it_did(tmp_path, capsys):
     said = capsys.readouterr()
     assert "no lump in 1 pose(s)" in said.out and (d / "f.owners.nrrd").exists()  # the default raises it clean
     assert "warning" not in said.err  # every bone's flesh hangs from its own chain (rig/reach.py)
+
+
+def test_a_poses_boxes_and_balls_are_kept_per_ownership_and_never_lent_to_another(mannequin_rig):
+    """The live loop asks for the same pose's boxes and balls four times a picture: made once, read-only. A
+    repainted ownership (another object) gets its own, and the owners' array a caller lends is the answer's."""
+    from volanim_core.reconstruct.owned import _joint_balls, _posed_boxes, posed_boxes
+
+    s, conn = mannequin_rig
+    own = conn.ownership
+    m = pose_matrices(s.bones, {"L_UPPERARM": (0, -60, 0)})
+    boxes = posed_boxes(own, m)
+    assert posed_boxes(own, m.copy()) is boxes and not boxes.flags.writeable
+    assert np.array_equal(boxes, _posed_boxes(own, m))
+    balls = joint_balls(own, m)
+    assert joint_balls(own, m) is balls and all(np.array_equal(a, b) for a, b in zip(balls, _joint_balls(own, m)))
+    arm = s.bones.index("L_UPPERARM")
+    repainted = own.with_labels(np.where(own.labels == arm + 1, 1, own.labels).astype(own.labels.dtype))  # to SPINE
+    theirs = posed_boxes(repainted, m)
+    assert theirs is not boxes and np.array_equal(theirs, _posed_boxes(repainted, m))
+    assert theirs[arm, 3] < theirs[arm, 0]  # owns nothing now: no box, where the kept one had the arm's
+    assert not np.array_equal(posed_boxes(own, pose_matrices(s.bones, {"L_UPPERARM": (0, -90, 0)})), boxes)
+
+    whole = reconstruct_owned(own, m, mode="bone")
+    box = Bounds(whole.origin, tuple(np.add(whole.origin, whole.volume.shape) - 1))
+    lent = np.full(whole.volume.shape[::-1], 7, own.labels.dtype)  # [z, y, x], not zeroed: the call zeroes it
+    again = reconstruct_owned(own, m, mode="bone", bounds=box, owners=lent)
+    assert np.array_equal(again.volume, whole.volume) and np.shares_memory(again.volume, lent)
+    with pytest.raises(ValueError, match="owners must be"):
+        reconstruct_owned(own, m, mode="bone", bounds=box, owners=lent.T)
