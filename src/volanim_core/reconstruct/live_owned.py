@@ -46,7 +46,7 @@ class LiveOwned:
         self.threads, self.clock = threads, clock
         self._frame: Reconstruction | None = None
         self._matrices: np.ndarray | None = None
-        self._owners = np.empty(0, own.labels.dtype)  # a moved box's owners, grown to the largest box so far
+        self._owners = np.empty(0, own.labels.dtype)  # a moved box's owners: the grid's size, made once
         self.redone = 0  # voxels the last update decided again (the whole grid's on a first frame)
         # the grid's z-slices the last update may have changed: (first, last), None (none) or "all" (a first frame)
         self.changed: tuple[int, int] | None | str = "all"
@@ -82,8 +82,8 @@ class LiveOwned:
         n = int(np.prod(bounds.shape, dtype=np.int64))
         owners = None
         if kept:
-            if self._owners.size < n:
-                self._owners = np.empty(n, self.own.labels.dtype)
+            if self._owners.size < n:  # the grid's size at once: a drag's box grows as it sweeps, and each larger
+                self._owners = np.empty(int(np.prod(self.bounds.shape)), self.own.labels.dtype)  # array faulted anew
             owners = self._owners[:n].reshape(bounds.shape[::-1])
         return reconstruct_owned(self.own, matrices, mode=self.mode, bounds=bounds, value=self.value,
                                  threads=1 if n < ONE_THREAD_VOXELS else self.threads, clock=self.clock, owners=owners)
