@@ -45,6 +45,17 @@ METHODS = ("owned", "rigid", "smooth", "fitted", "lbs", "bender")
 GOALS = {"dice": 0.995, "blob": 0.5, "p95": 1.5}
 
 
+def joint_poses(bones, label: str, angles) -> list[tuple[int, np.ndarray]]:
+    """``(angle, matrices)`` for each angle of joint ``label`` (:data:`JOINTS`): its bone turned, the rest at rest."""
+    from volanim_core.rig.pose import pose_matrices
+
+    bone, _top, rotation = JOINTS[label]
+    b = bones.bones[bones.index(bone)]
+    axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
+    u = axis / np.linalg.norm(axis)
+    return [(a, pose_matrices(bones, {bone: rotation(a, u)})) for a in angles]
+
+
 def default_connectivity(sample, method: str = "nearest"):
     """What a user's pipeline gives: skeletonize (thinness >= 0.5), then every point to its nearest bone
     (``method``: another rule of `volanim connect`, e.g. fitted)."""
@@ -73,7 +84,7 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
     from volanim_core.reconstruct.engine import reconstruct
     from volanim_core.reconstruct.lumps import bone_reach, find_lumps, limb_voxels
     from volanim_core.reconstruct.shape import compare_shapes, extra_flesh
-    from volanim_core.rig.pose import pose_matrices, posed_joints
+    from volanim_core.rig.pose import posed_joints
 
     conn = default_connectivity(sample)
     frame = frames_of(sample, conn)
@@ -88,13 +99,9 @@ def rows_for(name: str, sample, step: int, joints: list[str]) -> list[dict]:
     smooth_rest = RestParts.of(conn.with_joints(Joints("smooth")))  # smooth frames: followed back by their blends
     rows = []
     for label in joints:
-        bone, top, rotation = JOINTS[label]
-        b = bones.bones[bones.index(bone)]
-        axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
-        u = axis / np.linalg.norm(axis)
+        bone, top, _ = JOINTS[label]
         limb = moved_limb_voxels(sample, bone)
-        for angle in range(0, top + 1, step):
-            m = pose_matrices(bones, {bone: rotation(angle, u)})
+        for angle, m in joint_poses(bones, label, range(0, top + 1, step)):
             truth = posed_sample(name, m)
             at = posed_joints(bones, m)
             segments = {s.label: (at[s.proximal], at[s.distal]) for s in bones.bones}
@@ -318,7 +325,6 @@ def floor_rows(step: int, joints: list[str], walk_every: int | None) -> None:
     from volanim_core import samples
     from volanim_core.io.bvh_files import read_bvh
     from volanim_core.motion.retarget import Retarget
-    from volanim_core.rig.pose import pose_matrices
 
     capsules = rest_capsules()
     smooth = {}
@@ -330,11 +336,7 @@ def floor_rows(step: int, joints: list[str], walk_every: int | None) -> None:
     bones = sample.bones
     poses = []
     for label in joints:
-        bone, top, rotation = JOINTS[label]
-        b = bones.bones[bones.index(bone)]
-        axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
-        poses += [(f"{label} {a}", pose_matrices(bones, {bone: rotation(a, axis / np.linalg.norm(axis))}))
-                  for a in range(step, top + 1, step)]
+        poses += [(f"{label} {a}", m) for a, m in joint_poses(bones, label, range(step, JOINTS[label][1] + 1, step))]
     if walk_every:
         mats = Retarget.build(bones, read_bvh(samples.walk_clip())).matrices()
         poses += [(f"walk frame {i}", mats[i]) for i in range(0, len(mats), walk_every)]
@@ -355,7 +357,7 @@ def true_owner_rows(step: int, joints: list[str]) -> None:
     from volanim_core.reconstruct.engine import reconstruct
     from volanim_core.reconstruct.shape import compare_shapes
     from volanim_core.rig.ownership import ownership
-    from volanim_core.rig.pose import pose_matrices, posed_joints
+    from volanim_core.rig.pose import posed_joints
 
     s = samples.mannequin()
     conn = default_connectivity(s)
@@ -368,12 +370,9 @@ def true_owner_rows(step: int, joints: list[str]) -> None:
     print("| row | " + " | ".join(f"{k}: Dice / blob % limb" for k in owners) + " |")
     print("|---|" + "---|" * len(owners))
     for label in joints:
-        bone, top, rotation = JOINTS[label]
-        b = bones.bones[bones.index(bone)]
-        axis = np.asarray(bones.joints[b.distal], float) - bones.joints[b.proximal]
+        bone, top, _ = JOINTS[label]
         limb = moved_limb_voxels(s, bone)
-        for angle in range(step, top + 1, step):
-            m = pose_matrices(bones, {bone: rotation(angle, axis / np.linalg.norm(axis))})
+        for angle, m in joint_poses(bones, label, range(step, top + 1, step)):
             truth = posed_sample("mannequin", m)
             at = posed_joints(bones, m)
             segments = {q.label: (at[q.proximal], at[q.distal]) for q in bones.bones}
@@ -401,11 +400,12 @@ def main() -> None:
     parser.add_argument("--true-owners", action="store_true",
                         help="only the owned default over its owners and over the truth's parts as owners")
     args = parser.parse_args()
+    joints = [j.strip() for j in args.joints.split(",") if j.strip()]
     if args.true_owners:
-        true_owner_rows(args.step, [j.strip() for j in args.joints.split(",") if j.strip()])
+        true_owner_rows(args.step, joints)
         return
     if args.floor:
-        floor_rows(args.step, [j.strip() for j in args.joints.split(",") if j.strip()], args.walk)
+        floor_rows(args.step, joints, args.walk)
         return
     if args.cost:
         cost(args.cost)
@@ -413,7 +413,6 @@ def main() -> None:
     if args.walk:
         print_walk(walk_rows(samples.mannequin(), args.walk))
         return
-    joints = [j.strip() for j in args.joints.split(",")]
     rows = rows_for("mannequin", samples.mannequin(), args.step, joints)
     if args.large:
         rows += rows_for("mannequin-large", samples.mannequin_large(), args.step, joints)
