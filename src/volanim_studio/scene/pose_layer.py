@@ -99,8 +99,10 @@ class PoseLayer:
         if old:
             text = f"Old picture: {doc.picture_change or 'the session'} changed since. F5 redraws."
             if self._note is None:  # made once: pyvista's add_text took 45-65 ms of the GUI thread each time
+                # drawn by the widget's next paint (view.render below): pyvista's own render draws the whole
+                # view on the GUI thread at once (130-190 ms of software GL under load)
                 self._note = view.plotter.add_text(text, position="upper_left", font_size=9, color="#d0d0d0",
-                                                   name=STALE_NOTE)
+                                                   name=STALE_NOTE, render=False)
             else:
                 self._note.SetText(2, text)  # a corner annotation: corner 2 is upper left
                 if STALE_NOTE not in view.plotter.actors:
@@ -300,7 +302,7 @@ class PoseLayer:
         else:
             plotter.remove_actor("preview", render=False)
             if plotter.scalar_bars:
-                plotter.remove_scalar_bar()
+                plotter.remove_scalar_bar(render=False)  # the new volume's paint draws it
             colour = volume.ndim == 4
             style = volume_style(mode, volume, n_bones) if not colour else {"show_scalar_bar": False}
             labels = style.pop("categories", None)
