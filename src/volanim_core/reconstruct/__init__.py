@@ -14,7 +14,8 @@ source_space.py .... where a sampled frame reads its source: the frame's grid ag
 speedups.py ........ the optimisations as switches, to measure what each is worth (Fig 5.5)
 breakage.py ........ cracks, stumps and torn-off pieces of a posed frame (_label_kernels.py: pieces
                      found on x-runs, nogil); cracks.py the sphere pairs that part; lumps.py flesh a
-                     bone cannot carry, found without the true shape
+                     bone cannot carry, found without the true shape; torn.py which
+                     pieces the pose tore off, and the specks it let go as the rest pose's lie
 scan.py ............ many frames, worst first; whole.py one piece proved from the spheres alone
                      (_whole_kernels.py); lump_watch.py the frames that can carry a lump, found
                      from the rest pose's foreign voxels, then the report's own test on those

@@ -35,6 +35,7 @@ from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import OWNER, Reconstruction, moves_owned, reconstruct
 from volanim_core.reconstruct.lumps import frame_lumps
+from volanim_core.reconstruct.torn import SPECK_REACH, SPECK_VOXELS, loose_specks, pieces_at, torn_off
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.pose import apply_matrices, apply_rows
@@ -67,6 +68,7 @@ class BreakageReport:
     body_pieces: int | None = None  # the segmented volume's pieces, when the caller knows them (the studio)
     lumps: list = field(default_factory=list)  # Lump (lumps.py), largest first: flesh carried off (rigid frames)
     source_coverage: tuple[int, int] | None = None  # (covered at rest, object voxels) of the scan, when given
+    specks: list = field(default_factory=list)  # (voxels, nearest joint, posed centroid): let go near (torn.py)
 
     @property
     def loss_percent(self) -> float:
@@ -117,6 +119,10 @@ class BreakageReport:
         out = [f"{len(self.components)} connected component(s){sizes}"
                + (f"; {self.rest_pieces:,} at rest" if self.rest_pieces > 1 else ""),
                *(f"piece of {n} voxels torn off near {j}" for n, j, _ in self.pieces[:5]),
+               *([f"{len(self.specks)} speck(s) of at most {SPECK_VOXELS} voxels let go within {SPECK_REACH} voxels "
+                  f"of the body near {self.specks[0][1]}, where the rest pose's own lie (the voxel grid's, not "
+                  "breakage)"]
+                 if self.specks else []),
                *(s.text() for s in self.stumps[:5]),
                *(lump.text() for lump in self.lumps[:5]),
                f"{self.posed_voxels:,} voxels, {self.size_change} ({self.lost_voxels:,} rest voxels not covered)",
@@ -290,35 +296,6 @@ def _components(volume: np.ndarray) -> tuple[list[tuple[int, np.ndarray, int]], 
     return out, labels
 
 
-def pieces_at(labels: tuple, volume: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """The piece number (``labels``: :func:`_components`' runs of ``volume``) of each voxel ``points``
-    ``(K, 3)`` (array coordinates ``[x, y, z]``; 0: empty or outside the grid)."""
-    first, x0, x1, piece, _ = labels
-    shape = np.array(np.shape(volume)[::-1], np.int64)
-    return L.piece_at(first, x0, x1, piece, shape, np.ascontiguousarray(np.asarray(points, np.int64)[:, ::-1]))
-
-
-def torn_off(rest_piece: np.ndarray, posed_piece: np.ndarray, n_posed: int) -> np.ndarray:
-    """The posed pieces the pose tore off: those that are no rest piece's home.
-
-    ``rest_piece``/``posed_piece``: per rest voxel, the rest piece it belongs to and the posed piece its
-    image under its bone lands in (0: empty). A rest piece's home is the posed piece most of its voxels
-    land in; a rest piece split by the pose leaves its other parts homeless. A body already in several
-    pieces at rest (the frog's 6,069 specks) whose pose keeps them apart tears nothing off; two rest
-    pieces the pose joins share a home, which is not breakage either.
-    Returns the torn-off posed piece numbers (1..n), ascending.
-    """
-    hit = posed_piece > 0
-    keys, counts = np.unique(rest_piece[hit] * (n_posed + 1) + posed_piece[hit], return_counts=True)
-    r, p = keys // (n_posed + 1), keys % (n_posed + 1)
-    order = np.lexsort((-counts, r))  # per rest piece, its most-hit posed piece first
-    home = p[order][np.r_[True, r[order][1:] != r[order][:-1]]] if len(order) else np.zeros(0, np.int64)
-    torn = np.ones(n_posed + 1, bool)
-    torn[0] = False
-    torn[home] = False
-    return np.flatnonzero(torn)
-
-
 def rest_voxels(rest_bone: Reconstruction) -> tuple[np.ndarray, np.ndarray]:
     """Every filled voxel of a rest reconstruction in bone (or owner) mode: its rest coordinates ``(K, 3)``
     and its label - 1 ``(K,)`` (the bone; the owner's row of the transform table), grouped by it (so
@@ -410,8 +387,13 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     where, gaps = cracks(tskel, pairs=rest.pairs)
     check(0, 1)
     parts, labels = _components(posed.volume)
-    torn = set(torn_off(rest.piece, pieces_at(labels, posed.volume, images), labels[4]).tolist()) \
-        if rest.piece is not None else {k for _, _, k in parts[1:]}
+    specks = set()
+    if rest.piece is not None:
+        landed = pieces_at(labels, posed.volume, images)
+        torn = set(torn_off(rest.piece, landed, labels[4]).tolist())
+        specks = loose_specks(torn, {k: n for n, _, k in parts}, rest.piece, landed, images, labels, posed.volume)
+    else:
+        torn = {k for _, _, k in parts[1:]}
     report = BreakageReport([n for n, _, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),
                             len(lost), int(hot.stats["hotspot_max"]), float(hot.stats["hotspot_mean"]),
                             cracks=len(gaps), stumps=stumps(tskel, joints), rest_pieces=rest.pieces)
@@ -422,7 +404,7 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
         if k in torn:
             c = centroid + np.asarray(posed.origin)
             near = names[int(((posed_pos - c) ** 2).sum(1).argmin())] if names else ""
-            report.pieces.append((size, near, c))
+            (report.specks if k in specks else report.pieces).append((size, near, c))
     if len(gaps) and names:
         from scipy.spatial import cKDTree
 

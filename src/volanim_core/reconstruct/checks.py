@@ -87,6 +87,7 @@ def report_json(rep: BreakageReport) -> dict:
            "lost_voxels": rep.lost_voxels, "loss_percent": round(rep.loss_percent, 4), "cracks": rep.cracks,
            "hotspot_max": rep.hotspot_max, "hotspot_mean": round(rep.hotspot_mean, 4),
            "pieces": [{"voxels": int(n), "near": j, "at": [round(float(v), 3) for v in c]} for n, j, c in rep.pieces],
+           "specks": [{"voxels": int(n), "near": j, "at": [round(float(v), 3) for v in c]} for n, j, c in rep.specks],
            "stumps": [{"points": s.points, "near": s.joint, "attached": s.attached, "lies_along": s.lies_along}
                       for s in rep.stumps],
            "lumps": [{"voxels": lump.voxels, "near": lump.near, "at": [round(float(v), 3) for v in lump.centre]}

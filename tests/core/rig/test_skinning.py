@@ -250,7 +250,7 @@ def test_mannequin_large_raises_its_arm_with_nothing_torn_off_and_no_stump():
     m = pose_matrices(s.bones, {"L_UPPERARM": (0, -90, 0)})
     report = breakage_report(conn.posed(m), s.bones.joints, posed_joints(s.bones, m))
     assert report.rest_pieces == 3 and len(report.components) == 3
-    assert report.pieces == [] and report.stumps == [] and report.cracks == 0 and report.healthy
+    assert report.pieces == report.specks == [] and report.stumps == [] and report.cracks == 0 and report.healthy
 
 
 def slab(width=24, length=60, radius=3.0, joint=30) -> Connectivity:
