@@ -35,7 +35,7 @@ from volanim_core.reconstruct import _label_kernels as L
 from volanim_core.reconstruct.cracks import cracks, touching_pairs
 from volanim_core.reconstruct.engine import OWNER, Reconstruction, moves_owned, reconstruct
 from volanim_core.reconstruct.lumps import frame_lumps
-from volanim_core.reconstruct.torn import SPECK_REACH, SPECK_VOXELS, loose_specks, pieces_at, torn_off
+from volanim_core.reconstruct.torn import SPECK_REACH, SPECK_VOXELS, homes, loose_specks, pieces_at, torn_off
 from volanim_core.rig.connectivity import Connectivity, Tskel
 from volanim_core.rig.nearest import segment_distances
 from volanim_core.rig.pose import apply_matrices, apply_rows
@@ -390,8 +390,10 @@ def breakage_report(tskel: Tskel, joints: dict[str, np.ndarray], posed_joints: d
     specks = set()
     if rest.piece is not None:
         landed = pieces_at(labels, posed.volume, images)
-        torn = set(torn_off(rest.piece, landed, labels[4]).tolist())
-        specks = loose_specks(torn, {k: n for n, _, k in parts}, rest.piece, landed, images, labels, posed.volume)
+        home = homes(rest.piece, landed, labels[4])  # made once: the rest voxels' sort is the report's dearest
+        torn = set(torn_off(home, labels[4]).tolist())
+        specks = loose_specks(torn, {k: n for n, _, k in parts}, home, rest.piece, landed, images, labels,
+                              posed.volume)
     else:
         torn = {k for _, _, k in parts[1:]}
     report = BreakageReport([n for n, _, _ in parts], int(posed.stats["filled"]), int(rest.rest_bone.stats["filled"]),

@@ -55,8 +55,8 @@ def homes(rest_piece: np.ndarray, posed_piece: np.ndarray, n_posed: int) -> np.n
     return out
 
 
-def torn_off(rest_piece: np.ndarray, posed_piece: np.ndarray, n_posed: int) -> np.ndarray:
-    """The posed pieces the pose tore off: those that are no rest piece's home.
+def torn_off(home: np.ndarray, n_posed: int) -> np.ndarray:
+    """The posed pieces the pose tore off: those that are no rest piece's home (``home``: :func:`homes`).
 
     A rest piece split by the pose leaves its other parts homeless. A body already in several pieces at
     rest (the frog's 6,069 specks) whose pose keeps them apart tears nothing off; two rest pieces the pose
@@ -64,23 +64,23 @@ def torn_off(rest_piece: np.ndarray, posed_piece: np.ndarray, n_posed: int) -> n
     ascending."""
     torn = np.ones(n_posed + 1, bool)
     torn[0] = False
-    torn[homes(rest_piece, posed_piece, n_posed)] = False
+    torn[home] = False
     return np.flatnonzero(torn)
 
 
-def loose_specks(torn, sizes: dict, rest_piece: np.ndarray, posed_piece: np.ndarray, images: np.ndarray,
-                 labels: tuple, volume: np.ndarray) -> set:
+def loose_specks(torn, sizes: dict, home: np.ndarray, rest_piece: np.ndarray, posed_piece: np.ndarray,
+                 images: np.ndarray, labels: tuple, volume: np.ndarray) -> set:
     """The torn-off posed pieces (``torn``) that are specks let go where they were: at most
-    :data:`SPECK_VOXELS` voxels (``sizes``: posed piece -> voxels), with the home of a rest piece they came
-    from within :data:`SPECK_REACH` voxels. ``images``: each rest voxel's posed array coordinates
-    ``[x, y, z]``; ``labels``: the posed volume's runs."""
-    small = [k for k in torn if sizes[k] <= SPECK_VOXELS]
-    if not small:
+    :data:`SPECK_VOXELS` voxels (``sizes``: posed piece -> voxels), with the home (``home``: :func:`homes`) of
+    a rest piece they came from within :data:`SPECK_REACH` voxels. ``images``: each rest voxel's posed array
+    coordinates ``[x, y, z]``; ``labels``: the posed volume's runs."""
+    small = np.array([k for k in torn if sizes[k] <= SPECK_VOXELS], np.int64)
+    if not len(small):
         return set()
-    home = homes(rest_piece, posed_piece, int(labels[4]))
+    at = np.flatnonzero(np.isin(posed_piece, small))  # one pass over the rest voxels, not one a speck
     out = set()
     for k in small:
-        mine = posed_piece == k
+        mine = at[posed_piece[at] == k]
         theirs = np.unique(home[rest_piece[mine]])
         around = (images[mine][:, None, :] + _AROUND[None]).reshape(-1, 3)
         if np.isin(pieces_at(labels, volume, around), theirs[theirs > 0]).any():

@@ -66,4 +66,4 @@ def test_a_rest_piece_s_home_is_where_most_of_it_lands():
     rest_piece = np.array([1, 1, 1, 2, 2, 3])
     posed_piece = np.array([4, 4, 5, 6, 0, 0])  # piece 1 splits 2:1; 2 lands in 6 once; 3 lands nowhere
     assert homes(rest_piece, posed_piece, 6).tolist() == [0, 4, 6, 0]
-    assert torn_off(rest_piece, posed_piece, 6).tolist() == [1, 2, 3, 5]
+    assert torn_off(homes(rest_piece, posed_piece, 6), 6).tolist() == [1, 2, 3, 5]
