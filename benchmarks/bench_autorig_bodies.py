@@ -9,7 +9,8 @@ Bodies: the mannequin and mannequin-large (hand-made rigs: the proposal's mean j
 pyvista's ant, and three closed meshes other projects ship (voxelized at 160 voxels along the longest
 side, as the README's ant): trimesh's rabbit, and Keenan Crane's Spot (a cow) and Bob (a duck), CC0,
 from geometry-central's test assets in potpourri3d's source distribution on PyPI (``volanim samples``
-copies all three). Seconds are autorig's, with its ratio to skeletonize measured beside it.
+copies all three); and Khronos' glTF sample Fox (CC BY 4.0), its skinned surface at rest. Seconds are
+autorig's, with its ratio to skeletonize measured beside it.
 
 Run: .venv/bin/python benchmarks/bench_autorig_bodies.py [--bodies a,b,...] [--angles 45,90] [--size 320]
 """
@@ -24,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-BODIES = ("mannequin", "mannequin-large", "frog", "ant", "rabbit", "spot", "bob")
+BODIES = ("mannequin", "mannequin-large", "frog", "ant", "rabbit", "spot", "bob", "fox")
 JOINTS = ("owned", "hung on", "rigid", "smooth")
 
 
@@ -37,7 +38,7 @@ def body_mask(name: str, folder: Path, size: int = 160):
         s = samples.load(name)
         return s.mask, (s.bones if name != "frog" else None)
     samples.write_sample(name, folder)
-    vol, _ = voxelize(read_mesh(folder / f"{name}.ply"), size=size)
+    vol, _ = voxelize(read_mesh(folder / ("Fox.glb" if name == "fox" else f"{name}.ply")), size=size)
     return vol > 0, None
 
 
@@ -81,26 +82,31 @@ def leaf_poses(skel, bones, angles, mask=None) -> tuple[dict, str]:
 
 def clip_of_its_kind(bones, folder: Path) -> str:
     """The rig's kind (by names, else by shape: motion/chains.py) and a clip of that kind retargeted onto it:
-    the share of sampled frames its least-held check holds, or why none ran. The quadruped's and the insect's
-    clips are the tests' written ones (tests/written_clips.py): no real animal clip we may ship is on hand."""
+    the share of sampled frames its least-held check holds, or why none ran. A quadruped walks the real fox's
+    Walk (Khronos' Fox, ``volanim samples fox``); a many-legged rig the tests' written insect
+    (tests/written_clips.py): no real many-legged clip we may ship is on hand."""
     from volanim_core import samples
-    from volanim_core.io.bvh_files import read_bvh
+    from volanim_core.io.clip_files import read_clip
     from volanim_core.motion.kind import rig_kind
     from volanim_core.motion.plausible import check_clip
     from volanim_core.motion.retarget import Retarget
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-    from written_clips import elephant_bvh, insect_bvh
+    from written_clips import insect_bvh
 
     kind = rig_kind(bones)
     if kind == "biped":
-        clip, path = "walk", samples.walk_clip()
-    elif kind in ("quadruped", "many-legged"):
-        clip, path = ("elephant", folder / "elephant.bvh") if kind == "quadruped" else ("insect", folder / "insect.bvh")
-        (elephant_bvh if kind == "quadruped" else insect_bvh)(path)
+        clip, motion = "walk", read_clip(samples.walk_clip())
+    elif kind == "quadruped":
+        samples.write_sample("fox", folder)
+        clip, motion = "the fox's Walk", read_clip(folder / "Fox.glb", "Walk")
+    elif kind == "many-legged":
+        clip, path = "insect", folder / "insect.bvh"
+        insect_bvh(path)
+        motion = read_clip(path)
     else:
         return f"{kind or 'other'}: no clip"
-    checks, _ = check_clip(Retarget.build(bones, read_bvh(path)))
+    checks, _ = check_clip(Retarget.build(bones, motion))
     failed = [c.name for c in checks if not c.ok]
     return f"{kind}: {clip} {100 * min(c.held for c in checks):.0f}%" + (f" ({', '.join(failed)})" if failed else "")
 

@@ -116,9 +116,9 @@ def series_choices(path) -> list[tuple[str, str]]:
 def load_volume_file(path: str, dims=None, series: str | None = None) -> dict:
     """Read any supported volume (fast; the heavy part is :func:`prepare_volume`). A colour volume
     stays in colour (``volume``); ``grey`` is what its threshold is chosen on."""
-    from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh, voxelize
+    from volanim_core.io.mesh_files import READ_MESH_SUFFIXES, read_mesh, voxelize
 
-    if Path(path).suffix.lower() in MESH_SUFFIXES:  # a closed surface: filled, as `volanim voxelize` fills it
+    if Path(path).suffix.lower() in READ_MESH_SUFFIXES:  # a closed surface: filled, as `volanim voxelize` fills it
         data, geometry = voxelize(read_mesh(path))
         return {"volume": data, "grey": data, "spacing": geometry.spacing, "path": path, "geometry": geometry,
                 "segments": {}, "histogram": value_histogram(data)}

@@ -27,3 +27,17 @@ def test_regrown_pieces_counts_as_scipy_without_holding_the_gil(monkeypatch):
     monkeypatch.setattr(ndimage, "label", refused)
     assert tasks.regrown_pieces(skel, s.mask) == want
     assert paint_balls.targetoptions.get("nogil")
+
+
+def test_open_volume_fills_a_gltf_animal_as_volanim_voxelize_fills_it(tmp_path):
+    """File > Open volume on Khronos' Fox (a skinned glTF): its surface at rest, filled, as the command fills it."""
+    import numpy as np
+
+    from paths import FOX
+    from volanim_core.cli import main
+    from volanim_core.io import read_volume
+
+    loaded = tasks.load_volume_file(str(FOX))
+    assert main(["voxelize", str(FOX), str(tmp_path / "fox.nrrd")]) == 0
+    assert np.array_equal(loaded["volume"], read_volume(tmp_path / "fox.nrrd"))
+    assert loaded["geometry"].spacing == loaded["spacing"] and np.count_nonzero(loaded["volume"]) > 20_000

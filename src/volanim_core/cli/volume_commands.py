@@ -411,10 +411,12 @@ def register(sub) -> None:
     how.add_argument("--size", nargs=3, type=ascii_int, metavar=("X", "Y", "Z"), help="new dimensions")
     p.add_argument("--labels", action="store_true", help="nearest voxel (labels, masks) instead of linear")
 
-    p = add_command(sub, "voxelize", "Fill a closed surface mesh (.ply, .obj, .stl, .vtp) into a binary volume "
-                    "with its geometry, ready to skeletonize.",
-                    "volanim voxelize ant.ply ant.nrrd --size 160", _voxelize)
-    p.add_argument("mesh", help="closed surface mesh (.ply, .obj, .stl, .vtp)")
+    p = add_command(sub, "voxelize", "Fill a closed surface mesh (.ply, .obj, .stl, .vtp; or a glTF file's "
+                    "surface at rest, .glb, .gltf) into a binary volume with its geometry, ready to skeletonize.",
+                    ("volanim voxelize ant.ply ant.nrrd --size 160",
+                     "volanim voxelize Fox.glb fox.nrrd --size 160   # `volanim samples fox`: a skinned animal"),
+                    _voxelize)
+    p.add_argument("mesh", help="closed surface mesh (.ply, .obj, .stl, .vtp, or glTF .glb, .gltf)")
     p.add_argument("output", help="output volume (.nrrd, .nii, .mha, .vti keep the geometry; .VOL, .vol do not)")
     size = p.add_mutually_exclusive_group()
     size.add_argument("--spacing", type=positive_float, metavar="S", help="voxel size, in the mesh's units")

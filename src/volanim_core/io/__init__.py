@@ -19,6 +19,7 @@ for a bad file; all writers are atomic.
       keys_files.py ....... .keys (keyframes)
       bvh_files.py ........ BVH clips read (the clip's own hierarchy and forward kinematics); bvh_export.py: written
       gltf_files.py ....... glTF 2.0 clips (.glb .gltf .vrma): a skeleton and one animation, read as a BVH Motion
+      gltf_meshes.py ...... a glTF file's surface at rest (skins applied), a mesh to voxelize
       fbx_files.py ........ FBX clips through assimp (impasse), read as a Motion by the glTF rules
       gltf_export.py ...... an animated, skinned .glb written from arrays (what: render/skinned_body.py)
       clip_bake.py ........ what the glTF and FBX readers share: key sampling, frame times, world matrices -> Motion
@@ -29,7 +30,8 @@ for a bad file; all writers are atomic.
     rendering, colour, meshes, other programs
       render_files.py ..... the Rendering section's files: .camera and .tf
       palette_files.py .... palettes, alpha maps, remap tables
-      mesh_files.py ....... surfaces out (.ply .vtp .obj .stl); mesh_checks.py: meshes checked before VTK reads them
+      mesh_files.py ....... surfaces in and out (.ply .vtp .obj .stl; .glb .gltf in); mesh_checks.py: meshes
+                            checked before VTK reads them
       slicer_files.py ..... 3D Slicer's markups and transform files
       bundle.py ........... several files saved as one unit (a project): data files, then the manifest
     what every reader and writer shares

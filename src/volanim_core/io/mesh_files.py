@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 MESH_SUFFIXES = (".ply", ".vtp", ".obj", ".stl")
+#: what read_mesh also reads: a glTF file's surface at rest (io/gltf_meshes.py); written as none of them
+READ_MESH_SUFFIXES = MESH_SUFFIXES + (".glb", ".gltf")
 
 
 def write_mesh(path, vertices: np.ndarray, faces: np.ndarray) -> None:
@@ -25,8 +27,9 @@ def write_mesh(path, vertices: np.ndarray, faces: np.ndarray) -> None:
 
 
 def read_mesh(path):
-    """A mesh file (``.ply``, ``.vtp``, ``.obj``, ``.stl``) as a pyvista PolyData; a file VTK cannot
-    read, or one holding no triangles, raises FormatError naming it."""
+    """A mesh file (``.ply``, ``.vtp``, ``.obj``, ``.stl``; or a glTF file's surface at rest, ``.glb``,
+    ``.gltf``) as a pyvista PolyData; a file VTK cannot read, or one holding no triangles, raises FormatError
+    naming it."""
     from pathlib import Path
 
     import pyvista as pv
@@ -36,12 +39,18 @@ def read_mesh(path):
     from .vtk_headers import check_mesh_claims
 
     path = Path(path)
-    if path.suffix.lower() not in MESH_SUFFIXES:
-        raise ValueError(f"{path}: not a mesh file ({', '.join(MESH_SUFFIXES)})")
+    if path.suffix.lower() not in READ_MESH_SUFFIXES:
+        raise ValueError(f"{path}: not a mesh file ({', '.join(READ_MESH_SUFFIXES)})")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     if path.stat().st_size == 0:
         raise FormatError(path, "is empty")
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        from .gltf_meshes import read_gltf_mesh
+
+        vertices, faces = read_gltf_mesh(path)  # our reader: each accessor checked against its buffer
+        # glTF splits a vertex wherever its normal or texture coordinate changes: merged, the surface closes
+        return pv.PolyData(vertices, np.c_[np.full(len(faces), 3), faces].ravel()).clean(tolerance=1e-9)
     check_mesh_claims(path)  # VTK allocates whatever a header claims
     from .mesh_checks import check_ply, read_obj
 

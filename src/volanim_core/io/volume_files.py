@@ -316,9 +316,9 @@ def _read_any(path: Path, dims, colour: bool, series):
         return data, geometry, {}, mode
     if suffix in DICOM_SUFFIXES or dicom_files.is_dicom_file(path):
         return (*dicom_files.read_dicom(path, series=series), {})
-    from .mesh_files import MESH_SUFFIXES
+    from .mesh_files import READ_MESH_SUFFIXES
 
-    if suffix in MESH_SUFFIXES:
+    if suffix in READ_MESH_SUFFIXES:
         raise FormatError(path, f"is a surface mesh, not a volume: fill it first with `volanim voxelize {path.name} "
                                 f"{path.stem}.nrrd` (the studio's File > Open volume fills a mesh itself)")
     raise FormatError(path, f"unknown volume format {path.suffix!r}; expected "

@@ -6,7 +6,7 @@
       --the two longest pairs, and any other whose ends stand as low-->  legs
     legs  -> up: from the feet to where the legs leave the body
           -> spine: the tree path from the hind pair's fork to the front pair's
-    the other end chains, by the spine end they hang from -> head (the end whose chains reach highest
+    the other end chains, by the spine end they hang from -> head (the end whose chains end highest
                                                              along up) and tail (the other), each what
                                                              the paths out of its end share
     sides -> the figure's left is up x forward (forward: hind fork -> front fork)
@@ -121,13 +121,15 @@ def read_figure(points: np.ndarray, parent: np.ndarray, hips: int | None = None,
         legs.sort(key=lambda pair: (spine.index(pair[0][0]), np.mean([points[p[1]] @ axis for p in pair])))
         out = {a: [], b: []}  # each spine end: paths out from it through no leg and no other spine point
         for path in ends:
-            if path[-1] in used:
-                continue
+            if path[-1] in used or parent[path[-1]] < 0:  # a root with one child: the file's wrapper (the
+                continue  # Fox's _rootJoint, at the floor under its hips), no head or tail: it voided the tail
             way = _path(nbrs, path[-1], a)
             hit = next((n for n in way if n in spine), None)  # None: a tree apart from the body's
             if hit in out and not set(way[:way.index(hit)]) & (set(spine) | used):
                 out[hit].append(_path(nbrs, hit, path[-1]))
-        high = {e: max((points[n] @ up for p in paths for n in p), default=points[e] @ up) for e, paths in out.items()}
+        # how high each end's chains end: a head is held up, a tail hangs (the Fox's tail leaves its hips
+        # higher than its neck leaves its shoulders, and every point of a chain read its head as its tail)
+        high = {e: max((points[p[-1]] @ up for p in paths), default=points[e] @ up) for e, paths in out.items()}
         if high[a] == high[b] and hips is not None:  # nothing tells: a clip's hierarchy starts at its hips
             front = b if len(_path(nbrs, hips, a)) <= len(_path(nbrs, hips, b)) else a
         else:
@@ -361,12 +363,25 @@ def match_chains(bones, motion: Motion) -> tuple[ChainMatch | None, str]:
 def _limb_parts(fig: Figure, path: list[int]) -> list[list[int]]:
     """A leg as ``[before, limb]``: the limb from the first of its two longest consecutive steps (thigh and
     shin, upper arm and forearm) to the foot, and what leads to it (a clavicle, a scapula), so a clip's
-    clavicle does not drive a rig's upper leg. ``before`` is ``[]`` when the limb starts at the fork."""
-    lengths = fig.lengths(path)
+    clavicle does not drive a rig's upper leg. ``before`` is ``[]`` when the limb starts at the fork.
+
+    A step is measured across the body, its part along the body's forward left out: Khronos' Fox's shoulder
+    joint sits 19.5 cm forward of its spine's, as long as its forearm, and that step was taken for the
+    upper arm (the rig's upper arm turned with the spine, its forearm as the fox's upper arm). Twin legs
+    are split alike, by their steps summed: the fox's auto-rig put one wrist 8 voxels higher than the
+    other, and that leg alone was split a step lower."""
+    twins = next((list(pair.values()) for pair in fig.legs if path in pair.values()), [path])
+    lengths = sum(_across(fig, p) for p in twins if len(p) == len(path))
     if len(lengths) < 3:
         return [[], path]
     i = int(np.argmax(lengths[:-1] + lengths[1:]))
     return [path[:i + 1] if i else [], path[i:]]
+
+
+def _across(fig: Figure, path: list[int]) -> np.ndarray:
+    """Each step's length along a path, its part along the figure's forward left out."""
+    steps = np.diff(fig.points[path], axis=0)
+    return np.linalg.norm(steps - np.outer(steps @ fig.forward, fig.forward), axis=1)
 
 
 def _steps(fig: Figure, path: list[int]) -> list[tuple[tuple[int, int], float]]:

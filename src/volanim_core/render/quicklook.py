@@ -38,7 +38,7 @@ def read_look(path, *, style: str = "surface", preset: str | None = None, view: 
     """Read ``path`` (a mesh, a volume, or frame ``frame`` of a sequence) for :func:`draw_look`;
     ``transfer`` (a :class:`~volanim_core.transfer_function.TransferFunction`) colours a volume instead of
     its preset (a colour volume by its luminance; a colour sequence's frame likewise, through its palette)."""
-    from volanim_core.io.mesh_files import MESH_SUFFIXES, read_mesh
+    from volanim_core.io.mesh_files import READ_MESH_SUFFIXES, read_mesh
 
     from .framing import place_camera
     from .movie import open_inputs, read_frame
@@ -46,7 +46,7 @@ def read_look(path, *, style: str = "surface", preset: str | None = None, view: 
 
     path = Path(path)
     w, h = size
-    if path.suffix.lower() in MESH_SUFFIXES:
+    if path.suffix.lower() in READ_MESH_SUFFIXES:
         mesh = read_mesh(path)
         lo, hi = tuple(np.asarray(mesh.bounds[0::2])), tuple(np.asarray(mesh.bounds[1::2]))
         settings = RenderSettings(named_view(view, lo, hi, aspect=w / h, faces=0.0), size=(w, h))

@@ -70,7 +70,8 @@ class FilesController(Controller):
         """Ask for a volume, a mesh or a sequence (its ``NAME.zarr`` folder, or the ``zarr.json`` in it), then
         :meth:`view_file` it. Not modal: the dialog (``look_dialog``) is returned and kept while it is open."""
         dialog = LookDialog(self.window, "View volume, mesh or sequence", self.folder(),
-                            f"Volumes, meshes and sequences ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl *.zarr "
+                            f"Volumes, meshes and sequences ({VOLUME_PATTERNS} *.ply *.vtp *.obj *.stl *.glb *.gltf "
+                            "*.zarr "
                             "zarr.json);;All files (*)")
         dialog.finished.connect(lambda _: dialog.chosen and self.view_file(dialog.chosen))
         self.look_dialog = dialog
@@ -228,7 +229,8 @@ class FilesController(Controller):
     def _ask_volume(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self.window, "Open volume", self.folder(),
                                               f"Volumes, grey or RGB ({VOLUME_PATTERNS});;"
-                                              "Closed meshes, filled (*.ply *.obj *.stl *.vtp);;DICOM files (*.dcm *);;"
+                                              "Closed meshes, filled (*.ply *.obj *.stl *.vtp *.glb *.gltf);;"
+                                              "DICOM files (*.dcm *);;"
                                               "All files (*)")
         if path:
             self.open_volume(self._dicom_series_folder(path))

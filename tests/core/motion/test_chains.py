@@ -1,18 +1,19 @@
 """#86 item 2: a clip of its kind onto a creature's auto-rig, matched chain to chain (motion/chains.py).
 
 Spot the cow (Keenan Crane, CC0) voxelized at 160 and auto-rigged gets chains named by where they lie
-(``ANT3_1``); the quadruped is the 3ds Max biped-rigged elephant of test_clip_kind (no real animal clip
-with a licence we can ship is on hand). The truth the matching is checked against is the clip's own
-forward kinematics, computed by the BVH reader, not by the retargeting."""
+(``ANT3_1``); the quadruped clips are the 3ds Max biped-rigged elephant of test_clip_kind and Khronos'
+Fox's real Walk (CC BY 4.0), which also drives the fox's own auto-rig. The truth the matching is checked
+against is the clip's own forward kinematics, computed by the clip's reader, not by the retargeting."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests.paths import WALK
+from tests.paths import FOX, WALK
 
 from volanim_core.cli import main
 from volanim_core.io.bvh_files import read_bvh
+from volanim_core.io.clip_files import read_clip
 from volanim_core.motion.chains import match_chains, rig_figure
 from volanim_core.motion.kind import rig_kind
 from volanim_core.motion.plausible import check_clip
@@ -90,6 +91,53 @@ def test_bvh2trans_walks_spot_with_the_elephant_and_every_check_holds(spot, tmp_
     assert "feet near the floor: 100%" in out and "feet below the body: 100%" in out
     assert "chain: hind L leg, 1 of 2" in out
     assert len(list((tmp_path / "frames").glob("*.trans"))) == 48
+
+
+@pytest.fixture(scope="module")
+def fox():
+    """Khronos' Fox (CC BY 4.0): its own skinned surface at rest, filled at 160 and auto-rigged."""
+    from volanim_core.io.mesh_files import read_mesh, voxelize
+    from volanim_core.rig.autorig import autorig
+    from volanim_core.skeleton.skeletonize import skeletonize
+
+    vol, _ = voxelize(read_mesh(FOX), size=160)
+    return autorig(skeletonize(vol > 0)).bones
+
+
+@pytest.mark.parametrize("body", ["fox", "spot"])
+def test_a_real_fox_s_walk_drives_each_leg_by_the_fox_s_leg_of_the_same_pair_and_side(body, request):
+    """The Fox's Walk onto the fox's own auto-rig and onto Spot: each leg bone follows a joint of the fox's
+    leg of the same pair and side (hind legs ``b_LeftLeg01`` .. ``b_LeftFoot02``, front legs ``b_LeftUpperArm``
+    .. ``b_LeftHand``), the head the neck, the tail the tail; and as the fox's left hind foot swings forward
+    and back, the rig's does the same way (the clip's own forward kinematics against our posed joints).
+    The fox's tail starts higher than its neck, and its head was read as its tail: hind legs walked by front
+    ones, left by right, every plausibility check still passing."""
+    bones = request.getfixturevalue(body)
+    bones = bones[1] if isinstance(bones, tuple) else bones
+    motion = read_clip(FOX, "Walk")
+    found, why = match_chains(bones, motion)
+    assert found is not None, why
+    rig = found.rig
+    driver = {b.distal: found.mapping.get(b.label) for b in bones.bones}
+    for pair, fork, limb in zip(rig.legs, ("b_Hip_01", "b_Spine02_03"), (("Leg", "Foot"), ("Arm", "Hand"))):
+        for side, path in pair.items():
+            if driver[rig.names[path[1]]] == fork:
+                path = path[1:]  # a pelvis or scapula bone before the leg turns with the body: the fox has none
+            for n in path[1:]:
+                joint = driver[rig.names[n]]
+                assert joint.startswith(f"b_{'Left' if side == 'L' else 'Right'}"), (side, rig.names[n], joint)
+                assert any(part in joint for part in limb), (side, rig.names[n], joint)
+    # the head and the tail from their own ends (a first step from the body turns with it)
+    assert {driver[rig.names[n]].split("_")[1] for n in rig.tail[1:]} <= {"Hip", "Tail01", "Tail02", "Tail03"}
+    assert {driver[rig.names[n]].split("_")[1] for n in rig.head[1:]} <= {"Spine02", "Neck", "Head"}
+    mats = Retarget.build(bones, motion).matrices()
+    foot = rig.names[rig.legs[0]["L"][-1]]
+    k = _bone_ending(bones, foot)
+    ours = bones.joints[foot] @ mats[:, k, :3, :3] + mats[:, k, 3, :3]
+    root = bones.joints[rig.names[rig.spine[0]]] @ mats[:, 0, :3, :3] + mats[:, 0, 3, :3]
+    _, pos = motion.forward_kinematics(slice(None))
+    theirs = pos[:, motion.index("b_LeftFoot02_018")] - pos[:, motion.index("b_Hip_01")]
+    assert np.corrcoef((ours - root) @ rig.forward, theirs @ np.array([0.0, 0.0, 1.0]))[0, 1] > 0.9  # faces +z
 
 
 def test_a_person_s_walk_is_refused_for_spot_saying_what_each_is(spot, tmp_path, capsys):
