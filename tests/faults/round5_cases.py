@@ -1,4 +1,5 @@
-"""Fault cases of the fifth round (#88): glTF and FBX clips. A truncated GLB, a buffer file that is not there, NaN
+"""Fault cases of the fifth round (#88): glTF and FBX clips (and, #86, a glTF file's surface to voxelize).
+A truncated GLB, a buffer file that is not there, NaN
 keys, a count of keys the buffer does not hold, key times that span years, nodes that loop, a file with no
 animation; FBX files cut short, empty (assimp aborts the process on it: refused before assimp sees it) and
 holding a box but no skeleton. Real bytes where they exist: Khronos' Fox and assimp's huesitos cut short,
@@ -46,4 +47,17 @@ def round5_cases() -> list[Case]:
              "bvh2trans {d}/c.fbx --bones {d}/m.bones -o {d}/out", says=("FBX-Tokenize",)),
         Case("bvh2trans: a GLB cut short", "cli:bvh2trans", {"Fox.glb": fox[:100_000], "m.bones": bones},
              "bvh2trans {d}/Fox.glb --bones {d}/m.bones -o {d}/out", says=("truncated",)),
+        *voxelize_cases(fox, loop),
     ]
+
+
+def voxelize_cases(fox: bytes, loop: list) -> list[Case]:
+    """A glTF file's surface to fill (#86, io/gltf_meshes.py): the clip reader's checks, and a file with no mesh."""
+    def case(name, data, says, file="m.gltf"):
+        return Case(f"voxelize: {name}", "cli:voxelize", {file: data}, f"voxelize {{d}}/{file} {{d}}/o.nrrd", says=says)
+
+    return [case("a GLB cut short", fox[:100_000], ("truncated",), file="Fox.glb"),
+            case("a GLB whose header claims more", fox[:8] + (10**9).to_bytes(4, "little") + fox[12:],
+                 ("header says 1,000,000,000 bytes",), file="Fox.glb"),
+            case("a glTF clip with no mesh", gltf(), ("holds no triangles",)),
+            case("nodes that are each other's child", gltf(nodes=loop), ("cycle of children",))]
