@@ -27,12 +27,17 @@ from volanim_core.io.gltf_files import Gltf, _index, _item, _parents, _rest_loca
 
 GLTF_MESH_SUFFIXES = (".glb", ".gltf")
 TRIANGLES, STRIP, FAN = 4, 5, 6
+COMPRESSED = {"KHR_draco_mesh_compression", "EXT_meshopt_compression"}
 
 
 def read_gltf_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """``(vertices (N, 3), faces (M, 3))``: every triangle of the file at its rest pose (module docstring);
     FormatError, naming the file, for one that holds no triangles or indexes a vertex it lacks."""
     g = load_gltf(path)
+    packed = sorted(set(g.doc.get("extensionsRequired") or []) & COMPRESSED)
+    if packed:  # their accessors have no buffer view of their own: read as they stand, every vertex at 0
+        raise g.fail(f"its meshes are compressed ({', '.join(packed)}), which volanim does not read: export "
+                     "them uncompressed")
     world = _world_matrices(g)
     verts, faces, n = [], [], 0
     for k, node in enumerate(g.doc.get("nodes") or []):

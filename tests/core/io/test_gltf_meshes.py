@@ -117,7 +117,10 @@ def test_a_skinned_mesh_is_drawn_where_its_joint_rests_not_where_it_was_bound(tm
     (lambda p: p.write_bytes(FOX.read_bytes()[:90_000]), "truncated"),
     (lambda p: write_gltf(p, [0, 1, 7], 4), "names vertex 7 of its 4"),
     (lambda p: write_gltf(p, [0, 1, 2, 3], 1), "holds no triangles"),
-], ids=["truncated-glb", "index-past-the-vertices", "lines-only"])
+    (lambda p: p.write_text(json.dumps({**json.loads(write_gltf(p, FACES).read_text()),
+                                        "extensionsRequired": ["KHR_draco_mesh_compression"]})),
+     "compressed \\(KHR_draco_mesh_compression\\)"),
+], ids=["truncated-glb", "index-past-the-vertices", "lines-only", "draco"])
 def test_a_bad_file_is_refused_naming_it(tmp_path, make, says):
     path = tmp_path / "body.gltf"
     make(path)

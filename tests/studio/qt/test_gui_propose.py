@@ -141,3 +141,50 @@ def test_propose_bones_then_load_a_clip_of_the_ant_s_kind_and_play_it(qtbot, win
     root = next(j for j in doc.bones.joints if not any(b.distal == j for b in doc.bones.bones))
     spread = np.ptp([[p.joints[f] - p.joints[root] for f in feet] for p in moved], axis=0).max()
     assert spread > 2.0  # voxels: the legs' ends moved against the body between the pictures drawn
+
+
+@pytest.mark.long("the fox's glTF surface filled, skeletonized, proposed, connected, then its own Walk loaded and played")
+def test_open_the_fox_s_gltf_propose_bones_and_play_its_own_walk(qtbot, window):
+    """#86 item 4 on a real animal: File > Open volume on Khronos' Fox (its skinned glTF surface, filled) ->
+    Propose bones (auto: a quadruped) -> Accept -> connect -> Load clip: the same file, its Walk picked ->
+    Play. The mapping dialog puts each leg bone on a chain and drives it by the fox's leg of the same side
+    (its head was once read as its tail: the left hind leg walked as the right front one), and the pictures
+    drawn move the feet."""
+    import numpy as np
+
+    from paths import FOX
+
+    window.files.open_volume(FOX, params={"lo": 1, "hi": None, "fill": False})
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    doc = window.doc
+    dialog = _propose(qtbot, window, "auto")
+    assert "quadruped" in dialog.summary.text()
+    qtbot.mouseClick(dialog.buttons.button(QDialogButtonBox.Ok), Qt.LeftButton)
+    qtbot.mouseClick(window.connect_panel.auto_button, Qt.LeftButton)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    shown, picked = {}, []
+
+    def ask(d):
+        shown.update({label: (w.text(), d.combos[label].currentText()) for label, w in d.how.items()})
+        return True
+
+    assert window.timeline.load_bvh(FOX, ask=ask, pick=lambda names: picked.append(names) or "Walk") is not None
+    qtbot.waitUntil(lambda: not window.readers.busy, timeout=JOB_TIMEOUT_MS)
+    assert picked == [["Survey", "Walk", "Run"]] and doc.timeline.clip.animation == "Walk"
+    assert doc.timeline.frame_count == 18
+    for label in ("L_FEMUR", "L_TIBIA", "R_FEMUR", "L_HUMERUS", "L_RADIUS", "R_HUMERUS"):
+        how, joint = shown[label]
+        side = "Left" if label.startswith("L_") else "Right"
+        limb = ("Leg", "Foot") if label.endswith(("FEMUR", "TIBIA")) else ("Arm", "Hand")
+        assert how.startswith("chain: ") and "leg" in how, shown[label]
+        assert joint.startswith(f"b_{side}") and any(p in joint for p in limb), shown[label]
+    pictures = []
+    doc.events.preview.connect(lambda **_: pictures.append(doc.preview) if doc.settings.playing else None)
+    qtbot.keyClick(window, Qt.Key_Space)
+    qtbot.waitUntil(lambda: len(pictures) >= 3, timeout=JOB_TIMEOUT_MS)
+    qtbot.keyClick(window, Qt.Key_Space)
+    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
+    moved = [p for p in pictures if p.joints is not None]
+    assert len({p.frame for p in pictures}) >= 2
+    spread = np.ptp([p.joints["L_HIND_TOE"] - p.joints["PELVIS"] for p in moved], axis=0).max()
+    assert spread > 2.0  # voxels: the left hind foot moved against the body between the pictures drawn
