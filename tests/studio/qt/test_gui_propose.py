@@ -143,7 +143,7 @@ def test_propose_bones_then_load_a_clip_of_the_ant_s_kind_and_play_it(qtbot, win
     assert spread > 2.0  # voxels: the legs' ends moved against the body between the pictures drawn
 
 
-@pytest.mark.long("the fox's glTF surface filled, skeletonized, proposed, connected, then its own Walk loaded and played")
+@pytest.mark.long("the fox's glTF surface filled, skeletonized, proposed, connected, its own Walk loaded and played")
 def test_open_the_fox_s_gltf_propose_bones_and_play_its_own_walk(qtbot, window):
     """#86 item 4 on a real animal: File > Open volume on Khronos' Fox (its skinned glTF surface, filled) ->
     Propose bones (auto: a quadruped) -> Accept -> connect -> Load clip: the same file, its Walk picked ->
