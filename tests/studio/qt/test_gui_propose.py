@@ -128,15 +128,7 @@ def test_propose_bones_then_load_a_clip_of_the_ant_s_kind_and_play_it(qtbot, win
     assert doc.timeline.clip is not before and doc.timeline.frame_count == 48
     legs = [text for label, text in shown.items() if "leg" in text]
     assert len(legs) >= 12 and all(t.startswith("chain: ") for t in legs), shown
-    pictures = []
-    doc.events.preview.connect(lambda **_: pictures.append(doc.preview) if doc.settings.playing else None)
-    qtbot.keyClick(window, Qt.Key_Space)
-    qtbot.waitUntil(lambda: len(pictures) >= 3, timeout=JOB_TIMEOUT_MS)
-    qtbot.keyClick(window, Qt.Key_Space)
-    qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
-    frames = {p.frame for p in pictures}
-    assert len(frames) >= 2
-    moved = [p for p in pictures if p.joints is not None]
+    moved = _play(qtbot, window)
     feet = [j for j in doc.bones.joints if not any(b.proximal == j for b in doc.bones.bones)]
     root = next(j for j in doc.bones.joints if not any(b.distal == j for b in doc.bones.bones))
     spread = np.ptp([[p.joints[f] - p.joints[root] for f in feet] for p in moved], axis=0).max()
@@ -178,13 +170,19 @@ def test_open_the_fox_s_gltf_propose_bones_and_play_its_own_walk(qtbot, window):
         limb = ("Leg", "Foot") if label.endswith(("FEMUR", "TIBIA")) else ("Arm", "Hand")
         assert how.startswith("chain: ") and "leg" in how, shown[label]
         assert joint.startswith(f"b_{side}") and any(p in joint for p in limb), shown[label]
-    pictures = []
+    moved = _play(qtbot, window)
+    spread = np.ptp([p.joints["L_HIND_TOE"] - p.joints["PELVIS"] for p in moved], axis=0).max()
+    assert spread > 2.0  # voxels: the left hind foot moved against the body between the pictures drawn
+
+
+def _play(qtbot, window) -> list:
+    """Space, at least three pictures drawn while playing, Space: the pictures with their posed joints, drawn
+    of at least two frames."""
+    doc, pictures = window.doc, []
     doc.events.preview.connect(lambda **_: pictures.append(doc.preview) if doc.settings.playing else None)
     qtbot.keyClick(window, Qt.Key_Space)
     qtbot.waitUntil(lambda: len(pictures) >= 3, timeout=JOB_TIMEOUT_MS)
     qtbot.keyClick(window, Qt.Key_Space)
     qtbot.waitUntil(lambda: not window.busy, timeout=JOB_TIMEOUT_MS)
-    moved = [p for p in pictures if p.joints is not None]
     assert len({p.frame for p in pictures}) >= 2
-    spread = np.ptp([p.joints["L_HIND_TOE"] - p.joints["PELVIS"] for p in moved], axis=0).max()
-    assert spread > 2.0  # voxels: the left hind foot moved against the body between the pictures drawn
+    return [p for p in pictures if p.joints is not None]
