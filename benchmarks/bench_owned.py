@@ -2,8 +2,7 @@
 and the ownership (once per rig) against the skeletonize it follows, same run, as ratios.
 
     body (frog, mannequin, mannequin-large) --skeletonize (timed)--> skeleton --connect (nearest)--> connectivity
-        --ownership and the tables every frame reads (flags, cells, thin, diagonals, spans, hulls, the smoothed
-          body), timed--> labels
+        --ownership and the tables every frame reads (flags, cells, thin, diagonals, spans, hulls), timed--> labels
     one pose, frames alternated: reconstruct(method='spheres') vs reconstruct(method='owned'), bone mode
     goals: frame owned / spheres <= 1.0; ownership / skeletonize <= 1.0
 
@@ -32,11 +31,10 @@ def timed(make, *args, rounds: int = 3, **kwargs):
 
 def with_tables(mask, conn):
     """The ownership of ``conn`` with the tables every frame reads made (once per rig, at the first frame)."""
-    from volanim_core.reconstruct.owned import smoothed_body
     from volanim_core.rig.ownership import ownership
 
     own = ownership(mask, conn)
-    for table in (own.flags, own.cells, own.thin, own.diagonals, own.spans, own.hulls, lambda: smoothed_body(own)):
+    for table in (own.flags, own.cells, own.thin, own.diagonals, own.spans, own.hulls):
         table()
     return own
 

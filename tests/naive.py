@@ -199,28 +199,11 @@ def thinned_radii(rest, posed, dt, sheet, pairs, floor):
     return out
 
 
-def soft_body(labels):
-    """The body as the reads see it (reconstruct/soft_body.py's definition): ``labels > 0`` correlated with
-    ``1 4 6 4 1`` along each axis (scipy.ndimage, zero outside the array), times 255 / 4096 rounded half up; then
-    each body voxel at least 128 and each other voxel at most 127."""
-    from scipy import ndimage
-
-    body = labels != 0
-    blur = body.astype(np.int64)
-    for axis in range(3):
-        blur = ndimage.correlate1d(blur, [1, 4, 6, 4, 1], axis=axis, mode="constant")
-    out = np.zeros(labels.shape, np.int64)
-    for k in np.ndindex(*labels.shape):
-        v = (blur[k] * 255 + 2048) // 4096
-        out[k] = max(v, 128) if body[k] else min(v, 127)
-    return out
-
-
-def _claims(labels, p, bone1, soft):
+def _claims(labels, p, bone1):
     """Whether label ``bone1`` claims the rest point ``p`` (labels' voxel coordinates): the 8 voxels around p,
-    weighted trilinearly by ``soft`` (:func:`soft_body`; outside the array: 0), sum to over half of 255, and p's
-    nearest voxel is bone1's or, when that voxel is outside the body, bone1's share of the 8 is the largest (a tie
-    to the lower label)."""
+    weighted trilinearly (outside the array: 0), fill more than half of it with body, and p's nearest voxel is
+    bone1's or, when that voxel is outside the body, bone1's share of the 8 is the largest (a tie to the lower
+    label)."""
     import math
 
     base = [int(math.floor(v)) for v in p]
@@ -233,13 +216,11 @@ def _claims(labels, p, bone1, soft):
             w *= t if corner[a] else 1.0 - t
         inside = all(0 <= k[a] < labels.shape[a] for a in range(3))
         v = int(labels[tuple(k)]) if inside else 0
-        if inside:
-            share[v] = share.get(v, 0.0) + w * soft[tuple(k)]
+        if v:
+            share[v] = share.get(v, 0.0) + w
     near = [int(math.floor(v + 0.5)) for v in p]
     nearest = int(labels[tuple(near)]) if all(0 <= near[a] < labels.shape[a] for a in range(3)) else 0
-    body = sum(share.values())
-    share.pop(0, None)
-    if body <= 127.5 or nearest not in (0, bone1):
+    if sum(share.values()) <= 0.5 or nearest not in (0, bone1):
         return False
     if nearest == bone1:
         return True
@@ -283,18 +264,17 @@ def _thin(labels, k):
 
 def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
     """The ownership warp (reconstruct/owned.py) voxel by voxel: each output voxel q of ``bounds`` is bone b's
-    (first in order) when b claims the rest point ``[q 1] @ inv(M_b)`` (:func:`_claims`: the smoothed body's
-    trilinear share there more than half, and p b's); a bone moved by whole voxels only reads its own voxel there.
+    (first in order) when b claims the rest point ``[q 1] @ inv(M_b)`` (:func:`_claims`: the body's trilinear
+    share there more than half, and p b's); a bone moved by whole voxels only reads its own voxel there.
     Then each thin rest voxel (its bone's flesh one voxel thick along an axis) of a turned bone is written where
     it lands, rounded, if that is empty, and so is the midpoint to each of its edge and corner neighbours of the
     same bone (unless a thin voxel of the bone lies a face step from it on the way); then each
-    empty voxel strictly inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. ``soft``: the body
-    the reads weigh (default :func:`soft_body`). Returns 1 + bone per voxel ``[x, y, z]``."""
+    empty voxel strictly inside a ball ``(centre, radius, bone)`` (in order) is that ball's bone. Returns 1 + bone
+    per voxel ``[x, y, z]``."""
     import math
 
     lo, hi = np.asarray(bounds[0]), np.asarray(bounds[1])
     out = np.zeros(tuple(hi - lo + 1), np.int64)
-    soft = soft_body(labels)
     for b, m in enumerate(matrices):
         inv = np.linalg.inv(m)
         whole = np.array_equal(m[:3, :3], np.eye(3)) and np.array_equal(m[3, :3], np.round(m[3, :3]))
@@ -306,7 +286,7 @@ def owned_warp(labels, rest_lo, matrices, bounds, balls=()):
                 k = q - np.round(m[3, :3]).astype(np.int64) - rest_lo
                 if (k >= 0).all() and (k < labels.shape).all() and labels[tuple(k)] == b + 1:
                     out[idx] = b + 1
-            elif _claims(labels, q @ inv[:3, :3] + inv[3, :3] - rest_lo, b + 1, soft):
+            elif _claims(labels, q @ inv[:3, :3] + inv[3, :3] - rest_lo, b + 1):
                 out[idx] = b + 1
     for b, m in enumerate(matrices):  # each turned bone's thin rest voxels pushed to where they land, if empty
         if np.array_equal(m[:3, :3], np.eye(3)) and np.array_equal(m[3, :3], np.round(m[3, :3])):

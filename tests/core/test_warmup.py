@@ -40,7 +40,6 @@ INLINED = {
     "volanim_core.reconstruct._owned_kernels._moved",
     "volanim_core.reconstruct._owned_kernels._label",
     "volanim_core.reconstruct._owned_kernels.claims_point",
-    "volanim_core.reconstruct._soft_kernels.most_read_near",
     "volanim_core.rig._ownership_kernels.tube_depth",
     "volanim_core.rig._ownership_kernels.tube_distance",
 }

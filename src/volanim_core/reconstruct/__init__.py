@@ -4,7 +4,6 @@ plan.py ............ a frame checked and made ready: FramePlan (grid, centres, v
 engine.py .......... reconstruct(): runs the plan, five modes, two metrics; result.py what it returns
 owned.py ........... the default when the rig has an ownership: each rest voxel moved by the bone that
                      owns it, joints closed by balls (_owned_kernels.py, tested against tests/naive.py)
-soft_body.py ....... the rest body smoothed for the owned reads between voxels (no stairs at a turn)
 live.py ............ LiveFrame: frame after frame on one grid, redoing only the slices moved spheres reach
 live_owned.py ...... LiveOwned: the owned body frame after frame on one grid, redoing only the box moved bones reach
 _plan_kernels.py ... the plan's numba kernels; _kernels.py the fill and sample kernels (tested

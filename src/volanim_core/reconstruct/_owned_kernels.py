@@ -1,10 +1,9 @@
 """Numba kernels of the ownership warp (reconstruct/owned.py): each output voxel read once per bone that can reach it.
 
-    warp_owners(labels, packed, shift, flags, rest_lo, inv, boxes, out_lo, out, row_lo, row_hi, claims, count)
+    warp_owners(labels, flags, rest_lo, inv, boxes, out_lo, out, row_lo, row_hi, claims, count)
         every output voxel q, for each bone b whose posed box holds q (root order), at its rest point
         p = [q 1] @ inv[b]: q is b's (the first such bone keeps it) when the body fills more than half of p
-        (trilinear over the 8 voxels around p, each weighing its soft value: ``packed``) and p is b's (its
-        nearest voxel's bone; outside the body, the
+        (trilinear over the 8 voxels around p) and p is b's (its nearest voxel's bone; outside the body, the
         largest share: :func:`claims_point`); a bone moved by whole voxels reads its own voxel, exactly
     posed_cells(cells, size, rest_lo, m, reach, out_lo, marks)
         the output cubes a turned bone's reads can find it in (warp_owners reads only there)
@@ -19,10 +18,8 @@ rotation spreads voxels apart; reading each output voxel from the rest voxel its
 every output voxel at most once per bone and leaves none out. Why trilinear, not the nearest voxel: the body
 is a voxel segmentation of a smooth shape, and reading it at the nearest voxel turns its surface into stairs
 at every turn. The mannequin turned whole by the walk's root (no joint bent) comes back at Dice 0.979 against
-its true shape read nearest, 0.985 trilinear over the bare voxels, 0.991 trilinear over the body smoothed first
-(``soft``: reconstruct/soft_body.py; #84: the walk's goal is 0.98). At whole-voxel points all three read the
-rest labels exactly (the smoothed body is clamped over half inside, under it outside), so the identity pose
-gives them back voxel for voxel. ``claims`` counts the bones
+its true shape read nearest, 0.985 trilinear (#84: the walk's goal is 0.98). At whole-voxel points both read
+the rest labels exactly, so the identity pose gives them back voxel for voxel. ``claims`` counts the bones
 (and balls) reaching a voxel: the hotspot mode.
 """
 
@@ -34,14 +31,12 @@ import numba
 import numpy as np
 from numba import njit
 
-from volanim_core.reconstruct.soft_body import HALF
-
 ZB = 4  # output slices a thread takes at a time (warp_owners)
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def warp_owners(labels, packed, shift, flags, spans, rest_lo, inv, shifts, turned, marks, cell, z_first, boxes,
-                out_lo, out, row_lo, row_hi, claims, count, threads):
+def warp_owners(labels, flags, spans, rest_lo, inv, shifts, turned, marks, cell, z_first, boxes, out_lo, out, row_lo,
+                row_hi, claims, count, threads):
     """``out`` ``[z, y, x]`` (zeroed): each voxel's owning bone + 1. ``labels`` ``[x, y, z]``: the rest owners,
     voxel ``[0, 0, 0]`` at rest voxel ``rest_lo``. ``boxes[b]``: bone b's posed box ``x0 y0 z0 x1 y1 z1`` in
     output indices (empty when x1 < x0). ``row_lo/row_hi[z, y]``:
@@ -51,9 +46,8 @@ def warp_owners(labels, packed, shift, flags, spans, rest_lo, inv, shifts, turne
     voxels are read without rounding), else ``0 0 0 0``. A turned bone b reads only in the output cubes (``cell``
     voxels a side; the launch's first slice is the output's slice ``z_first``) that ``marks[turned[b]]`` holds
     (:func:`posed_cells`). ``threads``: the launch's threads.
-    ``packed, shift``: labels and soft values (reconstruct/soft_body.packed_body). ``flags``: Ownership.flags()
-    with bit 8 as reconstruct/_soft_kernels.soft_refusals keeps it. Returns the voxel-bone reads and the voxels
-    written (counted here: a count of the output after cost the frog's frame 7 %)."""
+    ``flags``: Ownership.flags(). Returns the voxel-bone reads and the voxels written (counted here: a
+    count of the output after cost the frog's frame 7 %)."""
     nz, ny, nx = out.shape
     lx, ly, lz = labels.shape
     nb = inv.shape[0]
@@ -108,7 +102,7 @@ def warp_owners(labels, packed, shift, flags, spans, rest_lo, inv, shifts, turne
                                 n += 1
                                 if not count and out[z, y, x] != 0:
                                     continue
-                                if claims_point(packed, shift, flags, bx + qx * m[0, 0], by + qx * m[0, 1],
+                                if claims_point(labels, flags, bx + qx * m[0, 0], by + qx * m[0, 1],
                                                 bz + qx * m[0, 2], b + 1, lx, ly, lz) and _take(out, claims, z, y, x,
                                                                                                 b + 1, count):
                                     lo_x, hi_x = min(lo_x, x), max(hi_x, x)
@@ -147,11 +141,9 @@ def _label(labels, x, y, z, lx, ly, lz):
 
 
 @njit(cache=True, nogil=True, inline="always")
-def claims_point(packed, shift, flags, px, py, pz, bone1, lx, ly, lz):
-    """Whether label ``bone1`` claims rest point ``p`` (voxel coordinates of the labels). The body (labels > 0)
-    must fill more than half of p (:data:`HALF` of 255), trilinear over the 8 voxels around it, each voxel weighing
-    its soft value (``packed``: label | soft << ``shift``, reconstruct/soft_body.packed_body); then p is the
-    nearest voxel's bone, or,
+def claims_point(labels, flags, px, py, pz, bone1, lx, ly, lz):
+    """Whether label ``bone1`` claims rest point ``p`` (voxel coordinates of ``labels``). The body (labels > 0)
+    must fill more than half of p, trilinear over the 8 voxels around it; then p is the nearest voxel's bone, or,
     where the nearest voxel is outside the body, the bone with the largest share of the 8 (a tie to the lower
     label, as the first bone in root order keeps a voxel). Where the nearest voxel's 26 neighbours hold its
     label too (``flags`` bit 1), all 8 do: no interpolation. A nearest voxel of another bone ends the read at
@@ -159,13 +151,12 @@ def claims_point(packed, shift, flags, px, py, pz, bone1, lx, ly, lz):
     rx, ry, rz = int(math.floor(px + 0.5)), int(math.floor(py + 0.5)), int(math.floor(pz + 0.5))
     inside = 0 <= rx < lx and 0 <= ry < ly and 0 <= rz < lz
     f = flags[rx, ry, rz] if inside else 0
-    # outside the body with no face neighbour in it, where no read near it can weigh over half of the smoothed body
-    # (bit 8 of the soft refusals: reconstruct/_soft_kernels.soft_refusals; read before the labels: most refused
-    # reads need one line of memory)
+    # outside the body with no face neighbour in it (bit 8, read before the labels: most refused reads need one
+    # line of memory): the corners it shares an axis with are outside, and the others (two or three axes off,
+    # each by at most half a voxel) weigh at most half: never more than half body
     if f & 8 or (not inside and (rx < -1 or ry < -1 or rz < -1 or rx > lx or ry > ly or rz > lz)):
         return False
-    low = (1 << shift) - 1
-    v = packed[rx, ry, rz] & low if inside else 0
+    v = labels[rx, ry, rz] if inside else 0
     if v != 0 and v != bone1:
         return False
     if f & 1:
@@ -177,17 +168,16 @@ def claims_point(packed, shift, flags, px, py, pz, bone1, lx, ly, lz):
     whole = x0 >= 0 and y0 >= 0 and z0 >= 0 and x0 + 1 < lx and y0 + 1 < ly and z0 + 1 < lz
     for k in range(8):
         ax, ay, az = k & 1, (k >> 1) & 1, (k >> 2) & 1
-        p = packed[x0 + ax, y0 + ay, z0 + az] if whole else _label(packed, x0 + ax, y0 + ay, z0 + az, lx, ly, lz)
-        w = (tx if ax else 1.0 - tx) * (ty if ay else 1.0 - ty) * (tz if az else 1.0 - tz) * (p >> shift)
-        body += w
-        c = p & low
+        c = labels[x0 + ax, y0 + ay, z0 + az] if whole else _label(labels, x0 + ax, y0 + ay, z0 + az, lx, ly, lz)
         if c == 0:
             continue
+        w = (tx if ax else 1.0 - tx) * (ty if ay else 1.0 - ty) * (tz if az else 1.0 - tz)
+        body += w
         if c == bone1:
             mine += w
-        if v == bone1 and body > HALF:  # the nearest voxel is the bone's: more than half body is all it needs
+        if v == bone1 and body > 0.5:  # the nearest voxel is the bone's: more than half body is all it needs
             return True
-    if body <= HALF:
+    if body <= 0.5:
         return False
     if v == bone1:
         return True
@@ -195,15 +185,14 @@ def claims_point(packed, shift, flags, px, py, pz, bone1, lx, ly, lz):
         return False
     for k in range(8):  # the nearest voxel is outside: any other label with a larger share (or as large and lower) wins
         ax, ay, az = k & 1, (k >> 1) & 1, (k >> 2) & 1
-        c = _label(packed, x0 + ax, y0 + ay, z0 + az, lx, ly, lz) & low
+        c = _label(labels, x0 + ax, y0 + ay, z0 + az, lx, ly, lz)
         if c == 0 or c == bone1:
             continue
         other = 0.0
         for j in range(8):
             bx, by, bz = j & 1, (j >> 1) & 1, (j >> 2) & 1
-            p = _label(packed, x0 + bx, y0 + by, z0 + bz, lx, ly, lz)
-            if p & low == c:
-                other += (tx if bx else 1.0 - tx) * (ty if by else 1.0 - ty) * (tz if bz else 1.0 - tz) * (p >> shift)
+            if _label(labels, x0 + bx, y0 + by, z0 + bz, lx, ly, lz) == c:
+                other += (tx if bx else 1.0 - tx) * (ty if by else 1.0 - ty) * (tz if bz else 1.0 - tz)
         if other > mine or (other == mine and c < bone1):
             return False
     return True

@@ -4,9 +4,7 @@
         --each bone's owned box moved by its matrix--> posed boxes; output grid (their union + padding, or bounds)
         --K.posed_cells (each turned bone's rest cubes, Ownership.cells, moved)--> the output cubes it can land in
         --K.warp_owners (each output voxel read at the rest point its bone brings it from: the body's share
-                         there, trilinear over the body smoothed once per ownership (soft_body.py: a turned
-                         surface comes back smooth, not as stairs), and the bone owning most of it; a turned
-                         bone only in its cubes;
+                         there, trilinear, and the bone owning most of it; a turned bone only in its cubes;
                          launches of ~LAUNCH_SECONDS, as the spheres')--> owner [z, y, x]
         --K.splat_turned (each turned bone's thin rest voxels pushed to where they land, where still empty: a limb
                           one voxel thin that the read steps over stays in one piece)-->
@@ -49,11 +47,9 @@ from volanim_core.reconstruct._owned_kernels import ZB
 from volanim_core.reconstruct.plan import LAUNCH_SECONDS, MODES, mottled_values, output_dtype
 from volanim_core.reconstruct.result import Reconstruction
 from volanim_core.reconstruct.sampling import grid_to_source, sample_source
-from volanim_core.reconstruct.soft_body import packed_body
 from volanim_core.rig.ownership import CELL, DIAGONALS, Ownership
 from volanim_core.volume import Bounds
 
-_SOFT, _SOFT_LOCK = weakref.WeakKeyDictionary(), threading.Lock()  # Ownership -> (soft body, its flags)
 _POSES = weakref.WeakKeyDictionary()  # Ownership -> Recent: its boxes and balls in the last few poses
 _POSES_LOCK = threading.Lock()
 POSES_KEPT = 8  # (what, pose) pairs kept per ownership: a live picture asks for two poses, the full preview one
@@ -76,16 +72,6 @@ def _per_pose(own: Ownership, what: str, matrices: np.ndarray, make):
         return out
 
     return kept.get(content_key(np.ascontiguousarray(matrices, np.float64), text=what), made)
-
-
-def smoothed_body(own: Ownership) -> tuple[np.ndarray, int, np.ndarray]:
-    """The ownership's labels packed with its body smoothed for the reads, and its flags with the refusals that
-    still hold there (reconstruct/soft_body.packed_body), made once per ownership."""
-    with _SOFT_LOCK:
-        made = _SOFT.get(own)
-        if made is None:
-            made = _SOFT[own] = packed_body(own.labels, own.flags())
-    return made
 
 
 def posed_boxes(own: Ownership, matrices: np.ndarray) -> np.ndarray:
@@ -178,7 +164,7 @@ def reconstruct_owned(
     local[:, 3:] = np.minimum(local[:, 3:], np.array([nx, ny, nz]) - 1)
     inv = np.ascontiguousarray(np.linalg.inv(matrices))
     rest_lo = np.asarray(own.origin, np.int64)
-    packed, shift, flags = smoothed_body(own)
+    flags = own.flags()
     shifts = whole_voxel_shifts(matrices)
     # a bone whose posed box misses the grid adds nothing (a live update's box holds few): not splatted
     reaches = (boxes[:, 3:] >= lo).all(1) & (boxes[:, :3] <= np.asarray(grid.hi)).all(1)
@@ -196,9 +182,9 @@ def reconstruct_owned(
             slab = local.copy()
             slab[:, 2] = np.maximum(slab[:, 2] - z0, 0)
             slab[:, 5] = np.minimum(slab[:, 5] - z0, z1 - z0 - 1)
-            visits, wrote = K.warp_owners(own.labels, packed, shift, flags, own.spans(), rest_lo, inv, shifts, turned,
-                                          marks, CELL, z0, slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1],
-                                          row_hi[z0:z1], claims[z0:z1] if count else claims, count, nthreads)
+            visits, wrote = K.warp_owners(own.labels, flags, own.spans(), rest_lo, inv, shifts, turned, marks, CELL, z0,
+                                          slab, lo + (0, 0, z0), owner[z0:z1], row_lo[z0:z1], row_hi[z0:z1],
+                                          claims[z0:z1] if count else claims, count, nthreads)
             reads, filled = reads + visits, filled + wrote
             report(z1, total)
         # then each turned bone's own voxels pushed to where they land: a limb one voxel thin stays whole
